@@ -1,0 +1,107 @@
+//! Domains and service names.
+//!
+//! A domain isolates one deployment: every iceoryx2 resource of the domain carries the
+//! prefix [`prefix`], so tests in different domains run side by side and a test can check
+//! that nothing of its domain is left behind.
+
+use iceoryx2::config::Config;
+use iceoryx2::prelude::{FileName, SemanticString, ServiceName};
+
+use crate::{PlaneId, LAYOUT_VERSION};
+
+pub const DEFAULT_DOMAIN: &str = "physics";
+/// Environment variable naming the domain when no `--domain` is given.
+pub const DOMAIN_ENV: &str = "PHYSICS_DOMAIN";
+/// iceoryx2 node name of the daemon.
+pub const DAEMON_NODE_NAME: &str = "physics-daemon";
+
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("invalid domain {domain:?}: {reason}")]
+pub struct DomainError {
+    pub domain: String,
+    pub reason: &'static str,
+}
+
+/// Checks a domain name: 1 to 32 characters of `[A-Za-z0-9_-]`.
+pub fn validate_domain(domain: &str) -> Result<(), DomainError> {
+    let err = |reason| Err(DomainError { domain: domain.to_string(), reason });
+    if domain.is_empty() || domain.len() > 32 {
+        return err("must be 1 to 32 characters long");
+    }
+    if !domain.bytes().all(|b| b.is_ascii_alphanumeric() || b == b'_' || b == b'-') {
+        return err("may only contain letters, digits, '_' and '-'");
+    }
+    Ok(())
+}
+
+/// The file prefix of every shared-memory and socket resource of the domain.
+pub fn prefix(domain: &str) -> String {
+    format!("phys_{domain}_")
+}
+
+/// The iceoryx2 configuration of a domain.
+pub fn config(domain: &str) -> Result<Config, DomainError> {
+    validate_domain(domain)?;
+    let mut config = Config::default();
+    config.global.prefix = FileName::new(prefix(domain).as_bytes()).map_err(|_| DomainError {
+        domain: domain.to_string(),
+        reason: "is not usable as a file name",
+    })?;
+    Ok(config)
+}
+
+fn service(name: String) -> ServiceName {
+    ServiceName::new(&name).expect("service names built here are valid")
+}
+
+/// Request-response service carrying command batches.
+pub fn control() -> ServiceName {
+    service("physics/control".into())
+}
+
+/// Event the clients notify after sending a request; the daemon waits on it.
+pub fn control_wake() -> ServiceName {
+    service("physics/control/wake".into())
+}
+
+/// Event the daemon notifies when a reply for `client` is ready.
+pub fn client_wake(client: u128) -> ServiceName {
+    service(format!("physics/client/{client:032x}/wake"))
+}
+
+/// Publish-subscribe `[BodyState]` with a `TickHeader` user header.
+pub fn plane_bodies(plane: PlaneId) -> ServiceName {
+    service(format!("physics/v{LAYOUT_VERSION}/plane/{plane}/bodies"))
+}
+
+/// Publish-subscribe `[EventRecord]` with a `TickHeader` user header.
+pub fn plane_events(plane: PlaneId) -> ServiceName {
+    service(format!("physics/v{LAYOUT_VERSION}/plane/{plane}/events"))
+}
+
+/// Event notified after every published tick of the plane.
+pub fn plane_tick(plane: PlaneId) -> ServiceName {
+    service(format!("physics/plane/{plane}/tick"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn domains_are_validated() {
+        assert!(validate_domain("physics").is_ok());
+        assert!(validate_domain("t-12_ab").is_ok());
+        assert!(validate_domain("").is_err());
+        assert!(validate_domain("a/b").is_err());
+        assert!(validate_domain(&"x".repeat(33)).is_err());
+        let e = validate_domain("a b").unwrap_err().to_string();
+        assert!(e.contains("\"a b\""), "{e}");
+    }
+
+    #[test]
+    fn config_carries_the_prefix() {
+        let c = config("unit").unwrap();
+        assert_eq!(c.global.prefix.to_string(), "phys_unit_");
+    }
+}

@@ -1,0 +1,138 @@
+//! Fixed-size records written by the daemon straight into loaned shared-memory samples.
+
+use iceoryx2::prelude::ZeroCopySend;
+
+/// Body flag: the slot holds a live body.
+pub const FLAG_ALIVE: u32 = 1 << 0;
+/// Body flag: rapier put the body to sleep.
+pub const FLAG_SLEEPING: u32 = 1 << 1;
+/// Body flag: the body is anchored (fixed).
+pub const FLAG_ANCHORED: u32 = 1 << 2;
+
+/// A stable reference to one body: the slot indexes the published array, the generation
+/// tells a reused slot from the body that used to live there.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, serde::Serialize, serde::Deserialize)]
+pub struct Handle {
+    pub slot: u32,
+    pub generation: u32,
+}
+
+/// The state of one slot after a tick. 64 bytes: one cache line per body.
+#[derive(Debug, Clone, Copy, PartialEq, Default, ZeroCopySend)]
+#[type_name("physics::BodyState")]
+#[repr(C)]
+pub struct BodyState {
+    pub position: [f32; 3],
+    /// `FLAG_*` bits.
+    pub flags: u32,
+    /// Unit quaternion `[x, y, z, w]`.
+    pub rotation: [f32; 4],
+    pub linear_velocity: [f32; 3],
+    /// Generation of the body in this slot (matches [`Handle::generation`]).
+    pub generation: u32,
+    pub angular_velocity: [f32; 3],
+    pub _reserved: u32,
+}
+
+impl BodyState {
+    pub fn is_alive(&self) -> bool {
+        self.flags & FLAG_ALIVE != 0
+    }
+    pub fn is_sleeping(&self) -> bool {
+        self.flags & FLAG_SLEEPING != 0
+    }
+    pub fn is_anchored(&self) -> bool {
+        self.flags & FLAG_ANCHORED != 0
+    }
+    /// True when this slot currently holds the body `handle` refers to.
+    pub fn matches(&self, handle: Handle) -> bool {
+        self.is_alive() && self.generation == handle.generation
+    }
+}
+
+/// User header of every body sample: which tick this is and what it cost.
+#[derive(Debug, Clone, Copy, PartialEq, Default, ZeroCopySend)]
+#[type_name("physics::TickHeader")]
+#[repr(C)]
+pub struct TickHeader {
+    pub layout_version: u32,
+    pub plane_id: u32,
+    /// Number of steps taken so far (0 before the first step).
+    pub tick: u64,
+    /// Simulated seconds so far.
+    pub sim_time: f64,
+    /// CLOCK_MONOTONIC nanoseconds when the sample was sent (for delivery latency).
+    pub published_at_ns: u64,
+    /// Wall time of the last step, in microseconds.
+    pub step_time_us: f32,
+    /// The dt of the last step, in seconds.
+    pub dt: f32,
+    /// Number of slots in the sample (live or not).
+    pub slot_count: u32,
+    /// Number of live bodies.
+    pub body_count: u32,
+    /// Deepest contact penetration after the step (units, >= 0).
+    pub max_penetration: f32,
+    /// Largest joint / constraint error after the step (units, 0 without joints).
+    pub max_joint_error: f32,
+    /// Number of contact pairs with at least one contact point.
+    pub contact_pairs: u32,
+    pub _reserved: u32,
+}
+
+/// Kinds of per-tick events.
+pub const EVENT_CONTACT_STARTED: u32 = 1;
+pub const EVENT_CONTACT_STOPPED: u32 = 2;
+
+/// One per-tick event (published in the plane's event service).
+#[derive(Debug, Clone, Copy, PartialEq, Default, ZeroCopySend)]
+#[type_name("physics::EventRecord")]
+#[repr(C)]
+pub struct EventRecord {
+    /// `EVENT_*` kind.
+    pub kind: u32,
+    pub a_slot: u32,
+    pub a_generation: u32,
+    pub b_slot: u32,
+    pub b_generation: u32,
+    pub _reserved: u32,
+    pub tick: u64,
+}
+
+impl EventRecord {
+    pub fn a(&self) -> Handle {
+        Handle { slot: self.a_slot, generation: self.a_generation }
+    }
+    pub fn b(&self) -> Handle {
+        Handle { slot: self.b_slot, generation: self.b_generation }
+    }
+}
+
+/// Monotonic clock in nanoseconds, the same clock in every process of the machine.
+pub fn monotonic_ns() -> u64 {
+    let mut ts = libc::timespec { tv_sec: 0, tv_nsec: 0 };
+    // SAFETY: clock_gettime only writes into the provided timespec.
+    unsafe { libc::clock_gettime(libc::CLOCK_MONOTONIC, &mut ts) };
+    ts.tv_sec as u64 * 1_000_000_000 + ts.tv_nsec as u64
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn record_sizes_are_fixed() {
+        assert_eq!(core::mem::size_of::<BodyState>(), 64);
+        assert_eq!(core::mem::size_of::<EventRecord>(), 32);
+        assert_eq!(core::mem::size_of::<TickHeader>(), 64);
+    }
+
+    #[test]
+    fn handle_matching_checks_generation_and_liveness() {
+        let s = BodyState { flags: FLAG_ALIVE, generation: 3, ..Default::default() };
+        assert!(s.matches(Handle { slot: 0, generation: 3 }));
+        assert!(!s.matches(Handle { slot: 0, generation: 2 }));
+        let dead = BodyState { flags: 0, generation: 3, ..Default::default() };
+        assert!(!dead.matches(Handle { slot: 0, generation: 3 }));
+    }
+}
