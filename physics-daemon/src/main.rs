@@ -1,1 +1,45 @@
-fn main(){}
+//! `physics-daemon [--domain NAME]`: serves every physics plane of one domain.
+
+use std::process::ExitCode;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+
+use clap::Parser;
+use shm_layout::names;
+
+#[derive(Parser)]
+#[command(version, about = "Physics daemon: simulates planes and publishes them in shared memory")]
+struct Args {
+    /// Deployment domain; every process of one deployment uses the same one.
+    #[arg(long, env = names::DOMAIN_ENV, default_value = names::DEFAULT_DOMAIN)]
+    domain: String,
+}
+
+fn main() -> ExitCode {
+    let args = Args::parse();
+    tracing_subscriber::fmt()
+        .with_env_filter(
+            tracing_subscriber::EnvFilter::try_from_env("PHYSICS_LOG")
+                .unwrap_or_else(|_| "info".into()),
+        )
+        .with_writer(std::io::stderr)
+        .init();
+
+    let shutdown = Arc::new(AtomicBool::new(false));
+    let flag = shutdown.clone();
+    if let Err(e) = ctrlc::set_handler(move || flag.store(true, Ordering::Relaxed)) {
+        tracing::error!("cannot install the SIGINT/SIGTERM handler: {e}");
+        return ExitCode::FAILURE;
+    }
+    // Planes with Threads = 1 run on the global pool: keep it at one worker so they never
+    // spread over the machine's cores uninvited.
+    let _ = rapier3d::rayon::ThreadPoolBuilder::new().num_threads(1).build_global();
+
+    match physics_daemon::run(&args.domain, &shutdown) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            tracing::error!("{e}");
+            ExitCode::FAILURE
+        }
+    }
+}

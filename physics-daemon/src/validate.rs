@@ -2,14 +2,6 @@
 
 use shm_layout::{CommandError, Pose, Vec3};
 
-pub fn finite(field: &str, v: f32) -> Result<f32, CommandError> {
-    if v.is_finite() {
-        Ok(v)
-    } else {
-        Err(CommandError::invalid(format!("{field} must be a finite number, got {v}")))
-    }
-}
-
 pub fn finite3(field: &str, v: Vec3) -> Result<Vec3, CommandError> {
     if v.iter().all(|c| c.is_finite()) {
         Ok(v)

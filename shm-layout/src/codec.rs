@@ -107,7 +107,6 @@ mod tests {
 
     fn sample_request() -> Request {
         Request {
-            client: 42,
             commands: vec![
                 Command::AddObject {
                     plane: 1,
@@ -129,7 +128,7 @@ mod tests {
     #[test]
     fn response_round_trips() {
         let r = Response::Results(vec![
-            Ok(Reply::Object(Handle { slot: 3, generation: 7 })),
+            Ok(Reply::Object { handle: Handle { slot: 3, generation: 7 }, tick: 9 }),
             Err(CommandError::new(ErrorKind::StaleHandle, "gone")),
         ]);
         assert_eq!(decode_response(&encode_response(&r)).unwrap(), r);

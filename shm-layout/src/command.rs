@@ -105,7 +105,10 @@ pub enum Reply {
     Done,
     Welcome { daemon_pid: u32, daemon_node_id: u128, crate_version: String },
     Plane(PlaneInfo),
-    Object(Handle),
+    /// A new object, and the plane tick after which published samples include it.
+    Object { handle: Handle, tick: u64 },
+    /// An object mutation was applied after `tick`: samples newer than `tick` reflect it.
+    Applied { tick: u64 },
     /// The tick number now visible in shared memory.
     Stepped { tick: u64 },
 }
@@ -152,11 +155,10 @@ impl std::error::Error for CommandError {}
 
 pub type CommandResult = Result<Reply, CommandError>;
 
-/// One request: a batch of commands from one client.
+/// One request: a batch of commands from one client. The client's iceoryx2 node id travels
+/// in the request's user header, so even an undecodable request can be answered.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Request {
-    /// The client's iceoryx2 node id; replies are announced on its wake-up event.
-    pub client: u128,
     pub commands: Vec<Command>,
 }
 

@@ -61,8 +61,9 @@ pub struct TickHeader {
     pub tick: u64,
     /// Simulated seconds so far.
     pub sim_time: f64,
-    /// CLOCK_MONOTONIC nanoseconds when the sample was sent (for delivery latency).
-    pub published_at_ns: u64,
+    /// CLOCK_MONOTONIC nanoseconds when the step ended and publishing began (delivery latency
+    /// is measured from here: it includes the copy into shared memory).
+    pub tick_end_ns: u64,
     /// Wall time of the last step, in microseconds.
     pub step_time_us: f32,
     /// The dt of the last step, in seconds.

@@ -9,7 +9,7 @@ use std::time::Instant;
 
 use rapier3d::prelude::*;
 use shm_layout::{
-    BodyState, CommandError, EventRecord, Handle, PlaneId, PlaneInfo, PlaneProp, TickHeader,
+    BodyState, CommandError, EventRecord, PlaneId, PlaneInfo, PlaneProp, TickHeader,
     EVENT_CONTACT_STARTED, EVENT_CONTACT_STOPPED, FLAG_ALIVE, FLAG_ANCHORED, FLAG_SLEEPING,
     LAYOUT_VERSION,
 };
@@ -238,7 +238,7 @@ impl Plane {
             plane_id: self.id,
             tick: self.tick,
             sim_time: self.sim_time,
-            published_at_ns: 0,
+            tick_end_ns: 0,
             step_time_us: self.last_step_us,
             dt: self.last_dt,
             slot_count: self.slots.len() as u32,

@@ -1,0 +1,104 @@
+//! Connected clients: the notifier that wakes each one when its reply is ready, and the
+//! detection of clients whose process died (iceoryx2 dead-node detection).
+
+use std::collections::HashMap;
+
+use iceoryx2::config::Config;
+use iceoryx2::node::NodeView;
+use iceoryx2::port::notifier::Notifier;
+use iceoryx2::prelude::*;
+use shm_layout::names;
+
+/// Clients one daemon serves at once.
+pub const MAX_CLIENTS: usize = 64;
+
+pub struct Client {
+    pub pid: u32,
+    notifier: Notifier<ipc::Service>,
+}
+
+#[derive(Default)]
+pub struct Clients {
+    connected: HashMap<u128, Client>,
+}
+
+impl Clients {
+    pub fn is_connected(&self, id: u128) -> bool {
+        self.connected.contains_key(&id)
+    }
+
+    pub fn len(&self) -> usize {
+        self.connected.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.connected.is_empty()
+    }
+
+    /// Registers a client after its handshake. Fails when the client has no wake-up event.
+    pub fn connect(&mut self, node: &Node<ipc::Service>, id: u128, pid: u32) -> Result<(), String> {
+        if self.connected.len() >= MAX_CLIENTS && !self.is_connected(id) {
+            return Err(format!("the daemon already serves {MAX_CLIENTS} clients"));
+        }
+        let notifier = open_notifier(node, id)?;
+        self.connected.insert(id, Client { pid, notifier });
+        Ok(())
+    }
+
+    pub fn disconnect(&mut self, id: u128) -> bool {
+        self.connected.remove(&id).is_some()
+    }
+
+    /// Wakes the client `id` (its reply is ready). Clients that are not connected yet (a
+    /// malformed first request, say) get a notifier opened for this one reply.
+    pub fn wake(&self, node: &Node<ipc::Service>, id: u128) {
+        let result = match self.connected.get(&id) {
+            Some(c) => c.notifier.notify().map(|_| ()).map_err(|e| format!("{e:?}")),
+            None => open_notifier(node, id).and_then(|n| n.notify().map(|_| ()).map_err(|e| format!("{e:?}"))),
+        };
+        if let Err(e) = result {
+            tracing::debug!(client = format!("{id:032x}"), "cannot wake client: {e}");
+        }
+    }
+
+    /// Finds dead client processes, removes their stale iceoryx2 resources and returns the
+    /// ids of the connected clients that are gone.
+    pub fn reap(&mut self, config: &Config) -> Vec<u128> {
+        let mut present = Vec::new();
+        let mut dead = Vec::new();
+        let listed = Node::<ipc::Service>::list(config, |state| {
+            match state {
+                NodeState::Dead(view) => dead.push(view),
+                other => present.push(other.node_id().value()),
+            }
+            CallbackProgression::Continue
+        });
+        if let Err(e) = listed {
+            tracing::warn!("cannot list nodes: {e:?}");
+            return Vec::new();
+        }
+        for view in dead {
+            let id = view.id().value();
+            tracing::info!(node = format!("{id:032x}"), "removing resources of a dead process");
+            if let Err(e) = view.try_remove_stale_resources() {
+                tracing::warn!("cleanup of dead node failed: {e:?}");
+            }
+        }
+        let gone: Vec<u128> =
+            self.connected.keys().copied().filter(|id| !present.contains(id)).collect();
+        for id in &gone {
+            self.connected.remove(id);
+        }
+        gone
+    }
+}
+
+fn open_notifier(node: &Node<ipc::Service>, id: u128) -> Result<Notifier<ipc::Service>, String> {
+    node.service_builder(&names::client_wake(id))
+        .event()
+        .open()
+        .map_err(|e| format!("client wake-up event missing: {e:?}"))?
+        .notifier_builder()
+        .create()
+        .map_err(|e| format!("cannot notify client: {e:?}"))
+}

@@ -1,0 +1,373 @@
+//! The daemon's event loop. It sleeps in an iceoryx2 WaitSet until a client announces a
+//! request or the earliest plane tick is due, so an idle daemon costs no CPU.
+
+use std::collections::BTreeMap;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, Instant};
+
+use iceoryx2::config::Config;
+use iceoryx2::port::server::Server;
+use iceoryx2::prelude::*;
+use shm_layout::codec::{self, Frame};
+use shm_layout::{
+    names, Command, CommandError, CommandResult, ErrorKind, PlaneId, PlaneProp, Reply, Response,
+    CRATE_VERSION, LAYOUT_VERSION,
+};
+
+use crate::clients::{Clients, MAX_CLIENTS};
+use crate::plane::Plane;
+use crate::publish::{PlaneOutput, MAX_NODES};
+use crate::DaemonError;
+
+/// How often dead clients are looked for (and the shutdown flag at the latest).
+const HOUSEKEEPING: Duration = Duration::from_millis(200);
+/// Planes one daemon hosts at once.
+pub const MAX_PLANES: usize = 1024;
+
+type ControlServer = Server<ipc::Service, [u8], u128, [u8], ()>;
+
+struct PlaneEntry {
+    plane: Plane,
+    out: PlaneOutput,
+    /// When the next automatic tick is due; `None` for manual or disabled planes.
+    next_tick: Option<Instant>,
+}
+
+impl PlaneEntry {
+    fn reschedule(&mut self, now: Instant) {
+        let rate = self.plane.tick_rate();
+        self.next_tick = (rate > 0.0 && self.plane.enabled())
+            .then(|| now + Duration::from_secs_f64(1.0 / rate as f64));
+    }
+}
+
+/// Everything the daemon owns except the WaitSet and the request listener, which stay on
+/// the stack of [`run`] (the WaitSet borrows the listener).
+pub struct Daemon {
+    domain: String,
+    config: Config,
+    node: Node<ipc::Service>,
+    server: ControlServer,
+    clients: Clients,
+    planes: BTreeMap<PlaneId, PlaneEntry>,
+    next_plane_id: PlaneId,
+}
+
+/// Runs the daemon of `domain` until `shutdown` becomes true; then releases every resource.
+pub fn run(domain: &str, shutdown: &AtomicBool) -> Result<(), DaemonError> {
+    let config = names::config(domain)?;
+    remove_dead_nodes(&config);
+    serve(domain, &config, shutdown)?;
+    release_domain(&config);
+    Ok(())
+}
+
+/// The domain keeps one persistent segment (iceoryx2's node counter); the last process of the
+/// domain removes it so a stopped deployment leaves nothing in /dev/shm.
+fn release_domain(config: &Config) {
+    let mut others = 0;
+    let _ = Node::<ipc::Service>::list(config, |_| {
+        others += 1;
+        CallbackProgression::Continue
+    });
+    if others == 0 {
+        // SAFETY: no node of this domain exists any more, so nobody uses the segment.
+        let _ = unsafe { iceoryx2::testing::remove_global_mgmt_segment::<ipc::Service>(config) };
+    }
+}
+
+fn serve(domain: &str, config: &Config, shutdown: &AtomicBool) -> Result<(), DaemonError> {
+    let node = NodeBuilder::new()
+        .name(&NodeName::new(names::DAEMON_NODE_NAME).expect("valid node name"))
+        .config(config)
+        .signal_handling_mode(SignalHandlingMode::Disabled)
+        .create::<ipc::Service>()
+        .map_err(|e| DaemonError::Ipc(format!("cannot create node: {e:?}")))?;
+    let listener = node
+        .service_builder(&names::control_wake())
+        .event()
+        .max_listeners(2)
+        .max_notifiers(MAX_CLIENTS + 8)
+        .max_nodes(MAX_NODES)
+        .open_or_create()
+        .map_err(|e| DaemonError::Ipc(format!("cannot create the request event: {e:?}")))?
+        .listener_builder()
+        .create()
+        .map_err(|e| DaemonError::Ipc(format!("cannot create the request listener: {e:?}")))?;
+    let server = node
+        .service_builder(&names::control())
+        .request_response::<[u8], [u8]>()
+        .request_user_header::<u128>()
+        .max_servers(1)
+        .max_clients(MAX_CLIENTS + 8)
+        .max_nodes(MAX_NODES)
+        .max_active_requests_per_client(4)
+        .open_or_create()
+        .map_err(|e| DaemonError::Ipc(format!("cannot create the control service: {e:?}")))?
+        .server_builder()
+        .initial_max_slice_len(4096)
+        .allocation_strategy(AllocationStrategy::PowerOfTwo)
+        .create()
+        .map_err(|_| DaemonError::AlreadyRunning { domain: domain.to_string() })?;
+    let waitset = WaitSetBuilder::new()
+        .signal_handling_mode(SignalHandlingMode::Disabled)
+        .create::<ipc::Service>()
+        .map_err(|e| DaemonError::Ipc(format!("cannot create the waitset: {e:?}")))?;
+    let _request_guard = waitset
+        .attach_notification(&listener)
+        .map_err(|e| DaemonError::Ipc(format!("cannot attach the request listener: {e:?}")))?;
+
+    let mut daemon = Daemon {
+        domain: domain.to_string(),
+        config: config.clone(),
+        node,
+        server,
+        clients: Clients::default(),
+        planes: BTreeMap::new(),
+        next_plane_id: 1,
+    };
+    tracing::info!(domain, pid = std::process::id(), "physics daemon ready");
+
+    let mut next_housekeeping = Instant::now() + HOUSEKEEPING;
+    while !shutdown.load(Ordering::Relaxed) {
+        let now = Instant::now();
+        let wake_at = daemon.next_tick().map_or(next_housekeeping, |t| t.min(next_housekeeping));
+        let timeout = wake_at.saturating_duration_since(now);
+        if let Err(e) =
+            waitset.wait_and_process_once_with_timeout(|_| CallbackProgression::Continue, timeout)
+        {
+            tracing::warn!("waitset: {e:?}");
+        }
+        // Consume the wake-ups, then serve everything that is queued.
+        if let Err(e) = listener.try_wait(|_| {}) {
+            tracing::warn!("request listener: {e:?}");
+        }
+        daemon.serve_requests();
+        daemon.tick_due_planes(Instant::now());
+        if Instant::now() >= next_housekeeping {
+            daemon.release_gone_clients();
+            next_housekeeping = Instant::now() + HOUSEKEEPING;
+        }
+    }
+    tracing::info!(domain = daemon.domain, "shutting down");
+    Ok(())
+}
+
+/// Removes what crashed processes of this domain left behind (a crashed daemon's server
+/// port would otherwise block the new daemon).
+fn remove_dead_nodes(config: &Config) {
+    let mut dead = Vec::new();
+    let _ = Node::<ipc::Service>::list(config, |state| {
+        if let NodeState::Dead(view) = state {
+            dead.push(view);
+        }
+        CallbackProgression::Continue
+    });
+    for view in dead {
+        let _ = view.try_remove_stale_resources();
+    }
+}
+
+impl Daemon {
+    fn next_tick(&self) -> Option<Instant> {
+        self.planes.values().filter_map(|p| p.next_tick).min()
+    }
+
+    fn serve_requests(&mut self) {
+        loop {
+            let request = match self.server.receive() {
+                Ok(Some(request)) => request,
+                Ok(None) => break,
+                Err(e) => {
+                    tracing::warn!("receive failed: {e:?}");
+                    break;
+                }
+            };
+            let client = *request.user_header();
+            let reply = self.handle_bytes(client, request.payload());
+            let sent = request
+                .loan_slice_uninit(reply.len())
+                .map_err(|e| format!("{e:?}"))
+                .and_then(|r| r.write_from_slice(&reply).send().map_err(|e| format!("{e:?}")));
+            if let Err(e) = sent {
+                tracing::warn!(client = format!("{client:032x}"), "reply failed: {e}");
+            }
+            self.clients.wake(&self.node, client);
+        }
+    }
+
+    /// Decodes one request and executes its commands. Never panics on any input.
+    pub fn handle_bytes(&mut self, client: u128, bytes: &[u8]) -> Vec<u8> {
+        let rejected = |e: String| {
+            codec::encode_response(&Response::Rejected(CommandError::new(ErrorKind::Malformed, e)))
+        };
+        match Frame::parse(bytes) {
+            Err(e) => return rejected(e.to_string()),
+            Ok(frame) if frame.version != LAYOUT_VERSION => return codec::encode_version_mismatch(),
+            Ok(_) => {}
+        }
+        let request = match codec::decode_request(bytes) {
+            Ok(r) => r,
+            Err(e) => return rejected(e.to_string()),
+        };
+        let results: Vec<CommandResult> =
+            request.commands.into_iter().map(|c| self.execute(client, c)).collect();
+        codec::encode_response(&Response::Results(results))
+    }
+
+    fn execute(&mut self, client: u128, command: Command) -> CommandResult {
+        if let Command::Hello { crate_version, pid } = &command {
+            return self.hello(client, crate_version, *pid);
+        }
+        if !self.clients.is_connected(client) {
+            return Err(CommandError::new(
+                ErrorKind::NotConnected,
+                "the first command of a client must be Hello",
+            ));
+        }
+        let now = Instant::now();
+        match command {
+            Command::Hello { .. } => unreachable!("handled above"),
+            Command::Goodbye => {
+                self.release_client(client);
+                Ok(Reply::Done)
+            }
+            Command::CreatePlane { props } => self.create_plane(client, &props, now),
+            Command::PlaneInfo { plane } => Ok(Reply::Plane(self.plane(plane)?.plane.info())),
+            Command::SetPlane { plane, prop } => {
+                let entry = self.plane(plane)?;
+                entry.plane.set(prop)?;
+                if matches!(prop, PlaneProp::TickRate(_) | PlaneProp::Enabled(_)) {
+                    entry.reschedule(now);
+                }
+                Ok(Reply::Done)
+            }
+            Command::Step { plane, dt } => {
+                let entry = self.plane(plane)?;
+                if entry.plane.step(dt)? {
+                    entry.out.publish(&entry.plane).map_err(internal)?;
+                }
+                Ok(Reply::Stepped { tick: entry.plane.tick() })
+            }
+            Command::DestroyPlane { plane } => {
+                self.plane(plane)?;
+                self.planes.remove(&plane);
+                tracing::info!(plane, "plane destroyed");
+                Ok(Reply::Done)
+            }
+            Command::AddObject { plane, shape, pose, props } => {
+                let entry = self.plane(plane)?;
+                let handle = entry.plane.add_object(shape, pose, &props)?;
+                Ok(Reply::Object { handle, tick: entry.plane.tick() })
+            }
+            Command::SetObject { plane, object, prop } => {
+                let entry = self.plane(plane)?;
+                entry.plane.set_object(object, prop)?;
+                Ok(Reply::Applied { tick: entry.plane.tick() })
+            }
+            Command::ApplyImpulse { plane, object, impulse } => {
+                let entry = self.plane(plane)?;
+                entry.plane.apply_impulse(object, impulse)?;
+                Ok(Reply::Applied { tick: entry.plane.tick() })
+            }
+            Command::DestroyObject { plane, object } => {
+                let entry = self.plane(plane)?;
+                entry.plane.destroy_object(object)?;
+                Ok(Reply::Applied { tick: entry.plane.tick() })
+            }
+        }
+    }
+
+    fn hello(&mut self, client: u128, crate_version: &str, pid: u32) -> CommandResult {
+        if crate_version != CRATE_VERSION {
+            return Err(CommandError::new(
+                ErrorKind::VersionMismatch,
+                format!(
+                    "crate version mismatch: client {crate_version}, daemon {CRATE_VERSION} \
+                     (LAYOUT_VERSION {LAYOUT_VERSION} on both)"
+                ),
+            ));
+        }
+        self.clients
+            .connect(&self.node, client, pid)
+            .map_err(|e| CommandError::new(ErrorKind::Internal, e))?;
+        tracing::info!(client = format!("{client:032x}"), pid, "client connected");
+        Ok(Reply::Welcome {
+            daemon_pid: std::process::id(),
+            daemon_node_id: self.node.id().value(),
+            crate_version: CRATE_VERSION.to_string(),
+        })
+    }
+
+    fn plane(&mut self, id: PlaneId) -> Result<&mut PlaneEntry, CommandError> {
+        self.planes.get_mut(&id).ok_or_else(|| {
+            CommandError::new(ErrorKind::UnknownPlane, format!("plane {id} does not exist"))
+        })
+    }
+
+    fn create_plane(&mut self, owner: u128, props: &[PlaneProp], now: Instant) -> CommandResult {
+        if self.planes.len() >= MAX_PLANES {
+            return Err(CommandError::new(
+                ErrorKind::Internal,
+                format!("the daemon already hosts {MAX_PLANES} planes"),
+            ));
+        }
+        let id = self.next_plane_id;
+        let plane = Plane::new(id, owner, props)?;
+        let out = PlaneOutput::new(&self.node, id).map_err(internal)?;
+        // Publish tick 0 so readers see the plane (and late joiners get history) at once.
+        out.publish(&plane).map_err(internal)?;
+        let mut entry = PlaneEntry { plane, out, next_tick: None };
+        entry.reschedule(now);
+        let info = entry.plane.info();
+        self.planes.insert(id, entry);
+        self.next_plane_id += 1;
+        tracing::info!(plane = id, ?info, "plane created");
+        Ok(Reply::Plane(info))
+    }
+
+    fn tick_due_planes(&mut self, now: Instant) {
+        for entry in self.planes.values_mut() {
+            let Some(due) = entry.next_tick.filter(|t| *t <= now) else { continue };
+            let period = Duration::from_secs_f64(1.0 / entry.plane.tick_rate() as f64);
+            let result = entry.plane.step(period.as_secs_f32()).and_then(|stepped| {
+                if stepped {
+                    entry.out.publish(&entry.plane).map_err(internal)?;
+                }
+                Ok(())
+            });
+            if let Err(e) = result {
+                tracing::warn!(plane = entry.plane.id, "tick failed: {e}");
+            }
+            // Keep the cadence; after a stall, restart from now instead of catching up.
+            let next = due + period;
+            entry.next_tick = Some(if next + period * 4 < now { now + period } else { next });
+        }
+    }
+
+    fn release_client(&mut self, client: u128) {
+        let before = self.planes.len();
+        self.planes.retain(|_, p| p.plane.owner != client);
+        self.clients.disconnect(client);
+        tracing::info!(
+            client = format!("{client:032x}"),
+            planes_released = before - self.planes.len(),
+            "client released"
+        );
+    }
+
+    fn release_gone_clients(&mut self) {
+        for client in self.clients.reap(&self.config) {
+            tracing::warn!(client = format!("{client:032x}"), "client process is gone");
+            self.release_client(client);
+        }
+    }
+
+    pub fn plane_count(&self) -> usize {
+        self.planes.len()
+    }
+}
+
+fn internal(e: DaemonError) -> CommandError {
+    CommandError::new(ErrorKind::Internal, e.to_string())
+}
