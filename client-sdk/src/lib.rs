@@ -1,1 +1,25 @@
-pub fn _x(){}
+//! Rust API for game processes talking to the physics daemon.
+//!
+//! - [`Client`]: the connection (handshake, batched commands, daemon liveness).
+//! - [`Plane`]: one simulation plane; zero-copy [`Snapshot`]s of its newest tick.
+//! - [`Object`]: one body; reads index into the newest sample, writes join the batch.
+//!
+//! Writes are queued and sent as one request per [`Client::flush`] (or when a call needs an
+//! answer); reads see your own writes until the daemon's samples reflect them.
+
+mod client;
+mod error;
+mod object;
+mod overlay;
+mod plane;
+mod spawn;
+
+pub use client::{Client, ConnectOptions};
+pub use error::Error;
+pub use object::Object;
+pub use plane::{Plane, PlaneOptions, Snapshot};
+pub use spawn::{connect_or_start, daemon_executable, DaemonChild, Session};
+pub use shm_layout::{
+    BodyState, CommandError, ErrorKind, EventRecord, Handle, PlaneId, PlaneInfo, PlaneProp, Pose,
+    Shape, TickHeader, Vec3,
+};

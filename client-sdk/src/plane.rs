@@ -1,0 +1,313 @@
+//! Planes: options, zero-copy snapshots of the newest tick, stepping and waiting for ticks.
+
+use std::cell::RefCell;
+use std::rc::Rc;
+use std::time::{Duration, Instant};
+
+use iceoryx2::port::listener::Listener;
+use iceoryx2::port::subscriber::Subscriber;
+use iceoryx2::prelude::*;
+use iceoryx2::sample::Sample;
+use shm_layout::{
+    names, BodyState, Command, EventRecord, Handle, ObjectProp, PlaneId, PlaneInfo, PlaneProp,
+    Pose, Reply, Shape, TickHeader, Vec3,
+};
+
+use crate::overlay::Overlay;
+use crate::{Client, Error, Object};
+
+type BodySample = Sample<ipc::Service, [BodyState], TickHeader>;
+
+/// Options of a new plane; `None` keeps the daemon's default.
+#[derive(Debug, Clone, Default)]
+pub struct PlaneOptions {
+    pub gravity: Option<Vec3>,
+    pub threads: Option<u32>,
+    /// Ticks per second of wall time; 0 = manual (only [`Plane::step`] advances it).
+    pub tick_rate: Option<f32>,
+    pub enabled: Option<bool>,
+}
+
+impl PlaneOptions {
+    /// A manual plane: it advances only on [`Plane::step`]. What tests and replays use.
+    pub fn manual() -> Self {
+        PlaneOptions { tick_rate: Some(0.0), ..Default::default() }
+    }
+
+    pub(crate) fn props(&self) -> Vec<PlaneProp> {
+        let mut props = Vec::new();
+        if let Some(g) = self.gravity {
+            props.push(PlaneProp::Gravity(g));
+        }
+        if let Some(n) = self.threads {
+            props.push(PlaneProp::Threads(n));
+        }
+        if let Some(hz) = self.tick_rate {
+            props.push(PlaneProp::TickRate(hz));
+        }
+        if let Some(on) = self.enabled {
+            props.push(PlaneProp::Enabled(on));
+        }
+        props
+    }
+}
+
+/// What a client keeps per plane: the subscriber, the newest sample, the overlay.
+pub(crate) struct PlaneShared {
+    pub(crate) id: PlaneId,
+    bodies: Subscriber<ipc::Service, [BodyState], TickHeader>,
+    latest: RefCell<Option<Rc<BodySample>>>,
+    pub(crate) overlay: RefCell<Overlay>,
+    /// Created on the first wait: readers that never wait pay nothing for it.
+    ticks: RefCell<Option<Listener<ipc::Service>>>,
+    events: RefCell<Option<Subscriber<ipc::Service, [EventRecord], TickHeader>>>,
+}
+
+impl PlaneShared {
+    pub(crate) fn open(node: &Node<ipc::Service>, id: PlaneId) -> Result<PlaneShared, Error> {
+        let bodies = node
+            .service_builder(&names::plane_bodies(id))
+            .publish_subscribe::<[BodyState]>()
+            .user_header::<TickHeader>()
+            .open()
+            .map_err(|e| Error::ipc("open plane body service", e))?
+            .subscriber_builder()
+            .buffer_size(1)
+            .create()
+            .map_err(|e| Error::ipc("create plane subscriber", e))?;
+        Ok(PlaneShared {
+            id,
+            bodies,
+            latest: RefCell::new(None),
+            overlay: RefCell::default(),
+            ticks: RefCell::new(None),
+            events: RefCell::new(None),
+        })
+    }
+
+    /// Takes the newest sample if one arrived: a check of a shared-memory queue, no syscall.
+    fn refresh(&self) -> Result<(), Error> {
+        loop {
+            match self.bodies.receive() {
+                Ok(Some(sample)) => *self.latest.borrow_mut() = Some(Rc::new(sample)),
+                Ok(None) => return Ok(()),
+                // Every borrow slot is held by snapshots the caller keeps: keep the newest we have.
+                Err(iceoryx2::port::ReceiveError::ExceedsMaxBorrows) => return Ok(()),
+                Err(e) => return Err(Error::ipc("receive tick", e)),
+            }
+        }
+    }
+
+    fn latest(&self) -> Result<Option<Rc<BodySample>>, Error> {
+        self.refresh()?;
+        Ok(self.latest.borrow().clone())
+    }
+
+    fn current_tick(&self) -> Option<u64> {
+        self.latest.borrow().as_ref().map(|s| s.user_header().tick)
+    }
+}
+
+/// One tick of a plane, read in place from shared memory.
+#[derive(Clone)]
+pub struct Snapshot {
+    sample: Rc<BodySample>,
+}
+
+impl Snapshot {
+    pub fn header(&self) -> &TickHeader {
+        self.sample.user_header()
+    }
+
+    pub fn tick(&self) -> u64 {
+        self.header().tick
+    }
+
+    /// Every slot of the plane, indexed by [`Handle::slot`].
+    pub fn bodies(&self) -> &[BodyState] {
+        self.sample.payload()
+    }
+
+    /// The state of `handle`, or `None` when the slot is empty or reused.
+    pub fn get(&self, handle: Handle) -> Option<&BodyState> {
+        self.bodies().get(handle.slot as usize).filter(|s| s.matches(handle))
+    }
+}
+
+/// A plane of the daemon. Cheap to clone.
+#[derive(Clone)]
+pub struct Plane {
+    client: Client,
+    pub(crate) shared: Rc<PlaneShared>,
+}
+
+impl Plane {
+    pub(crate) fn new(client: Client, shared: Rc<PlaneShared>) -> Plane {
+        Plane { client, shared }
+    }
+
+    pub fn id(&self) -> PlaneId {
+        self.shared.id
+    }
+
+    pub fn client(&self) -> &Client {
+        &self.client
+    }
+
+    /// The newest published tick (zero-copy).
+    pub fn snapshot(&self) -> Result<Snapshot, Error> {
+        match self.shared.latest()? {
+            Some(sample) => Ok(Snapshot { sample }),
+            None => Err(Error::Protocol(format!("plane {} has published nothing yet", self.id()))),
+        }
+    }
+
+    /// The state of `handle` as this process should see it: the newest sample with this
+    /// process's unconfirmed writes on top. `None` when the object does not exist.
+    pub(crate) fn body(&self, handle: Handle) -> Result<Option<BodyState>, Error> {
+        let sample = self.shared.latest()?;
+        let tick = sample.as_ref().map_or(0, |s| s.user_header().tick);
+        let base = sample
+            .as_ref()
+            .and_then(|s| s.payload().get(handle.slot as usize).copied())
+            .filter(|s| s.matches(handle));
+        let mut overlay = self.shared.overlay.borrow_mut();
+        Ok(match overlay.get(handle, tick) {
+            Some(entry) => entry.apply(handle, base),
+            None => base,
+        })
+    }
+
+    pub fn info(&self) -> Result<PlaneInfo, Error> {
+        match self.client.call(Command::PlaneInfo { plane: self.id() })? {
+            Reply::Plane(info) => Ok(info),
+            other => Err(Error::Protocol(format!("unexpected reply {other:?}"))),
+        }
+    }
+
+    /// Changes a plane option (sent with the next flush).
+    pub fn set(&self, prop: PlaneProp) {
+        self.client.queue(Command::SetPlane { plane: self.id(), prop }, None);
+    }
+
+    /// Adds an object; sends the queue and waits for the new handle.
+    pub fn add(&self, shape: Shape, pose: Pose, props: &[ObjectProp]) -> Result<Object, Error> {
+        let reply = self.client.call(Command::AddObject {
+            plane: self.id(),
+            shape,
+            pose,
+            props: props.to_vec(),
+        })?;
+        let Reply::Object { handle, tick } = reply else {
+            return Err(Error::Protocol(format!("unexpected reply {reply:?}")));
+        };
+        // Until a sample shows it, the object reads back as created.
+        let mut overlay = self.shared.overlay.borrow_mut();
+        overlay.write(handle, |e| {
+            e.pose = Some(pose);
+            e.velocity = Some([0.0; 3]);
+            e.angular_velocity = Some([0.0; 3]);
+            for p in props {
+                match *p {
+                    ObjectProp::Pose(p) => e.pose = Some(p),
+                    ObjectProp::Velocity(v) => e.velocity = Some(v),
+                    ObjectProp::AngularVelocity(w) => e.angular_velocity = Some(w),
+                    ObjectProp::Anchored(a) => e.anchored = Some(a),
+                    ObjectProp::ReportContacts(_) => {}
+                }
+            }
+        });
+        overlay.confirm(handle, tick);
+        Ok(Object::new(self.clone(), handle))
+    }
+
+    /// Advances a plane by `dt` seconds (with the queue sent first) and returns once the
+    /// new tick is visible in [`Plane::snapshot`]. Returns the tick number.
+    pub fn step(&self, dt: f32) -> Result<u64, Error> {
+        match self.client.call(Command::Step { plane: self.id(), dt })? {
+            Reply::Stepped { tick } => {
+                // The daemon sends the sample before the reply, so it is already here.
+                self.shared.refresh()?;
+                Ok(tick)
+            }
+            other => Err(Error::Protocol(format!("unexpected reply {other:?}"))),
+        }
+    }
+
+    /// Waits until a tick newer than the one visible now is published. Returns its number.
+    pub fn wait_tick(&self, timeout: Duration) -> Result<u64, Error> {
+        self.shared.refresh()?;
+        let seen = self.shared.current_tick();
+        let deadline = Instant::now() + timeout;
+        loop {
+            self.shared.refresh()?;
+            match self.shared.current_tick() {
+                Some(t) if Some(t) != seen => return Ok(t),
+                _ => {}
+            }
+            let now = Instant::now();
+            if now >= deadline {
+                return Err(Error::Timeout(timeout));
+            }
+            self.tick_listener()?;
+            let wait = (deadline - now).min(Duration::from_millis(100));
+            if let Some(l) = self.shared.ticks.borrow().as_ref() {
+                let _ = l.timed_wait(|_| {}, wait);
+            }
+            self.client.check_daemon()?;
+        }
+    }
+
+    fn tick_listener(&self) -> Result<(), Error> {
+        if self.shared.ticks.borrow().is_some() {
+            return Ok(());
+        }
+        let listener = self
+            .client
+            .inner
+            .node
+            .service_builder(&names::plane_tick(self.id()))
+            .event()
+            .open()
+            .map_err(|e| Error::ipc("open tick event", e))?
+            .listener_builder()
+            .create()
+            .map_err(|e| Error::ipc("create tick listener", e))?;
+        *self.shared.ticks.borrow_mut() = Some(listener);
+        Ok(())
+    }
+
+    /// Events (contact started / stopped) published since the last call. The first call
+    /// subscribes; events before it are not seen.
+    pub fn events(&self) -> Result<Vec<EventRecord>, Error> {
+        if self.shared.events.borrow().is_none() {
+            let sub = self
+                .client
+                .inner
+                .node
+                .service_builder(&names::plane_events(self.id()))
+                .publish_subscribe::<[EventRecord]>()
+                .user_header::<TickHeader>()
+                .open()
+                .map_err(|e| Error::ipc("open event service", e))?
+                .subscriber_builder()
+                .create()
+                .map_err(|e| Error::ipc("create event subscriber", e))?;
+            *self.shared.events.borrow_mut() = Some(sub);
+        }
+        let mut out = Vec::new();
+        if let Some(sub) = self.shared.events.borrow().as_ref() {
+            while let Some(sample) = sub.receive().map_err(|e| Error::ipc("receive events", e))? {
+                out.extend_from_slice(sample.payload());
+            }
+        }
+        Ok(out)
+    }
+
+    /// Destroys the plane and everything in it.
+    pub fn destroy(&self) -> Result<(), Error> {
+        self.client.call(Command::DestroyPlane { plane: self.id() })?;
+        self.client.forget_plane(self.id());
+        Ok(())
+    }
+}

@@ -1,0 +1,101 @@
+//! Connect to the daemon of a domain, starting one as a child process when none answers.
+
+use std::path::PathBuf;
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+use crate::{Client, Error};
+
+/// A daemon started by this process; stopped (SIGINT, then waited for) when dropped.
+pub struct DaemonChild {
+    child: Child,
+}
+
+impl DaemonChild {
+    pub fn pid(&self) -> u32 {
+        self.child.id()
+    }
+}
+
+impl Drop for DaemonChild {
+    fn drop(&mut self) {
+        // SAFETY: plain kill(2) on our own child's pid.
+        unsafe { libc::kill(self.child.id() as i32, libc::SIGINT) };
+        let deadline = Instant::now() + Duration::from_secs(3);
+        while Instant::now() < deadline {
+            if let Ok(Some(_)) = self.child.try_wait() {
+                return;
+            }
+            std::thread::sleep(Duration::from_millis(10));
+        }
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+/// The daemon executable: `$PHYSICS_DAEMON_BIN`, else `physics-daemon` next to the
+/// current executable (cargo puts all workspace binaries together), else from `PATH`.
+pub fn daemon_executable() -> PathBuf {
+    if let Some(p) = std::env::var_os("PHYSICS_DAEMON_BIN") {
+        return PathBuf::from(p);
+    }
+    if let Ok(exe) = std::env::current_exe() {
+        for dir in exe.ancestors().skip(1).take(2) {
+            let candidate = dir.join("physics-daemon");
+            if candidate.is_file() {
+                return candidate;
+            }
+        }
+    }
+    PathBuf::from("physics-daemon")
+}
+
+/// A client plus the daemon it started, if it had to. Dropping it says goodbye to the
+/// daemon first, then stops the daemon it started (fields drop in declaration order).
+pub struct Session {
+    pub client: Client,
+    pub daemon: Option<DaemonChild>,
+}
+
+impl std::ops::Deref for Session {
+    type Target = Client;
+    fn deref(&self) -> &Client {
+        &self.client
+    }
+}
+
+/// Connects to the daemon of `domain`; when none answers, starts one and connects to it.
+pub fn connect_or_start(domain: &str) -> Result<Session, Error> {
+    match Client::connect(domain) {
+        Ok(client) => return Ok(Session { client, daemon: None }),
+        Err(Error::NoDaemon { .. }) => {}
+        Err(e) => return Err(e),
+    }
+    let exe = daemon_executable();
+    let child = Command::new(&exe)
+        .arg("--domain")
+        .arg(domain)
+        .stdin(Stdio::null())
+        .spawn()
+        .map_err(|e| Error::NoDaemon {
+            domain: domain.to_string(),
+            detail: format!("cannot start {}: {e}", exe.display()),
+        })?;
+    let mut child = DaemonChild { child };
+    let deadline = Instant::now() + Duration::from_secs(10);
+    loop {
+        match Client::connect(domain) {
+            Ok(client) => return Ok(Session { client, daemon: Some(child) }),
+            Err(Error::NoDaemon { detail, .. }) if Instant::now() < deadline => {
+                if let Ok(Some(status)) = child.child.try_wait() {
+                    return Err(Error::NoDaemon {
+                        domain: domain.to_string(),
+                        detail: format!("the started daemon exited with {status} ({detail})"),
+                    });
+                }
+                std::thread::sleep(Duration::from_millis(20));
+            }
+            Err(e) => return Err(e),
+        }
+    }
+}
