@@ -8,9 +8,19 @@ fn main() -> Result<(), client_sdk::Error> {
     let domain = std::env::args().nth(1).unwrap_or_else(|| "physics".into());
     let client = connect_or_start(&domain)?;
     let plane = client.create_plane(&PlaneOptions::manual())?;
-    let floor = plane.add(Shape::Cube { size: [20.0, 1.0, 20.0] }, Pose::at([0.0, -0.5, 0.0]), &[])?;
+    let floor = plane.add(
+        Shape::Cube {
+            size: [20.0, 1.0, 20.0],
+        },
+        Pose::at([0.0, -0.5, 0.0]),
+        &[],
+    )?;
     floor.set_anchored(true);
-    let ball = plane.add(Shape::Sphere { radius: 0.5 }, Pose::at([0.0, 10.0, 0.0]), &[])?;
+    let ball = plane.add(
+        Shape::Sphere { radius: 0.5 },
+        Pose::at([0.0, 10.0, 0.0]),
+        &[],
+    )?;
     for frame in 0..=90 {
         plane.step(1.0 / 60.0)?;
         if frame % 10 == 0 {

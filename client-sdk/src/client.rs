@@ -6,11 +6,12 @@ use std::rc::Rc;
 use std::time::{Duration, Instant};
 
 use iceoryx2::config::Config;
+use iceoryx2::node::NodeView;
 use iceoryx2::port::client::Client as RequestPort;
 use iceoryx2::port::listener::Listener;
 use iceoryx2::port::notifier::Notifier;
 use iceoryx2::prelude::*;
-use shm_layout::codec::{self, DecodeError};
+use shm_layout::codec;
 use shm_layout::{
     names, Command, CommandError, CommandResult, ErrorKind, Handle, PlaneId, Reply, Request,
     Response, CRATE_VERSION, LAYOUT_VERSION,
@@ -89,9 +90,18 @@ impl Client {
 
     pub fn connect_with(options: ConnectOptions) -> Result<Client, Error> {
         let domain = options.domain.clone();
-        let config = names::config(&domain)
-            .map_err(|e| Error::Invalid { field: "domain".into(), message: e.to_string() })?;
-        let no_daemon = |detail: String| Error::NoDaemon { domain: domain.clone(), detail };
+        let config = names::config(&domain).map_err(|e| Error::Invalid {
+            field: "domain".into(),
+            message: e.to_string(),
+        })?;
+        let no_daemon = |detail: String| Error::NoDaemon {
+            domain: domain.clone(),
+            detail,
+        };
+        // A crashed daemon leaves its services behind: look for a live daemon process first.
+        if daemon_alive(&config, 0) == Some(false) {
+            return Err(no_daemon("no live daemon process in this domain".into()));
+        }
         let node = NodeBuilder::new()
             .name(&NodeName::new("physics-client").expect("valid node name"))
             .config(&config)
@@ -145,7 +155,11 @@ impl Client {
             pid: std::process::id(),
         };
         match inner.round_trip(vec![hello])?.pop() {
-            Some(Ok(Reply::Welcome { daemon_pid, daemon_node_id, .. })) => {
+            Some(Ok(Reply::Welcome {
+                daemon_pid,
+                daemon_node_id,
+                ..
+            })) => {
                 inner.daemon_pid = daemon_pid;
                 inner.daemon_node = daemon_node_id;
             }
@@ -153,9 +167,15 @@ impl Client {
                 return Err(Error::VersionMismatch(e.message))
             }
             Some(Err(e)) => return Err(e.into()),
-            other => return Err(Error::Protocol(format!("unexpected handshake reply {other:?}"))),
+            other => {
+                return Err(Error::Protocol(format!(
+                    "unexpected handshake reply {other:?}"
+                )))
+            }
         }
-        Ok(Client { inner: Rc::new(inner) })
+        Ok(Client {
+            inner: Rc::new(inner),
+        })
     }
 
     pub fn domain(&self) -> &str {
@@ -169,30 +189,35 @@ impl Client {
 
     /// Creates a plane owned by this client (released when the client goes away).
     pub fn create_plane(&self, options: &PlaneOptions) -> Result<Plane, Error> {
-        match self.call(Command::CreatePlane { props: options.props() })? {
-            Reply::Plane(info) => self.attach_info(info),
+        match self.call(Command::CreatePlane {
+            props: options.props(),
+        })? {
+            Reply::Plane(info) => self.attach_plane(info.id),
             other => Err(unexpected(other)),
         }
     }
 
-    /// Opens an existing plane (created by any client) for reading and writing.
+    /// Opens an existing plane (created by any client) for reading and writing. Returns once
+    /// the plane's newest tick is readable.
     pub fn attach_plane(&self, id: PlaneId) -> Result<Plane, Error> {
-        match self.call(Command::PlaneInfo { plane: id })? {
-            Reply::Plane(info) => self.attach_info(info),
-            other => Err(unexpected(other)),
+        if let Some(shared) = self.inner.state.borrow().planes.get(&id) {
+            return Ok(Plane::new(self.clone(), shared.clone()));
         }
-    }
-
-    fn attach_info(&self, info: shm_layout::PlaneInfo) -> Result<Plane, Error> {
-        let existing = self.inner.state.borrow().planes.get(&info.id).cloned();
-        let shared = match existing {
-            Some(s) => s,
-            None => {
-                let s = Rc::new(PlaneShared::open(&self.inner.node, info.id)?);
-                self.inner.state.borrow_mut().planes.insert(info.id, s.clone());
-                s
+        let shared = match PlaneShared::open(&self.inner.node, id) {
+            Ok(s) => Rc::new(s),
+            // No such service: let the daemon say why (unknown plane, or gone).
+            Err(e) => {
+                self.call(Command::PlaneInfo { plane: id })?;
+                return Err(e);
             }
         };
+        // Asking after subscribing makes the daemon hand the newest tick to the new reader.
+        self.call(Command::PlaneInfo { plane: id })?;
+        self.inner
+            .state
+            .borrow_mut()
+            .planes
+            .insert(id, shared.clone());
         Ok(Plane::new(self.clone(), shared))
     }
 
@@ -226,7 +251,11 @@ impl Client {
     }
 
     pub(crate) fn queue(&self, command: Command, confirms: Option<(PlaneId, Handle)>) {
-        self.inner.state.borrow_mut().queue.push(Queued { command, confirms });
+        self.inner
+            .state
+            .borrow_mut()
+            .queue
+            .push(Queued { command, confirms });
     }
 
     /// One request: the queued commands first, then `extra`. Returns the results of `extra`.
@@ -294,6 +323,18 @@ impl Inner {
             codec::encode_request_with_version(&request, self.options.layout_version)
         };
         let reply = self.exchange(&bytes)?;
+        let frame = codec::Frame::parse(&reply).map_err(|e| Error::Protocol(e.to_string()))?;
+        if frame.version != self.options.layout_version {
+            // The daemon answered in the version-neutral form: its crate version as text.
+            return Err(Error::VersionMismatch(format!(
+                "layout version mismatch: client has LAYOUT_VERSION {} (crate {}), daemon has \
+                 LAYOUT_VERSION {} (crate {})",
+                self.options.layout_version,
+                self.options.crate_version,
+                frame.version,
+                String::from_utf8_lossy(frame.body),
+            )));
+        }
         match codec::decode_response(&reply) {
             Ok(Response::Results(results)) if results.len() == n => Ok(results),
             Ok(Response::Results(results)) => Err(Error::Protocol(format!(
@@ -301,7 +342,6 @@ impl Inner {
                 results.len()
             ))),
             Ok(Response::Rejected(e)) => Err(Error::Command(e)),
-            Err(e @ DecodeError::VersionMismatch { .. }) => Err(Error::VersionMismatch(e.to_string())),
             Err(e) => Err(Error::Protocol(e.to_string())),
         }
     }
@@ -309,16 +349,25 @@ impl Inner {
     /// Sends raw request bytes and waits for the raw reply, checking the daemon's liveness
     /// while waiting so a dead daemon is an error within a bounded time, not a hang.
     pub(crate) fn exchange(&self, bytes: &[u8]) -> Result<Vec<u8>, Error> {
-        let mut request =
-            self.port.loan_slice_uninit(bytes.len()).map_err(|e| Error::ipc("loan request", e))?;
+        let mut request = self
+            .port
+            .loan_slice_uninit(bytes.len())
+            .map_err(|e| Error::ipc("loan request", e))?;
         *request.user_header_mut() = self.id;
-        let pending =
-            request.write_from_slice(bytes).send().map_err(|e| Error::ipc("send request", e))?;
-        self.daemon_wake.notify().map_err(|e| Error::ipc("wake daemon", e))?;
+        let pending = request
+            .write_from_slice(bytes)
+            .send()
+            .map_err(|e| Error::ipc("send request", e))?;
+        self.daemon_wake
+            .notify()
+            .map_err(|e| Error::ipc("wake daemon", e))?;
         let started = Instant::now();
         let mut last_check = started;
         loop {
-            if let Some(response) = pending.receive().map_err(|e| Error::ipc("receive reply", e))? {
+            if let Some(response) = pending
+                .receive()
+                .map_err(|e| Error::ipc("receive reply", e))?
+            {
                 return Ok(response.payload().to_vec());
             }
             if !pending.is_connected() {
@@ -337,27 +386,24 @@ impl Inner {
     }
 
     pub(crate) fn check_daemon(&self) -> Result<(), Error> {
-        if self.daemon_node == 0 {
-            return Ok(()); // still in the handshake: the request port tells us
-        }
-        let id = self.daemon_node;
-        let mut alive = false;
-        let listed = Node::<ipc::Service>::list(&self.config, |state| {
-            if state.node_id().value() == id {
-                alive = matches!(state, NodeState::Alive(_));
-                return CallbackProgression::Stop;
+        match daemon_alive(&self.config, self.daemon_node) {
+            Some(false) if self.daemon_node == 0 => Err(Error::NoDaemon {
+                domain: self.options.domain.clone(),
+                detail: "no live daemon process answers".into(),
+            }),
+            Some(false) => {
+                self.state.borrow_mut().gone = true;
+                Err(self.gone())
             }
-            CallbackProgression::Continue
-        });
-        if listed.is_ok() && !alive {
-            self.state.borrow_mut().gone = true;
-            return Err(self.gone());
+            _ => Ok(()),
         }
-        Ok(())
     }
 
     fn gone(&self) -> Error {
-        Error::DaemonGone { domain: self.options.domain.clone(), pid: self.daemon_pid }
+        Error::DaemonGone {
+            domain: self.options.domain.clone(),
+            pid: self.daemon_pid,
+        }
     }
 }
 
@@ -371,6 +417,40 @@ impl Drop for Inner {
     }
 }
 
+/// Whether the daemon's node is alive: found by id once the handshake told us the id, by
+/// name before. `None` when the node list cannot be read (then we assume nothing).
+fn daemon_alive(config: &Config, daemon_node: u128) -> Option<bool> {
+    let mut alive = false;
+    Node::<ipc::Service>::list(config, |state| {
+        if daemon_node != 0 && state.node_id().value() == daemon_node {
+            alive = matches!(state, NodeState::Alive(_));
+            return CallbackProgression::Stop;
+        }
+        if let (0, NodeState::Alive(view)) = (daemon_node, &state) {
+            if view
+                .details()
+                .as_ref()
+                .is_some_and(|d| d.name().as_str() == names::DAEMON_NODE_NAME)
+            {
+                alive = true;
+                return CallbackProgression::Stop;
+            }
+        }
+        CallbackProgression::Continue
+    })
+    .ok()?;
+    Some(alive)
+}
+
 fn unexpected(reply: Reply) -> Error {
     Error::Protocol(format!("unexpected reply {reply:?}"))
+}
+
+impl std::fmt::Debug for Client {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Client")
+            .field("domain", &self.domain())
+            .field("daemon_pid", &self.daemon_pid())
+            .finish()
+    }
 }

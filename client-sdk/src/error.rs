@@ -4,7 +4,9 @@ use shm_layout::CommandError;
 pub enum Error {
     #[error("no physics daemon is serving domain {domain:?} ({detail})")]
     NoDaemon { domain: String, detail: String },
-    #[error("the physics daemon of domain {domain:?} is gone (process {pid} exited or was killed)")]
+    #[error(
+        "the physics daemon of domain {domain:?} is gone (process {pid} exited or was killed)"
+    )]
     DaemonGone { domain: String, pid: u32 },
     #[error("{0}")]
     VersionMismatch(String),

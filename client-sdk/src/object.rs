@@ -15,7 +15,10 @@ fn check3(field: &str, v: Vec3) -> Result<Vec3, Error> {
     if v.iter().all(|c| c.is_finite()) {
         Ok(v)
     } else {
-        Err(Error::Invalid { field: field.into(), message: format!("must be finite, got {v:?}") })
+        Err(Error::Invalid {
+            field: field.into(),
+            message: format!("must be finite, got {v:?}"),
+        })
     }
 }
 
@@ -42,7 +45,11 @@ impl Object {
         self.plane.body(self.handle)?.ok_or_else(|| {
             Error::Command(shm_layout::CommandError::new(
                 shm_layout::ErrorKind::StaleHandle,
-                format!("object {:?} of plane {} no longer exists", self.handle, self.plane.id()),
+                format!(
+                    "object {:?} of plane {} no longer exists",
+                    self.handle,
+                    self.plane.id()
+                ),
             ))
         })
     }
@@ -53,7 +60,10 @@ impl Object {
 
     pub fn pose(&self) -> Result<Pose, Error> {
         let s = self.state()?;
-        Ok(Pose { position: s.position, rotation: s.rotation })
+        Ok(Pose {
+            position: s.position,
+            rotation: s.rotation,
+        })
     }
 
     pub fn position(&self) -> Result<Vec3, Error> {
@@ -75,9 +85,14 @@ impl Object {
     fn write(&self, prop: ObjectProp, f: impl FnOnce(&mut crate::overlay::Entry)) {
         self.plane.shared.overlay.borrow_mut().write(self.handle, f);
         let plane = self.plane.id();
-        self.plane
-            .client()
-            .queue(Command::SetObject { plane, object: self.handle, prop }, Some((plane, self.handle)));
+        self.plane.client().queue(
+            Command::SetObject {
+                plane,
+                object: self.handle,
+                prop,
+            },
+            Some((plane, self.handle)),
+        );
     }
 
     /// Teleports the object (sent with the next flush; reads see it at once).
@@ -87,10 +102,16 @@ impl Object {
         if !n.is_finite() || n < 1e-6 {
             return Err(Error::Invalid {
                 field: "CFrame.rotation".into(),
-                message: format!("must be a finite non-zero quaternion, got {:?}", pose.rotation),
+                message: format!(
+                    "must be a finite non-zero quaternion, got {:?}",
+                    pose.rotation
+                ),
             });
         }
-        let pose = Pose { rotation: pose.rotation.map(|c| c / n), ..pose };
+        let pose = Pose {
+            rotation: pose.rotation.map(|c| c / n),
+            ..pose
+        };
         self.write(ObjectProp::Pose(pose), |e| e.pose = Some(pose));
         Ok(())
     }
@@ -103,7 +124,9 @@ impl Object {
 
     pub fn set_angular_velocity(&self, w: Vec3) -> Result<(), Error> {
         let w = check3("AngularVelocity", w)?;
-        self.write(ObjectProp::AngularVelocity(w), |e| e.angular_velocity = Some(w));
+        self.write(ObjectProp::AngularVelocity(w), |e| {
+            e.angular_velocity = Some(w)
+        });
         Ok(())
     }
 
@@ -119,7 +142,11 @@ impl Object {
     pub fn set_report_contacts(&self, on: bool) {
         let plane = self.plane.id();
         self.plane.client().queue(
-            Command::SetObject { plane, object: self.handle, prop: ObjectProp::ReportContacts(on) },
+            Command::SetObject {
+                plane,
+                object: self.handle,
+                prop: ObjectProp::ReportContacts(on),
+            },
             None,
         );
     }
@@ -128,16 +155,40 @@ impl Object {
     pub fn apply_impulse(&self, impulse: Vec3) -> Result<(), Error> {
         let impulse = check3("impulse", impulse)?;
         let plane = self.plane.id();
-        self.plane.client().queue(Command::ApplyImpulse { plane, object: self.handle, impulse }, None);
+        self.plane.client().queue(
+            Command::ApplyImpulse {
+                plane,
+                object: self.handle,
+                impulse,
+            },
+            None,
+        );
         Ok(())
     }
 
     /// Removes the object (sent with the next flush; reads see it gone at once).
     pub fn destroy(&self) {
-        self.plane.shared.overlay.borrow_mut().write(self.handle, |e| e.destroyed = true);
-        let plane = self.plane.id();
         self.plane
-            .client()
-            .queue(Command::DestroyObject { plane, object: self.handle }, Some((plane, self.handle)));
+            .shared
+            .overlay
+            .borrow_mut()
+            .write(self.handle, |e| e.destroyed = true);
+        let plane = self.plane.id();
+        self.plane.client().queue(
+            Command::DestroyObject {
+                plane,
+                object: self.handle,
+            },
+            Some((plane, self.handle)),
+        );
+    }
+}
+
+impl std::fmt::Debug for Object {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Object")
+            .field("plane", &self.plane.id())
+            .field("handle", &self.handle)
+            .finish()
     }
 }

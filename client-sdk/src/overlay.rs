@@ -41,7 +41,11 @@ impl Entry {
             s.angular_velocity = w;
         }
         if let Some(a) = self.anchored {
-            s.flags = if a { s.flags | FLAG_ANCHORED } else { s.flags & !FLAG_ANCHORED };
+            s.flags = if a {
+                s.flags | FLAG_ANCHORED
+            } else {
+                s.flags & !FLAG_ANCHORED
+            };
         }
         Some(s)
     }
@@ -91,7 +95,10 @@ impl Overlay {
 mod tests {
     use super::*;
 
-    const H: Handle = Handle { slot: 2, generation: 5 };
+    const H: Handle = Handle {
+        slot: 2,
+        generation: 5,
+    };
 
     #[test]
     fn entry_lives_until_a_newer_sample() {
@@ -99,19 +106,33 @@ mod tests {
         o.write(H, |e| e.velocity = Some([1.0, 2.0, 3.0]));
         assert!(o.get(H, 100).is_some(), "unconfirmed writes always show");
         o.confirm(H, 10);
-        assert!(o.get(H, 10).is_some(), "the sample of the apply tick predates the write");
+        assert!(
+            o.get(H, 10).is_some(),
+            "the sample of the apply tick predates the write"
+        );
         assert!(o.get(H, 11).is_none(), "tick 11 reflects the write");
         assert!(o.is_empty());
     }
 
     #[test]
     fn entry_overrides_only_written_fields() {
-        let base = BodyState { position: [9.0; 3], flags: FLAG_ALIVE, generation: 5, ..Default::default() };
-        let e = Entry { velocity: Some([1.0, 0.0, 0.0]), ..Default::default() };
+        let base = BodyState {
+            position: [9.0; 3],
+            flags: FLAG_ALIVE,
+            generation: 5,
+            ..Default::default()
+        };
+        let e = Entry {
+            velocity: Some([1.0, 0.0, 0.0]),
+            ..Default::default()
+        };
         let s = e.apply(H, Some(base)).unwrap();
         assert_eq!(s.position, [9.0; 3]);
         assert_eq!(s.linear_velocity, [1.0, 0.0, 0.0]);
-        let gone = Entry { destroyed: true, ..Default::default() };
+        let gone = Entry {
+            destroyed: true,
+            ..Default::default()
+        };
         assert!(gone.apply(H, Some(base)).is_none());
     }
 }

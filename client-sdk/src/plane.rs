@@ -31,7 +31,10 @@ pub struct PlaneOptions {
 impl PlaneOptions {
     /// A manual plane: it advances only on [`Plane::step`]. What tests and replays use.
     pub fn manual() -> Self {
-        PlaneOptions { tick_rate: Some(0.0), ..Default::default() }
+        PlaneOptions {
+            tick_rate: Some(0.0),
+            ..Default::default()
+        }
     }
 
     pub(crate) fn props(&self) -> Vec<PlaneProp> {
@@ -130,7 +133,9 @@ impl Snapshot {
 
     /// The state of `handle`, or `None` when the slot is empty or reused.
     pub fn get(&self, handle: Handle) -> Option<&BodyState> {
-        self.bodies().get(handle.slot as usize).filter(|s| s.matches(handle))
+        self.bodies()
+            .get(handle.slot as usize)
+            .filter(|s| s.matches(handle))
     }
 }
 
@@ -158,7 +163,10 @@ impl Plane {
     pub fn snapshot(&self) -> Result<Snapshot, Error> {
         match self.shared.latest()? {
             Some(sample) => Ok(Snapshot { sample }),
-            None => Err(Error::Protocol(format!("plane {} has published nothing yet", self.id()))),
+            None => Err(Error::Protocol(format!(
+                "plane {} has published nothing yet",
+                self.id()
+            ))),
         }
     }
 
@@ -187,7 +195,13 @@ impl Plane {
 
     /// Changes a plane option (sent with the next flush).
     pub fn set(&self, prop: PlaneProp) {
-        self.client.queue(Command::SetPlane { plane: self.id(), prop }, None);
+        self.client.queue(
+            Command::SetPlane {
+                plane: self.id(),
+                prop,
+            },
+            None,
+        );
     }
 
     /// Adds an object; sends the queue and waits for the new handle.
@@ -224,7 +238,10 @@ impl Plane {
     /// Advances a plane by `dt` seconds (with the queue sent first) and returns once the
     /// new tick is visible in [`Plane::snapshot`]. Returns the tick number.
     pub fn step(&self, dt: f32) -> Result<u64, Error> {
-        match self.client.call(Command::Step { plane: self.id(), dt })? {
+        match self.client.call(Command::Step {
+            plane: self.id(),
+            dt,
+        })? {
             Reply::Stepped { tick } => {
                 // The daemon sends the sample before the reply, so it is already here.
                 self.shared.refresh()?;
@@ -249,7 +266,9 @@ impl Plane {
             if now >= deadline {
                 return Err(Error::Timeout(timeout));
             }
-            self.tick_listener()?;
+            // A failure to reach the tick event most likely means the daemon is gone.
+            self.tick_listener()
+                .map_err(|e| self.client.check_daemon().err().unwrap_or(e))?;
             let wait = (deadline - now).min(Duration::from_millis(100));
             if let Some(l) = self.shared.ticks.borrow().as_ref() {
                 let _ = l.timed_wait(|_| {}, wait);
@@ -306,8 +325,15 @@ impl Plane {
 
     /// Destroys the plane and everything in it.
     pub fn destroy(&self) -> Result<(), Error> {
-        self.client.call(Command::DestroyPlane { plane: self.id() })?;
+        self.client
+            .call(Command::DestroyPlane { plane: self.id() })?;
         self.client.forget_plane(self.id());
         Ok(())
+    }
+}
+
+impl std::fmt::Debug for Plane {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Plane").field("id", &self.id()).finish()
     }
 }

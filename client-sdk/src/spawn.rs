@@ -67,7 +67,12 @@ impl std::ops::Deref for Session {
 /// Connects to the daemon of `domain`; when none answers, starts one and connects to it.
 pub fn connect_or_start(domain: &str) -> Result<Session, Error> {
     match Client::connect(domain) {
-        Ok(client) => return Ok(Session { client, daemon: None }),
+        Ok(client) => {
+            return Ok(Session {
+                client,
+                daemon: None,
+            })
+        }
         Err(Error::NoDaemon { .. }) => {}
         Err(e) => return Err(e),
     }
@@ -85,7 +90,12 @@ pub fn connect_or_start(domain: &str) -> Result<Session, Error> {
     let deadline = Instant::now() + Duration::from_secs(10);
     loop {
         match Client::connect(domain) {
-            Ok(client) => return Ok(Session { client, daemon: Some(child) }),
+            Ok(client) => {
+                return Ok(Session {
+                    client,
+                    daemon: Some(child),
+                })
+            }
             Err(Error::NoDaemon { detail, .. }) if Instant::now() < deadline => {
                 if let Ok(Some(status)) = child.child.try_wait() {
                     return Err(Error::NoDaemon {

@@ -53,8 +53,13 @@ impl Clients {
     /// malformed first request, say) get a notifier opened for this one reply.
     pub fn wake(&self, node: &Node<ipc::Service>, id: u128) {
         let result = match self.connected.get(&id) {
-            Some(c) => c.notifier.notify().map(|_| ()).map_err(|e| format!("{e:?}")),
-            None => open_notifier(node, id).and_then(|n| n.notify().map(|_| ()).map_err(|e| format!("{e:?}"))),
+            Some(c) => c
+                .notifier
+                .notify()
+                .map(|_| ())
+                .map_err(|e| format!("{e:?}")),
+            None => open_notifier(node, id)
+                .and_then(|n| n.notify().map(|_| ()).map_err(|e| format!("{e:?}"))),
         };
         if let Err(e) = result {
             tracing::debug!(client = format!("{id:032x}"), "cannot wake client: {e}");
@@ -79,13 +84,20 @@ impl Clients {
         }
         for view in dead {
             let id = view.id().value();
-            tracing::info!(node = format!("{id:032x}"), "removing resources of a dead process");
+            tracing::info!(
+                node = format!("{id:032x}"),
+                "removing resources of a dead process"
+            );
             if let Err(e) = view.try_remove_stale_resources() {
                 tracing::warn!("cleanup of dead node failed: {e:?}");
             }
         }
-        let gone: Vec<u128> =
-            self.connected.keys().copied().filter(|id| !present.contains(id)).collect();
+        let gone: Vec<u128> = self
+            .connected
+            .keys()
+            .copied()
+            .filter(|id| !present.contains(id))
+            .collect();
         for id in &gone {
             self.connected.remove(id);
         }

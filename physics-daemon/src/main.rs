@@ -8,7 +8,10 @@ use clap::Parser;
 use shm_layout::names;
 
 #[derive(Parser)]
-#[command(version, about = "Physics daemon: simulates planes and publishes them in shared memory")]
+#[command(
+    version,
+    about = "Physics daemon: simulates planes and publishes them in shared memory"
+)]
 struct Args {
     /// Deployment domain; every process of one deployment uses the same one.
     #[arg(long, env = names::DOMAIN_ENV, default_value = names::DEFAULT_DOMAIN)]
@@ -33,7 +36,9 @@ fn main() -> ExitCode {
     }
     // Planes with Threads = 1 run on the global pool: keep it at one worker so they never
     // spread over the machine's cores uninvited.
-    let _ = rapier3d::rayon::ThreadPoolBuilder::new().num_threads(1).build_global();
+    let _ = rapier3d::rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build_global();
 
     match physics_daemon::run(&args.domain, &shutdown) {
         Ok(()) => ExitCode::SUCCESS,

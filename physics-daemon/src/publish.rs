@@ -2,8 +2,9 @@
 
 use iceoryx2::port::notifier::Notifier;
 use iceoryx2::port::publisher::Publisher;
+use iceoryx2::port::update_connections::UpdateConnections;
 use iceoryx2::prelude::*;
-use shm_layout::{names, monotonic_ns, BodyState, EventRecord, PlaneId, TickHeader};
+use shm_layout::{monotonic_ns, names, BodyState, EventRecord, PlaneId, TickHeader};
 
 use crate::plane::Plane;
 use crate::DaemonError;
@@ -70,7 +71,19 @@ impl PlaneOutput {
             .notifier_builder()
             .create()
             .map_err(|e| ipc("tick notifier", &e))?;
-        Ok(PlaneOutput { bodies, events, tick })
+        Ok(PlaneOutput {
+            bodies,
+            events,
+            tick,
+        })
+    }
+
+    /// Connects readers that subscribed since the last tick and hands them the newest one
+    /// (a manual plane may not tick again for a long time).
+    pub fn connect_readers(&self) {
+        if let Err(e) = self.bodies.update_connections() {
+            tracing::warn!("connecting new readers failed: {e:?}");
+        }
     }
 
     /// Writes every slot straight into one loaned sample (the only copy), sends it, sends the
@@ -89,19 +102,17 @@ impl PlaneOutput {
             .map_err(|e| DaemonError::Ipc(format!("plane {}: send failed: {e:?}", plane.id)))?;
         let events = plane.events();
         if !events.is_empty() {
-            let mut sample = self
-                .events
-                .loan_slice_uninit(events.len())
-                .map_err(|e| DaemonError::Ipc(format!("plane {}: event loan failed: {e:?}", plane.id)))?;
+            let mut sample = self.events.loan_slice_uninit(events.len()).map_err(|e| {
+                DaemonError::Ipc(format!("plane {}: event loan failed: {e:?}", plane.id))
+            })?;
             *sample.user_header_mut() = header;
-            sample
-                .write_from_slice(events)
-                .send()
-                .map_err(|e| DaemonError::Ipc(format!("plane {}: event send failed: {e:?}", plane.id)))?;
+            sample.write_from_slice(events).send().map_err(|e| {
+                DaemonError::Ipc(format!("plane {}: event send failed: {e:?}", plane.id))
+            })?;
         }
-        self.tick
-            .notify()
-            .map_err(|e| DaemonError::Ipc(format!("plane {}: tick notify failed: {e:?}", plane.id)))?;
+        self.tick.notify().map_err(|e| {
+            DaemonError::Ipc(format!("plane {}: tick notify failed: {e:?}", plane.id))
+        })?;
         Ok(())
     }
 }

@@ -108,7 +108,9 @@ fn serve(domain: &str, config: &Config, shutdown: &AtomicBool) -> Result<(), Dae
         .initial_max_slice_len(4096)
         .allocation_strategy(AllocationStrategy::PowerOfTwo)
         .create()
-        .map_err(|_| DaemonError::AlreadyRunning { domain: domain.to_string() })?;
+        .map_err(|_| DaemonError::AlreadyRunning {
+            domain: domain.to_string(),
+        })?;
     let waitset = WaitSetBuilder::new()
         .signal_handling_mode(SignalHandlingMode::Disabled)
         .create::<ipc::Service>()
@@ -131,7 +133,9 @@ fn serve(domain: &str, config: &Config, shutdown: &AtomicBool) -> Result<(), Dae
     let mut next_housekeeping = Instant::now() + HOUSEKEEPING;
     while !shutdown.load(Ordering::Relaxed) {
         let now = Instant::now();
-        let wake_at = daemon.next_tick().map_or(next_housekeeping, |t| t.min(next_housekeeping));
+        let wake_at = daemon
+            .next_tick()
+            .map_or(next_housekeeping, |t| t.min(next_housekeeping));
         let timeout = wake_at.saturating_duration_since(now);
         if let Err(e) =
             waitset.wait_and_process_once_with_timeout(|_| CallbackProgression::Continue, timeout)
@@ -188,7 +192,11 @@ impl Daemon {
             let sent = request
                 .loan_slice_uninit(reply.len())
                 .map_err(|e| format!("{e:?}"))
-                .and_then(|r| r.write_from_slice(&reply).send().map_err(|e| format!("{e:?}")));
+                .and_then(|r| {
+                    r.write_from_slice(&reply)
+                        .send()
+                        .map_err(|e| format!("{e:?}"))
+                });
             if let Err(e) = sent {
                 tracing::warn!(client = format!("{client:032x}"), "reply failed: {e}");
             }
@@ -199,19 +207,27 @@ impl Daemon {
     /// Decodes one request and executes its commands. Never panics on any input.
     pub fn handle_bytes(&mut self, client: u128, bytes: &[u8]) -> Vec<u8> {
         let rejected = |e: String| {
-            codec::encode_response(&Response::Rejected(CommandError::new(ErrorKind::Malformed, e)))
+            codec::encode_response(&Response::Rejected(CommandError::new(
+                ErrorKind::Malformed,
+                e,
+            )))
         };
         match Frame::parse(bytes) {
             Err(e) => return rejected(e.to_string()),
-            Ok(frame) if frame.version != LAYOUT_VERSION => return codec::encode_version_mismatch(),
+            Ok(frame) if frame.version != LAYOUT_VERSION => {
+                return codec::encode_version_mismatch()
+            }
             Ok(_) => {}
         }
         let request = match codec::decode_request(bytes) {
             Ok(r) => r,
             Err(e) => return rejected(e.to_string()),
         };
-        let results: Vec<CommandResult> =
-            request.commands.into_iter().map(|c| self.execute(client, c)).collect();
+        let results: Vec<CommandResult> = request
+            .commands
+            .into_iter()
+            .map(|c| self.execute(client, c))
+            .collect();
         codec::encode_response(&Response::Results(results))
     }
 
@@ -233,7 +249,11 @@ impl Daemon {
                 Ok(Reply::Done)
             }
             Command::CreatePlane { props } => self.create_plane(client, &props, now),
-            Command::PlaneInfo { plane } => Ok(Reply::Plane(self.plane(plane)?.plane.info())),
+            Command::PlaneInfo { plane } => {
+                let entry = self.plane(plane)?;
+                entry.out.connect_readers();
+                Ok(Reply::Plane(entry.plane.info()))
+            }
             Command::SetPlane { plane, prop } => {
                 let entry = self.plane(plane)?;
                 entry.plane.set(prop)?;
@@ -247,7 +267,9 @@ impl Daemon {
                 if entry.plane.step(dt)? {
                     entry.out.publish(&entry.plane).map_err(internal)?;
                 }
-                Ok(Reply::Stepped { tick: entry.plane.tick() })
+                Ok(Reply::Stepped {
+                    tick: entry.plane.tick(),
+                })
             }
             Command::DestroyPlane { plane } => {
                 self.plane(plane)?;
@@ -255,25 +277,47 @@ impl Daemon {
                 tracing::info!(plane, "plane destroyed");
                 Ok(Reply::Done)
             }
-            Command::AddObject { plane, shape, pose, props } => {
+            Command::AddObject {
+                plane,
+                shape,
+                pose,
+                props,
+            } => {
                 let entry = self.plane(plane)?;
                 let handle = entry.plane.add_object(shape, pose, &props)?;
-                Ok(Reply::Object { handle, tick: entry.plane.tick() })
+                Ok(Reply::Object {
+                    handle,
+                    tick: entry.plane.tick(),
+                })
             }
-            Command::SetObject { plane, object, prop } => {
+            Command::SetObject {
+                plane,
+                object,
+                prop,
+            } => {
                 let entry = self.plane(plane)?;
                 entry.plane.set_object(object, prop)?;
-                Ok(Reply::Applied { tick: entry.plane.tick() })
+                Ok(Reply::Applied {
+                    tick: entry.plane.tick(),
+                })
             }
-            Command::ApplyImpulse { plane, object, impulse } => {
+            Command::ApplyImpulse {
+                plane,
+                object,
+                impulse,
+            } => {
                 let entry = self.plane(plane)?;
                 entry.plane.apply_impulse(object, impulse)?;
-                Ok(Reply::Applied { tick: entry.plane.tick() })
+                Ok(Reply::Applied {
+                    tick: entry.plane.tick(),
+                })
             }
             Command::DestroyObject { plane, object } => {
                 let entry = self.plane(plane)?;
                 entry.plane.destroy_object(object)?;
-                Ok(Reply::Applied { tick: entry.plane.tick() })
+                Ok(Reply::Applied {
+                    tick: entry.plane.tick(),
+                })
             }
         }
     }
@@ -301,7 +345,10 @@ impl Daemon {
 
     fn plane(&mut self, id: PlaneId) -> Result<&mut PlaneEntry, CommandError> {
         self.planes.get_mut(&id).ok_or_else(|| {
-            CommandError::new(ErrorKind::UnknownPlane, format!("plane {id} does not exist"))
+            CommandError::new(
+                ErrorKind::UnknownPlane,
+                format!("plane {id} does not exist"),
+            )
         })
     }
 
@@ -317,7 +364,11 @@ impl Daemon {
         let out = PlaneOutput::new(&self.node, id).map_err(internal)?;
         // Publish tick 0 so readers see the plane (and late joiners get history) at once.
         out.publish(&plane).map_err(internal)?;
-        let mut entry = PlaneEntry { plane, out, next_tick: None };
+        let mut entry = PlaneEntry {
+            plane,
+            out,
+            next_tick: None,
+        };
         entry.reschedule(now);
         let info = entry.plane.info();
         self.planes.insert(id, entry);
@@ -328,7 +379,9 @@ impl Daemon {
 
     fn tick_due_planes(&mut self, now: Instant) {
         for entry in self.planes.values_mut() {
-            let Some(due) = entry.next_tick.filter(|t| *t <= now) else { continue };
+            let Some(due) = entry.next_tick.filter(|t| *t <= now) else {
+                continue;
+            };
             let period = Duration::from_secs_f64(1.0 / entry.plane.tick_rate() as f64);
             let result = entry.plane.step(period.as_secs_f32()).and_then(|stepped| {
                 if stepped {
@@ -341,7 +394,11 @@ impl Daemon {
             }
             // Keep the cadence; after a stall, restart from now instead of catching up.
             let next = due + period;
-            entry.next_tick = Some(if next + period * 4 < now { now + period } else { next });
+            entry.next_tick = Some(if next + period * 4 < now {
+                now + period
+            } else {
+                next
+            });
         }
     }
 

@@ -6,7 +6,9 @@ pub fn finite3(field: &str, v: Vec3) -> Result<Vec3, CommandError> {
     if v.iter().all(|c| c.is_finite()) {
         Ok(v)
     } else {
-        Err(CommandError::invalid(format!("{field} must have finite components, got {v:?}")))
+        Err(CommandError::invalid(format!(
+            "{field} must have finite components, got {v:?}"
+        )))
     }
 }
 
@@ -14,7 +16,9 @@ pub fn positive(field: &str, v: f32) -> Result<f32, CommandError> {
     if v.is_finite() && v > 0.0 {
         Ok(v)
     } else {
-        Err(CommandError::invalid(format!("{field} must be a positive finite number, got {v}")))
+        Err(CommandError::invalid(format!(
+            "{field} must be a positive finite number, got {v}"
+        )))
     }
 }
 
@@ -22,7 +26,9 @@ pub fn in_range(field: &str, v: f32, lo: f32, hi: f32) -> Result<f32, CommandErr
     if v.is_finite() && (lo..=hi).contains(&v) {
         Ok(v)
     } else {
-        Err(CommandError::invalid(format!("{field} must be within [{lo}, {hi}], got {v}")))
+        Err(CommandError::invalid(format!(
+            "{field} must be within [{lo}, {hi}], got {v}"
+        )))
     }
 }
 
@@ -36,7 +42,10 @@ pub fn pose(field: &str, p: Pose) -> Result<Pose, CommandError> {
             "{field}.rotation must be a finite non-zero quaternion, got {q:?}"
         )));
     }
-    Ok(Pose { position: p.position, rotation: q.map(|c| c / norm) })
+    Ok(Pose {
+        position: p.position,
+        rotation: q.map(|c| c / norm),
+    })
 }
 
 #[cfg(test)]
@@ -46,16 +55,36 @@ mod tests {
     #[test]
     fn errors_name_field_and_value() {
         let e = finite3("Velocity", [0.0, f32::NAN, 0.0]).unwrap_err();
-        assert!(e.message.contains("Velocity") && e.message.contains("NaN"), "{e}");
+        assert!(
+            e.message.contains("Velocity") && e.message.contains("NaN"),
+            "{e}"
+        );
         let e = positive("Size.x", -1.0).unwrap_err();
-        assert!(e.message.contains("Size.x") && e.message.contains("-1"), "{e}");
+        assert!(
+            e.message.contains("Size.x") && e.message.contains("-1"),
+            "{e}"
+        );
         assert!(in_range("TickRate", 2000.0, 0.0, 1000.0).is_err());
     }
 
     #[test]
     fn pose_normalises_rotation_and_rejects_zero() {
-        let p = pose("CFrame", Pose { position: [1.0; 3], rotation: [0.0, 0.0, 0.0, 2.0] }).unwrap();
+        let p = pose(
+            "CFrame",
+            Pose {
+                position: [1.0; 3],
+                rotation: [0.0, 0.0, 0.0, 2.0],
+            },
+        )
+        .unwrap();
         assert_eq!(p.rotation, [0.0, 0.0, 0.0, 1.0]);
-        assert!(pose("CFrame", Pose { position: [0.0; 3], rotation: [0.0; 4] }).is_err());
+        assert!(pose(
+            "CFrame",
+            Pose {
+                position: [0.0; 3],
+                rotation: [0.0; 4]
+            }
+        )
+        .is_err());
     }
 }

@@ -22,7 +22,11 @@ pub enum DecodeError {
         "layout version mismatch: this side has LAYOUT_VERSION {ours} (crate {CRATE_VERSION}), \
          the peer has LAYOUT_VERSION {theirs} (crate {their_crate})"
     )]
-    VersionMismatch { ours: u32, theirs: u32, their_crate: String },
+    VersionMismatch {
+        ours: u32,
+        theirs: u32,
+        their_crate: String,
+    },
     #[error("malformed body: {0}")]
     Body(String),
 }
@@ -43,7 +47,10 @@ impl<'a> Frame<'a> {
             return Err(DecodeError::BadMagic { found: magic });
         }
         let version = u32::from_le_bytes(bytes[4..8].try_into().expect("4 bytes"));
-        Ok(Frame { version, body: &bytes[HEADER_LEN..] })
+        Ok(Frame {
+            version,
+            body: &bytes[HEADER_LEN..],
+        })
     }
 
     /// Decodes the body, first checking that the peer speaks our layout version.
@@ -52,7 +59,10 @@ impl<'a> Frame<'a> {
             return Err(DecodeError::VersionMismatch {
                 ours: LAYOUT_VERSION,
                 theirs: self.version,
-                their_crate: String::from_utf8_lossy(self.body).chars().take(64).collect(),
+                their_crate: String::from_utf8_lossy(self.body)
+                    .chars()
+                    .take(64)
+                    .collect(),
             });
         }
         postcard::from_bytes(self.body).map_err(|e| DecodeError::Body(e.to_string()))
@@ -110,11 +120,16 @@ mod tests {
             commands: vec![
                 Command::AddObject {
                     plane: 1,
-                    shape: Shape::Cube { size: [1.0, 2.0, 3.0] },
+                    shape: Shape::Cube {
+                        size: [1.0, 2.0, 3.0],
+                    },
                     pose: Pose::at([0.0, 5.0, 0.0]),
                     props: vec![ObjectProp::Anchored(true)],
                 },
-                Command::Step { plane: 1, dt: 1.0 / 60.0 },
+                Command::Step {
+                    plane: 1,
+                    dt: 1.0 / 60.0,
+                },
             ],
         }
     }
@@ -128,7 +143,13 @@ mod tests {
     #[test]
     fn response_round_trips() {
         let r = Response::Results(vec![
-            Ok(Reply::Object { handle: Handle { slot: 3, generation: 7 }, tick: 9 }),
+            Ok(Reply::Object {
+                handle: Handle {
+                    slot: 3,
+                    generation: 7,
+                },
+                tick: 9,
+            }),
             Err(CommandError::new(ErrorKind::StaleHandle, "gone")),
         ]);
         assert_eq!(decode_response(&encode_response(&r)).unwrap(), r);
@@ -136,7 +157,10 @@ mod tests {
 
     #[test]
     fn short_and_foreign_frames_are_errors() {
-        assert_eq!(decode_request(&[1, 2]).unwrap_err(), DecodeError::TooShort { len: 2 });
+        assert_eq!(
+            decode_request(&[1, 2]).unwrap_err(),
+            DecodeError::TooShort { len: 2 }
+        );
         assert!(matches!(
             decode_request(b"NOPE\x01\x00\x00\x00").unwrap_err(),
             DecodeError::BadMagic { .. }
@@ -147,19 +171,30 @@ mod tests {
     fn version_mismatch_names_both_versions() {
         let bytes = encode_request_with_version(&sample_request(), LAYOUT_VERSION + 1);
         let err = decode_request(&bytes).unwrap_err();
-        assert!(matches!(err, DecodeError::VersionMismatch { theirs, .. } if theirs == LAYOUT_VERSION + 1));
+        assert!(
+            matches!(err, DecodeError::VersionMismatch { theirs, .. } if theirs == LAYOUT_VERSION + 1)
+        );
         let mut reply = encode_version_mismatch();
         reply[4..8].copy_from_slice(&(LAYOUT_VERSION + 7).to_le_bytes());
         let msg = decode_response(&reply).unwrap_err().to_string();
-        assert!(msg.contains(&format!("LAYOUT_VERSION {}", LAYOUT_VERSION + 7)), "{msg}");
-        assert!(msg.contains(&format!("LAYOUT_VERSION {LAYOUT_VERSION}")), "{msg}");
+        assert!(
+            msg.contains(&format!("LAYOUT_VERSION {}", LAYOUT_VERSION + 7)),
+            "{msg}"
+        );
+        assert!(
+            msg.contains(&format!("LAYOUT_VERSION {LAYOUT_VERSION}")),
+            "{msg}"
+        );
     }
 
     #[test]
     fn every_truncation_of_a_valid_request_fails_cleanly() {
         let bytes = encode_request(&sample_request());
         for n in 0..bytes.len() {
-            assert!(decode_request(&bytes[..n]).is_err(), "prefix of {n} bytes decoded");
+            assert!(
+                decode_request(&bytes[..n]).is_err(),
+                "prefix of {n} bytes decoded"
+            );
         }
     }
 

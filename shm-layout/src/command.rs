@@ -18,10 +18,16 @@ pub struct Pose {
 }
 
 impl Pose {
-    pub const IDENTITY: Pose = Pose { position: [0.0; 3], rotation: [0.0, 0.0, 0.0, 1.0] };
+    pub const IDENTITY: Pose = Pose {
+        position: [0.0; 3],
+        rotation: [0.0, 0.0, 0.0, 1.0],
+    };
 
     pub fn at(position: Vec3) -> Pose {
-        Pose { position, ..Pose::IDENTITY }
+        Pose {
+            position,
+            ..Pose::IDENTITY
+        }
     }
 }
 
@@ -69,21 +75,52 @@ pub enum ObjectProp {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub enum Command {
     /// Must be the first command of a client: identifies it and checks versions.
-    Hello { crate_version: String, pid: u32 },
+    Hello {
+        crate_version: String,
+        pid: u32,
+    },
     /// Creates a plane with defaults, then applies `props` in order. Owned by the sender.
-    CreatePlane { props: Vec<PlaneProp> },
+    CreatePlane {
+        props: Vec<PlaneProp>,
+    },
     /// Describes a plane (any client may ask; used to attach to planes of other clients).
-    PlaneInfo { plane: PlaneId },
-    SetPlane { plane: PlaneId, prop: PlaneProp },
+    PlaneInfo {
+        plane: PlaneId,
+    },
+    SetPlane {
+        plane: PlaneId,
+        prop: PlaneProp,
+    },
     /// Advances the plane by `dt` seconds; the reply comes after the new tick is published.
-    Step { plane: PlaneId, dt: f32 },
+    Step {
+        plane: PlaneId,
+        dt: f32,
+    },
     /// Removes the plane and all its objects.
-    DestroyPlane { plane: PlaneId },
-    AddObject { plane: PlaneId, shape: Shape, pose: Pose, props: Vec<ObjectProp> },
-    SetObject { plane: PlaneId, object: Handle, prop: ObjectProp },
+    DestroyPlane {
+        plane: PlaneId,
+    },
+    AddObject {
+        plane: PlaneId,
+        shape: Shape,
+        pose: Pose,
+        props: Vec<ObjectProp>,
+    },
+    SetObject {
+        plane: PlaneId,
+        object: Handle,
+        prop: ObjectProp,
+    },
     /// Velocity-space impulse (`Δv = impulse / mass`).
-    ApplyImpulse { plane: PlaneId, object: Handle, impulse: Vec3 },
-    DestroyObject { plane: PlaneId, object: Handle },
+    ApplyImpulse {
+        plane: PlaneId,
+        object: Handle,
+        impulse: Vec3,
+    },
+    DestroyObject {
+        plane: PlaneId,
+        object: Handle,
+    },
     /// Orderly goodbye: the daemon releases the client's planes.
     Goodbye,
 }
@@ -103,14 +140,25 @@ pub struct PlaneInfo {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub enum Reply {
     Done,
-    Welcome { daemon_pid: u32, daemon_node_id: u128, crate_version: String },
+    Welcome {
+        daemon_pid: u32,
+        daemon_node_id: u128,
+        crate_version: String,
+    },
     Plane(PlaneInfo),
     /// A new object, and the plane tick after which published samples include it.
-    Object { handle: Handle, tick: u64 },
+    Object {
+        handle: Handle,
+        tick: u64,
+    },
     /// An object mutation was applied after `tick`: samples newer than `tick` reflect it.
-    Applied { tick: u64 },
+    Applied {
+        tick: u64,
+    },
     /// The tick number now visible in shared memory.
-    Stepped { tick: u64 },
+    Stepped {
+        tick: u64,
+    },
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -138,7 +186,10 @@ pub struct CommandError {
 
 impl CommandError {
     pub fn new(kind: ErrorKind, message: impl Into<String>) -> Self {
-        CommandError { kind, message: message.into() }
+        CommandError {
+            kind,
+            message: message.into(),
+        }
     }
     pub fn invalid(message: impl Into<String>) -> Self {
         Self::new(ErrorKind::InvalidValue, message)

@@ -24,11 +24,19 @@ pub struct DomainError {
 
 /// Checks a domain name: 1 to 32 characters of `[A-Za-z0-9_-]`.
 pub fn validate_domain(domain: &str) -> Result<(), DomainError> {
-    let err = |reason| Err(DomainError { domain: domain.to_string(), reason });
+    let err = |reason| {
+        Err(DomainError {
+            domain: domain.to_string(),
+            reason,
+        })
+    };
     if domain.is_empty() || domain.len() > 32 {
         return err("must be 1 to 32 characters long");
     }
-    if !domain.bytes().all(|b| b.is_ascii_alphanumeric() || b == b'_' || b == b'-') {
+    if !domain
+        .bytes()
+        .all(|b| b.is_ascii_alphanumeric() || b == b'_' || b == b'-')
+    {
         return err("may only contain letters, digits, '_' and '-'");
     }
     Ok(())

@@ -11,7 +11,9 @@ pub const FLAG_ANCHORED: u32 = 1 << 2;
 
 /// A stable reference to one body: the slot indexes the published array, the generation
 /// tells a reused slot from the body that used to live there.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, serde::Serialize, serde::Deserialize)]
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Hash, Default, serde::Serialize, serde::Deserialize,
+)]
 pub struct Handle {
     pub slot: u32,
     pub generation: u32,
@@ -72,7 +74,7 @@ pub struct TickHeader {
     pub slot_count: u32,
     /// Number of live bodies.
     pub body_count: u32,
-    /// Deepest contact penetration after the step (units, >= 0).
+    /// Deepest contact penetration found by the step's collision detection (units, >= 0).
     pub max_penetration: f32,
     /// Largest joint / constraint error after the step (units, 0 without joints).
     pub max_joint_error: f32,
@@ -102,16 +104,25 @@ pub struct EventRecord {
 
 impl EventRecord {
     pub fn a(&self) -> Handle {
-        Handle { slot: self.a_slot, generation: self.a_generation }
+        Handle {
+            slot: self.a_slot,
+            generation: self.a_generation,
+        }
     }
     pub fn b(&self) -> Handle {
-        Handle { slot: self.b_slot, generation: self.b_generation }
+        Handle {
+            slot: self.b_slot,
+            generation: self.b_generation,
+        }
     }
 }
 
 /// Monotonic clock in nanoseconds, the same clock in every process of the machine.
 pub fn monotonic_ns() -> u64 {
-    let mut ts = libc::timespec { tv_sec: 0, tv_nsec: 0 };
+    let mut ts = libc::timespec {
+        tv_sec: 0,
+        tv_nsec: 0,
+    };
     // SAFETY: clock_gettime only writes into the provided timespec.
     unsafe { libc::clock_gettime(libc::CLOCK_MONOTONIC, &mut ts) };
     ts.tv_sec as u64 * 1_000_000_000 + ts.tv_nsec as u64
@@ -130,10 +141,27 @@ mod tests {
 
     #[test]
     fn handle_matching_checks_generation_and_liveness() {
-        let s = BodyState { flags: FLAG_ALIVE, generation: 3, ..Default::default() };
-        assert!(s.matches(Handle { slot: 0, generation: 3 }));
-        assert!(!s.matches(Handle { slot: 0, generation: 2 }));
-        let dead = BodyState { flags: 0, generation: 3, ..Default::default() };
-        assert!(!dead.matches(Handle { slot: 0, generation: 3 }));
+        let s = BodyState {
+            flags: FLAG_ALIVE,
+            generation: 3,
+            ..Default::default()
+        };
+        assert!(s.matches(Handle {
+            slot: 0,
+            generation: 3
+        }));
+        assert!(!s.matches(Handle {
+            slot: 0,
+            generation: 2
+        }));
+        let dead = BodyState {
+            flags: 0,
+            generation: 3,
+            ..Default::default()
+        };
+        assert!(!dead.matches(Handle {
+            slot: 0,
+            generation: 3
+        }));
     }
 }

@@ -1,1 +1,148 @@
+//! Harness of the multi-process suite: each test starts a real `physics-daemon` process in a
+//! domain of its own, so tests run in parallel without seeing each other.
 
+use std::path::PathBuf;
+use std::process::{Child, Command, ExitStatus, Stdio};
+use std::sync::atomic::{AtomicU32, Ordering};
+use std::time::{Duration, Instant};
+
+use client_sdk::{Client, Error};
+use shm_layout::names;
+
+/// A daemon process owned by one test; killed when dropped.
+pub struct TestDaemon {
+    pub domain: String,
+    child: Option<Child>,
+}
+
+/// A domain no other test (or earlier run) uses.
+pub fn unique_domain(tag: &str) -> String {
+    static COUNTER: AtomicU32 = AtomicU32::new(0);
+    let n = COUNTER.fetch_add(1, Ordering::Relaxed);
+    let t = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .unwrap()
+        .subsec_nanos();
+    format!("{tag}-{}-{n}-{}", std::process::id(), t % 100_000)
+}
+
+fn daemon_bin() -> PathBuf {
+    let bin = client_sdk::daemon_executable();
+    assert!(
+        bin.is_file(),
+        "physics-daemon binary not found at {} (build it first: cargo build --workspace)",
+        bin.display()
+    );
+    bin
+}
+
+impl TestDaemon {
+    pub fn start(tag: &str) -> TestDaemon {
+        Self::start_in(&unique_domain(tag))
+    }
+
+    /// Starts a daemon in an existing domain (e.g. after the previous one crashed).
+    pub fn start_in(domain: &str) -> TestDaemon {
+        let domain = domain.to_string();
+        let child = Command::new(daemon_bin())
+            .args(["--domain", &domain])
+            .env("PHYSICS_LOG", "warn")
+            .stdin(Stdio::null())
+            .spawn()
+            .expect("spawn physics-daemon");
+        let daemon = TestDaemon {
+            domain,
+            child: Some(child),
+        };
+        let deadline = Instant::now() + Duration::from_secs(10);
+        loop {
+            match Client::connect(&daemon.domain) {
+                Ok(_) => return daemon,
+                Err(Error::NoDaemon { .. }) if Instant::now() < deadline => {
+                    std::thread::sleep(Duration::from_millis(20))
+                }
+                Err(e) => panic!("daemon of {} did not come up: {e}", daemon.domain),
+            }
+        }
+    }
+
+    pub fn client(&self) -> Client {
+        Client::connect(&self.domain).expect("connect to test daemon")
+    }
+
+    pub fn pid(&self) -> u32 {
+        self.child.as_ref().expect("daemon running").id()
+    }
+
+    fn signal(&self, sig: i32) {
+        // SAFETY: kill(2) on our own child.
+        unsafe { libc::kill(self.pid() as i32, sig) };
+    }
+
+    /// SIGKILL, then reap the process.
+    pub fn kill9(&mut self) {
+        self.signal(libc::SIGKILL);
+        let _ = self.child.take().expect("daemon running").wait();
+    }
+
+    /// Sends `sig` and waits up to `timeout` for the exit. Returns the status and the time.
+    pub fn stop_with(&mut self, sig: i32, timeout: Duration) -> (ExitStatus, Duration) {
+        let started = Instant::now();
+        self.signal(sig);
+        let mut child = self.child.take().expect("daemon running");
+        loop {
+            if let Some(status) = child.try_wait().expect("wait daemon") {
+                return (status, started.elapsed());
+            }
+            if started.elapsed() > timeout {
+                let _ = child.kill();
+                panic!("daemon did not exit within {timeout:?} of signal {sig}");
+            }
+            std::thread::sleep(Duration::from_millis(5));
+        }
+    }
+}
+
+impl Drop for TestDaemon {
+    fn drop(&mut self) {
+        if let Some(mut child) = self.child.take() {
+            let _ = child.kill();
+            let _ = child.wait();
+        }
+    }
+}
+
+/// Every file of `domain` under /dev/shm and the iceoryx2 root (sockets, node records).
+pub fn domain_files(domain: &str) -> Vec<PathBuf> {
+    let prefix = names::prefix(domain);
+    let mut found = Vec::new();
+    let mut dirs = vec![PathBuf::from("/dev/shm"), PathBuf::from("/tmp/iceoryx2")];
+    while let Some(dir) = dirs.pop() {
+        let Ok(entries) = std::fs::read_dir(&dir) else {
+            continue;
+        };
+        for entry in entries.flatten() {
+            let path = entry.path();
+            if path.is_dir() {
+                dirs.push(path);
+            } else if entry.file_name().to_string_lossy().starts_with(&prefix) {
+                found.push(path);
+            }
+        }
+    }
+    found
+}
+
+/// Polls `f` until it returns `Some` or `timeout` passes.
+pub fn eventually<T>(timeout: Duration, mut f: impl FnMut() -> Option<T>) -> Option<T> {
+    let deadline = Instant::now() + timeout;
+    loop {
+        if let Some(v) = f() {
+            return Some(v);
+        }
+        if Instant::now() > deadline {
+            return None;
+        }
+        std::thread::sleep(Duration::from_millis(10));
+    }
+}

@@ -169,7 +169,9 @@ impl Plane {
     pub fn step(&mut self, dt: f32) -> Result<bool, CommandError> {
         let dt = validate::positive("dt", dt)?;
         if dt > MAX_DT {
-            return Err(CommandError::invalid(format!("dt must be at most {MAX_DT} s, got {dt}")));
+            return Err(CommandError::invalid(format!(
+                "dt must be at most {MAX_DT} s, got {dt}"
+            )));
         }
         if !self.enabled {
             return Ok(false);
@@ -199,7 +201,12 @@ impl Plane {
     fn contact_figures(&self) -> (f32, u32) {
         let mut deepest = 0.0f32;
         let mut pairs = 0;
-        for (_, contact) in self.world.narrow_phase.contact_pairs().filter_map(|p| p.find_deepest_contact()) {
+        for (_, contact) in self
+            .world
+            .narrow_phase
+            .contact_pairs()
+            .filter_map(|p| p.find_deepest_contact())
+        {
             deepest = deepest.max(-contact.dist);
             pairs += 1;
         }
@@ -209,10 +216,15 @@ impl Plane {
     fn collect_events(&mut self) {
         self.events.clear();
         while let Ok(event) = self.collision_rx.try_recv() {
-            let kind = if event.started() { EVENT_CONTACT_STARTED } else { EVENT_CONTACT_STOPPED };
-            let (Some(a), Some(b)) =
-                (self.handle_of_collider(event.collider1()), self.handle_of_collider(event.collider2()))
-            else {
+            let kind = if event.started() {
+                EVENT_CONTACT_STARTED
+            } else {
+                EVENT_CONTACT_STOPPED
+            };
+            let (Some(a), Some(b)) = (
+                self.handle_of_collider(event.collider1()),
+                self.handle_of_collider(event.collider2()),
+            ) else {
                 continue; // one side was removed in the same step
             };
             self.events.push(EventRecord {
@@ -258,7 +270,10 @@ impl Plane {
     pub fn body_state(&self, i: usize) -> BodyState {
         let slot = self.slots[i];
         let Some(body) = slot.body.and_then(|h| self.world.bodies.get(h)) else {
-            return BodyState { generation: slot.generation, ..BodyState::default() };
+            return BodyState {
+                generation: slot.generation,
+                ..BodyState::default()
+            };
         };
         let pose = body.position();
         let mut flags = FLAG_ALIVE;

@@ -54,7 +54,9 @@ impl Plane {
                 ))
             }
         };
-        let body = RigidBodyBuilder::dynamic().pose(rapier_pose(pose)).user_data(slot as u128);
+        let body = RigidBodyBuilder::dynamic()
+            .pose(rapier_pose(pose))
+            .user_data(slot as u128);
         let body = self.world.insert_body(body);
         let collider = self.world.insert_collider(collider.build(), Some(body));
         ensure_min_mass(&mut self.world.bodies[body], collider);
@@ -62,7 +64,10 @@ impl Plane {
         entry.generation = entry.generation.wrapping_add(1).max(1);
         entry.body = Some(body);
         self.live += 1;
-        let handle = Handle { slot, generation: entry.generation };
+        let handle = Handle {
+            slot,
+            generation: entry.generation,
+        };
         for prop in props {
             self.set_object(handle, *prop)?;
         }
@@ -85,7 +90,11 @@ impl Plane {
                     "object {handle:?} is stale: slot {} now holds generation {} ({})",
                     handle.slot,
                     slot.generation,
-                    if slot.body.is_some() { "alive" } else { "empty" }
+                    if slot.body.is_some() {
+                        "alive"
+                    } else {
+                        "empty"
+                    }
                 ),
             )),
         }
@@ -103,11 +112,17 @@ impl Plane {
         let h = self.body_of(handle)?;
         let body = &mut self.world.bodies[h];
         match prop {
-            ObjectProp::Pose(p) => body.set_position(rapier_pose(validate::pose("CFrame", p)?), true),
+            ObjectProp::Pose(p) => {
+                body.set_position(rapier_pose(validate::pose("CFrame", p)?), true)
+            }
             ObjectProp::Velocity(v) => body.set_linvel(Vector::from(v), true),
             ObjectProp::AngularVelocity(w) => body.set_angvel(Vector::from(w), true),
             ObjectProp::Anchored(on) => {
-                let kind = if on { RigidBodyType::Fixed } else { RigidBodyType::Dynamic };
+                let kind = if on {
+                    RigidBodyType::Fixed
+                } else {
+                    RigidBodyType::Dynamic
+                };
                 body.set_body_type(kind, true);
                 body.set_linvel(Vector::ZERO, true);
                 body.set_angvel(Vector::ZERO, true);
@@ -117,7 +132,9 @@ impl Plane {
                 let mut changed = false;
                 for c in colliders {
                     let collider = &mut self.world.colliders[c];
-                    let was = collider.active_events().contains(ActiveEvents::COLLISION_EVENTS);
+                    let was = collider
+                        .active_events()
+                        .contains(ActiveEvents::COLLISION_EVENTS);
                     changed |= was != on;
                     collider.set_active_events(if on {
                         ActiveEvents::COLLISION_EVENTS

@@ -1,0 +1,50 @@
+//! A second client process for the multi-process tests.
+//!
+//! test-client hold DOMAIN                  create a plane + ball, print "plane=ID", then sleep
+//! test-client read DOMAIN PLANE SLOT GEN   attach, print "tick=T x y z" of that body
+
+use std::io::Write;
+
+use client_sdk::{Client, Handle, Object, PlaneOptions, Pose, Shape};
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let client = Client::connect(&args[2]).expect("connect");
+    match args[1].as_str() {
+        "hold" => {
+            let plane = client
+                .create_plane(&PlaneOptions::manual())
+                .expect("create plane");
+            plane
+                .add(
+                    Shape::Sphere { radius: 0.5 },
+                    Pose::at([0.0, 5.0, 0.0]),
+                    &[],
+                )
+                .expect("add");
+            println!("plane={}", plane.id());
+            std::io::stdout().flush().unwrap();
+            std::thread::sleep(std::time::Duration::from_secs(3600));
+        }
+        "read" => {
+            let n = |i: usize| args[i].parse::<u32>().expect("number");
+            let plane = client.attach_plane(n(3)).expect("attach");
+            let obj = Object::from_handle(
+                &plane,
+                Handle {
+                    slot: n(4),
+                    generation: n(5),
+                },
+            );
+            let p = obj.position().expect("position");
+            println!(
+                "tick={} {} {} {}",
+                plane.snapshot().unwrap().tick(),
+                p[0],
+                p[1],
+                p[2]
+            );
+        }
+        other => panic!("unknown mode {other}"),
+    }
+}
