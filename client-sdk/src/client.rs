@@ -21,7 +21,7 @@ use crate::plane::{PlaneOptions, PlaneShared};
 use crate::{Error, Plane};
 
 /// How often a waiting client checks that the daemon process is still alive.
-const LIVENESS_PERIOD: Duration = Duration::from_millis(100);
+pub(crate) const LIVENESS_PERIOD: Duration = Duration::from_millis(100);
 
 #[derive(Debug, Clone)]
 pub struct ConnectOptions {

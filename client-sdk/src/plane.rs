@@ -13,6 +13,7 @@ use shm_layout::{
     Pose, Reply, Shape, TickHeader, Vec3,
 };
 
+use crate::client::LIVENESS_PERIOD;
 use crate::overlay::Overlay;
 use crate::{Client, Error, Object};
 
@@ -255,7 +256,9 @@ impl Plane {
     pub fn wait_tick(&self, timeout: Duration) -> Result<u64, Error> {
         self.shared.refresh()?;
         let seen = self.shared.current_tick();
-        let deadline = Instant::now() + timeout;
+        let started = Instant::now();
+        let deadline = started + timeout;
+        let mut last_check = started;
         loop {
             self.shared.refresh()?;
             match self.shared.current_tick() {
@@ -266,14 +269,19 @@ impl Plane {
             if now >= deadline {
                 return Err(Error::Timeout(timeout));
             }
+            // Listing nodes costs a directory scan: check the daemon's liveness only when a
+            // wait brought no tick for a while, never on the hot path of a delivered tick.
+            if now.duration_since(last_check) >= LIVENESS_PERIOD {
+                self.client.check_daemon()?;
+                last_check = now;
+            }
             // A failure to reach the tick event most likely means the daemon is gone.
             self.tick_listener()
                 .map_err(|e| self.client.check_daemon().err().unwrap_or(e))?;
-            let wait = (deadline - now).min(Duration::from_millis(100));
+            let wait = (deadline - now).min(LIVENESS_PERIOD);
             if let Some(l) = self.shared.ticks.borrow().as_ref() {
                 let _ = l.timed_wait(|_| {}, wait);
             }
-            self.client.check_daemon()?;
         }
     }
 

@@ -1,1 +1,1 @@
-pub fn _x() {}
+//! The documented Luau `PhysicsService` API on top of client-sdk (in progress).

@@ -12,7 +12,7 @@ pub mod publish;
 pub mod server;
 mod validate;
 
-pub use server::{run, Daemon};
+pub use server::{cleanup_domain, run, wake, Daemon};
 
 #[derive(Debug, thiserror::Error)]
 pub enum DaemonError {

@@ -30,7 +30,15 @@ fn main() -> ExitCode {
 
     let shutdown = Arc::new(AtomicBool::new(false));
     let flag = shutdown.clone();
-    if let Err(e) = ctrlc::set_handler(move || flag.store(true, Ordering::Relaxed)) {
+    let domain = args.domain.clone();
+    let on_signal = move || {
+        flag.store(true, Ordering::Relaxed);
+        // The loop sleeps until an event: give it one.
+        if let Err(e) = physics_daemon::wake(&domain) {
+            tracing::debug!("cannot wake the loop for shutdown (it may have stopped already): {e}");
+        }
+    };
+    if let Err(e) = ctrlc::set_handler(on_signal) {
         tracing::error!("cannot install the SIGINT/SIGTERM handler: {e}");
         return ExitCode::FAILURE;
     }

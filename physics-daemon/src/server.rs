@@ -19,8 +19,9 @@ use crate::plane::Plane;
 use crate::publish::{PlaneOutput, MAX_NODES};
 use crate::DaemonError;
 
-/// How often dead clients are looked for (and the shutdown flag at the latest).
-const HOUSEKEEPING: Duration = Duration::from_millis(200);
+/// How often dead clients are looked for while clients are connected. Without clients the
+/// daemon has nothing to look for and sleeps until a request (or a shutdown wake-up).
+const HOUSEKEEPING: Duration = Duration::from_millis(250);
 /// Planes one daemon hosts at once.
 pub const MAX_PLANES: usize = 1024;
 
@@ -53,6 +54,29 @@ pub struct Daemon {
     next_plane_id: PlaneId,
 }
 
+/// Wakes the loop of the daemon of `domain` (e.g. from a signal handler thread after setting
+/// the shutdown flag). Uses a node of its own: iceoryx2 ports stay on their thread.
+pub fn wake(domain: &str) -> Result<(), DaemonError> {
+    let config = names::config(domain)?;
+    let node = NodeBuilder::new()
+        .config(&config)
+        .signal_handling_mode(SignalHandlingMode::Disabled)
+        .create::<ipc::Service>()
+        .map_err(|e| DaemonError::Ipc(format!("cannot create node: {e:?}")))?;
+    let notifier = node
+        .service_builder(&names::control_wake())
+        .event()
+        .open()
+        .map_err(|e| DaemonError::Ipc(format!("cannot open the request event: {e:?}")))?
+        .notifier_builder()
+        .create()
+        .map_err(|e| DaemonError::Ipc(format!("cannot create a notifier: {e:?}")))?;
+    notifier
+        .notify()
+        .map_err(|e| DaemonError::Ipc(format!("cannot notify: {e:?}")))?;
+    Ok(())
+}
+
 /// Runs the daemon of `domain` until `shutdown` becomes true; then releases every resource.
 pub fn run(domain: &str, shutdown: &AtomicBool) -> Result<(), DaemonError> {
     let config = names::config(domain)?;
@@ -62,17 +86,36 @@ pub fn run(domain: &str, shutdown: &AtomicBool) -> Result<(), DaemonError> {
     Ok(())
 }
 
+/// Removes what dead processes of `domain` left behind, and the domain's last segment when
+/// no process of it is left (for tools and tests that kill daemons).
+pub fn cleanup_domain(domain: &str) -> Result<(), DaemonError> {
+    let config = names::config(domain)?;
+    remove_dead_nodes(&config);
+    release_domain(&config);
+    Ok(())
+}
+
 /// The domain keeps one persistent segment (iceoryx2's node counter); the last process of the
 /// domain removes it so a stopped deployment leaves nothing in /dev/shm.
 fn release_domain(config: &Config) {
-    let mut others = 0;
-    let _ = Node::<ipc::Service>::list(config, |_| {
-        others += 1;
-        CallbackProgression::Continue
-    });
-    if others == 0 {
-        // SAFETY: no node of this domain exists any more, so nobody uses the segment.
-        let _ = unsafe { iceoryx2::testing::remove_global_mgmt_segment::<ipc::Service>(config) };
+    // A node may be on its way out (the signal handler's waker): give it a moment.
+    let deadline = Instant::now() + Duration::from_millis(300);
+    loop {
+        let mut nodes = 0;
+        let _ = Node::<ipc::Service>::list(config, |_| {
+            nodes += 1;
+            CallbackProgression::Continue
+        });
+        if nodes == 0 {
+            // SAFETY: no node of this domain exists any more, so nobody uses the segment.
+            let _ =
+                unsafe { iceoryx2::testing::remove_global_mgmt_segment::<ipc::Service>(config) };
+            return;
+        }
+        if Instant::now() > deadline {
+            return;
+        }
+        std::thread::sleep(Duration::from_millis(5));
     }
 }
 
@@ -148,7 +191,9 @@ fn serve(domain: &str, config: &Config, shutdown: &AtomicBool) -> Result<(), Dae
         }
         daemon.serve_requests();
         daemon.tick_due_planes(Instant::now());
-        if Instant::now() >= next_housekeeping {
+        if daemon.clients.is_empty() {
+            next_housekeeping = Instant::now() + HOUSEKEEPING;
+        } else if Instant::now() >= next_housekeeping {
             daemon.release_gone_clients();
             next_housekeeping = Instant::now() + HOUSEKEEPING;
         }

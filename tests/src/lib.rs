@@ -104,11 +104,20 @@ impl TestDaemon {
 }
 
 impl Drop for TestDaemon {
+    /// Stops the daemon cleanly (SIGINT, SIGKILL after 2 s), then removes whatever killed
+    /// processes of the test left in the domain.
     fn drop(&mut self) {
         if let Some(mut child) = self.child.take() {
+            // SAFETY: kill(2) on our own child.
+            unsafe { libc::kill(child.id() as i32, libc::SIGINT) };
+            let deadline = Instant::now() + Duration::from_secs(2);
+            while Instant::now() < deadline && matches!(child.try_wait(), Ok(None)) {
+                std::thread::sleep(Duration::from_millis(5));
+            }
             let _ = child.kill();
             let _ = child.wait();
         }
+        let _ = physics_daemon::cleanup_domain(&self.domain);
     }
 }
 

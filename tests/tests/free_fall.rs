@@ -114,7 +114,7 @@ fn automatic_ticks_follow_the_tick_rate() {
     }
     let rate = (last - first) as f64 / started.elapsed().as_secs_f64();
     // Wall-clock ticking on a shared machine: generous band around 100 Hz.
-    assert!((50.0..=130.0).contains(&rate), "ticks per second {rate}");
+    assert!((30.0..=130.0).contains(&rate), "ticks per second {rate}");
     let h = *plane.snapshot().unwrap().header();
     assert!(
         (h.sim_time - h.tick as f64 / 100.0).abs() < 1e-6,
