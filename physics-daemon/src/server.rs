@@ -21,7 +21,7 @@ use crate::DaemonError;
 
 /// How often dead clients are looked for while clients are connected. Without clients the
 /// daemon has nothing to look for and sleeps until a request (or a shutdown wake-up).
-const HOUSEKEEPING: Duration = Duration::from_millis(250);
+const HOUSEKEEPING: Duration = Duration::from_millis(500);
 /// Planes one daemon hosts at once.
 pub const MAX_PLANES: usize = 1024;
 
