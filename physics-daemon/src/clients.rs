@@ -27,10 +27,6 @@ impl Clients {
         self.connected.contains_key(&id)
     }
 
-    pub fn len(&self) -> usize {
-        self.connected.len()
-    }
-
     pub fn is_empty(&self) -> bool {
         self.connected.is_empty()
     }

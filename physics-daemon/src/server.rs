@@ -464,10 +464,6 @@ impl Daemon {
             self.release_client(client);
         }
     }
-
-    pub fn plane_count(&self) -> usize {
-        self.planes.len()
-    }
 }
 
 fn internal(e: DaemonError) -> CommandError {
