@@ -22,6 +22,8 @@ use crate::{Error, Plane};
 
 /// How often a waiting client checks that the daemon process is still alive.
 pub(crate) const LIVENESS_PERIOD: Duration = Duration::from_millis(100);
+/// How long `connect` waits for a starting daemon to open its request server.
+const SERVER_WAIT: Duration = Duration::from_secs(2);
 
 #[derive(Debug, Clone)]
 pub struct ConnectOptions {
@@ -109,12 +111,22 @@ impl Client {
             .create::<ipc::Service>()
             .map_err(|e| Error::ipc("cannot create node", e))?;
         let id = node.id().value();
-        let port = node
+        let control = node
             .service_builder(&names::control())
             .request_response::<[u8], [u8]>()
             .request_user_header::<u128>()
             .open()
-            .map_err(|e| no_daemon(format!("{e:?}")))?
+            .map_err(|e| no_daemon(format!("{e:?}")))?;
+        // A daemon that is starting has its node before its server port; a request sent in
+        // between would reach no one. Wait (bounded) until the server is there.
+        let deadline = Instant::now() + SERVER_WAIT;
+        while control.dynamic_config().number_of_servers() == 0 {
+            if Instant::now() >= deadline {
+                return Err(no_daemon("the control service has no server".into()));
+            }
+            std::thread::sleep(Duration::from_millis(2));
+        }
+        let port = control
             .client_builder()
             .initial_max_slice_len(4096)
             .allocation_strategy(AllocationStrategy::PowerOfTwo)
