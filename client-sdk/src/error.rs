@@ -26,6 +26,19 @@ pub enum Error {
 }
 
 impl Error {
+    /// A value the shared checks refused before it was sent. Their messages start with the
+    /// field's name.
+    pub(crate) fn invalid_value(e: CommandError) -> Error {
+        let (field, message) = e
+            .message
+            .split_once(' ')
+            .unwrap_or((e.message.as_str(), ""));
+        Error::Invalid {
+            field: field.into(),
+            message: message.into(),
+        }
+    }
+
     pub(crate) fn ipc(what: &str, e: impl core::fmt::Debug) -> Error {
         Error::Ipc(format!("{what}: {e:?}"))
     }

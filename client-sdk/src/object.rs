@@ -1,7 +1,10 @@
 //! Objects: reads index into the newest sample, writes join the client's batch.
 
-use shm_layout::{BodyState, Command, Handle, ObjectProp, Pose, Vec3};
+use shm_layout::{
+    BodyState, Command, Handle, ObjectInfo, ObjectProp, Pin, Pose, Reply, Restraint, RotateTo, Vec3,
+};
 
+use crate::overlay::Entry;
 use crate::{Error, Plane};
 
 /// One body of a plane. Cheap to clone.
@@ -9,17 +12,6 @@ use crate::{Error, Plane};
 pub struct Object {
     plane: Plane,
     handle: Handle,
-}
-
-fn check3(field: &str, v: Vec3) -> Result<Vec3, Error> {
-    if v.iter().all(|c| c.is_finite()) {
-        Ok(v)
-    } else {
-        Err(Error::Invalid {
-            field: field.into(),
-            message: format!("must be finite, got {v:?}"),
-        })
-    }
 }
 
 impl Object {
@@ -82,78 +74,150 @@ impl Object {
         Ok(self.state()?.is_anchored())
     }
 
-    fn write(&self, prop: ObjectProp, f: impl FnOnce(&mut crate::overlay::Entry)) {
-        self.plane.shared.overlay.borrow_mut().write(self.handle, f);
+    /// Sets any property: checked now (errors name the property and the value), sent with
+    /// the next flush. Pose, velocities and Anchored read back at once.
+    pub fn set(&self, prop: ObjectProp) -> Result<(), Error> {
+        let prop = prop.checked().map_err(Error::invalid_value)?;
         let plane = self.plane.id();
+        let published = Entry::is_published(&prop);
+        if published {
+            self.plane
+                .shared
+                .overlay
+                .borrow_mut()
+                .write(self.handle, |e| e.record(&prop));
+        }
         self.plane.client().queue(
             Command::SetObject {
                 plane,
                 object: self.handle,
                 prop,
             },
-            Some((plane, self.handle)),
+            published.then_some((plane, self.handle)),
         );
+        Ok(())
     }
 
-    /// Teleports the object (sent with the next flush; reads see it at once).
+    /// Teleports the object.
     pub fn set_pose(&self, pose: Pose) -> Result<(), Error> {
-        check3("CFrame.position", pose.position)?;
-        let n = pose.rotation.iter().map(|c| c * c).sum::<f32>().sqrt();
-        if !n.is_finite() || n < 1e-6 {
-            return Err(Error::Invalid {
-                field: "CFrame.rotation".into(),
-                message: format!(
-                    "must be a finite non-zero quaternion, got {:?}",
-                    pose.rotation
-                ),
-            });
-        }
-        let pose = Pose {
-            rotation: pose.rotation.map(|c| c / n),
-            ..pose
-        };
-        self.write(ObjectProp::Pose(pose), |e| e.pose = Some(pose));
-        Ok(())
+        self.set(ObjectProp::Pose(pose))
     }
 
     pub fn set_velocity(&self, v: Vec3) -> Result<(), Error> {
-        let v = check3("Velocity", v)?;
-        self.write(ObjectProp::Velocity(v), |e| e.velocity = Some(v));
-        Ok(())
+        self.set(ObjectProp::Velocity(v))
     }
 
     pub fn set_angular_velocity(&self, w: Vec3) -> Result<(), Error> {
-        let w = check3("AngularVelocity", w)?;
-        self.write(ObjectProp::AngularVelocity(w), |e| {
-            e.angular_velocity = Some(w)
-        });
-        Ok(())
+        self.set(ObjectProp::AngularVelocity(w))
     }
 
+    /// Anchored objects do not move; setting it zeroes both velocities.
     pub fn set_anchored(&self, anchored: bool) {
-        self.write(ObjectProp::Anchored(anchored), |e| {
-            e.anchored = Some(anchored);
-            e.velocity = Some([0.0; 3]);
-            e.angular_velocity = Some([0.0; 3]);
-        });
+        let _ = self.set(ObjectProp::Anchored(anchored));
     }
 
     /// Ask the daemon to publish contact started / stopped events for this object.
     pub fn set_report_contacts(&self, on: bool) {
-        let plane = self.plane.id();
-        self.plane.client().queue(
-            Command::SetObject {
-                plane,
-                object: self.handle,
-                prop: ObjectProp::ReportContacts(on),
-            },
-            None,
-        );
+        let _ = self.set(ObjectProp::ReportContacts(on));
+    }
+
+    /// Mass for impulses when Density is 0 (free fall does not depend on it).
+    pub fn set_weight(&self, weight: f32) -> Result<(), Error> {
+        self.set(ObjectProp::Weight(weight))
+    }
+
+    /// Mass = density × volume when > 0 (wins over Weight); 0 returns to Weight.
+    pub fn set_density(&self, density: f32) -> Result<(), Error> {
+        self.set(ObjectProp::Density(density))
+    }
+
+    pub fn set_bounciness(&self, e: f32) -> Result<(), Error> {
+        self.set(ObjectProp::Bounciness(e))
+    }
+
+    pub fn set_friction(&self, mu: f32) -> Result<(), Error> {
+        self.set(ObjectProp::Friction(mu))
+    }
+
+    pub fn set_can_collide(&self, on: bool) -> Result<(), Error> {
+        self.set(ObjectProp::CanCollide(on))
+    }
+
+    pub fn set_hit_box_quality(&self, quality: u32) -> Result<(), Error> {
+        self.set(ObjectProp::HitBoxQuality(quality))
+    }
+
+    pub fn set_size(&self, size: Vec3) -> Result<(), Error> {
+        self.set(ObjectProp::Size(size))
+    }
+
+    pub fn set_center_of_mass(&self, com: Vec3) -> Result<(), Error> {
+        self.set(ObjectProp::CenterOfMass(com))
+    }
+
+    /// Persistent per-tick acceleration.
+    pub fn set_impulse_direction(&self, a: Vec3) -> Result<(), Error> {
+        self.set(ObjectProp::ImpulseDirection(a))
+    }
+
+    /// Persistent world-space force.
+    pub fn set_constant_force(&self, f: Vec3) -> Result<(), Error> {
+        self.set(ObjectProp::ConstantForce(f))
+    }
+
+    /// Locks or frees axes; flags left `None` keep their value.
+    pub fn field_restraint(&self, restraint: Restraint) -> Result<(), Error> {
+        self.set(ObjectProp::FieldRestraint(restraint))
+    }
+
+    /// Drives the angular velocity toward the orientation `target` (quaternion).
+    pub fn rotate_to(&self, target: [f32; 4], strength: f32) -> Result<(), Error> {
+        self.set(ObjectProp::RotateTo(Some(RotateTo { target, strength })))
+    }
+
+    pub fn stop_rotate_to(&self) -> Result<(), Error> {
+        self.set(ObjectProp::RotateTo(None))
+    }
+
+    /// Pins a body-local point to `target` with a force capped at `force`; `None` releases.
+    pub fn set_pin(&self, pin: Option<Pin>) -> Result<(), Error> {
+        self.set(ObjectProp::Pin(pin))
+    }
+
+    /// Every property as the daemon holds it (sends the queue first).
+    pub fn info(&self) -> Result<ObjectInfo, Error> {
+        match self.plane.client().call(Command::ObjectInfo {
+            plane: self.plane.id(),
+            object: self.handle,
+        })? {
+            Reply::ObjectInfo(info) => Ok(*info),
+            other => Err(Error::Protocol(format!("unexpected reply {other:?}"))),
+        }
+    }
+
+    /// CenterOfMass := vertex centroid of the object's mesh (no-op for cubes and spheres).
+    /// Returns the centre of mass in effect.
+    pub fn recalculate_center_of_mass(&self) -> Result<Vec3, Error> {
+        match self.plane.client().call(Command::RecalculateCenterOfMass {
+            plane: self.plane.id(),
+            object: self.handle,
+        })? {
+            Reply::CenterOfMass(c) => Ok(c),
+            other => Err(Error::Protocol(format!("unexpected reply {other:?}"))),
+        }
+    }
+
+    /// Takes the object out of the simulation and returns the pose it stays at.
+    pub fn unlink(&self) -> Result<Pose, Error> {
+        let pose = self.pose()?;
+        self.destroy();
+        Ok(pose)
     }
 
     /// Velocity-space impulse (`Δv = impulse / mass`), sent with the next flush.
     pub fn apply_impulse(&self, impulse: Vec3) -> Result<(), Error> {
-        let impulse = check3("impulse", impulse)?;
+        let impulse =
+            shm_layout::validate::finite3("impulse", impulse).map_err(Error::invalid_value)?;
         let plane = self.plane.id();
         self.plane.client().queue(
             Command::ApplyImpulse {

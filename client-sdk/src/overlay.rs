@@ -4,7 +4,7 @@
 
 use std::collections::HashMap;
 
-use shm_layout::{BodyState, Handle, Pose, Vec3, FLAG_ALIVE, FLAG_ANCHORED};
+use shm_layout::{BodyState, Handle, ObjectProp, Pose, Vec3, FLAG_ALIVE, FLAG_ANCHORED};
 
 #[derive(Debug, Default, Clone)]
 pub struct Entry {
@@ -19,6 +19,33 @@ pub struct Entry {
 }
 
 impl Entry {
+    /// Records what `prop` changes in the published state (other properties are not
+    /// published per tick, so there is nothing to overlay).
+    pub fn record(&mut self, prop: &ObjectProp) {
+        match *prop {
+            ObjectProp::Pose(p) => self.pose = Some(p),
+            ObjectProp::Velocity(v) => self.velocity = Some(v),
+            ObjectProp::AngularVelocity(w) => self.angular_velocity = Some(w),
+            ObjectProp::Anchored(a) => {
+                self.anchored = Some(a);
+                self.velocity = Some([0.0; 3]);
+                self.angular_velocity = Some([0.0; 3]);
+            }
+            _ => {}
+        }
+    }
+
+    /// Whether `prop` changes what a sample shows.
+    pub fn is_published(prop: &ObjectProp) -> bool {
+        matches!(
+            prop,
+            ObjectProp::Pose(_)
+                | ObjectProp::Velocity(_)
+                | ObjectProp::AngularVelocity(_)
+                | ObjectProp::Anchored(_)
+        )
+    }
+
     /// `base` with this entry's writes on top.
     pub fn apply(&self, handle: Handle, base: Option<BodyState>) -> Option<BodyState> {
         if self.destroyed {

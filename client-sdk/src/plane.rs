@@ -1,6 +1,6 @@
 //! Planes: options, zero-copy snapshots of the newest tick, stepping and waiting for ticks.
 
-use std::cell::RefCell;
+use std::cell::{Cell, RefCell};
 use std::rc::Rc;
 use std::time::{Duration, Instant};
 
@@ -27,6 +27,15 @@ pub struct PlaneOptions {
     /// Ticks per second of wall time; 0 = manual (only [`Plane::step`] advances it).
     pub tick_rate: Option<f32>,
     pub enabled: Option<bool>,
+    pub linear_damping: Option<f32>,
+    pub angular_damping: Option<f32>,
+    pub drag: Option<f32>,
+    pub buoyancy: Option<f32>,
+    pub constant_force: Option<Vec3>,
+    pub rest_threshold: Option<f32>,
+    pub solver_iterations: Option<u32>,
+    pub loop_solver: Option<bool>,
+    pub never_sleep: Option<bool>,
 }
 
 impl PlaneOptions {
@@ -39,20 +48,25 @@ impl PlaneOptions {
     }
 
     pub(crate) fn props(&self) -> Vec<PlaneProp> {
-        let mut props = Vec::new();
-        if let Some(g) = self.gravity {
-            props.push(PlaneProp::Gravity(g));
-        }
-        if let Some(n) = self.threads {
-            props.push(PlaneProp::Threads(n));
-        }
-        if let Some(hz) = self.tick_rate {
-            props.push(PlaneProp::TickRate(hz));
-        }
-        if let Some(on) = self.enabled {
-            props.push(PlaneProp::Enabled(on));
-        }
-        props
+        let o = self;
+        [
+            o.gravity.map(PlaneProp::Gravity),
+            o.threads.map(PlaneProp::Threads),
+            o.tick_rate.map(PlaneProp::TickRate),
+            o.enabled.map(PlaneProp::Enabled),
+            o.linear_damping.map(PlaneProp::LinearDamping),
+            o.angular_damping.map(PlaneProp::AngularDamping),
+            o.drag.map(PlaneProp::Drag),
+            o.buoyancy.map(PlaneProp::Buoyancy),
+            o.constant_force.map(PlaneProp::ConstantForce),
+            o.rest_threshold.map(PlaneProp::RestThreshold),
+            o.solver_iterations.map(PlaneProp::SolverIterations),
+            o.loop_solver.map(PlaneProp::LoopSolver),
+            o.never_sleep.map(PlaneProp::NeverSleep),
+        ]
+        .into_iter()
+        .flatten()
+        .collect()
     }
 }
 
@@ -65,6 +79,7 @@ pub(crate) struct PlaneShared {
     /// Created on the first wait: readers that never wait pay nothing for it.
     ticks: RefCell<Option<Listener<ipc::Service>>>,
     events: RefCell<Option<Subscriber<ipc::Service, [EventRecord], TickHeader>>>,
+    alive: Cell<bool>,
 }
 
 impl PlaneShared {
@@ -86,6 +101,7 @@ impl PlaneShared {
             overlay: RefCell::default(),
             ticks: RefCell::new(None),
             events: RefCell::new(None),
+            alive: Cell::new(true),
         })
     }
 
@@ -194,8 +210,9 @@ impl Plane {
         }
     }
 
-    /// Changes a plane option (sent with the next flush).
-    pub fn set(&self, prop: PlaneProp) {
+    /// Changes a plane option (checked now, sent with the next flush).
+    pub fn set(&self, prop: PlaneProp) -> Result<(), Error> {
+        let prop = prop.checked().map_err(Error::invalid_value)?;
         self.client.queue(
             Command::SetPlane {
                 plane: self.id(),
@@ -203,15 +220,42 @@ impl Plane {
             },
             None,
         );
+        Ok(())
+    }
+
+    /// False once this process destroyed the plane or the daemon no longer knows it.
+    pub fn is_alive(&self) -> bool {
+        if !self.shared.alive.get() {
+            return false;
+        }
+        match self.info() {
+            Err(Error::Command(e)) if e.kind == shm_layout::ErrorKind::UnknownPlane => {
+                self.shared.alive.set(false);
+                false
+            }
+            _ => true,
+        }
+    }
+
+    /// Live objects of the plane (asks the daemon, so it counts unpublished adds too).
+    pub fn object_count(&self) -> Result<u32, Error> {
+        Ok(self.info()?.object_count)
     }
 
     /// Adds an object; sends the queue and waits for the new handle.
     pub fn add(&self, shape: Shape, pose: Pose, props: &[ObjectProp]) -> Result<Object, Error> {
+        shape.check().map_err(Error::invalid_value)?;
+        let pose = shm_layout::validate::pose("CFrame", pose).map_err(Error::invalid_value)?;
+        let props = props
+            .iter()
+            .map(|p| p.checked())
+            .collect::<Result<Vec<_>, _>>()
+            .map_err(Error::invalid_value)?;
         let reply = self.client.call(Command::AddObject {
             plane: self.id(),
             shape,
             pose,
-            props: props.to_vec(),
+            props: props.clone(),
         })?;
         let Reply::Object { handle, tick } = reply else {
             return Err(Error::Protocol(format!("unexpected reply {reply:?}")));
@@ -222,14 +266,8 @@ impl Plane {
             e.pose = Some(pose);
             e.velocity = Some([0.0; 3]);
             e.angular_velocity = Some([0.0; 3]);
-            for p in props {
-                match *p {
-                    ObjectProp::Pose(p) => e.pose = Some(p),
-                    ObjectProp::Velocity(v) => e.velocity = Some(v),
-                    ObjectProp::AngularVelocity(w) => e.angular_velocity = Some(w),
-                    ObjectProp::Anchored(a) => e.anchored = Some(a),
-                    ObjectProp::ReportContacts(_) => {}
-                }
+            for p in &props {
+                e.record(p);
             }
         });
         overlay.confirm(handle, tick);
@@ -331,10 +369,11 @@ impl Plane {
         Ok(out)
     }
 
-    /// Destroys the plane and everything in it.
+    /// Destroys the plane and everything in it. Objects keep reading their last pose.
     pub fn destroy(&self) -> Result<(), Error> {
         self.client
             .call(Command::DestroyPlane { plane: self.id() })?;
+        self.shared.alive.set(false);
         self.client.forget_plane(self.id());
         Ok(())
     }

@@ -10,7 +10,6 @@ pub mod clients;
 pub mod plane;
 pub mod publish;
 pub mod server;
-mod validate;
 
 pub use server::{cleanup_domain, run, wake, Daemon};
 

@@ -329,7 +329,7 @@ impl Daemon {
                 props,
             } => {
                 let entry = self.plane(plane)?;
-                let handle = entry.plane.add_object(shape, pose, &props)?;
+                let handle = entry.plane.add_object(&shape, pose, &props)?;
                 Ok(Reply::Object {
                     handle,
                     tick: entry.plane.tick(),
@@ -356,6 +356,17 @@ impl Daemon {
                 Ok(Reply::Applied {
                     tick: entry.plane.tick(),
                 })
+            }
+            Command::ObjectInfo { plane, object } => {
+                let info = self.plane(plane)?.plane.object_info(object)?;
+                Ok(Reply::ObjectInfo(Box::new(info)))
+            }
+            Command::RecalculateCenterOfMass { plane, object } => {
+                let com = self
+                    .plane(plane)?
+                    .plane
+                    .recalculate_center_of_mass(object)?;
+                Ok(Reply::CenterOfMass(com))
             }
             Command::DestroyObject { plane, object } => {
                 let entry = self.plane(plane)?;

@@ -11,6 +11,7 @@ pub mod codec;
 pub mod command;
 pub mod names;
 pub mod records;
+pub mod validate;
 
 pub use codec::{DecodeError, Frame};
 pub use command::*;
@@ -18,7 +19,7 @@ pub use records::*;
 
 /// Bumped whenever a record layout or the command encoding changes. Client and daemon must
 /// agree on it; the handshake reports both values when they differ.
-pub const LAYOUT_VERSION: u32 = 1;
+pub const LAYOUT_VERSION: u32 = 2;
 
 /// The crate version both sides were built from; also checked by the handshake.
 pub const CRATE_VERSION: &str = env!("CARGO_PKG_VERSION");

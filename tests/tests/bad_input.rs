@@ -72,7 +72,10 @@ fn nan_and_negative_sizes_are_rejected_by_name() {
         "{:?}",
         r[3]
     );
-    plane.set(shm_layout::PlaneProp::Gravity([0.0; 3]));
+    plane.set(shm_layout::PlaneProp::Gravity([0.0; 3])).unwrap();
+    plane
+        .set(shm_layout::PlaneProp::LinearDamping(0.0))
+        .unwrap();
     for _ in 0..50 {
         plane.step(0.01).unwrap();
     }
@@ -92,7 +95,7 @@ fn nan_and_negative_sizes_are_rejected_by_name() {
         )
         .unwrap_err();
     let msg = err.to_string();
-    assert!(msg.contains("Size.y") && msg.contains("-2"), "{msg}");
+    assert!(msg.contains("Size.Y") && msg.contains("-2"), "{msg}");
     let err = plane.add(
         Shape::Sphere { radius: 1.0 },
         Pose {

@@ -1,31 +1,32 @@
 //! One 3D plane: a rapier world, the slot table that gives bodies stable handles, and the
 //! plane options. No I/O here: the server feeds it commands and publishes what it reports.
 
+mod contacts;
+mod forces;
 mod objects;
+mod part;
+mod properties;
+mod solver;
 
 use std::sync::mpsc;
 use std::sync::Arc;
 use std::time::Instant;
 
 use rapier3d::prelude::*;
+use shm_layout::validate::{self, MAX_DT, MAX_HIT_BOX_QUALITY};
 use shm_layout::{
-    BodyState, CommandError, EventRecord, PlaneId, PlaneInfo, PlaneProp, TickHeader,
-    EVENT_CONTACT_STARTED, EVENT_CONTACT_STOPPED, FLAG_ALIVE, FLAG_ANCHORED, FLAG_SLEEPING,
-    LAYOUT_VERSION,
+    BodyState, CommandError, EventRecord, PlaneId, PlaneInfo, PlaneProp, TickHeader, Vec3,
+    FLAG_ALIVE, FLAG_ANCHORED, FLAG_SLEEPING, LAYOUT_VERSION,
 };
 
-use crate::validate;
-
-pub const MAX_THREADS: u32 = 64;
-pub const MAX_TICK_RATE: f32 = 10_000.0;
-/// Largest accepted step: longer steps are almost certainly a unit mistake.
-pub const MAX_DT: f32 = 1.0;
+use part::Part;
 
 /// One entry of the slot table. The generation grows every time the slot is reused.
-#[derive(Debug, Clone, Copy, Default)]
+#[derive(Debug, Clone, Default)]
 struct Slot {
     generation: u32,
     body: Option<RigidBodyHandle>,
+    part: Option<Part>,
 }
 
 pub struct Plane {
@@ -39,6 +40,23 @@ pub struct Plane {
     threads: u32,
     tick_rate: f32,
     enabled: bool,
+    linear_damping: f32,
+    angular_damping: f32,
+    drag: f32,
+    buoyancy: f32,
+    constant_force: Vec3,
+    rest_threshold: f32,
+    solver_iterations: u32,
+    loop_solver: bool,
+    never_sleep: bool,
+    /// Objects per HitBoxQuality value: the plane-wide solver scales with the maximum.
+    quality_counts: [u32; MAX_HIT_BOX_QUALITY as usize + 1],
+    /// Objects with a drive of their own (ImpulseDirection, ConstantForce, RotateTo, SetPin).
+    driven: u32,
+    /// Bodies changed by commands since the last step: the force pass sees them even
+    /// before rapier's island manager lists them as awake.
+    touched: Vec<RigidBodyHandle>,
+    scratch: Vec<RigidBodyHandle>,
     tick: u64,
     sim_time: f64,
     last_step_us: f32,
@@ -72,6 +90,19 @@ impl Plane {
             threads: 1,
             tick_rate: 60.0,
             enabled: true,
+            linear_damping: 0.10,
+            angular_damping: 0.30,
+            drag: 0.0,
+            buoyancy: 0.0,
+            constant_force: [0.0; 3],
+            rest_threshold: 0.5,
+            solver_iterations: 4,
+            loop_solver: false,
+            never_sleep: false,
+            quality_counts: [0; MAX_HIT_BOX_QUALITY as usize + 1],
+            driven: 0,
+            touched: Vec::new(),
+            scratch: Vec::new(),
             tick: 0,
             sim_time: 0.0,
             last_step_us: 0.0,
@@ -97,31 +128,52 @@ impl Plane {
     }
 
     fn apply_prop(&mut self, prop: PlaneProp, creating: bool) -> Result<(), CommandError> {
+        let prop = prop.checked()?;
         match prop {
-            PlaneProp::Gravity(g) => {
-                self.world.gravity = Vector::from(validate::finite3("Gravity", g)?);
-                // Sleeping bodies would ignore the new gravity until touched.
-                self.world.wake_up_all(true);
-            }
+            PlaneProp::Gravity(g) => self.world.gravity = Vector::from(g),
             PlaneProp::Threads(n) => {
                 if !creating {
                     return Err(CommandError::invalid(format!(
                         "Threads is read-only after creation (tried to set {n})"
                     )));
                 }
-                if !(1..=MAX_THREADS).contains(&n) {
-                    return Err(CommandError::invalid(format!(
-                        "Threads must be within [1, {MAX_THREADS}], got {n}"
-                    )));
-                }
                 self.set_threads(n)?;
             }
-            PlaneProp::TickRate(hz) => {
-                self.tick_rate = validate::in_range("TickRate", hz, 0.0, MAX_TICK_RATE)?;
-            }
+            PlaneProp::TickRate(hz) => self.tick_rate = hz,
             PlaneProp::Enabled(on) => self.enabled = on,
+            PlaneProp::LinearDamping(k) => self.linear_damping = k,
+            PlaneProp::AngularDamping(k) => self.angular_damping = k,
+            PlaneProp::Drag(k) => self.drag = k,
+            PlaneProp::Buoyancy(b) => self.buoyancy = b,
+            PlaneProp::ConstantForce(f) => self.constant_force = f,
+            PlaneProp::RestThreshold(v) => self.rest_threshold = v,
+            PlaneProp::SolverIterations(n) => self.solver_iterations = n,
+            PlaneProp::LoopSolver(on) => self.loop_solver = on,
+            PlaneProp::NeverSleep(on) => self.set_never_sleep(on),
+        }
+        // Forces changed: resting bodies must feel them (sleeping ones would ignore them).
+        if matches!(
+            prop,
+            PlaneProp::Gravity(_) | PlaneProp::Buoyancy(_) | PlaneProp::ConstantForce(_)
+        ) {
+            self.world.wake_up_all(true);
         }
         Ok(())
+    }
+
+    fn set_never_sleep(&mut self, on: bool) {
+        self.never_sleep = on;
+        let template = if on {
+            RigidBodyActivation::cannot_sleep()
+        } else {
+            RigidBodyActivation::active()
+        };
+        for (_, body) in self.world.bodies.iter_mut() {
+            let activation = body.activation_mut();
+            activation.normalized_linear_threshold = template.normalized_linear_threshold;
+            activation.angular_threshold = template.angular_threshold;
+            body.wake_up(true);
+        }
     }
 
     fn set_threads(&mut self, n: u32) -> Result<(), CommandError> {
@@ -162,6 +214,17 @@ impl Plane {
             enabled: self.enabled,
             tick: self.tick,
             object_count: self.live,
+            linear_damping: self.linear_damping,
+            angular_damping: self.angular_damping,
+            drag: self.drag,
+            buoyancy: self.buoyancy,
+            constant_force: self.constant_force,
+            rest_threshold: self.rest_threshold,
+            solver_iterations: self.solver_iterations,
+            loop_solver: self.loop_solver,
+            never_sleep: self.never_sleep,
+            effective_solver_iterations: self.solver_settings().iterations as u32,
+            max_hit_box_quality: self.max_quality(),
         }
     }
 
@@ -178,15 +241,18 @@ impl Plane {
         }
         let started = Instant::now();
         self.world.integration_parameters.dt = dt;
+        self.tune_solver();
+        self.apply_forces(dt);
+        let hooks = contacts::RestThreshold(self.rest_threshold);
         if self.reporting > 0 {
             let collector = ChannelEventCollector::new(
                 self.collision_tx.clone(),
                 self.force_tx.clone(),
                 self.tear_tx.clone(),
             );
-            self.world.step_with_events(&(), &collector);
+            self.world.step_with_events(&hooks, &collector);
         } else {
-            self.world.step();
+            self.world.step_with_events(&hooks, &());
         }
         self.tick += 1;
         self.sim_time += dt as f64;
@@ -195,48 +261,6 @@ impl Plane {
         self.collect_events();
         self.last_step_us = started.elapsed().as_secs_f32() * 1e6;
         Ok(true)
-    }
-
-    /// Deepest penetration and number of touching pairs, for the tick header.
-    fn contact_figures(&self) -> (f32, u32) {
-        let mut deepest = 0.0f32;
-        let mut pairs = 0;
-        for (_, contact) in self
-            .world
-            .narrow_phase
-            .contact_pairs()
-            .filter_map(|p| p.find_deepest_contact())
-        {
-            deepest = deepest.max(-contact.dist);
-            pairs += 1;
-        }
-        (deepest, pairs)
-    }
-
-    fn collect_events(&mut self) {
-        self.events.clear();
-        while let Ok(event) = self.collision_rx.try_recv() {
-            let kind = if event.started() {
-                EVENT_CONTACT_STARTED
-            } else {
-                EVENT_CONTACT_STOPPED
-            };
-            let (Some(a), Some(b)) = (
-                self.handle_of_collider(event.collider1()),
-                self.handle_of_collider(event.collider2()),
-            ) else {
-                continue; // one side was removed in the same step
-            };
-            self.events.push(EventRecord {
-                kind,
-                a_slot: a.slot,
-                a_generation: a.generation,
-                b_slot: b.slot,
-                b_generation: b.generation,
-                _reserved: 0,
-                tick: self.tick,
-            });
-        }
     }
 
     /// Events of the last step (contact started / stopped).
@@ -268,7 +292,7 @@ impl Plane {
 
     /// The published state of slot `i` (dead slots carry only their generation).
     pub fn body_state(&self, i: usize) -> BodyState {
-        let slot = self.slots[i];
+        let slot = &self.slots[i];
         let Some(body) = slot.body.and_then(|h| self.world.bodies.get(h)) else {
             return BodyState {
                 generation: slot.generation,

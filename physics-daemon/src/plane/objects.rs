@@ -2,45 +2,35 @@
 //! handles.
 
 use rapier3d::prelude::*;
-use shm_layout::{CommandError, ErrorKind, Handle, ObjectProp, Pose, Shape};
+use shm_layout::{CommandError, ErrorKind, Handle, ObjectInfo, ObjectProp, Pose, Shape, Vec3};
 
+use super::part::Part;
 use super::{Plane, Slot};
-use crate::validate;
 
 /// Slots per plane; bounds memory a misbehaving client can make the daemon allocate.
 pub const MAX_SLOTS: usize = 1 << 20;
-/// Smallest mass a dynamic body may have: a zero-mass body neither falls nor takes impulses.
-const MIN_MASS: f32 = 1e-4;
 
-fn rapier_pose(p: Pose) -> rapier3d::math::Pose {
+pub(super) fn rapier_pose(p: Pose) -> rapier3d::math::Pose {
     rapier3d::math::Pose::from_parts(Vector::from(p.position), Rotation::from_array(p.rotation))
-}
-
-fn collider_for(shape: Shape) -> Result<ColliderBuilder, CommandError> {
-    Ok(match shape {
-        Shape::Cube { size } => {
-            for (axis, v) in ["x", "y", "z"].iter().zip(size) {
-                validate::positive(&format!("Size.{axis}"), v)?;
-            }
-            ColliderBuilder::cuboid(size[0] / 2.0, size[1] / 2.0, size[2] / 2.0)
-        }
-        Shape::Sphere { radius } => ColliderBuilder::ball(validate::positive("radius", radius)?),
-    })
 }
 
 impl Plane {
     pub fn add_object(
         &mut self,
-        shape: Shape,
+        shape: &Shape,
         pose: Pose,
         props: &[ObjectProp],
     ) -> Result<Handle, CommandError> {
-        let pose = validate::pose("CFrame", pose)?;
-        let collider = collider_for(shape)?;
+        let pose = shm_layout::validate::pose("CFrame", pose)?;
+        shape.check()?;
         // Check every property before touching the world so a bad one adds nothing.
-        for prop in props {
-            validate_prop(*prop)?;
-        }
+        let props = props
+            .iter()
+            .map(|p| p.checked())
+            .collect::<Result<Vec<_>, _>>()?;
+        let part = Part::new(shape);
+        let mut collider = ColliderBuilder::new(part.collider_shape()?).build();
+        part.configure_collider(&mut collider)?;
         let slot = match self.free_slots.pop() {
             Some(s) => s,
             None if self.slots.len() < MAX_SLOTS => {
@@ -54,28 +44,35 @@ impl Plane {
                 ))
             }
         };
-        let body = RigidBodyBuilder::dynamic()
+        let mut body = RigidBodyBuilder::dynamic()
             .pose(rapier_pose(pose))
-            .user_data(slot as u128);
+            .user_data(slot as u128)
+            .build();
+        if self.never_sleep {
+            *body.activation_mut() = RigidBodyActivation::cannot_sleep();
+        }
         let body = self.world.insert_body(body);
-        let collider = self.world.insert_collider(collider.build(), Some(body));
-        ensure_min_mass(&mut self.world.bodies[body], collider);
+        self.world.insert_collider(collider, Some(body));
+        part.configure_body(&mut self.world.bodies[body], &self.world.colliders);
+        self.quality_counts[part.quality as usize] += 1;
         let entry = &mut self.slots[slot as usize];
         entry.generation = entry.generation.wrapping_add(1).max(1);
         entry.body = Some(body);
+        entry.part = Some(part);
         self.live += 1;
+        self.touched.push(body);
         let handle = Handle {
             slot,
             generation: entry.generation,
         };
         for prop in props {
-            self.set_object(handle, *prop)?;
+            self.set_object(handle, prop)?;
         }
         Ok(handle)
     }
 
     /// The rapier body behind a handle, or a clear error for unknown and stale handles.
-    fn body_of(&self, handle: Handle) -> Result<RigidBodyHandle, CommandError> {
+    pub(super) fn body_of(&self, handle: Handle) -> Result<RigidBodyHandle, CommandError> {
         let slot = self.slots.get(handle.slot as usize).ok_or_else(|| {
             CommandError::new(
                 ErrorKind::StaleHandle,
@@ -107,57 +104,12 @@ impl Plane {
         Some(Handle { slot, generation })
     }
 
-    pub fn set_object(&mut self, handle: Handle, prop: ObjectProp) -> Result<(), CommandError> {
-        validate_prop(prop)?;
+    pub fn apply_impulse(&mut self, handle: Handle, impulse: Vec3) -> Result<(), CommandError> {
+        let impulse = shm_layout::validate::finite3("impulse", impulse)?;
         let h = self.body_of(handle)?;
-        let body = &mut self.world.bodies[h];
-        match prop {
-            ObjectProp::Pose(p) => {
-                body.set_position(rapier_pose(validate::pose("CFrame", p)?), true)
-            }
-            ObjectProp::Velocity(v) => body.set_linvel(Vector::from(v), true),
-            ObjectProp::AngularVelocity(w) => body.set_angvel(Vector::from(w), true),
-            ObjectProp::Anchored(on) => {
-                let kind = if on {
-                    RigidBodyType::Fixed
-                } else {
-                    RigidBodyType::Dynamic
-                };
-                body.set_body_type(kind, true);
-                body.set_linvel(Vector::ZERO, true);
-                body.set_angvel(Vector::ZERO, true);
-            }
-            ObjectProp::ReportContacts(on) => {
-                let colliders = body.colliders().to_vec();
-                let mut changed = false;
-                for c in colliders {
-                    let collider = &mut self.world.colliders[c];
-                    let was = collider
-                        .active_events()
-                        .contains(ActiveEvents::COLLISION_EVENTS);
-                    changed |= was != on;
-                    collider.set_active_events(if on {
-                        ActiveEvents::COLLISION_EVENTS
-                    } else {
-                        ActiveEvents::empty()
-                    });
-                }
-                if changed {
-                    if on {
-                        self.reporting += 1;
-                    } else {
-                        self.reporting -= 1;
-                    }
-                }
-            }
-        }
-        Ok(())
-    }
-
-    pub fn apply_impulse(&mut self, handle: Handle, impulse: [f32; 3]) -> Result<(), CommandError> {
-        let impulse = validate::finite3("impulse", impulse)?;
-        let h = self.body_of(handle)?;
+        // Rapier divides by the mass in effect and skips locked axes; fixed bodies absorb it.
         self.world.bodies[h].apply_impulse(Vector::from(impulse), true);
+        self.touched.push(h);
         Ok(())
     }
 
@@ -165,25 +117,69 @@ impl Plane {
         let h = self.body_of(handle)?;
         // Turn contact reporting off first so the plane's reporting count stays exact.
         self.set_object(handle, ObjectProp::ReportContacts(false))?;
+        let part = self.slots[handle.slot as usize]
+            .part
+            .take()
+            .expect("live slot has a part");
+        self.quality_counts[part.quality as usize] -= 1;
+        if part.is_driven() {
+            self.driven -= 1;
+        }
         self.world.remove_body(h);
         self.slots[handle.slot as usize].body = None;
         self.free_slots.push(handle.slot);
         self.live -= 1;
         Ok(())
     }
-}
 
-fn validate_prop(prop: ObjectProp) -> Result<(), CommandError> {
-    match prop {
-        ObjectProp::Pose(p) => validate::pose("CFrame", p).map(|_| ()),
-        ObjectProp::Velocity(v) => validate::finite3("Velocity", v).map(|_| ()),
-        ObjectProp::AngularVelocity(w) => validate::finite3("AngularVelocity", w).map(|_| ()),
-        ObjectProp::Anchored(_) | ObjectProp::ReportContacts(_) => Ok(()),
+    pub fn object_info(&self, handle: Handle) -> Result<ObjectInfo, CommandError> {
+        let h = self.body_of(handle)?;
+        let body = &self.world.bodies[h];
+        let part = self.part(handle);
+        let volume = body.colliders().first().map_or(1.0, |c| {
+            self.world.colliders[*c].shape().mass_properties(1.0).mass()
+        });
+        let mass = part.mass(volume);
+        Ok(ObjectInfo {
+            handle,
+            shape: part.shape,
+            size: part.size,
+            anchored: body.is_fixed(),
+            weight: part.weight,
+            density: mass / volume,
+            mass,
+            bounciness: part.bounciness,
+            friction: part.friction,
+            can_collide: part.can_collide,
+            hit_box_quality: part.quality,
+            center_of_mass: part.center_of_mass,
+            impulse_direction: part.impulse_direction,
+            constant_force: part.constant_force,
+            locks: part.locks,
+            rotation_locked_by_quality: part.rotation_locked_by_quality(),
+            ccd: body.is_ccd_enabled(),
+            rotate_to: part.rotate_to,
+            pin: part.pin,
+        })
     }
-}
 
-fn ensure_min_mass(body: &mut RigidBody, _collider: ColliderHandle) {
-    if body.mass() < MIN_MASS {
-        body.set_additional_mass(MIN_MASS, true);
+    /// Sets CenterOfMass to the mesh's vertex centroid (mesh parts only) and returns the
+    /// centre of mass in effect.
+    pub fn recalculate_center_of_mass(&mut self, handle: Handle) -> Result<Vec3, CommandError> {
+        self.body_of(handle)?;
+        match self.part(handle).mesh_centroid() {
+            Some(c) => {
+                self.set_object(handle, ObjectProp::CenterOfMass(c))?;
+                Ok(c)
+            }
+            None => Ok(self.part(handle).center_of_mass),
+        }
+    }
+
+    pub(super) fn part(&self, handle: Handle) -> &Part {
+        self.slots[handle.slot as usize]
+            .part
+            .as_ref()
+            .expect("live slot has a part")
     }
 }
