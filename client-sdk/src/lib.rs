@@ -19,7 +19,7 @@ pub use error::Error;
 pub use object::Object;
 pub use plane::{Plane, PlaneOptions, Snapshot};
 pub use shm_layout::{
-    BodyState, CommandError, ErrorKind, EventRecord, Handle, ObjectProp, PlaneId, PlaneInfo,
-    PlaneProp, Pose, Shape, TickHeader, Vec3,
+    BodyState, CommandError, ErrorKind, EventRecord, Handle, ObjectInfo, ObjectProp, Pin, PlaneId,
+    PlaneInfo, PlaneProp, Pose, Restraint, RotateTo, Shape, ShapeKind, TickHeader, Vec3,
 };
 pub use spawn::{connect_or_start, daemon_executable, DaemonChild, Session};

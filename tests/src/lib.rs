@@ -155,3 +155,64 @@ pub fn eventually<T>(timeout: Duration, mut f: impl FnMut() -> Option<T>) -> Opt
         std::thread::sleep(Duration::from_millis(10));
     }
 }
+
+/// One manual plane on a daemon of its own: what the physics tests start from.
+/// Fields drop in order, so the client says goodbye before its daemon stops.
+pub struct Scene {
+    pub plane: client_sdk::Plane,
+    pub client: Client,
+    pub daemon: TestDaemon,
+}
+
+impl Scene {
+    /// A manual plane (TickRate 0) with `options` on top.
+    pub fn new(tag: &str, options: client_sdk::PlaneOptions) -> Scene {
+        let daemon = TestDaemon::start(tag);
+        let client = daemon.client();
+        let plane = client
+            .create_plane(&client_sdk::PlaneOptions {
+                tick_rate: Some(0.0),
+                ..options
+            })
+            .expect("create plane");
+        Scene {
+            plane,
+            client,
+            daemon,
+        }
+    }
+
+    /// An anchored 200 × 1 × 200 slab whose top face is y = 0.
+    pub fn floor(&self) -> client_sdk::Object {
+        self.anchored_box([200.0, 1.0, 200.0], client_sdk::Pose::at([0.0, -0.5, 0.0]))
+    }
+
+    pub fn anchored_box(&self, size: [f32; 3], pose: client_sdk::Pose) -> client_sdk::Object {
+        self.plane
+            .add(
+                client_sdk::Shape::Cube { size },
+                pose,
+                &[client_sdk::ObjectProp::Anchored(true)],
+            )
+            .expect("add anchored box")
+    }
+
+    /// Steps `n` times by `dt`.
+    pub fn run(&self, dt: f32, n: u32) {
+        for _ in 0..n {
+            self.plane.step(dt).expect("step");
+        }
+    }
+}
+
+/// Unit quaternion `[x, y, z, w]` for `angle` radians about a unit `axis`.
+pub fn quat(axis: [f32; 3], angle: f32) -> [f32; 4] {
+    let (s, c) = (angle / 2.0).sin_cos();
+    [axis[0] * s, axis[1] * s, axis[2] * s, c]
+}
+
+/// Angle in radians between two unit quaternions.
+pub fn angle_between(a: [f32; 4], b: [f32; 4]) -> f32 {
+    let dot: f32 = a.iter().zip(b).map(|(x, y)| x * y).sum();
+    2.0 * dot.abs().min(1.0).acos()
+}

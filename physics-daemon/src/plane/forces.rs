@@ -1,6 +1,6 @@
 //! The force pass, run before every rapier step over the awake dynamic bodies (plus the ones
 //! touched by commands since the last step). Rapier integrates gravity and contacts; this
-//! pass adds what the API defines on top, as velocity changes over `dt`:
+//! pass adds what the API defines on top:
 //!
 //! - Buoyancy (acceleration), ConstantForce (plane + object, divided by mass),
 //!   ImpulseDirection (acceleration): exact for constant forces.
@@ -8,6 +8,12 @@
 //!   never overshoots or reverses a velocity at any dt (unconditionally stable).
 //! - LinearDamping / AngularDamping: `v *= max(0, 1 - k·dt)`, as documented.
 //! - RotateTo and SetPin: controllers that set the velocities they need, capped.
+//!
+//! The linear part becomes one force for the step, handed to rapier's force accumulator:
+//! rapier spreads it over its substeps exactly like gravity, so Buoyancy = -Gravity.Y
+//! cancels gravity in every substep (a velocity kick before the step would not, and the
+//! body would drift). Angular changes are set directly: "direct rotation" must also turn
+//! bodies whose rotation is locked against contacts.
 //!
 //! A plane with no forces and no driven objects skips the pass entirely.
 
@@ -45,6 +51,12 @@ impl Plane {
             && env.acceleration == Vector::ZERO
             && env.force == Vector::ZERO
             && self.driven == 0;
+        // Forces of the previous pass stay in rapier's accumulators until reset.
+        for h in self.forced.drain(..) {
+            if let Some(body) = self.world.bodies.get_mut(h) {
+                body.reset_forces(false);
+            }
+        }
         if idle {
             self.touched.clear();
             return;
@@ -72,18 +84,23 @@ impl Plane {
                 continue; // both awake and touched
             }
             part.forced_tick = stamp;
-            drive(body, part, &env);
+            if drive(body, part, &env) {
+                self.forced.push(*h);
+            }
         }
         self.scratch = handles;
     }
 }
 
-fn drive(body: &mut RigidBody, part: &Part, env: &Env) {
+/// Applies one body's forces for the step. Returns whether it left a force in rapier's
+/// accumulator.
+fn drive(body: &mut RigidBody, part: &Part, env: &Env) -> bool {
     let dt = env.dt;
     let mass = body.mass();
     let inv_mass = if mass > 0.0 { 1.0 / mass } else { 0.0 };
     let (v0, w0) = (body.linvel(), body.angvel());
     let forces = env.force + Vector::from(part.constant_force);
+    // The velocity this step should end at, before gravity and contacts.
     let mut v =
         v0 + (env.acceleration + Vector::from(part.impulse_direction) + forces * inv_mass) * dt;
     let mut w = w0;
@@ -103,21 +120,22 @@ fn drive(body: &mut RigidBody, part: &Part, env: &Env) {
     if !w_driven {
         w *= env.angular_keep;
     }
-    // Locked axes keep their (zero) velocity: rapier's solver holds them still.
+    // Locked rotation axes keep their velocity (locked translations are skipped by rapier,
+    // which applies forces through the effective inverse mass).
     for i in 0..3 {
-        if part.locks[i] {
-            v[i] = v0[i];
-        }
         if part.locks[i + 3] {
             w[i] = w0[i];
         }
     }
-    if v != v0 {
-        body.set_linvel(v, false);
-    }
     if w != w0 {
         body.set_angvel(w, false);
     }
+    let force = (v - v0) * (mass / dt);
+    if force == Vector::ZERO {
+        return false;
+    }
+    body.add_force(force, false);
+    true
 }
 
 /// Backward Euler on `dv/dt = -c·|v|·v`: the new speed s' solves `s' + c·dt·s'² = s`.

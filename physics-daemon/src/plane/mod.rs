@@ -56,6 +56,8 @@ pub struct Plane {
     /// Bodies changed by commands since the last step: the force pass sees them even
     /// before rapier's island manager lists them as awake.
     touched: Vec<RigidBodyHandle>,
+    /// Bodies the last force pass left a force on (reset at the next pass).
+    forced: Vec<RigidBodyHandle>,
     scratch: Vec<RigidBodyHandle>,
     tick: u64,
     sim_time: f64,
@@ -102,6 +104,7 @@ impl Plane {
             quality_counts: [0; MAX_HIT_BOX_QUALITY as usize + 1],
             driven: 0,
             touched: Vec::new(),
+            forced: Vec::new(),
             scratch: Vec::new(),
             tick: 0,
             sim_time: 0.0,
