@@ -18,7 +18,7 @@ impl Plane {
         let was_driven = part.is_driven();
         let old_quality = part.quality;
         // Which rapier state the change touches.
-        let (mut collider_changed, mut body_changed) = (false, false);
+        let (mut collider_changed, mut body_changed, mut shape_changed) = (false, false, false);
         let body = &mut self.world.bodies[h];
         match prop {
             ObjectProp::Pose(p) => body.set_position(rapier_pose(p), true),
@@ -81,7 +81,7 @@ impl Plane {
                     part.size = old;
                     return Err(e);
                 }
-                collider_changed = true;
+                shape_changed = true;
             }
             ObjectProp::CenterOfMass(c) => {
                 part.center_of_mass = c;
@@ -105,7 +105,17 @@ impl Plane {
             .part
             .as_ref()
             .expect("live slot has a part");
-        if collider_changed {
+        if shape_changed {
+            // Rapier recycles the contacts of pairs whose poses did not move, even when a
+            // shape changed: a fresh collider gets fresh contacts.
+            for c in self.world.bodies[h].colliders().to_vec() {
+                self.world.remove_collider(c);
+            }
+            let mut collider = ColliderBuilder::new(part.collider_shape()?).build();
+            part.configure_collider(&mut collider)?;
+            self.world.insert_collider(collider, Some(h));
+            body_changed = true;
+        } else if collider_changed {
             for c in self.world.bodies[h].colliders().to_vec() {
                 part.configure_collider(&mut self.world.colliders[c])?;
             }
