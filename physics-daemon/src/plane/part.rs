@@ -92,12 +92,18 @@ impl Part {
             (_, ShapeKind::Sphere) => SharedShape::ball(x.min(y).min(z) / 2.0),
             (Some(mesh), ShapeKind::Mesh) => {
                 let points = mesh.scaled(self.size);
-                SharedShape::convex_hull(&points).ok_or_else(|| {
+                let flat = || {
                     CommandError::invalid(format!(
                         "Mesh vertices span no volume (all coplanar?) at Size {:?}",
                         self.size
                     ))
-                })?
+                };
+                let hull = SharedShape::convex_hull(&points).ok_or_else(flat)?;
+                // A coplanar point set still yields a (flat) hull: it has no mass or inertia.
+                if hull.mass_properties(1.0).mass() <= 1e-9 {
+                    return Err(flat());
+                }
+                hull
             }
             (None, ShapeKind::Mesh) => unreachable!("mesh parts always carry their mesh"),
         })
