@@ -2,7 +2,7 @@
 //! `wait(s)` yields it with a marker and the scheduler resumes it in the first frame at least
 //! `s` seconds later, returning the time actually waited.
 
-use std::cell::{Cell, RefCell};
+use std::cell::RefCell;
 use std::ffi::c_void;
 use std::rc::{Rc, Weak};
 use std::time::Instant;
@@ -27,8 +27,6 @@ struct Waiting {
 
 pub struct Scheduler {
     started: Instant,
-    /// Time of the current frame (seconds since install).
-    now: Cell<f64>,
     waiting: RefCell<Vec<Waiting>>,
     pub heart: Signal,
     /// Parts whose CFrame change signal exists; probed each frame for listeners.
@@ -39,7 +37,6 @@ impl Scheduler {
     pub fn new() -> Scheduler {
         Scheduler {
             started: Instant::now(),
-            now: Cell::new(0.0),
             waiting: RefCell::default(),
             heart: Signal::new("Heart"),
             watched: RefCell::default(),
@@ -77,11 +74,22 @@ impl Scheduler {
             .any(|p| p.cframe_listeners() > 0)
     }
 
-    /// One frame: due waits resume, `Heart` fires with `dt`, then the change signals of
-    /// simulated parts with listeners fire when their pose changed.
+    /// One frame. Physics results come first: the change signals of simulated parts with
+    /// listeners fire when their pose moved; then due waits resume and `Heart` fires with
+    /// `dt`, so scripts see this frame's poses.
     pub fn frame(&self, lua: &Lua, dt: f64) -> mlua::Result<()> {
+        let parts: Vec<Rc<PartState>> = {
+            let mut watched = self.watched.borrow_mut();
+            watched.retain(|w| w.strong_count() > 0);
+            watched.iter().filter_map(Weak::upgrade).collect()
+        };
+        for part in parts {
+            // The empty-listener probe: parts nobody listens to cost one length check.
+            if part.cframe_listeners() > 0 {
+                part.fire_cframe_if_moved(lua)?;
+            }
+        }
         let now = self.clock();
-        self.now.set(now);
         let due: Vec<Waiting> = {
             let mut waiting = self.waiting.borrow_mut();
             let (due, rest) = std::mem::take(&mut *waiting)
@@ -94,19 +102,7 @@ impl Scheduler {
             resume(self, w.thread, (now - w.since).into_lua_multi_value())?;
         }
         self.heart
-            .fire(lua, Value::Number(dt).into_lua_multi_value())?;
-        let parts: Vec<Rc<PartState>> = {
-            let mut watched = self.watched.borrow_mut();
-            watched.retain(|w| w.strong_count() > 0);
-            watched.iter().filter_map(Weak::upgrade).collect()
-        };
-        for part in parts {
-            // The empty-listener probe: parts nobody listens to cost one length check.
-            if part.cframe_listeners() > 0 {
-                part.fire_cframe_if_moved(lua)?;
-            }
-        }
-        Ok(())
+            .fire(lua, Value::Number(dt).into_lua_multi_value())
     }
 }
 

@@ -45,7 +45,7 @@ pub fn module(lua: &Lua) -> mlua::Result<Table> {
 }
 
 /// `.X/.Y/.Z` (any case) and arithmetic are native to Luau vectors; this adds `Magnitude`,
-/// `Unit`, `:Dot` and `:Cross` through the vector type's metatable.
+/// `Unit`, `:Dot`, `:Cross` and `:Lerp` through the vector type's metatable.
 fn install_vector_metatable(lua: &Lua) -> mlua::Result<()> {
     let dot = lua.create_function(|_, (a, b): (Value, Value)| {
         let (a, b) = (vec_arg("Vector:Dot", &a)?, vec_arg("Vector:Dot", &b)?);
@@ -59,6 +59,11 @@ fn install_vector_metatable(lua: &Lua) -> mlua::Result<()> {
             a[0] * b[1] - a[1] * b[0],
         ]))
     })?;
+    let lerp = lua.create_function(|_, (a, b, t): (Value, Value, Value)| {
+        let (a, b) = (vec_arg("Vector:Lerp", &a)?, vec_arg("Vector:Lerp", &b)?);
+        let t = finite_number("Vector:Lerp alpha", &t)? as f32;
+        Ok(new_vector([0, 1, 2].map(|i| a[i] + (b[i] - a[i]) * t)))
+    })?;
     let index = lua.create_function(move |_, (v, key): (Value, mlua::String)| {
         let v = vec_arg("Vector", &v)?;
         let len = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
@@ -68,8 +73,9 @@ fn install_vector_metatable(lua: &Lua) -> mlua::Result<()> {
             b"Unit" => Ok(new_vector([0.0; 3])),
             b"Dot" => Ok(Value::Function(dot.clone())),
             b"Cross" => Ok(Value::Function(cross.clone())),
+            b"Lerp" => Ok(Value::Function(lerp.clone())),
             other => Err(mlua::Error::runtime(format!(
-                "Vector has no member \"{}\" (members: X, Y, Z, Magnitude, Unit, Dot, Cross)",
+                "Vector has no member \"{}\" (members: X, Y, Z, Magnitude, Unit, Dot, Cross, Lerp)",
                 String::from_utf8_lossy(other)
             ))),
         }

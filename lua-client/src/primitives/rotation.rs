@@ -37,12 +37,13 @@ pub fn from_euler(e: V3) -> Quat {
 
 pub fn to_euler(q: Quat) -> V3 {
     let m = matrix(q);
-    let sb = m[0][2].clamp(-1.0, 1.0);
-    let b = sb.asin();
-    let (a, c) = if sb.abs() < 0.999_999 {
+    // atan2 rather than asin(m02): asin loses half the digits near ±90°.
+    let cb = m[0][0].hypot(m[0][1]);
+    let b = m[0][2].atan2(cb);
+    let (a, c) = if cb > 1e-6 {
         ((-m[1][2]).atan2(m[2][2]), (-m[0][1]).atan2(m[0][0]))
     } else {
-        // Gimbal lock: only a + c (or a - c) is defined; put it all in a.
+        // Gimbal lock: only a ± c is defined; put it all in a.
         (m[2][1].atan2(m[1][1]), 0.0)
     };
     [a as f32, b as f32, c as f32]
@@ -100,6 +101,8 @@ mod tests {
             [0.0, 0.0, 0.0],
             [-2.5, 1.4, -3.0],
             [1.0, 0.0, 0.0],
+            [0.2, std::f32::consts::FRAC_PI_2, 0.0],
+            [0.0, -1.5, 0.1],
         ] {
             let back = to_euler(from_euler(e));
             assert!(close(back, e, 1e-5), "{e:?} -> {back:?}");
