@@ -26,6 +26,18 @@ use scheduler::Scheduler;
 /// The modules `import` knows, in the order error messages list them.
 const MODULES: [&str; 3] = ["PhysicsService", "Renderable", "Primitives"];
 
+/// Methods of the types whose `__index` is ours alone (see `part::BasePart`).
+pub(crate) struct MethodTables {
+    pub part: Table,
+    pub object: Table,
+}
+
+pub(crate) fn method_tables(lua: &Lua) -> Rc<MethodTables> {
+    lua.app_data_ref::<Rc<MethodTables>>()
+        .expect("lua_client::install registers the method tables")
+        .clone()
+}
+
 /// A host's handle on the installed API: drives frames.
 pub struct Host {
     lua: Lua,
@@ -40,6 +52,10 @@ pub fn install(lua: &Lua, client: Client) -> mlua::Result<Host> {
     lua.set_app_data(scheduler.clone());
     lua.set_app_data(context.clone());
 
+    lua.set_app_data(Rc::new(MethodTables {
+        part: part::methods(lua)?,
+        object: object::methods(lua)?,
+    }));
     let modules = lua.create_table()?;
     modules.set("PhysicsService", plane::module(lua)?)?;
     modules.set("Renderable", part::module(lua)?)?;

@@ -202,30 +202,66 @@ impl PartState {
 #[derive(Clone)]
 pub struct BasePart(pub Rc<PartState>);
 
-impl UserData for BasePart {
-    fn add_methods<M: UserDataMethods<Self>>(methods: &mut M) {
-        let changed = |lua: &Lua, part: &BasePart, name: Value| {
+/// `self` of a method called on a BasePart, or an error saying how it was called.
+fn this_part(what: &str, v: &Value) -> mlua::Result<Rc<PartState>> {
+    match v {
+        Value::UserData(ud) => ud.borrow::<BasePart>().map(|p| p.0.clone()).ok(),
+        _ => None,
+    }
+    .ok_or_else(|| expected(what, "a BasePart as self (call it with ':')", v))
+}
+
+/// BasePart's methods, looked up by `__index` after its properties.
+pub fn methods(lua: &Lua) -> mlua::Result<Table> {
+    let t = lua.create_table()?;
+    let changed = |what: &'static str| {
+        move |lua: &Lua, (this, name): (Value, Value)| {
+            let part = this_part(what, &this)?;
             let row = PART.row(&name).ok_or_else(|| {
                 mlua::Error::runtime(format!(
-                    "BasePart:GetPropertyChanged expects a property name (CFrame, Size, Name, \
-                     Shape), got {}",
+                    "{what} expects a property name (CFrame, Size, Name, Shape), got {}",
                     describe(&name)
                 ))
             })?;
-            let (signal, created) = part.0.signal(row.name);
+            let (signal, created) = part.signal(row.name);
             if created && row.name == "CFrame" {
-                scheduler(lua).watch(&part.0);
+                scheduler(lua).watch(&part);
             }
             Ok(signal)
-        };
-        methods.add_method("GetPropertyChanged", changed);
-        methods.add_method("GetPropertyChangedSignal", changed);
-        methods.add_method("Destroy", |_, part, ()| {
-            part.0.destroy();
+        }
+    };
+    t.set(
+        "GetPropertyChanged",
+        lua.create_function(changed("BasePart:GetPropertyChanged"))?,
+    )?;
+    t.set(
+        "GetPropertyChangedSignal",
+        lua.create_function(changed("BasePart:GetPropertyChangedSignal"))?,
+    )?;
+    t.set(
+        "Destroy",
+        lua.create_function(|_, this: Value| {
+            this_part("BasePart:Destroy", &this)?.destroy();
             Ok(())
-        });
+        })?,
+    )?;
+    Ok(t)
+}
+
+impl UserData for BasePart {
+    // Methods live in a table `__index` consults after the properties: with no mlua-registered
+    // methods, mlua installs this `__index` as is, sparing every property read a Lua-side
+    // method lookup.
+    fn add_methods<M: UserDataMethods<Self>>(methods: &mut M) {
         methods.add_meta_method(MetaMethod::Index, |lua, part, key: Value| {
-            PART.get(lua, part, &key)
+            match PART.row(&key) {
+                Some(_) => PART.get(lua, part, &key),
+                None => crate::method_tables(lua)
+                    .part
+                    .raw_get::<Option<mlua::Function>>(key.clone())?
+                    .map(Value::Function)
+                    .ok_or_else(|| PART.unknown(&key)),
+            }
         });
         methods.add_meta_method(
             MetaMethod::NewIndex,
