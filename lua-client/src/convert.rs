@@ -1,0 +1,92 @@
+//! Lua values to Rust values, and the error messages that name what was expected and what
+//! was given.
+
+use mlua::{Error as LuaError, Value};
+
+use crate::part::BasePart;
+use crate::primitives::{CFrame, Dim};
+
+/// A short description of a Lua value for error messages: its type and, when small, itself.
+pub fn describe(value: &Value) -> String {
+    match value {
+        Value::Nil => "nil".into(),
+        Value::Boolean(b) => format!("boolean {b}"),
+        Value::Integer(i) => format!("number {i}"),
+        Value::Number(n) => format!("number {n}"),
+        Value::Vector(v) => format!("Vector({}, {}, {})", v.x(), v.y(), v.z()),
+        Value::String(s) => {
+            let s = s.to_string_lossy();
+            if s.chars().count() > 40 {
+                let short: String = s.chars().take(40).collect();
+                format!("string \"{short}…\"")
+            } else {
+                format!("string \"{s}\"")
+            }
+        }
+        Value::Table(_) => "table".into(),
+        Value::Function(_) => "function".into(),
+        Value::Thread(_) => "thread".into(),
+        Value::UserData(ud) => {
+            if let Ok(cf) = ud.borrow::<CFrame>() {
+                cf.to_string()
+            } else if let Ok(d) = ud.borrow::<Dim>() {
+                d.to_string()
+            } else if let Ok(p) = ud.borrow::<BasePart>() {
+                format!("BasePart \"{}\"", p.0.name())
+            } else {
+                match ud.type_name() {
+                    Ok(Some(name)) => name,
+                    _ => "userdata".into(),
+                }
+            }
+        }
+        other => other.type_name().to_string(),
+    }
+}
+
+/// `"{what} expects {expected}, got {value}"`.
+pub fn expected(what: &str, expected: &str, got: &Value) -> LuaError {
+    LuaError::runtime(format!("{what} expects {expected}, got {}", describe(got)))
+}
+
+pub fn number(value: &Value) -> Option<f64> {
+    match *value {
+        Value::Number(n) => Some(n),
+        Value::Integer(i) => Some(i as f64),
+        _ => None,
+    }
+}
+
+/// A native Luau vector (what `Vector.new` and `vector.create` both make).
+pub fn vector(value: &Value) -> Option<[f32; 3]> {
+    match value {
+        Value::Vector(v) => Some([v.x(), v.y(), v.z()]),
+        _ => None,
+    }
+}
+
+/// A finite vector, or an error naming `what`.
+pub fn finite_vector(what: &str, value: &Value) -> Result<[f32; 3], LuaError> {
+    match vector(value) {
+        Some(v) if v.iter().all(|c| c.is_finite()) => Ok(v),
+        Some(_) => Err(expected(what, "a Vector with finite components", value)),
+        None => Err(expected(what, "a Vector", value)),
+    }
+}
+
+/// A finite number, or an error naming `what`.
+pub fn finite_number(what: &str, value: &Value) -> Result<f64, LuaError> {
+    match number(value) {
+        Some(n) if n.is_finite() => Ok(n),
+        _ => Err(expected(what, "a finite number", value)),
+    }
+}
+
+/// A Rust error from the SDK as a Lua error, prefixed by what was being done.
+pub fn sdk_error(what: &str, e: client_sdk::Error) -> LuaError {
+    LuaError::runtime(format!("{what}: {e}"))
+}
+
+pub fn new_vector(v: [f32; 3]) -> Value {
+    Value::Vector(mlua::Vector::new(v[0], v[1], v[2]))
+}

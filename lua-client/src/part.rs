@@ -1,0 +1,300 @@
+//! `Renderable.BasePart`: the host stand-in for a visual part. Once a plane simulates it,
+//! reading `part.CFrame` returns the pose of the newest tick, read from shared memory.
+
+use std::cell::{Cell, RefCell};
+use std::rc::{Rc, Weak};
+
+use client_sdk::{Object, Shape};
+use mlua::{Lua, MetaMethod, MultiValue, Table, UserData, UserDataMethods, Value};
+
+use crate::convert::{describe, expected};
+use crate::plane::PlaneState;
+use crate::primitives::CFrame;
+use crate::props::part::PART;
+use crate::scheduler::scheduler;
+use crate::signal::Signal;
+
+/// Shapes a BasePart can have (the collider the plane builds from it).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PartShape {
+    Cube,
+    Sphere,
+}
+
+impl PartShape {
+    pub const NAMES: &'static str = "\"Cube\" or \"Sphere\"";
+
+    pub fn name(self) -> &'static str {
+        match self {
+            PartShape::Cube => "Cube",
+            PartShape::Sphere => "Sphere",
+        }
+    }
+
+    /// The collider for a part of `size`: a box of that full size, or the largest sphere
+    /// that fits in it.
+    pub fn collider(self, size: [f32; 3]) -> Shape {
+        match self {
+            PartShape::Cube => Shape::Cube { size },
+            PartShape::Sphere => Shape::Sphere {
+                radius: size.iter().copied().fold(f32::INFINITY, f32::min) * 0.5,
+            },
+        }
+    }
+}
+
+/// A simulated part's body and the plane it is in.
+pub struct Link {
+    pub object: Object,
+    pub plane: Weak<PlaneState>,
+}
+
+pub struct PartState {
+    pub shape: PartShape,
+    name: RefCell<String>,
+    size: Cell<[f32; 3]>,
+    /// The pose while not simulated; the frozen last pose after the body went away.
+    cframe: Cell<CFrame>,
+    destroyed: Cell<bool>,
+    link: RefCell<Option<Link>>,
+    signals: RefCell<Vec<(&'static str, Signal)>>,
+    /// The last pose the per-tick change pass announced.
+    last_fired: Cell<Option<CFrame>>,
+}
+
+impl PartState {
+    fn new(shape: PartShape) -> PartState {
+        PartState {
+            shape,
+            name: RefCell::new(shape.name().to_string()),
+            size: Cell::new([1.0; 3]),
+            cframe: Cell::new(CFrame::IDENTITY),
+            destroyed: Cell::new(false),
+            link: RefCell::new(None),
+            signals: RefCell::default(),
+            last_fired: Cell::new(None),
+        }
+    }
+
+    pub fn name(&self) -> String {
+        self.name.borrow().clone()
+    }
+
+    pub fn set_name(&self, name: String) {
+        *self.name.borrow_mut() = name;
+    }
+
+    pub fn size(&self) -> [f32; 3] {
+        self.size.get()
+    }
+
+    pub fn set_size(&self, size: [f32; 3]) {
+        self.size.set(size);
+    }
+
+    pub fn is_destroyed(&self) -> bool {
+        self.destroyed.get()
+    }
+
+    /// The simulated body, if the part is in a plane.
+    pub fn object(&self) -> Option<Object> {
+        self.link.borrow().as_ref().map(|l| l.object.clone())
+    }
+
+    pub fn is_linked_to(&self, object: &Object) -> bool {
+        self.link.borrow().as_ref().is_some_and(|l| {
+            l.object.handle() == object.handle() && l.object.plane().id() == object.plane().id()
+        })
+    }
+
+    pub fn link(&self, link: Link) {
+        self.last_fired.set(None);
+        *self.link.borrow_mut() = Some(link);
+    }
+
+    /// The pose: the newest tick's for a simulated part, else the stored one.
+    pub fn cframe(&self) -> CFrame {
+        if let Some(link) = self.link.borrow().as_ref() {
+            if let Ok(pose) = link.object.pose() {
+                return CFrame::from_pose(pose);
+            }
+        }
+        self.cframe.get()
+    }
+
+    /// Stores a pose for a part that is not simulated.
+    pub fn store_cframe(&self, cf: CFrame) {
+        self.cframe.set(cf);
+    }
+
+    /// Leaves the plane: the part keeps its last simulated pose. Returns the body it had.
+    pub fn unlink(&self) -> Option<Object> {
+        let cf = self.cframe();
+        self.cframe.set(cf);
+        let link = self.link.borrow_mut().take()?;
+        Some(link.object)
+    }
+
+    /// Removes the part's body from its plane (queued), keeping the part.
+    pub fn detach(self: &Rc<Self>) {
+        let plane = self.link.borrow().as_ref().map(|l| l.plane.clone());
+        if let Some(object) = self.unlink() {
+            object.destroy();
+        }
+        if let Some(plane) = plane.and_then(|p| p.upgrade()) {
+            plane.forget(self);
+        }
+    }
+
+    pub fn destroy(self: &Rc<Self>) {
+        self.detach();
+        self.destroyed.set(true);
+        for (_, s) in self.signals.borrow().iter() {
+            s.disconnect_all();
+        }
+    }
+
+    fn signal(&self, name: &'static str) -> (Signal, bool) {
+        let mut signals = self.signals.borrow_mut();
+        if let Some((_, s)) = signals.iter().find(|(n, _)| *n == name) {
+            return (s.clone(), false);
+        }
+        let s = Signal::new(format!("{}.{name}", self.name.borrow()));
+        signals.push((name, s.clone()));
+        (s, true)
+    }
+
+    fn existing_signal(&self, name: &str) -> Option<Signal> {
+        let signals = self.signals.borrow();
+        signals
+            .iter()
+            .find(|(n, _)| *n == name)
+            .map(|(_, s)| s.clone())
+    }
+
+    pub fn cframe_listeners(&self) -> usize {
+        self.existing_signal("CFrame").map_or(0, |s| s.listeners())
+    }
+
+    /// Fires `name`'s change signal with `value` when someone listens.
+    pub fn changed(&self, lua: &Lua, name: &str, value: Value) -> mlua::Result<()> {
+        match self.existing_signal(name) {
+            Some(s) if s.listeners() > 0 => s.fire(lua, MultiValue::from_iter([value])),
+            _ => Ok(()),
+        }
+    }
+
+    /// The per-tick pass: a simulated part whose pose moved announces its new CFrame.
+    pub fn fire_cframe_if_moved(&self, lua: &Lua) -> mlua::Result<()> {
+        if self.link.borrow().is_none() {
+            return Ok(());
+        }
+        let cf = self.cframe();
+        if self.last_fired.get() == Some(cf) {
+            return Ok(());
+        }
+        self.last_fired.set(Some(cf));
+        self.changed(lua, "CFrame", Value::UserData(lua.create_userdata(cf)?))
+    }
+}
+
+/// The Lua handle of a part.
+#[derive(Clone)]
+pub struct BasePart(pub Rc<PartState>);
+
+/// `self` of a method called on a BasePart, or an error saying how it was called.
+fn this_part(what: &str, v: &Value) -> mlua::Result<Rc<PartState>> {
+    match v {
+        Value::UserData(ud) => ud.borrow::<BasePart>().map(|p| p.0.clone()).ok(),
+        _ => None,
+    }
+    .ok_or_else(|| expected(what, "a BasePart as self (call it with ':')", v))
+}
+
+/// BasePart's methods, looked up by `__index` after its properties.
+pub fn methods(lua: &Lua) -> mlua::Result<Table> {
+    let t = lua.create_table()?;
+    let changed = |what: &'static str| {
+        move |lua: &Lua, (this, name): (Value, Value)| {
+            let part = this_part(what, &this)?;
+            let row = PART.row(&name).ok_or_else(|| {
+                mlua::Error::runtime(format!(
+                    "{what} expects a property name (CFrame, Size, Name, Shape), got {}",
+                    describe(&name)
+                ))
+            })?;
+            let (signal, created) = part.signal(row.name);
+            if created && row.name == "CFrame" {
+                scheduler(lua).watch(&part);
+            }
+            Ok(signal)
+        }
+    };
+    t.set(
+        "GetPropertyChanged",
+        lua.create_function(changed("BasePart:GetPropertyChanged"))?,
+    )?;
+    t.set(
+        "GetPropertyChangedSignal",
+        lua.create_function(changed("BasePart:GetPropertyChangedSignal"))?,
+    )?;
+    t.set(
+        "Destroy",
+        lua.create_function(|_, this: Value| {
+            this_part("BasePart:Destroy", &this)?.destroy();
+            Ok(())
+        })?,
+    )?;
+    Ok(t)
+}
+
+impl UserData for BasePart {
+    // Methods live in a table `__index` consults after the properties: with no mlua-registered
+    // methods, mlua installs this `__index` as is, sparing every property read a Lua-side
+    // method lookup.
+    fn add_methods<M: UserDataMethods<Self>>(methods: &mut M) {
+        methods.add_meta_method(MetaMethod::Index, |lua, part, key: Value| {
+            match PART.row(&key) {
+                Some(_) => PART.get(lua, part, &key),
+                None => crate::method_tables(lua)
+                    .part
+                    .raw_get::<Option<mlua::Function>>(key.clone())?
+                    .map(Value::Function)
+                    .ok_or_else(|| PART.unknown(&key)),
+            }
+        });
+        methods.add_meta_method(
+            MetaMethod::NewIndex,
+            |lua, part, (key, value): (Value, Value)| PART.set(lua, part, &key, &value),
+        );
+        methods.add_meta_method(MetaMethod::ToString, |_, part, ()| {
+            Ok(format!("BasePart \"{}\"", part.0.name()))
+        });
+        methods.add_meta_method(MetaMethod::Eq, |_, part, other: Value| {
+            Ok(match other {
+                Value::UserData(ud) => ud
+                    .borrow::<BasePart>()
+                    .is_ok_and(|o| Rc::ptr_eq(&o.0, &part.0)),
+                _ => false,
+            })
+        });
+    }
+}
+
+/// The `Renderable` module: `Renderable.BasePart(shape)`.
+pub fn module(lua: &Lua) -> mlua::Result<Table> {
+    let renderable = lua.create_table()?;
+    renderable.set(
+        "BasePart",
+        lua.create_function(|_, shape: Value| {
+            let shape = match &shape {
+                Value::Nil => PartShape::Cube,
+                Value::String(s) if &*s.as_bytes() == b"Cube" => PartShape::Cube,
+                Value::String(s) if &*s.as_bytes() == b"Sphere" => PartShape::Sphere,
+                other => return Err(expected("Renderable.BasePart", PartShape::NAMES, other)),
+            };
+            Ok(BasePart(Rc::new(PartState::new(shape))))
+        })?,
+    )?;
+    Ok(renderable)
+}

@@ -1,0 +1,91 @@
+//! Host stand-ins for the `Primitives` module: `Vector` (Luau's native vector type, so
+//! `vector.create` values are Vectors too), `CFrame` and `Dim`.
+
+mod cframe;
+mod dim;
+pub mod rotation;
+
+pub use cframe::CFrame;
+pub use dim::Dim;
+
+use mlua::{Lua, Table, Value};
+
+use crate::convert::{finite_number, new_vector, vector};
+
+/// Builds the `Primitives` table and gives every vector its methods.
+pub fn module(lua: &Lua) -> mlua::Result<Table> {
+    install_vector_metatable(lua)?;
+    let vector_mod = lua.create_table()?;
+    vector_mod.set(
+        "new",
+        lua.create_function(|_, (x, y, z): (Value, Value, Value)| {
+            let comp = |name: &str, v: &Value| match v {
+                Value::Nil => Ok(0.0),
+                v => finite_number(&format!("Vector.new {name}"), v).map(|n| n as f32),
+            };
+            Ok(new_vector([comp("x", &x)?, comp("y", &y)?, comp("z", &z)?]))
+        })?,
+    )?;
+    vector_mod.set("zero", new_vector([0.0; 3]))?;
+    vector_mod.set("one", new_vector([1.0; 3]))?;
+
+    let cframe_mod = lua.create_table()?;
+    cframe_mod.set("new", lua.create_function(cframe::new)?)?;
+    cframe_mod.set("Angles", lua.create_function(cframe::angles)?)?;
+    cframe_mod.set("identity", CFrame::IDENTITY)?;
+
+    let dim_mod = lua.create_table()?;
+    dim_mod.set("new", lua.create_function(dim::new)?)?;
+
+    let primitives = lua.create_table()?;
+    primitives.set("Vector", vector_mod)?;
+    primitives.set("CFrame", cframe_mod)?;
+    primitives.set("Dim", dim_mod)?;
+    Ok(primitives)
+}
+
+/// `.X/.Y/.Z` (any case) and arithmetic are native to Luau vectors; this adds `Magnitude`,
+/// `Unit`, `:Dot`, `:Cross` and `:Lerp` through the vector type's metatable.
+fn install_vector_metatable(lua: &Lua) -> mlua::Result<()> {
+    let dot = lua.create_function(|_, (a, b): (Value, Value)| {
+        let (a, b) = (vec_arg("Vector:Dot", &a)?, vec_arg("Vector:Dot", &b)?);
+        Ok(a[0] * b[0] + a[1] * b[1] + a[2] * b[2])
+    })?;
+    let cross = lua.create_function(|_, (a, b): (Value, Value)| {
+        let (a, b) = (vec_arg("Vector:Cross", &a)?, vec_arg("Vector:Cross", &b)?);
+        Ok(new_vector([
+            a[1] * b[2] - a[2] * b[1],
+            a[2] * b[0] - a[0] * b[2],
+            a[0] * b[1] - a[1] * b[0],
+        ]))
+    })?;
+    let lerp = lua.create_function(|_, (a, b, t): (Value, Value, Value)| {
+        let (a, b) = (vec_arg("Vector:Lerp", &a)?, vec_arg("Vector:Lerp", &b)?);
+        let t = finite_number("Vector:Lerp alpha", &t)? as f32;
+        Ok(new_vector([0, 1, 2].map(|i| a[i] + (b[i] - a[i]) * t)))
+    })?;
+    let index = lua.create_function(move |_, (v, key): (Value, mlua::String)| {
+        let v = vec_arg("Vector", &v)?;
+        let len = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+        match &*key.as_bytes() {
+            b"Magnitude" => Ok(Value::Number(len as f64)),
+            b"Unit" if len > 0.0 => Ok(new_vector(v.map(|c| c / len))),
+            b"Unit" => Ok(new_vector([0.0; 3])),
+            b"Dot" => Ok(Value::Function(dot.clone())),
+            b"Cross" => Ok(Value::Function(cross.clone())),
+            b"Lerp" => Ok(Value::Function(lerp.clone())),
+            other => Err(mlua::Error::runtime(format!(
+                "Vector has no member \"{}\" (members: X, Y, Z, Magnitude, Unit, Dot, Cross, Lerp)",
+                String::from_utf8_lossy(other)
+            ))),
+        }
+    })?;
+    let mt = lua.create_table()?;
+    mt.set("__index", index)?;
+    lua.set_type_metatable::<mlua::Vector>(Some(mt));
+    Ok(())
+}
+
+fn vec_arg(what: &str, v: &Value) -> mlua::Result<[f32; 3]> {
+    vector(v).ok_or_else(|| crate::convert::expected(what, "a Vector", v))
+}

@@ -1,0 +1,66 @@
+//! BasePart properties.
+
+use mlua::{Error as LuaError, Value};
+
+use super::{Get, Kind, Props, Row, Set};
+use crate::convert::sdk_error;
+use crate::part::BasePart;
+
+pub static PART: Props<BasePart> = Props {
+    owner: "BasePart",
+    rows: &[
+        Row {
+            name: "CFrame",
+            kind: Kind::CFrame,
+            get: Get::Fn(|lua, p| Ok(Value::UserData(lua.create_userdata(p.0.cframe())?))),
+            // Writing the CFrame of a simulated part teleports its body (sent with the frame's
+            // batch; the per-tick pass announces the move). Otherwise it just moves the part.
+            set: Set::Fn(|lua, p, a| {
+                let cf = a.cframe()?;
+                match p.0.object() {
+                    Some(object) => object
+                        .set_pose(cf.pose())
+                        .map_err(|e| sdk_error("BasePart.CFrame", e)),
+                    None => {
+                        p.0.store_cframe(cf);
+                        p.0.changed(lua, "CFrame", Value::UserData(lua.create_userdata(cf)?))
+                    }
+                }
+            }),
+        },
+        Row {
+            name: "Size",
+            kind: Kind::PositiveVector,
+            get: Get::Fn(|_, p| Ok(crate::convert::new_vector(p.0.size()))),
+            set: Set::Fn(|lua, p, a| {
+                let size = a.vector()?;
+                if p.0.object().is_some() {
+                    return Err(LuaError::runtime(format!(
+                        "BasePart.Size cannot change while the part is simulated (resizing a \
+                         physics object is not supported yet; assigned Vector({}, {}, {}))",
+                        size[0], size[1], size[2]
+                    )));
+                }
+                p.0.set_size(size);
+                p.0.changed(lua, "Size", crate::convert::new_vector(size))
+            }),
+        },
+        Row {
+            name: "Name",
+            kind: Kind::String,
+            get: Get::Fn(|lua, p| Ok(Value::String(lua.create_string(p.0.name())?))),
+            set: Set::Fn(|lua, p, a| {
+                let name = a.string()?;
+                let value = Value::String(lua.create_string(&name)?);
+                p.0.set_name(name);
+                p.0.changed(lua, "Name", value)
+            }),
+        },
+        Row {
+            name: "Shape",
+            kind: Kind::String,
+            get: Get::Fn(|lua, p| Ok(Value::String(lua.create_string(p.0.shape.name())?))),
+            set: Set::ReadOnly,
+        },
+    ],
+};

@@ -1,0 +1,179 @@
+//! Frames, `wait` and coroutines. Every script thread and signal handler runs as a coroutine;
+//! `wait(s)` yields it with a marker and the scheduler resumes it in the first frame at least
+//! `s` seconds later, returning the time actually waited.
+
+use std::cell::RefCell;
+use std::ffi::c_void;
+use std::rc::{Rc, Weak};
+use std::time::Instant;
+
+use mlua::{Function, LightUserData, Lua, MultiValue, Thread, ThreadStatus, Value};
+
+use crate::convert::{expected, number};
+use crate::part::PartState;
+use crate::signal::Signal;
+
+static WAIT_MARK: u8 = 0;
+
+fn wait_mark() -> LightUserData {
+    LightUserData(&WAIT_MARK as *const u8 as *mut c_void)
+}
+
+struct Waiting {
+    wake_at: f64,
+    since: f64,
+    thread: Thread,
+}
+
+pub struct Scheduler {
+    started: Instant,
+    waiting: RefCell<Vec<Waiting>>,
+    pub heart: Signal,
+    /// Parts whose CFrame change signal exists; probed each frame for listeners.
+    watched: RefCell<Vec<Weak<PartState>>>,
+}
+
+impl Scheduler {
+    pub fn new() -> Scheduler {
+        Scheduler {
+            started: Instant::now(),
+            waiting: RefCell::default(),
+            heart: Signal::new("Heart"),
+            watched: RefCell::default(),
+        }
+    }
+
+    fn clock(&self) -> f64 {
+        self.started.elapsed().as_secs_f64()
+    }
+
+    pub fn watch(&self, part: &Rc<PartState>) {
+        self.watched.borrow_mut().push(Rc::downgrade(part));
+    }
+
+    pub fn pending_waits(&self) -> usize {
+        self.waiting.borrow().len()
+    }
+
+    /// Seconds until the earliest pending `wait` is due (None without waits).
+    pub fn next_wake_in(&self) -> Option<f64> {
+        let now = self.clock();
+        self.waiting
+            .borrow()
+            .iter()
+            .map(|w| (w.wake_at - now).max(0.0))
+            .min_by(f64::total_cmp)
+    }
+
+    /// Whether any per-tick change signal has a listener.
+    pub fn change_listeners(&self) -> bool {
+        self.watched
+            .borrow()
+            .iter()
+            .filter_map(Weak::upgrade)
+            .any(|p| p.cframe_listeners() > 0)
+    }
+
+    /// One frame. Physics results come first: the change signals of simulated parts with
+    /// listeners fire when their pose moved; then due waits resume and `Heart` fires with
+    /// `dt`, so scripts see this frame's poses.
+    pub fn frame(&self, lua: &Lua, dt: f64) -> mlua::Result<()> {
+        let parts: Vec<Rc<PartState>> = {
+            let mut watched = self.watched.borrow_mut();
+            watched.retain(|w| w.strong_count() > 0);
+            watched.iter().filter_map(Weak::upgrade).collect()
+        };
+        for part in parts {
+            // The empty-listener probe: parts nobody listens to cost one length check.
+            if part.cframe_listeners() > 0 {
+                part.fire_cframe_if_moved(lua)?;
+            }
+        }
+        let now = self.clock();
+        let due: Vec<Waiting> = {
+            let mut waiting = self.waiting.borrow_mut();
+            let (due, rest) = std::mem::take(&mut *waiting)
+                .into_iter()
+                .partition(|w| w.wake_at <= now);
+            *waiting = rest;
+            due
+        };
+        for w in due {
+            resume(self, w.thread, (now - w.since).into_lua_multi_value())?;
+        }
+        self.heart
+            .fire(lua, Value::Number(dt).into_lua_multi_value())
+    }
+}
+
+trait IntoMulti {
+    fn into_lua_multi_value(self) -> MultiValue;
+}
+
+impl IntoMulti for Value {
+    fn into_lua_multi_value(self) -> MultiValue {
+        MultiValue::from_iter([self])
+    }
+}
+
+impl IntoMulti for f64 {
+    fn into_lua_multi_value(self) -> MultiValue {
+        Value::Number(self).into_lua_multi_value()
+    }
+}
+
+pub fn scheduler(lua: &Lua) -> Rc<Scheduler> {
+    lua.app_data_ref::<Rc<Scheduler>>()
+        .expect("lua_client::install registers the scheduler")
+        .clone()
+}
+
+/// Runs `f(args)` as a new coroutine; if it waits, the scheduler resumes it later.
+pub fn spawn(lua: &Lua, f: Function, args: MultiValue) -> mlua::Result<()> {
+    let thread = lua.create_thread(f)?;
+    resume(&scheduler(lua), thread, args)
+}
+
+fn resume(sched: &Scheduler, thread: Thread, args: MultiValue) -> mlua::Result<()> {
+    let out: MultiValue = thread.resume(args)?;
+    if thread.status() != ThreadStatus::Resumable {
+        return Ok(());
+    }
+    // Yielded: by `wait` (marker, seconds) or by a bare coroutine.yield (next frame).
+    let delay = match (out.front(), out.get(1)) {
+        (Some(Value::LightUserData(m)), Some(s)) if *m == wait_mark() => number(s).unwrap_or(0.0),
+        _ => 0.0,
+    };
+    let now = sched.clock();
+    sched.waiting.borrow_mut().push(Waiting {
+        wake_at: now + delay,
+        since: now,
+        thread,
+    });
+    Ok(())
+}
+
+/// The global `wait(seconds?)`: a Luau function, since only Luau code can yield here.
+pub fn wait_function(lua: &Lua) -> mlua::Result<Function> {
+    let check = lua.create_function(|_, s: Value| match s {
+        Value::Nil => Ok(0.0),
+        v => match number(&v) {
+            Some(n) if n.is_finite() && n >= 0.0 => Ok(n),
+            _ => Err(expected(
+                "wait",
+                "a non-negative number of seconds (or nothing)",
+                &v,
+            )),
+        },
+    })?;
+    let yield_fn: Function = lua
+        .globals()
+        .get::<mlua::Table>("coroutine")?
+        .get("yield")?;
+    lua.load(
+        "local mark, check, yield = ...\n\
+         return function(seconds) return yield(mark, check(seconds)) end",
+    )
+    .set_name("=wait")
+    .call((wait_mark(), check, yield_fn))
+}

@@ -1,0 +1,122 @@
+//! Signals: `:Connect(fn)` returns a connection with `:Disconnect()`. Each handler runs in a
+//! coroutine of its own, so it may `wait`.
+
+use std::cell::{Cell, RefCell};
+use std::rc::{Rc, Weak};
+
+use mlua::{
+    Function, Lua, MetaMethod, MultiValue, UserData, UserDataFields, UserDataMethods, Value,
+};
+
+use crate::convert::expected;
+use crate::scheduler;
+
+struct Slot {
+    id: u64,
+    handler: Function,
+    once: bool,
+}
+
+#[derive(Default)]
+pub struct SignalInner {
+    name: String,
+    slots: RefCell<Vec<Slot>>,
+    next_id: Cell<u64>,
+}
+
+/// A signal; clones share the same connections.
+#[derive(Clone)]
+pub struct Signal(pub Rc<SignalInner>);
+
+impl Signal {
+    pub fn new(name: impl Into<String>) -> Signal {
+        Signal(Rc::new(SignalInner {
+            name: name.into(),
+            ..Default::default()
+        }))
+    }
+
+    /// How many handlers are connected: the probe that lets per-tick work stop at zero.
+    pub fn listeners(&self) -> usize {
+        self.0.slots.borrow().len()
+    }
+
+    pub fn disconnect_all(&self) {
+        self.0.slots.borrow_mut().clear();
+    }
+
+    fn connect(&self, handler: Function, once: bool) -> Connection {
+        let id = self.0.next_id.get();
+        self.0.next_id.set(id + 1);
+        self.0.slots.borrow_mut().push(Slot { id, handler, once });
+        Connection {
+            signal: Rc::downgrade(&self.0),
+            id,
+        }
+    }
+
+    /// Runs every handler connected now with `args`. Handlers connected while firing wait for
+    /// the next fire; one-shot handlers are removed before they run.
+    pub fn fire(&self, lua: &Lua, args: MultiValue) -> mlua::Result<()> {
+        let handlers: Vec<Function> = {
+            let mut slots = self.0.slots.borrow_mut();
+            let handlers = slots.iter().map(|s| s.handler.clone()).collect();
+            slots.retain(|s| !s.once);
+            handlers
+        };
+        for handler in handlers {
+            scheduler::spawn(lua, handler, args.clone())?;
+        }
+        Ok(())
+    }
+}
+
+fn handler_arg(what: &str, v: Value) -> mlua::Result<Function> {
+    match v {
+        Value::Function(f) => Ok(f),
+        other => Err(expected(what, "a function", &other)),
+    }
+}
+
+impl UserData for Signal {
+    fn add_methods<M: UserDataMethods<Self>>(methods: &mut M) {
+        methods.add_method("Connect", |_, s, f: Value| {
+            Ok(s.connect(handler_arg("Signal:Connect", f)?, false))
+        });
+        methods.add_method("Once", |_, s, f: Value| {
+            Ok(s.connect(handler_arg("Signal:Once", f)?, true))
+        });
+        methods.add_meta_method(MetaMethod::ToString, |_, s, ()| {
+            Ok(format!("Signal {}", s.0.name))
+        });
+    }
+}
+
+/// What `:Connect` returns.
+pub struct Connection {
+    signal: Weak<SignalInner>,
+    id: u64,
+}
+
+impl Connection {
+    fn connected(&self) -> bool {
+        self.signal
+            .upgrade()
+            .is_some_and(|s| s.slots.borrow().iter().any(|slot| slot.id == self.id))
+    }
+}
+
+impl UserData for Connection {
+    fn add_fields<F: UserDataFields<Self>>(fields: &mut F) {
+        fields.add_field_method_get("Connected", |_, c| Ok(c.connected()));
+    }
+
+    fn add_methods<M: UserDataMethods<Self>>(methods: &mut M) {
+        methods.add_method("Disconnect", |_, c, ()| {
+            if let Some(signal) = c.signal.upgrade() {
+                signal.slots.borrow_mut().retain(|slot| slot.id != c.id);
+            }
+            Ok(())
+        });
+    }
+}
