@@ -3,14 +3,56 @@
 
 use std::rc::Rc;
 
-use client_sdk::Object;
-use mlua::{AnyUserData, Lua, MetaMethod, MultiValue, Table, UserData, UserDataMethods, Value};
+use client_sdk::{Object, Pin, Restraint};
+use mlua::{AnyUserData, Lua, MetaMethod, Table, UserData, UserDataMethods, Value};
 
-use crate::convert::{expected, sdk_error};
+use crate::convert::{describe, expected, new_vector, sdk_error};
 
 use crate::part::PartState;
-use crate::props::object::{NOT_YET_METHODS, OBJECT};
+use crate::primitives::rotation;
+use crate::props::object::OBJECT;
 use crate::props::Kind;
+
+/// RotateTo's documented default strength.
+const DEFAULT_STRENGTH: f64 = 8.0;
+const LOCK_FLAGS: [&str; 6] = [
+    "LockX", "LockY", "LockZ", "LockRotX", "LockRotY", "LockRotZ",
+];
+
+/// `FieldRestraint{...}`: a table of the six lock flags; unknown keys and non-booleans fail.
+fn restraint(opts: &Value) -> mlua::Result<Restraint> {
+    let what = "PhysicsObject:FieldRestraint";
+    let Value::Table(t) = opts else {
+        return Err(expected(what, "a table of lock flags", opts));
+    };
+    let mut flags = [None; 6];
+    for pair in t.pairs::<Value, Value>() {
+        let (key, value) = pair?;
+        let name = match &key {
+            Value::String(s) => s.to_string_lossy(),
+            other => describe(other),
+        };
+        let Some(i) = LOCK_FLAGS.iter().position(|f| *f == name) else {
+            return Err(mlua::Error::runtime(format!(
+                "{what}: unknown flag \"{name}\" (expected one of {})",
+                LOCK_FLAGS.join(", ")
+            )));
+        };
+        let Value::Boolean(on) = value else {
+            return Err(expected(&format!("{what} {name}"), "a boolean", &value));
+        };
+        flags[i] = Some(on);
+    }
+    let [lock_x, lock_y, lock_z, lock_rot_x, lock_rot_y, lock_rot_z] = flags;
+    Ok(Restraint {
+        lock_x,
+        lock_y,
+        lock_z,
+        lock_rot_x,
+        lock_rot_y,
+        lock_rot_z,
+    })
+}
 
 pub struct PhysicsObject {
     pub object: Object,
@@ -82,16 +124,84 @@ pub fn methods(lua: &Lua) -> mlua::Result<Table> {
             Ok(())
         })?,
     )?;
-    for &name in NOT_YET_METHODS {
-        t.set(
-            name,
-            lua.create_function(move |_, _: MultiValue| -> mlua::Result<()> {
-                Err(mlua::Error::runtime(format!(
-                    "PhysicsObject:{name} is not supported yet"
-                )))
-            })?,
-        )?;
-    }
+    t.set(
+        "FieldRestraint",
+        lua.create_function(|_, (o, opts): (Value, Value)| {
+            let o = this("PhysicsObject:FieldRestraint", &o)?;
+            let r = restraint(&opts)?;
+            o.live("FieldRestraint")?
+                .field_restraint(r)
+                .map_err(|e| sdk_error("PhysicsObject:FieldRestraint", e))
+        })?,
+    )?;
+    t.set(
+        "RotateTo",
+        lua.create_function(|_, (o, target, strength): (Value, Value, Value)| {
+            let what = "PhysicsObject:RotateTo";
+            let o = this(what, &o)?;
+            let euler = Kind::Vector
+                .convert(&format!("{what} target"), &target)?
+                .vector()?;
+            let strength = match strength {
+                Value::Nil => DEFAULT_STRENGTH,
+                v => Kind::NON_NEGATIVE
+                    .convert(&format!("{what} strength"), &v)?
+                    .number()?,
+            };
+            o.live("RotateTo")?
+                .rotate_to(rotation::from_euler(euler), strength as f32)
+                .map_err(|e| sdk_error(what, e))
+        })?,
+    )?;
+    t.set(
+        "StopRotateTo",
+        lua.create_function(|_, o: Value| {
+            let o = this("PhysicsObject:StopRotateTo", &o)?;
+            o.live("StopRotateTo")?
+                .stop_rotate_to()
+                .map_err(|e| sdk_error("PhysicsObject:StopRotateTo", e))
+        })?,
+    )?;
+    t.set(
+        "SetPin",
+        lua.create_function(
+            |_, (o, force, relative, target): (Value, Value, Value, Value)| {
+                let what = "PhysicsObject:SetPin";
+                let o = this(what, &o)?;
+                let pin = match force {
+                    Value::Nil => None,
+                    force => Some(Pin {
+                        force: Kind::NON_NEGATIVE
+                            .convert(&format!("{what} force"), &force)?
+                            .number()? as f32,
+                        relative: Kind::Vector
+                            .convert(&format!("{what} relative"), &relative)?
+                            .vector()?,
+                        target: Kind::CFrame
+                            .convert(&format!("{what} target"), &target)?
+                            .cframe()?
+                            .pose(),
+                    }),
+                };
+                o.live("SetPin")?
+                    .set_pin(pin)
+                    .map_err(|e| sdk_error(what, e))
+            },
+        )?,
+    )?;
+    // Lua parts are Cube / Sphere (no mesh): this returns the CenterOfMass unchanged.
+    t.set(
+        "RecalculateCenterOfMass",
+        lua.create_function(|_, o: Value| {
+            let what = "PhysicsObject:RecalculateCenterOfMass";
+            let o = this(what, &o)?;
+            let com = o
+                .live("RecalculateCenterOfMass")?
+                .recalculate_center_of_mass()
+                .map_err(|e| sdk_error(what, e))?;
+            Ok(new_vector(com))
+        })?,
+    )?;
     Ok(t)
 }
 

@@ -38,8 +38,9 @@ impl PlaneState {
                 "PhysicsPlane: cannot set {prop:?} on a destroyed plane"
             )));
         }
-        self.plane.set(prop);
-        Ok(())
+        self.plane
+            .set(prop)
+            .map_err(|e| sdk_error("PhysicsPlane", e))
     }
 
     pub fn object_count(&self) -> Result<u32, client_sdk::Error> {

@@ -1,7 +1,8 @@
-//! PhysicsPlane properties (also the options of `PhysicsService.New`). Rows marked `not_yet`
-//! are documented but not in the SDK yet.
+//! PhysicsPlane properties (also the options of `PhysicsService.New`). Options the script
+//! does not cache are read back from the daemon (`plane.info()`, one round trip). Rows marked
+//! `not_yet` are documented but belong to a backend not built yet.
 
-use client_sdk::{PlaneOptions, PlaneProp};
+use client_sdk::{PlaneInfo, PlaneOptions, PlaneProp};
 use mlua::{Error as LuaError, Value};
 
 use super::{Arg, Get, Kind, Props, Row, Set};
@@ -11,6 +12,35 @@ use crate::plane::PlaneState;
 /// Mirrors the daemon's limits so a bad value fails at the assignment, not a frame later.
 const MAX_THREADS: i64 = 64;
 const MAX_TICK_RATE: f64 = 10_000.0;
+
+fn info(p: &PlaneState, what: &str) -> Result<PlaneInfo, LuaError> {
+    p.plane
+        .info()
+        .map_err(|e| sdk_error(&format!("PhysicsPlane.{what}"), e))
+}
+
+/// A number option read back from the daemon's plane info.
+macro_rules! number_row {
+    ($name:literal, $kind:expr, $field:ident, $prop:path) => {
+        Row {
+            name: $name,
+            kind: $kind,
+            get: Get::Fn(|_, p| Ok(Value::Number(info(p, $name)?.$field as f64))),
+            set: Set::Fn(|_, p, a| p.set($prop(a.number()? as f32))),
+        }
+    };
+}
+
+macro_rules! bool_row {
+    ($name:literal, $field:ident, $prop:path) => {
+        Row {
+            name: $name,
+            kind: Kind::Boolean,
+            get: Get::Fn(|_, p| Ok(Value::Boolean(info(p, $name)?.$field))),
+            set: Set::Fn(|_, p, a| p.set($prop(a.bool()?))),
+        }
+    };
+}
 
 pub static PLANE: Props<PlaneState> = Props {
     owner: "PhysicsPlane",
@@ -80,15 +110,50 @@ pub static PLANE: Props<PlaneState> = Props {
             }),
             set: Set::ReadOnly,
         },
-        Row::not_yet("LinearDamping", Kind::NON_NEGATIVE),
-        Row::not_yet("AngularDamping", Kind::NON_NEGATIVE),
-        Row::not_yet("Drag", Kind::NON_NEGATIVE),
-        Row::not_yet("Buoyancy", Kind::ANY_NUMBER),
-        Row::not_yet("ConstantForce", Kind::Vector),
-        Row::not_yet("RestThreshold", Kind::NON_NEGATIVE),
-        Row::not_yet("SolverIterations", Kind::Integer { min: 1, max: 64 }),
-        Row::not_yet("LoopSolver", Kind::Boolean),
-        Row::not_yet("NeverSleep", Kind::Boolean),
+        number_row!(
+            "LinearDamping",
+            Kind::NON_NEGATIVE,
+            linear_damping,
+            PlaneProp::LinearDamping
+        ),
+        number_row!(
+            "AngularDamping",
+            Kind::NON_NEGATIVE,
+            angular_damping,
+            PlaneProp::AngularDamping
+        ),
+        number_row!("Drag", Kind::NON_NEGATIVE, drag, PlaneProp::Drag),
+        number_row!("Buoyancy", Kind::ANY_NUMBER, buoyancy, PlaneProp::Buoyancy),
+        number_row!(
+            "RestThreshold",
+            Kind::NON_NEGATIVE,
+            rest_threshold,
+            PlaneProp::RestThreshold
+        ),
+        Row {
+            name: "ConstantForce",
+            kind: Kind::Vector,
+            get: Get::Fn(|_, p| Ok(new_vector(info(p, "ConstantForce")?.constant_force))),
+            set: Set::Fn(|_, p, a| p.set(PlaneProp::ConstantForce(a.vector()?))),
+        },
+        Row {
+            // Documented as clamped to [1, 64]: any integer is accepted and clamped.
+            name: "SolverIterations",
+            kind: Kind::Integer {
+                min: i64::MIN,
+                max: i64::MAX,
+            },
+            get: Get::Fn(|_, p| {
+                Ok(Value::Number(
+                    info(p, "SolverIterations")?.solver_iterations as f64,
+                ))
+            }),
+            set: Set::Fn(|_, p, a| {
+                p.set(PlaneProp::SolverIterations(a.integer()?.clamp(1, 64) as u32))
+            }),
+        },
+        bool_row!("LoopSolver", loop_solver, PlaneProp::LoopSolver),
+        bool_row!("NeverSleep", never_sleep, PlaneProp::NeverSleep),
         Row::not_yet("DeferGpu", Kind::Boolean),
     ],
 };
