@@ -173,3 +173,65 @@ fn gravity_is_live_editable() {
     let info = scene.plane.info().unwrap();
     assert_eq!(info.gravity, [0.0, 10.0, 0.0]);
 }
+
+#[test]
+fn angular_damping_decays_spin_by_the_documented_factor() {
+    let k = 0.3f32; // the default
+    let scene = Scene::new(
+        "spin",
+        PlaneOptions {
+            gravity: Some([0.0; 3]),
+            ..Default::default()
+        },
+    );
+    let b = ball(
+        &scene,
+        0.0,
+        0.0,
+        &[ObjectProp::AngularVelocity([0.0, 10.0, 0.0])],
+    );
+    let dt = 1.0 / 60.0;
+    scene.run(dt, 120);
+    // ω_n = ω_0 · (1 − k·dt)^n, exactly (f32 rounding only).
+    let expected = 10.0 * (1.0 - k * dt).powi(120);
+    let w = b.angular_velocity().unwrap()[1];
+    assert!((w - expected).abs() < 1e-3, "ω={w}, expected {expected}");
+}
+
+#[test]
+fn a_threaded_plane_simulates_the_same_physics() {
+    let run = |threads: u32| {
+        let scene = Scene::new(
+            "threads",
+            PlaneOptions {
+                threads: Some(threads),
+                ..Default::default()
+            },
+        );
+        scene.floor();
+        let balls: Vec<_> = (0..100)
+            .map(|i| {
+                let (x, z) = ((i % 10) as f32 * 1.5, (i / 10) as f32 * 1.5);
+                scene
+                    .plane
+                    .add(Shape::Sphere { radius: 0.5 }, Pose::at([x, 5.0, z]), &[])
+                    .unwrap()
+            })
+            .collect();
+        scene.run(1.0 / 60.0, 60);
+        assert_eq!(scene.plane.info().unwrap().threads, threads);
+        balls
+            .iter()
+            .map(|b| b.position().unwrap()[1])
+            .collect::<Vec<_>>()
+    };
+    // 100 separated balls land on the floor: same heights whatever the pool size.
+    let one = run(1);
+    let two = run(2);
+    for (a, b) in one.iter().zip(&two) {
+        assert!(
+            (a - b).abs() < 1e-3 && (a - 0.52).abs() < 0.02,
+            "{a} vs {b}"
+        );
+    }
+}
