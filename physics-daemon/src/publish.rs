@@ -47,6 +47,8 @@ struct Changes {
     changed_at: Vec<u64>,
     /// Slots awake at the last publish: they may have moved, or fallen asleep, since.
     awake_before: Vec<usize>,
+    /// Most bodies were awake at the last publish: every slot counted as changed.
+    mostly_awake_before: bool,
     /// Slots touched by commands since the last publish.
     touched: Vec<usize>,
     /// A command touched something it does not name: rewrite every slot.
@@ -75,12 +77,21 @@ impl Changes {
                 *c = seq;
             }
         }
-        for slot in plane.awake_slots() {
-            if let Some(c) = changed_at.get_mut(slot) {
-                *c = seq;
-                self.awake_before.push(slot);
+        // When most bodies are awake, looking up each one costs more than rewriting all.
+        let mostly_awake = plane.awake_count() * 2 >= n;
+        if mostly_awake || self.mostly_awake_before {
+            changed_at.fill(seq);
+            self.awake_before.clear();
+        }
+        if !mostly_awake {
+            for slot in plane.awake_slots() {
+                if let Some(c) = changed_at.get_mut(slot) {
+                    *c = seq;
+                    self.awake_before.push(slot);
+                }
             }
         }
+        self.mostly_awake_before = mostly_awake;
         seq
     }
 
@@ -237,14 +248,14 @@ impl PlaneOutput {
         let payload: &mut [MaybeUninit<BodyState>] = sample.payload_mut();
         let addr = payload.as_ptr() as usize;
         match changes.written_at(addr) {
-            Some(written) => {
+            Some(written) if !changes.mostly_awake_before => {
                 for (i, (dst, changed)) in payload.iter_mut().zip(&changes.changed_at).enumerate() {
                     if *changed > written {
                         dst.write(plane.body_state(i));
                     }
                 }
             }
-            None => {
+            _ => {
                 for (i, dst) in payload.iter_mut().enumerate() {
                     dst.write(plane.body_state(i));
                 }

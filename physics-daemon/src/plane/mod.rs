@@ -273,6 +273,11 @@ impl Plane {
         self.world.active_bodies().map(|(_, body)| body.user_data as usize)
     }
 
+    /// Number of bodies in [`Plane::awake_slots`].
+    pub fn awake_count(&self) -> usize {
+        self.world.islands.num_active_bodies()
+    }
+
     /// The published state of slot `i` (dead slots carry only their generation).
     pub fn body_state(&self, i: usize) -> BodyState {
         let slot = self.slots[i];
