@@ -13,8 +13,7 @@ use iceoryx2::port::publisher::Publisher;
 use iceoryx2::port::update_connections::UpdateConnections;
 use iceoryx2::prelude::*;
 use shm_layout::{
-    monotonic_ns, names, BodyState, Command, CommandResult, EventRecord, PlaneId, Reply,
-    TickHeader,
+    monotonic_ns, names, BodyState, Command, CommandResult, EventRecord, PlaneId, Reply, TickHeader,
 };
 
 use crate::plane::Plane;
@@ -97,7 +96,10 @@ impl Changes {
 
     /// The publish that last wrote the whole sample at `addr`, if it is one we wrote.
     fn written_at(&self, addr: usize) -> Option<u64> {
-        self.samples.iter().find(|(a, _)| *a == addr).map(|(_, s)| *s)
+        self.samples
+            .iter()
+            .find(|(a, _)| *a == addr)
+            .map(|(_, s)| *s)
     }
 
     fn remember(&mut self, addr: usize, seq: u64) {
@@ -399,8 +401,9 @@ mod tests {
             }
             out.publish(&plane).unwrap();
             let sample = reader.receive().unwrap().expect("a sample per publish");
-            let expected: Vec<BodyState> =
-                (0..plane.slot_count()).map(|i| plane.body_state(i)).collect();
+            let expected: Vec<BodyState> = (0..plane.slot_count())
+                .map(|i| plane.body_state(i))
+                .collect();
             assert_eq!(sample.payload(), &expected[..], "tick {tick}");
             asleep_seen |= expected.iter().filter(|b| b.is_sleeping()).count() > 30;
             // Keep a few samples borrowed now and then so the publisher recycles others.

@@ -19,7 +19,9 @@ pub fn cpu_time(pid: u32) -> BenchResult<Duration> {
     };
     // utime and stime are fields 14 and 15 of the line, 12 and 13 after the name.
     let ticks = field(11, "utime")? + field(12, "stime")?;
-    Ok(Duration::from_secs_f64(ticks as f64 / clock_ticks_per_second()))
+    Ok(Duration::from_secs_f64(
+        ticks as f64 / clock_ticks_per_second(),
+    ))
 }
 
 fn clock_ticks_per_second() -> f64 {
@@ -43,8 +45,7 @@ pub fn cpu_percent_over(pid: u32, window: Duration) -> BenchResult<f64> {
 /// Resident set size of `pid` in bytes (VmRSS, which includes the shared memory it touched).
 pub fn rss_bytes(pid: u32) -> BenchResult<u64> {
     let path = format!("/proc/{pid}/status");
-    let status =
-        std::fs::read_to_string(&path).map_err(BenchError::io(format!("read {path}")))?;
+    let status = std::fs::read_to_string(&path).map_err(BenchError::io(format!("read {path}")))?;
     status
         .lines()
         .find_map(|l| l.strip_prefix("VmRSS:"))

@@ -195,9 +195,15 @@ mod tests {
     #[test]
     fn scenes_have_the_asked_body_count() {
         for n in [1, 7, 100, 1000] {
-            let pile = Scene { kind: Kind::Pile, bodies: n };
+            let pile = Scene {
+                kind: Kind::Pile,
+                bodies: n,
+            };
             assert_eq!(pile.spawns().len(), n + 1, "pile has a floor on top");
-            let free = Scene { kind: Kind::Free, bodies: n };
+            let free = Scene {
+                kind: Kind::Free,
+                bodies: n,
+            };
             assert_eq!(free.spawns().len(), n);
         }
     }

@@ -270,7 +270,9 @@ impl Plane {
     /// outside this set has not moved since the step that put it to sleep.
     pub fn awake_slots(&self) -> impl Iterator<Item = usize> + '_ {
         // Every body carries its slot in user_data (set in add_object).
-        self.world.active_bodies().map(|(_, body)| body.user_data as usize)
+        self.world
+            .active_bodies()
+            .map(|(_, body)| body.user_data as usize)
     }
 
     /// Number of bodies in [`Plane::awake_slots`].

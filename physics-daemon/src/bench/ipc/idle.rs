@@ -23,10 +23,17 @@ pub fn run(window: Duration, progress: &Progress) -> BenchResult<IdleCpu> {
     let no_clients = cpu_percent_over(daemon.pid(), window)?;
     progress.done();
 
-    progress.phase(format!("idle CPU, one manual plane ({} s)", window.as_secs()));
+    progress.phase(format!(
+        "idle CPU, one manual plane ({} s)",
+        window.as_secs()
+    ));
     let client = daemon.connect()?;
     let plane = client.create_plane(&PlaneOptions::manual())?;
-    plane.add(Shape::Sphere { radius: 0.5 }, Pose::at([0.0, 1.0, 0.0]), &[])?;
+    plane.add(
+        Shape::Sphere { radius: 0.5 },
+        Pose::at([0.0, 1.0, 0.0]),
+        &[],
+    )?;
     let idle_manual_plane = cpu_percent_over(daemon.pid(), window)?;
     progress.done();
     Ok(IdleCpu {

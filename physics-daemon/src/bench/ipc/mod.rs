@@ -125,7 +125,9 @@ pub fn run(args: &IpcArgs) -> BenchResult<()> {
         idle.no_clients, idle.idle_manual_plane
     ));
 
-    progress.phase(format!("threads: {GOAL_BODIES}-body pile, Threads = 1 vs 2"));
+    progress.phase(format!(
+        "threads: {GOAL_BODIES}-body pile, Threads = 1 vs 2"
+    ));
     let threads = threads::run(GOAL_BODIES)?;
     progress.done();
     progress.note(format!(
@@ -229,10 +231,7 @@ fn goals(r: &IpcReport) -> Vec<Goal> {
             .and_then(|s| s.delivery.get(&kind))
             .map(|d| d.speedup);
         goals.push(Goal {
-            goal: format!(
-                "delivery speedup ≥ 20× at 10,000 bodies ({})",
-                kind.name()
-            ),
+            goal: format!("delivery speedup ≥ 20× at 10,000 bodies ({})", kind.name()),
             value: format!("{}×", report::num(speedup)),
             met: speedup.map(|v| v >= 20.0),
         });
@@ -259,10 +258,7 @@ fn goals(r: &IpcReport) -> Vec<Goal> {
             _ => ("one size only".to_string(), None),
         };
         goals.push(Goal {
-            goal: format!(
-                "zero-copy hand-over flat in body count ({})",
-                kind.name()
-            ),
+            goal: format!("zero-copy hand-over flat in body count ({})", kind.name()),
             value,
             met,
         });

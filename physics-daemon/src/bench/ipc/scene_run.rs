@@ -95,7 +95,10 @@ pub fn run(
     let mut local = scene.build_local(1)?;
     progress.done();
 
-    progress.phase(format!("{label}: settling ({} ticks)", scene.settle_ticks()));
+    progress.phase(format!(
+        "{label}: settling ({} ticks)",
+        scene.settle_ticks()
+    ));
     for _ in 0..scene.settle_ticks() {
         remote.step(DT)?;
         local.step(DT)?;
@@ -133,7 +136,8 @@ fn memory(
 ) -> BenchResult<Memory> {
     let rss = procfs::rss_bytes(daemon.pid())?;
     let (shm, backed) = procfs::shm_bytes(&daemon.domain)?;
-    let per_body = |after: u64, before: u64| after.saturating_sub(before) as f64 / scene.bodies as f64;
+    let per_body =
+        |after: u64, before: u64| after.saturating_sub(before) as f64 / scene.bodies as f64;
     Ok(Memory {
         bodies: scene.bodies,
         scene: scene.kind,

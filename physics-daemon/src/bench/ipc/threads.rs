@@ -47,7 +47,10 @@ pub fn run(bodies: usize) -> BenchResult<Threads> {
         }
     }
     let missing = || BenchError::Failed("no step was timed".into());
-    let (m1, m2) = (median(&t1).ok_or_else(missing)?, median(&t2).ok_or_else(missing)?);
+    let (m1, m2) = (
+        median(&t1).ok_or_else(missing)?,
+        median(&t2).ok_or_else(missing)?,
+    );
     Ok(Threads {
         scene: scene.kind,
         bodies,
