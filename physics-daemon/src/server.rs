@@ -16,7 +16,7 @@ use shm_layout::{
 
 use crate::clients::{Clients, MAX_CLIENTS};
 use crate::plane::Plane;
-use crate::publish::{PlaneOutput, MAX_NODES};
+use crate::publish::{PlaneOutput, Touch, MAX_NODES};
 use crate::DaemonError;
 
 /// How often dead clients are looked for while clients are connected. Without clients the
@@ -271,9 +271,27 @@ impl Daemon {
         let results: Vec<CommandResult> = request
             .commands
             .into_iter()
-            .map(|c| self.execute(client, c))
+            .map(|c| {
+                let touch = Touch::of(&c);
+                let result = self.execute(client, c);
+                self.note_touched(touch, &result);
+                result
+            })
             .collect();
         codec::encode_response(&Response::Results(results))
+    }
+
+    /// Tells the publisher what a command may have changed (it rewrites only changed slots).
+    fn note_touched(&self, touch: Touch, result: &CommandResult) {
+        if touch == Touch::All {
+            for entry in self.planes.values() {
+                entry.out.touched(None);
+            }
+        } else if let Some((plane, slot)) = touch.resolve(result) {
+            if let Some(entry) = self.planes.get(&plane) {
+                entry.out.touched(slot);
+            }
+        }
     }
 
     fn execute(&mut self, client: u128, command: Command) -> CommandResult {

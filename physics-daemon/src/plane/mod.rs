@@ -293,6 +293,20 @@ impl Plane {
         self.slots.len()
     }
 
+    /// Slots of the bodies rapier simulates now (awake dynamic and kinematic ones). A body
+    /// outside this set has not moved since the step that put it to sleep.
+    pub fn awake_slots(&self) -> impl Iterator<Item = usize> + '_ {
+        // Every body carries its slot in user_data (set in add_object).
+        self.world
+            .active_bodies()
+            .map(|(_, body)| body.user_data as usize)
+    }
+
+    /// Number of bodies in [`Plane::awake_slots`].
+    pub fn awake_count(&self) -> usize {
+        self.world.islands.num_active_bodies()
+    }
+
     /// The published state of slot `i` (dead slots carry only their generation).
     pub fn body_state(&self, i: usize) -> BodyState {
         let slot = &self.slots[i];

@@ -1,0 +1,44 @@
+//! `physics-bench`: measures the physics service against in-process physics.
+//!
+//! `physics-bench ipc [--quick] [--out DIR]` writes DIR/ipc.json and DIR/ipc.md. It starts
+//! real `physics-daemon` processes (the binary next to this one) in throw-away domains.
+
+#[path = "../bench/mod.rs"]
+mod bench;
+
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+#[derive(Parser)]
+#[command(version, about = "Benchmarks of the physics service")]
+struct Cli {
+    #[command(subcommand)]
+    command: Bench,
+}
+
+#[derive(Subcommand)]
+enum Bench {
+    /// Daemon overhead over in-process rapier, zero-copy vs socket delivery, request round
+    /// trips, threads, idle CPU and memory.
+    Ipc(bench::ipc::IpcArgs),
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    // In-process planes with Threads = 1 run on rayon's global pool: one worker, as in the
+    // daemon, so both sides of a comparison use one core.
+    let _ = rapier3d::rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build_global();
+    let result = match &cli.command {
+        Bench::Ipc(args) => bench::ipc::run(args),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("physics-bench: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
