@@ -20,7 +20,7 @@ fn settled_pile(n: usize) -> Plane {
     let width = side as f32 * 1.25;
     plane
         .add_object(
-            Shape::Cube {
+            &Shape::Cube {
                 size: [width + 2.0, 1.0, width + 2.0],
             },
             Pose::at([width / 2.0, -0.5, width / 2.0]),
@@ -33,7 +33,7 @@ fn settled_pile(n: usize) -> Plane {
         let z = (column / side) as f32 * 1.25 + 0.5;
         plane
             .add_object(
-                Shape::Cube { size: [1.0; 3] },
+                &Shape::Cube { size: [1.0; 3] },
                 Pose::at([x, 0.5 + layer as f32, z]),
                 &[],
             )
@@ -53,7 +53,7 @@ fn awake(n: usize) -> Plane {
         let p = [(i % 32) as f32, ((i / 32) % 32) as f32, (i / 1024) as f32].map(|c| c * 3.0);
         plane
             .add_object(
-                Shape::Cube { size: [1.0; 3] },
+                &Shape::Cube { size: [1.0; 3] },
                 Pose::at(p),
                 &[ObjectProp::Velocity([0.1, 0.2, 0.3])],
             )

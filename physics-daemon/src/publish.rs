@@ -135,14 +135,14 @@ impl Touch {
             | Command::CreatePlane { .. }
             | Command::PlaneInfo { .. }
             | Command::Step { .. }
+            | Command::ObjectInfo { .. }
             | Command::DestroyPlane { .. } => Touch::Nothing,
             Command::SetObject { plane, object, .. }
             | Command::ApplyImpulse { plane, object, .. }
+            | Command::RecalculateCenterOfMass { plane, object }
             | Command::DestroyObject { plane, object } => Touch::Slot(*plane, object.slot),
             Command::AddObject { plane, .. } => Touch::Created(*plane),
             Command::SetPlane { plane, .. } => Touch::Plane(*plane),
-            #[allow(unreachable_patterns)]
-            _ => Touch::All,
         }
     }
 
@@ -307,7 +307,7 @@ mod tests {
             Command::AddObject {
                 shape, pose, props, ..
             } => plane
-                .add_object(shape, pose, &props)
+                .add_object(&shape, pose, &props)
                 .map(|handle| Reply::Object { handle, tick: 0 }),
             other => panic!("not used here: {other:?}"),
         };
@@ -330,7 +330,7 @@ mod tests {
         let cube = Shape::Cube { size: [1.0; 3] };
         plane
             .add_object(
-                Shape::Cube {
+                &Shape::Cube {
                     size: [40.0, 1.0, 40.0],
                 },
                 Pose::at([0.0, -0.5, 0.0]),
@@ -340,7 +340,7 @@ mod tests {
         let mut handles: Vec<Handle> = (0..60)
             .map(|i| {
                 let (x, y) = ((i / 3) as f32 * 1.5 - 15.0, 0.5 + (i % 3) as f32);
-                plane.add_object(cube, Pose::at([x, y, 0.0]), &[]).unwrap()
+                plane.add_object(&cube, Pose::at([x, y, 0.0]), &[]).unwrap()
             })
             .collect();
         let out = PlaneOutput::new(&node, plane.id).unwrap();
@@ -387,7 +387,7 @@ mod tests {
                         &out,
                         Command::AddObject {
                             plane: 1,
-                            shape: cube,
+                            shape: cube.clone(),
                             pose: Pose::at([3.0, 6.0, 3.0]),
                             props: vec![],
                         },

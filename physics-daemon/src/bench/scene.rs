@@ -123,7 +123,7 @@ impl Scene {
     pub fn build_local(&self, threads: u32) -> BenchResult<LocalPlane> {
         let mut plane = LocalPlane::new(1, 0, &self.plane_props(threads))?;
         for s in self.spawns() {
-            plane.add_object(s.shape, s.pose, &s.props)?;
+            plane.add_object(&s.shape, s.pose, &s.props)?;
         }
         Ok(plane)
     }
@@ -142,7 +142,7 @@ impl Scene {
             }),
             threads: Some(threads),
             tick_rate: Some(0.0),
-            enabled: None,
+            ..Default::default()
         };
         let plane = client.create_plane(&options)?;
         let mut objects = Vec::with_capacity(self.bodies + 1);

@@ -207,7 +207,7 @@ fn delivery(
     local: &LocalPlane,
 ) -> BenchResult<Delivery> {
     // Zero-copy: the plane ticks on its own timer; we wait for each tick like a game would.
-    remote.set(PlaneProp::TickRate(60.0));
+    remote.set(PlaneProp::TickRate(60.0))?;
     client.flush()?;
     let mut zero_copy = Vec::new();
     let deadline = Instant::now() + plan.delivery_time_cap;
@@ -223,7 +223,7 @@ fn delivery(
             zero_copy.push(held.saturating_sub(snap.header().tick_end_ns) as f64 / 1e3);
         }
     }
-    remote.set(PlaneProp::TickRate(0.0));
+    remote.set(PlaneProp::TickRate(0.0))?;
     client.flush()?;
 
     let socket = socket::delivery_us(local, zero_copy.len().max(3))?;
