@@ -122,6 +122,21 @@ fn automatic_ticks_follow_the_tick_rate() {
         (h.sim_time - h.tick as f64 / 100.0).abs() < 1e-6,
         "each tick advances 1/100 s"
     );
+    // A polling wait sees each next tick too, and falls back to sleeping after its spin.
+    let polled = plane
+        .wait_tick_spin(
+            std::time::Duration::from_secs(2),
+            std::time::Duration::from_millis(20),
+        )
+        .unwrap();
+    assert!(polled > last, "{polled} after {last}");
+    let slept = plane
+        .wait_tick_spin(
+            std::time::Duration::from_secs(2),
+            std::time::Duration::from_micros(1),
+        )
+        .unwrap();
+    assert!(slept > polled, "{slept} after {polled}");
     // Disabling stops the ticks.
     plane.set(PlaneProp::Enabled(false)).unwrap();
     client.flush().unwrap();

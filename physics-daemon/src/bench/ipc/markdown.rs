@@ -33,7 +33,10 @@ pub fn method() -> BTreeMap<&'static str, &'static str> {
              gathered from the same world into a Vec, serialised with postcard, written to a \
              Unix socket; another thread reads, deserialises and reads every pose. publish_us: \
              the daemon's PlaneOutput::publish on the same world, timed in process; \
-             handover_us = zero_copy_us - publish_us.",
+             handover_us = zero_copy_us - publish_us. The *_poll figures repeat both with \
+             readers that poll instead of sleeping (Plane::wait_tick_spin on the shared-memory \
+             queue; a non-blocking socket read loop): the data path without the wake-up \
+             latency of the scheduler, which dominates the sleeping figures on this machine.",
         ),
         (
             "round_trip_us",
@@ -92,6 +95,10 @@ pub fn render(r: &IpcReport) -> String {
         "speedup",
         "publish_us",
         "handover_us",
+        "zero_copy_poll_us",
+        "socket_serde_poll_us",
+        "speedup_poll",
+        "handover_poll_us",
     ]);
     for s in &r.scenes {
         for kind in [Kind::Pile, Kind::Free] {
@@ -110,6 +117,10 @@ pub fn render(r: &IpcReport) -> String {
                 format!("{}×", num(Some(d.speedup))),
                 num(Some(d.publish_us)),
                 num(Some(d.handover_us)),
+                num(Some(d.zero_copy_poll_us)),
+                num(Some(d.socket_serde_poll_us)),
+                format!("{}×", num(Some(d.speedup_poll))),
+                num(Some(d.handover_poll_us)),
             ]);
         }
     }

@@ -43,6 +43,13 @@ pub struct Delivery {
     pub publish_us: f64,
     /// `zero_copy_us - publish_us`: the hand-over itself (notify, wake, read).
     pub handover_us: f64,
+    /// The same three with readers that poll instead of sleeping (the zero-copy client
+    /// spins on its shared-memory queue, the socket reader on a non-blocking socket): the
+    /// data path without the scheduler's wake-up latency.
+    pub zero_copy_poll_us: f64,
+    pub socket_serde_poll_us: f64,
+    pub speedup_poll: f64,
+    pub handover_poll_us: f64,
     pub ticks: usize,
 }
 
@@ -206,32 +213,25 @@ fn delivery(
     remote: &client_sdk::Plane,
     local: &LocalPlane,
 ) -> BenchResult<Delivery> {
-    // Zero-copy: the plane ticks on its own timer; we wait for each tick like a game would.
+    // Zero-copy: the plane ticks on its own timer; we wait for each tick like a game would,
+    // sleeping on the tick event, then again polling the queue.
     remote.set(PlaneProp::TickRate(60.0))?;
     client.flush()?;
-    let mut zero_copy = Vec::new();
-    let deadline = Instant::now() + plan.delivery_time_cap;
-    let mut seen = 0;
-    while zero_copy.len() < plan.delivery_ticks && Instant::now() < deadline {
-        remote.wait_tick(Duration::from_secs(10))?;
-        let snap: Snapshot = remote.snapshot()?;
-        std::hint::black_box(touch(snap.bodies()));
-        let held = monotonic_ns();
-        // The first ticks after switching to the timer include the switch itself.
-        seen += 1;
-        if seen > 2 {
-            zero_copy.push(held.saturating_sub(snap.header().tick_end_ns) as f64 / 1e3);
-        }
-    }
+    let zero_copy = zero_copy_us(plan, remote, Duration::ZERO)?;
+    let zero_copy_poll = zero_copy_us(plan, remote, FRAME)?;
     remote.set(PlaneProp::TickRate(0.0))?;
     client.flush()?;
 
-    let socket = socket::delivery_us(local, zero_copy.len().max(3))?;
-    let publish = publish_us(local, zero_copy.len().max(3))?;
+    let n = zero_copy.len().max(3);
+    let socket = socket::delivery_us(local, n, false)?;
+    let socket_poll = socket::delivery_us(local, n, true)?;
+    let publish = publish_us(local, n)?;
 
-    let zero_copy_us = median(&zero_copy)
-        .ok_or_else(|| BenchError::Failed("no tick was delivered in the time allowed".into()))?;
+    let none = || BenchError::Failed("no tick was delivered in the time allowed".into());
+    let zero_copy_us = median(&zero_copy).ok_or_else(none)?;
+    let zero_copy_poll_us = median(&zero_copy_poll).ok_or_else(none)?;
     let socket_serde_us = median(&socket).unwrap_or(f64::NAN);
+    let socket_serde_poll_us = median(&socket_poll).unwrap_or(f64::NAN);
     let publish_us = median(&publish).unwrap_or(f64::NAN);
     Ok(Delivery {
         zero_copy_us,
@@ -239,8 +239,34 @@ fn delivery(
         speedup: socket_serde_us / zero_copy_us,
         publish_us,
         handover_us: (zero_copy_us - publish_us).max(0.0),
+        zero_copy_poll_us,
+        socket_serde_poll_us,
+        speedup_poll: socket_serde_poll_us / zero_copy_poll_us,
+        handover_poll_us: (zero_copy_poll_us - publish_us).max(0.0),
         ticks: zero_copy.len(),
     })
+}
+
+/// One tick interval at 60 Hz: a polling reader spins at most this long before sleeping.
+const FRAME: Duration = Duration::from_micros(16_667);
+
+/// Tick end → every pose read, for each tick delivered within the plan's limits.
+fn zero_copy_us(plan: &Plan, remote: &client_sdk::Plane, spin: Duration) -> BenchResult<Vec<f64>> {
+    let mut times = Vec::new();
+    let deadline = Instant::now() + plan.delivery_time_cap;
+    let mut seen = 0;
+    while times.len() < plan.delivery_ticks && Instant::now() < deadline {
+        remote.wait_tick_spin(Duration::from_secs(10), spin)?;
+        let snap: Snapshot = remote.snapshot()?;
+        std::hint::black_box(touch(snap.bodies()));
+        let held = monotonic_ns();
+        // The first ticks after a switch include the switch itself.
+        seen += 1;
+        if seen > 2 {
+            times.push(held.saturating_sub(snap.header().tick_end_ns) as f64 / 1e3);
+        }
+    }
+    Ok(times)
 }
 
 /// The daemon's publish code on the in-process world, into shared memory of a domain of its

@@ -24,9 +24,13 @@ struct WireBody {
 
 /// Time from "tick end" (just before gathering) until the receiving thread holds every pose,
 /// in microseconds, for `ticks` messages. Messages go at 60 Hz, the zero-copy side's tick
-/// rate, so the receiver waits blocked in `read` just as the zero-copy client waits for a tick.
-pub fn delivery_us(plane: &LocalPlane, ticks: usize) -> BenchResult<Vec<f64>> {
+/// rate, so the receiver waits for each like the zero-copy client waits for a tick: blocked
+/// in `read`, or, with `poll`, spinning on a non-blocking socket (as the zero-copy client
+/// spins on its shared-memory queue).
+pub fn delivery_us(plane: &LocalPlane, ticks: usize, poll: bool) -> BenchResult<Vec<f64>> {
     let (mut tx, rx) = UnixStream::pair().map_err(BenchError::io("create a socket pair"))?;
+    rx.set_nonblocking(poll)
+        .map_err(BenchError::io("set the receiver's blocking mode"))?;
     let receiver = std::thread::spawn(move || receive(rx, ticks));
     let mut wire: Vec<WireBody> = Vec::new();
     let mut ack = [0u8; 1];
@@ -71,13 +75,11 @@ fn receive(mut rx: UnixStream, ticks: usize) -> BenchResult<Vec<f64>> {
     let mut buf = Vec::new();
     let mut header = [0u8; 16];
     for _ in 0..ticks {
-        rx.read_exact(&mut header)
-            .map_err(BenchError::io("read a pose message header"))?;
+        read_full(&mut rx, &mut header).map_err(BenchError::io("read a pose message header"))?;
         let len = u64::from_le_bytes(header[..8].try_into().unwrap_or_default()) as usize;
         let tick_end = u64::from_le_bytes(header[8..].try_into().unwrap_or_default());
         buf.resize(len, 0);
-        rx.read_exact(&mut buf)
-            .map_err(BenchError::io("read a pose message"))?;
+        read_full(&mut rx, &mut buf).map_err(BenchError::io("read a pose message"))?;
         let poses: Vec<WireBody> = postcard::from_bytes(&buf)
             .map_err(|e| BenchError::Failed(format!("deserialise poses: {e}")))?;
         let sum: f32 = poses
@@ -90,4 +92,18 @@ fn receive(mut rx: UnixStream, ticks: usize) -> BenchResult<Vec<f64>> {
             .map_err(BenchError::io("acknowledge a pose message"))?;
     }
     Ok(latencies)
+}
+
+/// `read_exact` that also works on a non-blocking socket, spinning while nothing is there.
+fn read_full(rx: &mut UnixStream, mut buf: &mut [u8]) -> std::io::Result<()> {
+    while !buf.is_empty() {
+        match rx.read(buf) {
+            Ok(0) => return Err(std::io::ErrorKind::UnexpectedEof.into()),
+            Ok(n) => buf = &mut buf[n..],
+            Err(e) if e.kind() == std::io::ErrorKind::WouldBlock => std::hint::spin_loop(),
+            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
+            Err(e) => return Err(e),
+        }
+    }
+    Ok(())
 }
