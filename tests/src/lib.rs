@@ -216,3 +216,20 @@ pub fn angle_between(a: [f32; 4], b: [f32; 4]) -> f32 {
     let dot: f32 = a.iter().zip(b).map(|(x, y)| x * y).sum();
     2.0 * dot.abs().min(1.0).acos()
 }
+
+/// Plane options without damping: for closed forms that have none.
+pub fn no_damping() -> client_sdk::PlaneOptions {
+    client_sdk::PlaneOptions {
+        linear_damping: Some(0.0),
+        angular_damping: Some(0.0),
+        ..Default::default()
+    }
+}
+
+/// No damping and no gravity.
+pub fn zero_gravity() -> client_sdk::PlaneOptions {
+    client_sdk::PlaneOptions {
+        gravity: Some([0.0; 3]),
+        ..no_damping()
+    }
+}

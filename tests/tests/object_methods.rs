@@ -2,24 +2,9 @@
 //! RecalculateCenterOfMass, mesh hulls, Unlink, Destroy, Alive, ObjectCount, solver options.
 
 use client_sdk::{ObjectProp, Pin, PlaneOptions, PlaneProp, Pose, Restraint, Shape};
-use integration_tests::{angle_between, quat, Scene};
+use integration_tests::{angle_between, no_damping, quat, zero_gravity, Scene};
 
 const G: f32 = 50.0;
-
-fn quiet() -> PlaneOptions {
-    PlaneOptions {
-        linear_damping: Some(0.0),
-        angular_damping: Some(0.0),
-        ..Default::default()
-    }
-}
-
-fn zero_g() -> PlaneOptions {
-    PlaneOptions {
-        gravity: Some([0.0; 3]),
-        ..quiet()
-    }
-}
 
 fn cube(scene: &Scene, at: [f32; 3], props: &[ObjectProp]) -> client_sdk::Object {
     scene
@@ -30,7 +15,7 @@ fn cube(scene: &Scene, at: [f32; 3], props: &[ObjectProp]) -> client_sdk::Object
 
 #[test]
 fn field_restraint_locks_axes_and_leaves_unspecified_flags() {
-    let scene = Scene::new("locks", quiet());
+    let scene = Scene::new("locks", no_damping());
     let b = cube(&scene, [0.0, 10.0, 0.0], &[ObjectProp::HitBoxQuality(2)]);
     b.field_restraint(Restraint {
         lock_y: Some(true),
@@ -71,7 +56,7 @@ fn field_restraint_locks_axes_and_leaves_unspecified_flags() {
 
 #[test]
 fn rotate_to_converges_exponentially_and_stop_leaves_the_spin() {
-    let scene = Scene::new("rotate", zero_g());
+    let scene = Scene::new("rotate", zero_gravity());
     // A quality-1 cube: rotation locked against contacts, but direct rotation works.
     let b = cube(&scene, [0.0; 3], &[]);
     let target = quat([0.0, 1.0, 0.0], std::f32::consts::FRAC_PI_2);
@@ -97,7 +82,7 @@ fn rotate_to_converges_exponentially_and_stop_leaves_the_spin() {
 
 #[test]
 fn set_pin_pulls_light_bodies_to_the_target_and_cannot_lift_heavy_ones() {
-    let scene = Scene::new("pin", quiet());
+    let scene = Scene::new("pin", no_damping());
     scene.floor();
     let light = cube(&scene, [0.0, 0.52, 0.0], &[ObjectProp::HitBoxQuality(2)]);
     let heavy = cube(
@@ -160,7 +145,7 @@ fn wedge() -> Shape {
 
 #[test]
 fn mesh_parts_collide_as_their_hull_and_recalculate_their_center_of_mass() {
-    let scene = Scene::new("mesh", quiet());
+    let scene = Scene::new("mesh", no_damping());
     scene.floor();
     let m = scene
         .plane
@@ -195,7 +180,7 @@ fn mesh_parts_collide_as_their_hull_and_recalculate_their_center_of_mass() {
 
 #[test]
 fn unlink_destroy_alive_and_object_count() {
-    let scene = Scene::new("life", quiet());
+    let scene = Scene::new("life", no_damping());
     let a = cube(&scene, [0.0, 10.0, 0.0], &[]);
     let b = cube(&scene, [5.0, 10.0, 0.0], &[]);
     assert_eq!(scene.plane.object_count().unwrap(), 2);

@@ -2,24 +2,9 @@
 //! CanCollide, HitBoxQuality, Size, CenterOfMass, ImpulseDirection, ConstantForce, CFrame.
 
 use client_sdk::{ObjectProp, PlaneOptions, Pose, Shape, ShapeKind};
-use integration_tests::{angle_between, quat, Scene};
+use integration_tests::{angle_between, no_damping, quat, zero_gravity, Scene};
 
 const G: f32 = 50.0;
-
-fn no_damping() -> PlaneOptions {
-    PlaneOptions {
-        linear_damping: Some(0.0),
-        angular_damping: Some(0.0),
-        ..Default::default()
-    }
-}
-
-fn zero_g() -> PlaneOptions {
-    PlaneOptions {
-        gravity: Some([0.0; 3]),
-        ..no_damping()
-    }
-}
 
 fn cube(scene: &Scene, size: f32, at: [f32; 3], props: &[ObjectProp]) -> client_sdk::Object {
     scene
@@ -54,7 +39,7 @@ fn weight_scales_impulses_but_not_free_fall() {
 
 #[test]
 fn density_sets_mass_from_volume_and_wins_over_weight() {
-    let scene = Scene::new("density", zero_g());
+    let scene = Scene::new("density", zero_gravity());
     let b = cube(&scene, 2.0, [0.0; 3], &[ObjectProp::Weight(5.0)]);
     let info = b.info().unwrap();
     assert_eq!(info.mass, 5.0);
@@ -148,7 +133,7 @@ fn rest_threshold_stops_slow_contacts_from_bouncing() {
             "rest",
             PlaneOptions {
                 rest_threshold: Some(threshold),
-                ..zero_g()
+                ..zero_gravity()
             },
         );
         scene.floor();
@@ -357,7 +342,7 @@ fn center_of_mass_beyond_the_edge_tips_the_box() {
 
 #[test]
 fn impulse_direction_is_a_mass_independent_acceleration_and_constant_force_is_a_force() {
-    let scene = Scene::new("drive", zero_g());
+    let scene = Scene::new("drive", zero_gravity());
     let a = sphere(
         &scene,
         0.5,
@@ -398,7 +383,7 @@ fn impulse_direction_is_a_mass_independent_acceleration_and_constant_force_is_a_
 
 #[test]
 fn cframe_write_teleports_and_velocities_read_back() {
-    let scene = Scene::new("cframe", zero_g());
+    let scene = Scene::new("cframe", zero_gravity());
     let b = cube(&scene, 1.0, [0.0; 3], &[]);
     let rot = quat([0.0, 1.0, 0.0], 1.0);
     b.set_pose(Pose {
