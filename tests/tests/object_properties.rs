@@ -406,3 +406,31 @@ fn cframe_write_teleports_and_velocities_read_back() {
     assert!((turned - 0.5).abs() < 1e-3, "turned {turned}");
     assert_eq!(b.info().unwrap().shape, ShapeKind::Cube);
 }
+
+#[test]
+fn continuous_collision_above_quality_one_stops_a_bullet_at_a_thin_wall() {
+    // 300 u/s at 60 Hz travels 5 units a tick: 50 times the wall's thickness. The wall is a
+    // heavy dynamic body: rapier catches fast bodies against fixed ones on its own, against
+    // moving ones only with CCD.
+    let run = |quality: u32| {
+        let scene = Scene::new("bullet", zero_gravity());
+        cube(&scene, 1.0, [0.0; 3], &[ObjectProp::Weight(1000.0)])
+            .set_size([0.1, 10.0, 10.0])
+            .unwrap();
+        let b = sphere(
+            &scene,
+            0.1,
+            [-3.0, 0.0, 0.0],
+            &[
+                ObjectProp::HitBoxQuality(quality),
+                ObjectProp::Velocity([300.0, 0.0, 0.0]),
+            ],
+        );
+        scene.run(1.0 / 60.0, 10);
+        b.position().unwrap()[0]
+    };
+    let x = run(4);
+    assert!(x < 0.0, "quality 4 tunnelled to x={x}");
+    let x = run(1);
+    assert!(x > 0.0, "quality 1 has no CCD against moving bodies: x={x}");
+}
