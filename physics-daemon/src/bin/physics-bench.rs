@@ -2,6 +2,9 @@
 //!
 //! `physics-bench ipc [--quick] [--out DIR]` writes DIR/ipc.json and DIR/ipc.md. It starts
 //! real `physics-daemon` processes (the binary next to this one) in throw-away domains.
+//!
+//! `physics-bench accuracy [--quick] [--out DIR]` writes DIR/accuracy.json, DIR/accuracy.md
+//! and DIR/accuracy-*.svg: error against cost of reference scenes, in process.
 
 #[path = "../bench/mod.rs"]
 mod bench;
@@ -22,6 +25,9 @@ enum Bench {
     /// Daemon overhead over in-process rapier, zero-copy vs socket delivery, request round
     /// trips, threads, idle CPU and memory.
     Ipc(bench::ipc::IpcArgs),
+    /// Error against run time on reference scenes with exact answers, swept over TickRate,
+    /// SolverIterations / LoopSolver and HitBoxQuality.
+    Accuracy(bench::accuracy::AccuracyArgs),
 }
 
 fn main() -> ExitCode {
@@ -33,6 +39,7 @@ fn main() -> ExitCode {
         .build_global();
     let result = match &cli.command {
         Bench::Ipc(args) => bench::ipc::run(args),
+        Bench::Accuracy(args) => bench::accuracy::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
