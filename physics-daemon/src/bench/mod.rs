@@ -20,4 +20,5 @@ pub mod progress;
 pub mod report;
 pub mod scene;
 pub mod sim;
+pub mod stability;
 pub mod stats;

@@ -70,6 +70,8 @@ pub struct Sim {
     pub dt: f32,
     steps: u64,
     step_wall: Duration,
+    /// Set once any body was non-finite after a step (checked outside the timed part).
+    pub went_nonfinite: bool,
 }
 
 impl Sim {
@@ -87,6 +89,7 @@ impl Sim {
             dt: config.dt(),
             steps: 0,
             step_wall: Duration::ZERO,
+            went_nonfinite: false,
         })
     }
 
@@ -117,6 +120,9 @@ impl Sim {
         self.plane.step(self.dt)?;
         self.step_wall += started.elapsed();
         self.steps += 1;
+        if !self.went_nonfinite && !self.all_finite() {
+            self.went_nonfinite = true;
+        }
         Ok(())
     }
 
@@ -140,6 +146,14 @@ impl Sim {
     /// Wall seconds of step calls per simulated second.
     pub fn cost(&self) -> f64 {
         self.step_wall.as_secs_f64() / self.time().max(f64::MIN_POSITIVE)
+    }
+
+    /// Steps covering `seconds`.
+    pub fn run_for(&mut self, seconds: f32) -> BenchResult<()> {
+        for _ in 0..self.steps_for(seconds) {
+            self.step()?;
+        }
+        Ok(())
     }
 
     /// Whether every body's pose and velocities are finite.

@@ -5,6 +5,7 @@
 //!
 //! `physics-bench accuracy [--quick] [--out DIR]` writes DIR/accuracy.json, DIR/accuracy.md
 //! and DIR/accuracy-*.svg: error against cost of reference scenes, in process.
+//! `physics-bench stability [--out DIR]` writes DIR/stability.json and DIR/stability.md.
 
 #[path = "../bench/mod.rs"]
 mod bench;
@@ -28,6 +29,9 @@ enum Bench {
     /// Error against run time on reference scenes with exact answers, swept over TickRate,
     /// SolverIterations / LoopSolver and HitBoxQuality.
     Accuracy(bench::accuracy::AccuracyArgs),
+    /// Stress scenes (tall stacks, mass ratios, fast bodies, overlap, far from the origin,
+    /// tiny objects, extreme forces and tick rates), each with a pass criterion.
+    Stability(bench::stability::StabilityArgs),
 }
 
 fn main() -> ExitCode {
@@ -40,6 +44,7 @@ fn main() -> ExitCode {
     let result = match &cli.command {
         Bench::Ipc(args) => bench::ipc::run(args),
         Bench::Accuracy(args) => bench::accuracy::run(args),
+        Bench::Stability(args) => bench::stability::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -3,10 +3,10 @@
 //! daemon steps), so the cost is the step calls alone, without IPC.
 
 mod chart;
-mod markdown;
+pub mod markdown;
 mod pareto;
 mod scenes;
-mod sweep;
+pub mod sweep;
 
 use std::path::PathBuf;
 
