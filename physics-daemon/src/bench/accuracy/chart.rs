@@ -39,8 +39,7 @@ fn floor_of(points: &[&Point]) -> f64 {
         .map(|p| p.error)
         .filter(|e| e.is_finite() && *e > 0.0)
         .fold(f64::INFINITY, f64::min)
-        .min(1.0)
-        .max(1e-12)
+        .clamp(1e-12, 1.0)
         / 10.0
 }
 
@@ -61,7 +60,17 @@ fn draw(path: &Path, name: &str, points: &[&Point]) -> Result<(), Box<dyn std::e
     let root = SVGBackend::new(path, (820, 560)).into_drawing_area();
     root.fill(&WHITE)?;
     let mut chart = ChartBuilder::on(&root)
-        .caption(format!("{name}: error vs cost"), ("sans-serif", 22))
+        .caption(
+            format!(
+                "{name}: error vs cost{}",
+                if usable.iter().any(|p| p.error == 0.0) {
+                    " (error 0 drawn at the bottom edge)"
+                } else {
+                    ""
+                }
+            ),
+            ("sans-serif", 20),
+        )
         .margin(12)
         .x_label_area_size(44)
         .y_label_area_size(72)

@@ -19,8 +19,8 @@ use super::stats::median;
 /// Options of the `accuracy` subcommand.
 #[derive(Debug, Clone, clap::Args)]
 pub struct AccuracyArgs {
-    /// The three families only, 3 repeats (under 2 minutes); otherwise also the full
-    /// TickRate × SolverIterations × HitBoxQuality cross product, 5 repeats.
+    /// The three families only, 5 repeats (under 2 minutes); otherwise also the full
+    /// TickRate × SolverIterations × HitBoxQuality cross product, 9 repeats.
     #[arg(long)]
     pub quick: bool,
     /// Folder receiving accuracy.json, accuracy.md and accuracy-*.svg.
@@ -46,7 +46,7 @@ pub struct Point {
 
 pub fn run(args: &AccuracyArgs) -> BenchResult<()> {
     let configs = sweep::configs(!args.quick);
-    let repeats = if args.quick { 3 } else { 5 };
+    let repeats = if args.quick { 5 } else { 9 };
     let progress = Progress::new((scenes::SCENES.len() * configs.len()) as u64);
     progress.note(format!(
         "accuracy: {} scenes × {} configurations × {repeats} repeats, in process",
