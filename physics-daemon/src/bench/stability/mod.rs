@@ -47,7 +47,8 @@ pub struct Entry {
     /// For a scene failing at its configuration: the cheapest candidate that passes
     /// (`None` with `remedy_searched` when none does).
     pub remedy: Option<Remedy>,
-    pub remedy_searched: bool,
+    /// Configurations tried for a remedy (0: the scene passed).
+    pub remedy_candidates: usize,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub critical_default: Option<f64>,
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -56,21 +57,18 @@ pub struct Entry {
     pub points: Vec<SweepPoint>,
 }
 
-/// Configurations tried on a failing scene: the accuracy families and the strongest.
-fn candidates() -> Vec<Config> {
-    let mut v = configs::configs(false);
-    v.push(Config {
-        tick_rate: 240,
-        ..Config::DEFAULT
-    });
-    v.push(Config {
-        tick_rate: 240,
-        solver_iterations: 64,
-        loop_solver: true,
-        ..Config::DEFAULT
-    });
-    v.push(Config::STRONGEST);
-    v.dedup();
+/// Configurations tried on a scene failing at `at`: the whole TickRate × SolverIterations ×
+/// HitBoxQuality grid of the accuracy bench (the strongest configuration included). A scene
+/// about a tick rate keeps its tick rate.
+fn candidates(at: Config) -> Vec<Config> {
+    let mut v = configs::configs(true);
+    if at.tick_rate != Config::DEFAULT.tick_rate {
+        for c in &mut v {
+            c.tick_rate = at.tick_rate;
+        }
+        v.sort();
+        v.dedup();
+    }
     v
 }
 
@@ -88,7 +86,7 @@ pub fn run(args: &StabilityArgs) -> BenchResult<()> {
                 "{}: searching a configuration that passes",
                 scene.name
             ));
-            remedy = find_remedy(scene.run)?;
+            remedy = Some(find_remedy(scene.run, scene.config)?);
         }
         progress.note(format!(
             "{:<24} {} ({:.3e} vs bound {:.3e})",
@@ -172,7 +170,7 @@ pub fn run(args: &StabilityArgs) -> BenchResult<()> {
             finite: points.iter().all(|p| p.check.finite),
             cost,
             remedy: None,
-            remedy_searched: false,
+            remedy_candidates: 0,
             critical_default,
             critical_strongest,
             points,
@@ -197,7 +195,7 @@ fn entry(
     unit: &'static str,
     config: Config,
     check: Check,
-    remedy: Option<Remedy>,
+    remedy: Option<(Option<Remedy>, usize)>,
 ) -> Entry {
     Entry {
         scene,
@@ -209,26 +207,31 @@ fn entry(
         config,
         finite: check.finite,
         cost: check.cost,
-        remedy_searched: !check.pass,
-        remedy,
+        remedy_candidates: remedy.as_ref().map_or(0, |r| r.1),
+        remedy: remedy.and_then(|r| r.0),
         critical_default: None,
         critical_strongest: None,
         points: Vec::new(),
     }
 }
 
-/// The cheapest candidate configuration under which the scene passes.
-fn find_remedy(run: fn(Config) -> BenchResult<Check>) -> BenchResult<Option<Remedy>> {
+/// The cheapest candidate configuration under which the scene passes, and how many were
+/// tried.
+fn find_remedy(
+    run: fn(Config) -> BenchResult<Check>,
+    at: Config,
+) -> BenchResult<(Option<Remedy>, usize)> {
+    let candidates = candidates(at);
     let mut best: Option<Remedy> = None;
-    for config in candidates() {
-        let check = run(config)?;
+    for config in &candidates {
+        let check = run(*config)?;
         if check.pass && best.as_ref().is_none_or(|b| check.cost < b.cost) {
             best = Some(Remedy {
-                config,
+                config: *config,
                 figure: check.figure,
                 cost: check.cost,
             });
         }
     }
-    Ok(best)
+    Ok((best, candidates.len()))
 }
