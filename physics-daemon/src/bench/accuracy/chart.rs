@@ -85,6 +85,23 @@ fn draw(path: &Path, name: &str, points: &[&Point]) -> Result<(), Box<dyn std::e
         .x_label_formatter(&|v| format!("{v:.0e}"))
         .y_label_formatter(&|v| format!("{v:.0e}"))
         .draw()?;
+    let on_a_line = |p: &Point| Family::ALL.iter().any(|f| f.configs().contains(&p.config));
+    let others: Vec<(f64, f64)> = usable
+        .iter()
+        .filter(|p| !on_a_line(p))
+        .map(|p| (p.cost, shown(p)))
+        .collect();
+    if !others.is_empty() {
+        let grey = RGBColor(160, 160, 160);
+        chart
+            .draw_series(
+                others
+                    .iter()
+                    .map(|&(x, y)| Circle::new((x, y), 2, grey.filled())),
+            )?
+            .label("other grid points")
+            .legend(move |(x, y)| Circle::new((x + 10, y), 2, grey.filled()));
+    }
     for (family, color) in Family::ALL.iter().zip(COLORS) {
         let line: Vec<(f64, f64)> = family
             .configs()
