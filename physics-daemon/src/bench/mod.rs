@@ -7,7 +7,11 @@
 //! - [`progress`]: the progress bar and its log lines.
 //! - [`report`]: writing the JSON and markdown reports.
 //! - [`ipc`]: the `ipc` subcommand (daemon overhead, delivery, requests, idle, memory).
+//! - [`sim`]: an in-process plane stepped at a fixed dt with its step time accumulated.
+//! - [`accuracy`]: the `accuracy` subcommand (error against run time).
+//! - [`stability`]: the `stability` subcommand (stiff and extreme scenes, pass/fail).
 
+pub mod accuracy;
 pub mod daemon;
 pub mod error;
 pub mod ipc;
@@ -15,4 +19,6 @@ pub mod procfs;
 pub mod progress;
 pub mod report;
 pub mod scene;
+pub mod sim;
+pub mod stability;
 pub mod stats;

@@ -2,6 +2,10 @@
 //!
 //! `physics-bench ipc [--quick] [--out DIR]` writes DIR/ipc.json and DIR/ipc.md. It starts
 //! real `physics-daemon` processes (the binary next to this one) in throw-away domains.
+//!
+//! `physics-bench accuracy [--quick] [--out DIR]` writes DIR/accuracy.json, DIR/accuracy.md
+//! and DIR/accuracy-*.svg: error against cost of reference scenes, in process.
+//! `physics-bench stability [--out DIR]` writes DIR/stability.json and DIR/stability.md.
 
 #[path = "../bench/mod.rs"]
 mod bench;
@@ -22,6 +26,12 @@ enum Bench {
     /// Daemon overhead over in-process rapier, zero-copy vs socket delivery, request round
     /// trips, threads, idle CPU and memory.
     Ipc(bench::ipc::IpcArgs),
+    /// Error against run time on reference scenes with exact answers, swept over TickRate,
+    /// SolverIterations / LoopSolver and HitBoxQuality.
+    Accuracy(bench::accuracy::AccuracyArgs),
+    /// Stress scenes (tall stacks, mass ratios, fast bodies, overlap, far from the origin,
+    /// tiny objects, extreme forces and tick rates), each with a pass criterion.
+    Stability(bench::stability::StabilityArgs),
 }
 
 fn main() -> ExitCode {
@@ -33,6 +43,8 @@ fn main() -> ExitCode {
         .build_global();
     let result = match &cli.command {
         Bench::Ipc(args) => bench::ipc::run(args),
+        Bench::Accuracy(args) => bench::accuracy::run(args),
+        Bench::Stability(args) => bench::stability::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -9,7 +9,9 @@ use super::Plane;
 /// Rapier's defaults at HitBoxQuality 1.
 const ALLOWED_LINEAR_ERROR: f32 = 0.005;
 const PREDICTION_DISTANCE: f32 = 0.02;
-/// Largest solver-work factor, reached at HitBoxQuality 32.
+/// Largest solver-work factor, reached at HitBoxQuality 32. Contact stiffness (rapier's
+/// natural frequency) scales by the same factor: raising the damping ratio instead would
+/// slow penetration recovery, and heavy bodies would sink deeper at higher quality.
 const MAX_WORK_FACTOR: f32 = 2.5;
 
 /// What one tick of the plane's solver runs with.
@@ -19,7 +21,7 @@ pub(super) struct SolverSettings {
     pub internal_iterations: usize,
     pub allowed_linear_error: f32,
     pub prediction_distance: f32,
-    pub damping_factor: f32,
+    pub stiffness_factor: f32,
 }
 
 impl Plane {
@@ -45,7 +47,7 @@ impl Plane {
             internal_iterations: factor.round() as usize,
             allowed_linear_error: ALLOWED_LINEAR_ERROR / q.sqrt(),
             prediction_distance: PREDICTION_DISTANCE / q.sqrt(),
-            damping_factor: factor,
+            stiffness_factor: factor,
         }
     }
 
@@ -59,7 +61,8 @@ impl Plane {
         p.normalized_prediction_distance = s.prediction_distance;
         let base = SpringCoefficients::<f32>::contact_defaults();
         let base_static = SpringCoefficients::<f32>::contact_static_defaults();
-        p.contact_softness.damping_ratio = base.damping_ratio * s.damping_factor;
-        p.static_contact_softness.damping_ratio = base_static.damping_ratio * s.damping_factor;
+        p.contact_softness.natural_frequency = base.natural_frequency * s.stiffness_factor;
+        p.static_contact_softness.natural_frequency =
+            base_static.natural_frequency * s.stiffness_factor;
     }
 }
