@@ -413,7 +413,8 @@ mod tests {
             }
         }
         assert!(asleep_seen, "the pile should fall asleep during the test");
-        drop((reader, out, node));
+        // Samples still held keep the node's segments alive: release them first.
+        drop((held, reader, out, node));
         let _ = crate::cleanup_domain(&domain);
     }
 }
