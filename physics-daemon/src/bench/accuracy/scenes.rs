@@ -7,6 +7,7 @@
 //! include that gap; a pair's friction is `sqrt(a·b)`, so both sides carry the same μ.
 
 use client_sdk::{ObjectProp, PlaneProp, Pose, Shape};
+use rapier3d::glamx::{DQuat, DVec3};
 
 use crate::bench::error::BenchResult;
 use crate::bench::sim::{about_z, distance, Config, Sim};
@@ -321,55 +322,25 @@ fn free_rotation(c: Config) -> BenchResult<Outcome> {
         (a * a + b_ * b_) / 12.0,
     ];
     let (l0, e0) = momentum_energy(&sim.state(b), inertia);
-    let l0_norm = norm(l0);
     let mut worst = 0.0f64;
     for _ in 0..sim.steps_for(5.0) {
         sim.step()?;
         let (l, e) = momentum_energy(&sim.state(b), inertia);
-        let dl = norm([l[0] - l0[0], l[1] - l0[1], l[2] - l0[2]]) / l0_norm;
+        let dl = (l - l0).length() / l0.length();
         worst = worst.max(dl).max((e - e0).abs() / e0);
     }
     outcome(&sim, worst)
 }
 
-fn norm(v: [f64; 3]) -> f64 {
-    (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt()
-}
-
 /// World angular momentum `R·I·Rᵀ·ω` and kinetic energy `ω·L/2` of a body with principal
 /// inertia `inertia` (unit mass) along its local axes.
-fn momentum_energy(s: &client_sdk::BodyState, inertia: [f64; 3]) -> ([f64; 3], f64) {
+fn momentum_energy(s: &client_sdk::BodyState, inertia: [f64; 3]) -> (DVec3, f64) {
     let [x, y, z, w] = s.rotation.map(|v| v as f64);
-    // Columns of R are the body axes in world space.
-    let r = [
-        [
-            1.0 - 2.0 * (y * y + z * z),
-            2.0 * (x * y - w * z),
-            2.0 * (x * z + w * y),
-        ],
-        [
-            2.0 * (x * y + w * z),
-            1.0 - 2.0 * (x * x + z * z),
-            2.0 * (y * z - w * x),
-        ],
-        [
-            2.0 * (x * z - w * y),
-            2.0 * (y * z + w * x),
-            1.0 - 2.0 * (x * x + y * y),
-        ],
-    ];
-    let omega = s.angular_velocity.map(|v| v as f64);
-    // Body-frame ω = Rᵀ·ω.
-    let local: Vec<f64> = (0..3)
-        .map(|j| (0..3).map(|i| r[i][j] * omega[i]).sum())
-        .collect();
-    let l_local: Vec<f64> = (0..3).map(|j| inertia[j] * local[j]).collect();
-    let l: Vec<f64> = (0..3)
-        .map(|i| (0..3).map(|j| r[i][j] * l_local[j]).sum())
-        .collect();
-    let l = [l[0], l[1], l[2]];
-    let e = 0.5 * (0..3).map(|i| omega[i] * l[i]).sum::<f64>();
-    (l, e)
+    let q = DQuat::from_xyzw(x, y, z, w);
+    let omega = DVec3::from(s.angular_velocity.map(|v| v as f64));
+    // Body frame: L_local = I·(Rᵀ·ω); back to the world with R.
+    let l = q * (DVec3::from(inertia) * (q.inverse() * omega));
+    (l, 0.5 * omega.dot(l))
 }
 
 /// A 5-box stack resting on a floor, each box placed at its rest height. Returns the drift
