@@ -46,6 +46,15 @@ impl BodyState {
     pub fn is_anchored(&self) -> bool {
         self.flags & FLAG_ANCHORED != 0
     }
+    /// Whether pose and velocities are all finite numbers.
+    pub fn is_finite(&self) -> bool {
+        self.position
+            .iter()
+            .chain(&self.rotation)
+            .chain(&self.linear_velocity)
+            .chain(&self.angular_velocity)
+            .all(|x| x.is_finite())
+    }
     /// True when this slot currently holds the body `handle` refers to.
     pub fn matches(&self, handle: Handle) -> bool {
         self.is_alive() && self.generation == handle.generation

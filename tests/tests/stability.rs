@@ -12,22 +12,13 @@ fn cube(side: f32) -> Shape {
     }
 }
 
-fn finite(s: &BodyState) -> bool {
-    s.position
-        .iter()
-        .chain(&s.rotation)
-        .chain(&s.linear_velocity)
-        .chain(&s.angular_velocity)
-        .all(|x| x.is_finite())
-}
-
 /// Steps `n` times, asserting after each step that every body is finite.
 fn run_finite(scene: &Scene, dt: f32, n: u32) {
     for i in 0..n {
         scene.plane.step(dt).expect("step");
         let snap = scene.plane.snapshot().unwrap();
         assert!(
-            snap.bodies().iter().all(finite),
+            snap.bodies().iter().all(BodyState::is_finite),
             "a body went non-finite at step {i}"
         );
     }

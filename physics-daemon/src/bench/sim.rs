@@ -158,17 +158,8 @@ impl Sim {
 
     /// Whether every body's pose and velocities are finite.
     pub fn all_finite(&self) -> bool {
-        (0..self.plane.slot_count()).all(|i| finite(&self.plane.body_state(i)))
+        (0..self.plane.slot_count()).all(|i| self.plane.body_state(i).is_finite())
     }
-}
-
-pub fn finite(s: &BodyState) -> bool {
-    s.position
-        .iter()
-        .chain(&s.rotation)
-        .chain(&s.linear_velocity)
-        .chain(&s.angular_velocity)
-        .all(|x| x.is_finite())
 }
 
 /// Unit quaternion `[x, y, z, w]` for `angle` radians about the z axis.
