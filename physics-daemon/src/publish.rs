@@ -122,12 +122,10 @@ pub enum Touch {
     Created(PlaneId),
     /// Anything in the plane.
     Plane(PlaneId),
-    /// Anything in any plane.
-    All,
 }
 
 impl Touch {
-    /// What `command` may change. Unknown kinds of commands count as changing everything.
+    /// What `command` may change. The match has no catch-all: a new command must say.
     pub fn of(command: &Command) -> Touch {
         match command {
             Command::Hello { .. }
@@ -149,7 +147,7 @@ impl Touch {
     /// The plane concerned and the slot, once the result is known.
     pub fn resolve(self, result: &CommandResult) -> Option<(PlaneId, Option<u32>)> {
         match (self, result) {
-            (Touch::Nothing, _) | (Touch::All, _) => None,
+            (Touch::Nothing, _) => None,
             (Touch::Slot(p, s), _) => Some((p, Some(s))),
             (Touch::Created(p), Ok(Reply::Object { handle, .. })) => Some((p, Some(handle.slot))),
             (Touch::Created(_), _) => None,

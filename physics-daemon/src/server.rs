@@ -283,11 +283,7 @@ impl Daemon {
 
     /// Tells the publisher what a command may have changed (it rewrites only changed slots).
     fn note_touched(&self, touch: Touch, result: &CommandResult) {
-        if touch == Touch::All {
-            for entry in self.planes.values() {
-                entry.out.touched(None);
-            }
-        } else if let Some((plane, slot)) = touch.resolve(result) {
+        if let Some((plane, slot)) = touch.resolve(result) {
             if let Some(entry) = self.planes.get(&plane) {
                 entry.out.touched(slot);
             }
