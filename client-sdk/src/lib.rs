@@ -18,6 +18,8 @@ pub use client::{Client, ConnectOptions};
 pub use error::Error;
 pub use object::Object;
 pub use plane::{Plane, PlaneOptions, Snapshot};
+/// The limits and checks the daemon applies, for callers that want to check early.
+pub use shm_layout::validate;
 pub use shm_layout::{
     BodyState, CommandError, ErrorKind, EventRecord, Handle, ObjectInfo, ObjectProp, Pin, PlaneId,
     PlaneInfo, PlaneProp, Pose, Restraint, RotateTo, Shape, ShapeKind, TickHeader, Vec3,

@@ -6,14 +6,13 @@ use std::rc::Rc;
 use client_sdk::{Client, Plane, PlaneOptions, PlaneProp};
 use mlua::{Lua, MetaMethod, Table, UserData, UserDataMethods, Value};
 
+use client_sdk::validate::MAX_DT;
+
 use crate::convert::{describe, expected, finite_number, sdk_error};
 use crate::object::PhysicsObject;
 use crate::part::{BasePart, Link, PartState};
 use crate::props::plane::{AT_CREATION, NOT_YET_METHODS, PLANE};
 use crate::props::{not_yet_methods, Set};
-
-/// The longest step the daemon accepts.
-const MAX_DT: f64 = 1.0;
 
 pub struct PlaneState {
     pub plane: Plane,
@@ -103,7 +102,7 @@ impl UserData for PhysicsPlane {
         });
         methods.add_method("Step", |_, p, dt: Value| {
             let dt = match finite_number("PhysicsPlane:Step", &dt) {
-                Ok(dt) if dt > 0.0 && dt <= MAX_DT => dt,
+                Ok(dt) if dt > 0.0 && dt <= MAX_DT as f64 => dt,
                 _ => {
                     return Err(expected(
                         "PhysicsPlane:Step",

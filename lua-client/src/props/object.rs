@@ -1,6 +1,7 @@
 //! PhysicsObject properties. Pose and velocities read zero-copy from shared memory; the
 //! other properties are read back from the daemon (`object.info()`, one round trip).
 
+use client_sdk::validate::MAX_HIT_BOX_QUALITY;
 use client_sdk::{ObjectInfo, ObjectProp};
 use mlua::{Error as LuaError, Value};
 
@@ -134,6 +135,7 @@ pub static OBJECT: Props<PhysicsObject> = Props {
         info_row!(
             "Weight",
             Kind::Number {
+                // validate::MIN_MASS, written as the decimal Lua users see in errors.
                 min: 1e-4,
                 max: f64::INFINITY,
             },
@@ -173,7 +175,7 @@ pub static OBJECT: Props<PhysicsObject> = Props {
                 max: i64::MAX,
             },
             |i| Value::Number(i.hit_box_quality as f64),
-            |a| ObjectProp::HitBoxQuality(a.integer()?.clamp(1, 32) as u32)
+            |a| ObjectProp::HitBoxQuality(a.integer()?.clamp(1, MAX_HIT_BOX_QUALITY as i64) as u32)
         ),
         info_row!(
             "CenterOfMass",

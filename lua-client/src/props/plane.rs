@@ -2,16 +2,13 @@
 //! does not cache are read back from the daemon (`plane.info()`, one round trip). Rows marked
 //! `not_yet` are documented but belong to a backend not built yet.
 
+use client_sdk::validate::{MAX_SOLVER_ITERATIONS, MAX_THREADS, MAX_TICK_RATE};
 use client_sdk::{PlaneInfo, PlaneOptions, PlaneProp};
 use mlua::{Error as LuaError, Value};
 
 use super::{Arg, Get, Kind, Props, Row, Set};
 use crate::convert::{new_vector, sdk_error};
 use crate::plane::PlaneState;
-
-/// Mirrors the daemon's limits so a bad value fails at the assignment, not a frame later.
-const MAX_THREADS: i64 = 64;
-const MAX_TICK_RATE: f64 = 10_000.0;
 
 fn info(p: &PlaneState, what: &str) -> Result<PlaneInfo, LuaError> {
     p.plane
@@ -71,7 +68,7 @@ pub static PLANE: Props<PlaneState> = Props {
             name: "TickRate",
             kind: Kind::Number {
                 min: 0.0,
-                max: MAX_TICK_RATE,
+                max: MAX_TICK_RATE as f64,
             },
             get: Get::Fn(|_, p| Ok(Value::Number(p.tick_rate.get() as f64))),
             set: Set::Fn(|_, p, a| {
@@ -85,7 +82,7 @@ pub static PLANE: Props<PlaneState> = Props {
             name: "Threads",
             kind: Kind::Integer {
                 min: 1,
-                max: MAX_THREADS,
+                max: MAX_THREADS as i64,
             },
             get: Get::Fn(|_, p| Ok(Value::Number(p.threads as f64))),
             set: Set::ReadOnly,
@@ -149,7 +146,9 @@ pub static PLANE: Props<PlaneState> = Props {
                 ))
             }),
             set: Set::Fn(|_, p, a| {
-                p.set(PlaneProp::SolverIterations(a.integer()?.clamp(1, 64) as u32))
+                p.set(PlaneProp::SolverIterations(
+                    a.integer()?.clamp(1, MAX_SOLVER_ITERATIONS as i64) as u32,
+                ))
             }),
         },
         bool_row!("LoopSolver", loop_solver, PlaneProp::LoopSolver),
