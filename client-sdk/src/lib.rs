@@ -24,4 +24,4 @@ pub use shm_layout::{
     BodyState, CommandError, ErrorKind, EventRecord, Handle, ObjectInfo, ObjectProp, Pin, PlaneId,
     PlaneInfo, PlaneProp, Pose, Restraint, RotateTo, Shape, ShapeKind, TickHeader, Vec3,
 };
-pub use spawn::{connect_or_start, daemon_executable, DaemonChild, Session};
+pub use spawn::{connect_or_start, daemon_executable, start_daemon, DaemonChild, Session};

@@ -67,15 +67,24 @@ impl std::ops::Deref for Session {
 /// Connects to the daemon of `domain`; when none answers, starts one and connects to it.
 pub fn connect_or_start(domain: &str) -> Result<Session, Error> {
     match Client::connect(domain) {
-        Ok(client) => {
-            return Ok(Session {
+        Ok(client) => Ok(Session {
+            client,
+            daemon: None,
+        }),
+        Err(Error::NoDaemon { .. }) => {
+            let (daemon, client) = start_daemon(domain)?;
+            Ok(Session {
                 client,
-                daemon: None,
+                daemon: Some(daemon),
             })
         }
-        Err(Error::NoDaemon { .. }) => {}
-        Err(e) => return Err(e),
+        Err(e) => Err(e),
     }
+}
+
+/// Starts a daemon for `domain` as a child process and waits (up to 10 s) until it answers.
+/// Returns it with a connected client.
+pub fn start_daemon(domain: &str) -> Result<(DaemonChild, Client), Error> {
     let exe = daemon_executable();
     let child = Command::new(&exe)
         .arg("--domain")
@@ -90,12 +99,7 @@ pub fn connect_or_start(domain: &str) -> Result<Session, Error> {
     let deadline = Instant::now() + Duration::from_secs(10);
     loop {
         match Client::connect(domain) {
-            Ok(client) => {
-                return Ok(Session {
-                    client,
-                    daemon: Some(child),
-                })
-            }
+            Ok(client) => return Ok((child, client)),
             Err(Error::NoDaemon { detail, .. }) if Instant::now() < deadline => {
                 if let Ok(Some(status)) = child.child.try_wait() {
                     return Err(Error::NoDaemon {

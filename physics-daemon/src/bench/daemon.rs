@@ -1,17 +1,15 @@
 //! Real daemon processes for the bench, each in a domain of its own, stopped and cleaned up
 //! when dropped.
 
-use std::process::{Child, Command, Stdio};
 use std::sync::atomic::{AtomicU32, Ordering};
-use std::time::{Duration, Instant};
 
-use client_sdk::{Client, Error};
+use client_sdk::{Client, DaemonChild};
 
-use super::error::{BenchError, BenchResult};
+use super::error::BenchResult;
 
 pub struct DaemonProcess {
     pub domain: String,
-    child: Option<Child>,
+    child: Option<DaemonChild>,
 }
 
 /// A domain no other run uses (pid + counter), within the 32-character limit.
@@ -24,41 +22,16 @@ pub fn unique_domain(tag: &str) -> String {
 impl DaemonProcess {
     /// Starts the `physics-daemon` next to this executable and waits until it answers.
     pub fn start(tag: &str) -> BenchResult<DaemonProcess> {
-        let exe = client_sdk::daemon_executable();
         let domain = unique_domain(tag);
-        let child = Command::new(&exe)
-            .args(["--domain", &domain])
-            .env("PHYSICS_LOG", "warn")
-            .stdin(Stdio::null())
-            .spawn()
-            .map_err(BenchError::io(format!(
-                "start {} (build it with cargo build --release --workspace --bins)",
-                exe.display()
-            )))?;
-        let mut daemon = DaemonProcess {
+        let (child, _) = client_sdk::start_daemon(&domain)?;
+        Ok(DaemonProcess {
             domain,
             child: Some(child),
-        };
-        let deadline = Instant::now() + Duration::from_secs(10);
-        loop {
-            match Client::connect(&daemon.domain) {
-                Ok(_) => return Ok(daemon),
-                Err(Error::NoDaemon { detail, .. }) if Instant::now() < deadline => {
-                    if let Some(Ok(Some(status))) = daemon.child.as_mut().map(|c| c.try_wait()) {
-                        return Err(BenchError::Failed(format!(
-                            "daemon of domain {} exited with {status} ({detail})",
-                            daemon.domain
-                        )));
-                    }
-                    std::thread::sleep(Duration::from_millis(20));
-                }
-                Err(e) => return Err(e.into()),
-            }
-        }
+        })
     }
 
     pub fn pid(&self) -> u32 {
-        self.child.as_ref().map_or(0, |c| c.id())
+        self.child.as_ref().map_or(0, |c| c.pid())
     }
 
     pub fn connect(&self) -> BenchResult<Client> {
@@ -67,18 +40,10 @@ impl DaemonProcess {
 }
 
 impl Drop for DaemonProcess {
-    /// SIGINT (a clean exit), SIGKILL after 3 s, then removal of whatever is left in the domain.
+    /// Stops the daemon (SIGINT, SIGKILL after 3 s), then removes whatever is left in the
+    /// domain.
     fn drop(&mut self) {
-        if let Some(mut child) = self.child.take() {
-            // SAFETY: kill(2) on our own child.
-            unsafe { libc::kill(child.id() as i32, libc::SIGINT) };
-            let deadline = Instant::now() + Duration::from_secs(3);
-            while Instant::now() < deadline && matches!(child.try_wait(), Ok(None)) {
-                std::thread::sleep(Duration::from_millis(5));
-            }
-            let _ = child.kill();
-            let _ = child.wait();
-        }
+        drop(self.child.take());
         let _ = physics_daemon::cleanup_domain(&self.domain);
     }
 }

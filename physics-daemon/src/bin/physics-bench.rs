@@ -36,6 +36,11 @@ enum Bench {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    // The daemons it starts inherit this: warnings only, so their logs stay out of the
+    // progress display.
+    if std::env::var_os("PHYSICS_LOG").is_none() {
+        std::env::set_var("PHYSICS_LOG", "warn");
+    }
     // In-process planes with Threads = 1 run on rayon's global pool: one worker, as in the
     // daemon, so both sides of a comparison use one core.
     let _ = rapier3d::rayon::ThreadPoolBuilder::new()
