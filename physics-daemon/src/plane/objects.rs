@@ -115,12 +115,13 @@ impl Plane {
 
     pub fn destroy_object(&mut self, handle: Handle) -> Result<(), CommandError> {
         let h = self.body_of(handle)?;
-        // Turn contact reporting off first so the plane's reporting count stays exact.
-        self.set_object(handle, ObjectProp::ReportContacts(false))?;
         let part = self.slots[handle.slot as usize]
             .part
             .take()
             .expect("live slot has a part");
+        if part.report_contacts {
+            self.reporting -= 1;
+        }
         self.quality_counts[part.quality as usize] -= 1;
         if part.is_driven() {
             self.driven -= 1;
