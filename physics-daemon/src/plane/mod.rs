@@ -22,7 +22,7 @@ use shm_layout::{
 use part::Part;
 
 /// One entry of the slot table. The generation grows every time the slot is reused.
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Default)]
 struct Slot {
     generation: u32,
     body: Option<RigidBodyHandle>,

@@ -9,14 +9,14 @@ use shm_layout::{CommandError, Pin, RotateTo, Shape, ShapeKind, Vec3};
 const BASE_CONTACT_SKIN: f32 = 0.01;
 
 /// A mesh part: vertices as given, and the size they span (Size rescales them).
-#[derive(Debug, Clone)]
+#[derive(Debug)]
 pub(super) struct Mesh {
     vertices: Vec<Vec3>,
     extent: Vec3,
 }
 
 /// The API-level properties of one object.
-#[derive(Debug, Clone)]
+#[derive(Debug)]
 pub(super) struct Part {
     pub shape: ShapeKind,
     pub size: Vec3,
