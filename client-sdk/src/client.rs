@@ -5,28 +5,23 @@ use std::collections::HashMap;
 use std::rc::Rc;
 use std::time::{Duration, Instant};
 
-use iceoryx2::config::Config;
-use iceoryx2::node::NodeView;
-use iceoryx2::port::client::Client as RequestPort;
-use iceoryx2::port::listener::Listener;
-use iceoryx2::port::notifier::Notifier;
-use iceoryx2::prelude::*;
 use shm_layout::codec;
 use shm_layout::{
-    names, Command, CommandError, CommandResult, ErrorKind, Handle, PlaneId, Reply, Request,
+    Command, CommandError, CommandResult, ErrorKind, Handle, PlaneId, PlaneOp, Reply, Request,
     Response, CRATE_VERSION, LAYOUT_VERSION,
 };
 
 use crate::plane::{PlaneOptions, PlaneShared};
+use crate::transport::Transport;
 use crate::{Error, Plane};
 
 /// How often a waiting client checks that the daemon process is still alive.
 pub(crate) const LIVENESS_PERIOD: Duration = Duration::from_millis(100);
-/// How long `connect` waits for a starting daemon to open its request server.
-const SERVER_WAIT: Duration = Duration::from_secs(2);
 
+/// How to connect.
 #[derive(Debug, Clone)]
 pub struct ConnectOptions {
+    /// The deployment domain.
     pub domain: String,
     /// Longest wait for one reply (a Step of a huge plane may legitimately take a while).
     pub request_timeout: Duration,
@@ -39,6 +34,7 @@ pub struct ConnectOptions {
 }
 
 impl ConnectOptions {
+    /// Defaults for `domain` (30 s request timeout).
     pub fn new(domain: &str) -> Self {
         ConnectOptions {
             domain: domain.to_string(),
@@ -64,14 +60,9 @@ struct State {
     gone: bool,
 }
 
-pub(crate) struct Inner {
-    pub(crate) options: ConnectOptions,
-    pub(crate) config: Config,
-    pub(crate) node: Node<ipc::Service>,
-    port: RequestPort<ipc::Service, [u8], u128, [u8], ()>,
-    daemon_wake: Notifier<ipc::Service>,
-    replies: Listener<ipc::Service>,
-    id: u128,
+struct Inner {
+    options: ConnectOptions,
+    transport: Transport,
     daemon_node: u128,
     daemon_pid: u32,
     state: RefCell<State>,
@@ -81,7 +72,7 @@ pub(crate) struct Inner {
 /// memory ports belong to the thread that opened them).
 #[derive(Clone)]
 pub struct Client {
-    pub(crate) inner: Rc<Inner>,
+    inner: Rc<Inner>,
 }
 
 impl Client {
@@ -90,74 +81,12 @@ impl Client {
         Self::connect_with(ConnectOptions::new(domain))
     }
 
+    /// Connects with explicit options.
     pub fn connect_with(options: ConnectOptions) -> Result<Client, Error> {
-        let domain = options.domain.clone();
-        let config = names::config(&domain).map_err(|e| Error::Invalid {
-            field: "domain".into(),
-            message: e.to_string(),
-        })?;
-        let no_daemon = |detail: String| Error::NoDaemon {
-            domain: domain.clone(),
-            detail,
-        };
-        // A crashed daemon leaves its services behind: look for a live daemon process first.
-        if daemon_alive(&config, 0) == Some(false) {
-            return Err(no_daemon("no live daemon process in this domain".into()));
-        }
-        let node = NodeBuilder::new()
-            .name(&NodeName::new("physics-client").expect("valid node name"))
-            .config(&config)
-            .signal_handling_mode(SignalHandlingMode::Disabled)
-            .create::<ipc::Service>()
-            .map_err(|e| Error::ipc("cannot create node", e))?;
-        let id = node.id().value();
-        let control = node
-            .service_builder(&names::control())
-            .request_response::<[u8], [u8]>()
-            .request_user_header::<u128>()
-            .open()
-            .map_err(|e| no_daemon(format!("{e:?}")))?;
-        // A daemon that is starting has its node before its server port; a request sent in
-        // between would reach no one. Wait (bounded) until the server is there.
-        let deadline = Instant::now() + SERVER_WAIT;
-        while control.dynamic_config().number_of_servers() == 0 {
-            if Instant::now() >= deadline {
-                return Err(no_daemon("the control service has no server".into()));
-            }
-            std::thread::sleep(Duration::from_millis(2));
-        }
-        let port = control
-            .client_builder()
-            .initial_max_slice_len(4096)
-            .allocation_strategy(AllocationStrategy::PowerOfTwo)
-            .create()
-            .map_err(|e| Error::ipc("cannot create request port", e))?;
-        let daemon_wake = node
-            .service_builder(&names::control_wake())
-            .event()
-            .open()
-            .map_err(|e| no_daemon(format!("{e:?}")))?
-            .notifier_builder()
-            .create()
-            .map_err(|e| Error::ipc("cannot create notifier", e))?;
-        let replies = node
-            .service_builder(&names::client_wake(id))
-            .event()
-            .max_notifiers(2)
-            .max_listeners(1)
-            .create()
-            .map_err(|e| Error::ipc("cannot create reply event", e))?
-            .listener_builder()
-            .create()
-            .map_err(|e| Error::ipc("cannot create reply listener", e))?;
+        let transport = Transport::open(&options.domain)?;
         let mut inner = Inner {
             options,
-            config,
-            node,
-            port,
-            daemon_wake,
-            replies,
-            id,
+            transport,
             daemon_node: 0,
             daemon_pid: 0,
             state: RefCell::default(),
@@ -190,6 +119,7 @@ impl Client {
         })
     }
 
+    /// The domain this client talks to.
     pub fn domain(&self) -> &str {
         &self.inner.options.domain
     }
@@ -202,6 +132,7 @@ impl Client {
     /// Creates a plane owned by this client (released when the client goes away).
     pub fn create_plane(&self, options: &PlaneOptions) -> Result<Plane, Error> {
         match self.call(Command::CreatePlane {
+            kind: options.kind.unwrap_or_default(),
             props: options.props(),
         })? {
             Reply::Plane(info) => self.attach_plane(info.id),
@@ -215,16 +146,16 @@ impl Client {
         if let Some(shared) = self.inner.state.borrow().planes.get(&id) {
             return Ok(Plane::new(self.clone(), shared.clone()));
         }
-        let shared = match PlaneShared::open(&self.inner.node, id) {
+        let shared = match PlaneShared::open(&self.inner.transport, id) {
             Ok(s) => Rc::new(s),
             // No such service: let the daemon say why (unknown plane, or gone).
             Err(e) => {
-                self.call(Command::PlaneInfo { plane: id })?;
+                self.call(Command::plane(id, PlaneOp::Info))?;
                 return Err(e);
             }
         };
         // Asking after subscribing makes the daemon hand the newest tick to the new reader.
-        self.call(Command::PlaneInfo { plane: id })?;
+        self.call(Command::plane(id, PlaneOp::Info))?;
         self.inner
             .state
             .borrow_mut()
@@ -288,7 +219,7 @@ impl Client {
             match (result, confirm) {
                 (Ok(Reply::Applied { tick }), Some((plane, handle))) => {
                     if let Some(p) = state.planes.get(&plane) {
-                        p.overlay.borrow_mut().confirm(handle, tick);
+                        p.confirm(handle, tick);
                     }
                 }
                 (Ok(_), _) => {}
@@ -296,7 +227,7 @@ impl Client {
                     // A rejected write must not linger as if it had happened.
                     if let Some((plane, handle)) = confirm {
                         if let Some(p) = state.planes.get(&plane) {
-                            p.overlay.borrow_mut().discard(handle);
+                            p.discard(handle);
                         }
                     }
                     state.deferred.push(e);
@@ -319,6 +250,11 @@ impl Client {
 
     pub(crate) fn forget_plane(&self, id: PlaneId) {
         self.inner.state.borrow_mut().planes.remove(&id);
+    }
+
+    /// The ports of this client (planes open their subscribers through it).
+    pub(crate) fn transport(&self) -> &Transport {
+        &self.inner.transport
     }
 }
 
@@ -360,45 +296,28 @@ impl Inner {
 
     /// Sends raw request bytes and waits for the raw reply, checking the daemon's liveness
     /// while waiting so a dead daemon is an error within a bounded time, not a hang.
-    pub(crate) fn exchange(&self, bytes: &[u8]) -> Result<Vec<u8>, Error> {
-        let mut request = self
-            .port
-            .loan_slice_uninit(bytes.len())
-            .map_err(|e| Error::ipc("loan request", e))?;
-        *request.user_header_mut() = self.id;
-        let pending = request
-            .write_from_slice(bytes)
-            .send()
-            .map_err(|e| Error::ipc("send request", e))?;
-        self.daemon_wake
-            .notify()
-            .map_err(|e| Error::ipc("wake daemon", e))?;
+    fn exchange(&self, bytes: &[u8]) -> Result<Vec<u8>, Error> {
         let started = Instant::now();
         let mut last_check = started;
-        loop {
-            if let Some(response) = pending
-                .receive()
-                .map_err(|e| Error::ipc("receive reply", e))?
-            {
-                return Ok(response.payload().to_vec());
-            }
-            if !pending.is_connected() {
-                self.check_daemon()?;
-            }
-            let _ = self.replies.timed_wait(|_| {}, LIVENESS_PERIOD);
-            let now = Instant::now();
-            if now.duration_since(last_check) >= LIVENESS_PERIOD {
-                self.check_daemon()?;
-                last_check = now;
-            }
-            if now.duration_since(started) > self.options.request_timeout {
-                return Err(Error::Timeout(self.options.request_timeout));
-            }
-        }
+        self.transport
+            .exchange(bytes, LIVENESS_PERIOD, |connected| {
+                if !connected {
+                    self.check_daemon()?;
+                }
+                let now = Instant::now();
+                if now.duration_since(last_check) >= LIVENESS_PERIOD {
+                    self.check_daemon()?;
+                    last_check = now;
+                }
+                if now.duration_since(started) > self.options.request_timeout {
+                    return Err(Error::Timeout(self.options.request_timeout));
+                }
+                Ok(())
+            })
     }
 
     pub(crate) fn check_daemon(&self) -> Result<(), Error> {
-        match daemon_alive(&self.config, self.daemon_node) {
+        match self.transport.daemon_alive(self.daemon_node) {
             Some(false) if self.daemon_node == 0 => Err(Error::NoDaemon {
                 domain: self.options.domain.clone(),
                 detail: "no live daemon process answers".into(),
@@ -427,31 +346,6 @@ impl Drop for Inner {
             let _ = self.round_trip(vec![Command::Goodbye]);
         }
     }
-}
-
-/// Whether the daemon's node is alive: found by id once the handshake told us the id, by
-/// name before. `None` when the node list cannot be read (then we assume nothing).
-fn daemon_alive(config: &Config, daemon_node: u128) -> Option<bool> {
-    let mut alive = false;
-    Node::<ipc::Service>::list(config, |state| {
-        if daemon_node != 0 && state.node_id().value() == daemon_node {
-            alive = matches!(state, NodeState::Alive(_));
-            return CallbackProgression::Stop;
-        }
-        if let (0, NodeState::Alive(view)) = (daemon_node, &state) {
-            if view
-                .details()
-                .as_ref()
-                .is_some_and(|d| d.name().as_str() == names::DAEMON_NODE_NAME)
-            {
-                alive = true;
-                return CallbackProgression::Stop;
-            }
-        }
-        CallbackProgression::Continue
-    })
-    .ok()?;
-    Some(alive)
 }
 
 fn unexpected(reply: Reply) -> Error {

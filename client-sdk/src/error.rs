@@ -26,16 +26,14 @@ pub enum Error {
 }
 
 impl Error {
-    /// A value the shared checks refused before it was sent. Their messages start with the
-    /// field's name.
+    /// A value the shared checks refused before it was sent (they name the field).
     pub(crate) fn invalid_value(e: CommandError) -> Error {
-        let (field, message) = e
-            .message
-            .split_once(' ')
-            .unwrap_or((e.message.as_str(), ""));
-        Error::Invalid {
-            field: field.into(),
-            message: message.into(),
+        match &e.field {
+            Some(field) => Error::Invalid {
+                field: field.clone(),
+                message: e.detail().to_string(),
+            },
+            None => Error::Command(e),
         }
     }
 

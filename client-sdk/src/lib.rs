@@ -6,6 +6,11 @@
 //!
 //! Writes are queued and sent as one request per [`Client::flush`] (or when a call needs an
 //! answer); reads see your own writes until the daemon's samples reflect them.
+//!
+//! Every iceoryx2 port is built in one module (`transport`); the other modules hold what it
+//! returns.
+
+#![warn(missing_docs)]
 
 mod client;
 mod error;
@@ -13,6 +18,7 @@ mod object;
 mod overlay;
 mod plane;
 mod spawn;
+mod transport;
 
 pub use client::{Client, ConnectOptions};
 pub use error::Error;
@@ -21,7 +27,8 @@ pub use plane::{Plane, PlaneOptions, Snapshot};
 /// The limits and checks the daemon applies, for callers that want to check early.
 pub use shm_layout::validate;
 pub use shm_layout::{
-    BodyState, CommandError, ErrorKind, EventRecord, Handle, ObjectInfo, ObjectProp, Pin, PlaneId,
-    PlaneInfo, PlaneProp, Pose, Restraint, RotateTo, Shape, ShapeKind, TickHeader, Vec3,
+    BodyState, CommandError, ErrorKind, EventRecord, Handle, ObjectInfo, ObjectOp, ObjectProp,
+    ObjectSettings, Pin, PlaneId, PlaneInfo, PlaneKind, PlaneOp, PlaneProp, PlaneSettings, Pose,
+    Restraint, RotateTo, Shape, ShapeKind, TickHeader, Vec3,
 };
 pub use spawn::{connect_or_start, daemon_executable, start_daemon, DaemonChild, Session};

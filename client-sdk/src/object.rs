@@ -1,10 +1,10 @@
 //! Objects: reads index into the newest sample, writes join the client's batch.
 
 use shm_layout::{
-    BodyState, Command, Handle, ObjectInfo, ObjectProp, Pin, Pose, Reply, Restraint, RotateTo, Vec3,
+    BodyState, Command, Handle, ObjectInfo, ObjectOp, ObjectProp, Pin, Pose, Reply, Restraint,
+    RotateTo, Vec3,
 };
 
-use crate::overlay::Entry;
 use crate::{Error, Plane};
 
 /// One body of a plane. Cheap to clone.
@@ -79,20 +79,12 @@ impl Object {
     pub fn set(&self, prop: ObjectProp) -> Result<(), Error> {
         let prop = prop.checked().map_err(Error::invalid_value)?;
         let plane = self.plane.id();
-        let published = Entry::is_published(&prop);
+        let published = prop.is_published();
         if published {
-            self.plane
-                .shared
-                .overlay
-                .borrow_mut()
-                .write(self.handle, |e| e.record(&prop));
+            self.plane.overlay_write(self.handle, |e| e.record(&prop));
         }
         self.plane.client().queue(
-            Command::SetObject {
-                plane,
-                object: self.handle,
-                prop,
-            },
+            Command::object(plane, self.handle, ObjectOp::Set(prop)),
             published.then_some((plane, self.handle)),
         );
         Ok(())
@@ -112,13 +104,13 @@ impl Object {
     }
 
     /// Anchored objects do not move; setting it zeroes both velocities.
-    pub fn set_anchored(&self, anchored: bool) {
-        let _ = self.set(ObjectProp::Anchored(anchored));
+    pub fn set_anchored(&self, anchored: bool) -> Result<(), Error> {
+        self.set(ObjectProp::Anchored(anchored))
     }
 
     /// Ask the daemon to publish contact started / stopped events for this object.
-    pub fn set_report_contacts(&self, on: bool) {
-        let _ = self.set(ObjectProp::ReportContacts(on));
+    pub fn set_report_contacts(&self, on: bool) -> Result<(), Error> {
+        self.set(ObjectProp::ReportContacts(on))
     }
 
     /// Mass for impulses when Density is 0 (free fall does not depend on it).
@@ -186,10 +178,7 @@ impl Object {
 
     /// Every property as the daemon holds it (sends the queue first).
     pub fn info(&self) -> Result<ObjectInfo, Error> {
-        match self.plane.client().call(Command::ObjectInfo {
-            plane: self.plane.id(),
-            object: self.handle,
-        })? {
+        match self.plane.client().call(self.op(ObjectOp::Info))? {
             Reply::ObjectInfo(info) => Ok(*info),
             other => Err(Error::Protocol(format!("unexpected reply {other:?}"))),
         }
@@ -198,10 +187,7 @@ impl Object {
     /// CenterOfMass := vertex centroid of the object's mesh (no-op for cubes and spheres).
     /// Returns the centre of mass in effect.
     pub fn recalculate_center_of_mass(&self) -> Result<Vec3, Error> {
-        match self.plane.client().call(Command::RecalculateCenterOfMass {
-            plane: self.plane.id(),
-            object: self.handle,
-        })? {
+        match self.plane.client().call(self.op(ObjectOp::RecalculateCenterOfMass))? {
             Reply::CenterOfMass(c) => Ok(c),
             other => Err(Error::Protocol(format!("unexpected reply {other:?}"))),
         }
@@ -218,33 +204,37 @@ impl Object {
     pub fn apply_impulse(&self, impulse: Vec3) -> Result<(), Error> {
         let impulse =
             shm_layout::validate::finite3("impulse", impulse).map_err(Error::invalid_value)?;
-        let plane = self.plane.id();
-        self.plane.client().queue(
-            Command::ApplyImpulse {
-                plane,
-                object: self.handle,
-                impulse,
-            },
-            None,
-        );
+        self.plane
+            .client()
+            .queue(self.op(ObjectOp::ApplyImpulse(impulse)), None);
         Ok(())
+    }
+
+    /// Whether the object is asleep at the newest tick (read from shared memory, no
+    /// request). A sleeping body does not move until something wakes it.
+    pub fn is_sleeping(&self) -> Result<bool, Error> {
+        Ok(self.state()?.is_sleeping())
+    }
+
+    /// Wakes the object (and, at the next step, what rests on it); sent with the next flush.
+    pub fn wake(&self) -> Result<(), Error> {
+        self.state()?;
+        self.plane.client().queue(self.op(ObjectOp::Wake), None);
+        Ok(())
+    }
+
+    fn op(&self, op: ObjectOp) -> Command {
+        Command::object(self.plane.id(), self.handle, op)
     }
 
     /// Removes the object (sent with the next flush; reads see it gone at once).
     pub fn destroy(&self) {
         self.plane
-            .shared
-            .overlay
-            .borrow_mut()
-            .write(self.handle, |e| e.destroyed = true);
+            .overlay_write(self.handle, |e| e.destroyed = true);
         let plane = self.plane.id();
-        self.plane.client().queue(
-            Command::DestroyObject {
-                plane,
-                object: self.handle,
-            },
-            Some((plane, self.handle)),
-        );
+        self.plane
+            .client()
+            .queue(self.op(ObjectOp::Destroy), Some((plane, self.handle)));
     }
 }
 

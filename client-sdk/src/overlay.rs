@@ -35,17 +35,6 @@ impl Entry {
         }
     }
 
-    /// Whether `prop` changes what a sample shows.
-    pub fn is_published(prop: &ObjectProp) -> bool {
-        matches!(
-            prop,
-            ObjectProp::Pose(_)
-                | ObjectProp::Velocity(_)
-                | ObjectProp::AngularVelocity(_)
-                | ObjectProp::Anchored(_)
-        )
-    }
-
     /// `base` with this entry's writes on top.
     pub fn apply(&self, handle: Handle, base: Option<BodyState>) -> Option<BodyState> {
         if self.destroyed {

@@ -4,37 +4,46 @@ use std::cell::{Cell, RefCell};
 use std::rc::Rc;
 use std::time::{Duration, Instant};
 
-use iceoryx2::port::listener::Listener;
-use iceoryx2::port::subscriber::Subscriber;
-use iceoryx2::prelude::*;
-use iceoryx2::sample::Sample;
 use shm_layout::{
-    names, BodyState, Command, EventRecord, Handle, ObjectProp, PlaneId, PlaneInfo, PlaneProp,
-    Pose, Reply, Shape, TickHeader, Vec3,
+    BodyState, Command, EventRecord, Handle, ObjectProp, PlaneId, PlaneInfo, PlaneKind, PlaneOp,
+    PlaneProp, Pose, Reply, Shape, TickHeader, Vec3,
 };
 
 use crate::client::LIVENESS_PERIOD;
-use crate::overlay::Overlay;
+use crate::overlay::{Entry, Overlay};
+use crate::transport::{BodySample, BodySubscriber, EventSubscriber, TickListener, Transport};
 use crate::{Client, Error, Object};
-
-type BodySample = Sample<ipc::Service, [BodyState], TickHeader>;
 
 /// Options of a new plane; `None` keeps the daemon's default.
 #[derive(Debug, Clone, Default)]
 pub struct PlaneOptions {
+    /// Which backend simulates the plane (default: rapier3d).
+    pub kind: Option<PlaneKind>,
+    /// `Gravity`.
     pub gravity: Option<Vec3>,
+    /// `Threads` (creation only).
     pub threads: Option<u32>,
     /// Ticks per second of wall time; 0 = manual (only [`Plane::step`] advances it).
     pub tick_rate: Option<f32>,
+    /// `Enabled`.
     pub enabled: Option<bool>,
+    /// `LinearDamping`.
     pub linear_damping: Option<f32>,
+    /// `AngularDamping`.
     pub angular_damping: Option<f32>,
+    /// `Drag`.
     pub drag: Option<f32>,
+    /// `Buoyancy`.
     pub buoyancy: Option<f32>,
+    /// `ConstantForce`.
     pub constant_force: Option<Vec3>,
+    /// `RestThreshold`.
     pub rest_threshold: Option<f32>,
+    /// `SolverIterations`.
     pub solver_iterations: Option<u32>,
+    /// `LoopSolver`.
     pub loop_solver: Option<bool>,
+    /// `NeverSleep`.
     pub never_sleep: Option<bool>,
 }
 
@@ -72,28 +81,19 @@ impl PlaneOptions {
 
 /// What a client keeps per plane: the subscriber, the newest sample, the overlay.
 pub(crate) struct PlaneShared {
-    pub(crate) id: PlaneId,
-    bodies: Subscriber<ipc::Service, [BodyState], TickHeader>,
+    id: PlaneId,
+    bodies: BodySubscriber,
     latest: RefCell<Option<Rc<BodySample>>>,
-    pub(crate) overlay: RefCell<Overlay>,
+    overlay: RefCell<Overlay>,
     /// Created on the first wait: readers that never wait pay nothing for it.
-    ticks: RefCell<Option<Listener<ipc::Service>>>,
-    events: RefCell<Option<Subscriber<ipc::Service, [EventRecord], TickHeader>>>,
+    ticks: RefCell<Option<TickListener>>,
+    events: RefCell<Option<EventSubscriber>>,
     alive: Cell<bool>,
 }
 
 impl PlaneShared {
-    pub(crate) fn open(node: &Node<ipc::Service>, id: PlaneId) -> Result<PlaneShared, Error> {
-        let bodies = node
-            .service_builder(&names::plane_bodies(id))
-            .publish_subscribe::<[BodyState]>()
-            .user_header::<TickHeader>()
-            .open()
-            .map_err(|e| Error::ipc("open plane body service", e))?
-            .subscriber_builder()
-            .buffer_size(1)
-            .create()
-            .map_err(|e| Error::ipc("create plane subscriber", e))?;
+    pub(crate) fn open(transport: &Transport, id: PlaneId) -> Result<PlaneShared, Error> {
+        let bodies = transport.plane_bodies(id)?;
         Ok(PlaneShared {
             id,
             bodies,
@@ -103,6 +103,16 @@ impl PlaneShared {
             events: RefCell::new(None),
             alive: Cell::new(true),
         })
+    }
+
+    /// The daemon applied this process's writes to `handle` after `tick`.
+    pub(crate) fn confirm(&self, handle: Handle, tick: u64) {
+        self.overlay.borrow_mut().confirm(handle, tick);
+    }
+
+    /// The daemon refused a write to `handle`: it must not linger as if it had happened.
+    pub(crate) fn discard(&self, handle: Handle) {
+        self.overlay.borrow_mut().discard(handle);
     }
 
     /// Takes the newest sample if one arrived: a check of a shared-memory queue, no syscall.
@@ -135,10 +145,12 @@ pub struct Snapshot {
 }
 
 impl Snapshot {
+    /// The tick's header (tick number, time, step time, error figures).
     pub fn header(&self) -> &TickHeader {
         self.sample.user_header()
     }
 
+    /// The tick number.
     pub fn tick(&self) -> u64 {
         self.header().tick
     }
@@ -168,10 +180,12 @@ impl Plane {
         Plane { client, shared }
     }
 
+    /// The plane's id.
     pub fn id(&self) -> PlaneId {
         self.shared.id
     }
 
+    /// The client this handle talks through.
     pub fn client(&self) -> &Client {
         &self.client
     }
@@ -203,8 +217,14 @@ impl Plane {
         })
     }
 
+    /// Records this process's write to `handle` so reads see it until a tick shows it.
+    pub(crate) fn overlay_write(&self, handle: Handle, f: impl FnOnce(&mut Entry)) {
+        self.shared.overlay.borrow_mut().write(handle, f);
+    }
+
+    /// Every option and figure of the plane (sends the queue first).
     pub fn info(&self) -> Result<PlaneInfo, Error> {
-        match self.client.call(Command::PlaneInfo { plane: self.id() })? {
+        match self.client.call(Command::plane(self.id(), PlaneOp::Info))? {
             Reply::Plane(info) => Ok(info),
             other => Err(Error::Protocol(format!("unexpected reply {other:?}"))),
         }
@@ -213,13 +233,8 @@ impl Plane {
     /// Changes a plane option (checked now, sent with the next flush).
     pub fn set(&self, prop: PlaneProp) -> Result<(), Error> {
         let prop = prop.checked().map_err(Error::invalid_value)?;
-        self.client.queue(
-            Command::SetPlane {
-                plane: self.id(),
-                prop,
-            },
-            None,
-        );
+        self.client
+            .queue(Command::plane(self.id(), PlaneOp::Set(prop)), None);
         Ok(())
     }
 
@@ -251,12 +266,14 @@ impl Plane {
             .map(|p| p.checked())
             .collect::<Result<Vec<_>, _>>()
             .map_err(Error::invalid_value)?;
-        let reply = self.client.call(Command::AddObject {
-            plane: self.id(),
-            shape,
-            pose,
-            props: props.clone(),
-        })?;
+        let reply = self.client.call(Command::plane(
+            self.id(),
+            PlaneOp::AddObject {
+                shape,
+                pose,
+                props: props.clone(),
+            },
+        ))?;
         let Reply::Object { handle, tick } = reply else {
             return Err(Error::Protocol(format!("unexpected reply {reply:?}")));
         };
@@ -277,10 +294,7 @@ impl Plane {
     /// Advances a plane by `dt` seconds (with the queue sent first) and returns once the
     /// new tick is visible in [`Plane::snapshot`]. Returns the tick number.
     pub fn step(&self, dt: f32) -> Result<u64, Error> {
-        match self.client.call(Command::Step {
-            plane: self.id(),
-            dt,
-        })? {
+        match self.client.call(Command::plane(self.id(), PlaneOp::Step { dt }))? {
             Reply::Stepped { tick } => {
                 // The daemon sends the sample before the reply, so it is already here.
                 self.shared.refresh()?;
@@ -340,17 +354,7 @@ impl Plane {
         if self.shared.ticks.borrow().is_some() {
             return Ok(());
         }
-        let listener = self
-            .client
-            .inner
-            .node
-            .service_builder(&names::plane_tick(self.id()))
-            .event()
-            .open()
-            .map_err(|e| Error::ipc("open tick event", e))?
-            .listener_builder()
-            .create()
-            .map_err(|e| Error::ipc("create tick listener", e))?;
+        let listener = self.client.transport().plane_ticks(self.id())?;
         *self.shared.ticks.borrow_mut() = Some(listener);
         Ok(())
     }
@@ -359,18 +363,7 @@ impl Plane {
     /// subscribes; events before it are not seen.
     pub fn events(&self) -> Result<Vec<EventRecord>, Error> {
         if self.shared.events.borrow().is_none() {
-            let sub = self
-                .client
-                .inner
-                .node
-                .service_builder(&names::plane_events(self.id()))
-                .publish_subscribe::<[EventRecord]>()
-                .user_header::<TickHeader>()
-                .open()
-                .map_err(|e| Error::ipc("open event service", e))?
-                .subscriber_builder()
-                .create()
-                .map_err(|e| Error::ipc("create event subscriber", e))?;
+            let sub = self.client.transport().plane_events(self.id())?;
             *self.shared.events.borrow_mut() = Some(sub);
         }
         let mut out = Vec::new();
@@ -385,7 +378,7 @@ impl Plane {
     /// Destroys the plane and everything in it. Objects keep reading their last pose.
     pub fn destroy(&self) -> Result<(), Error> {
         self.client
-            .call(Command::DestroyPlane { plane: self.id() })?;
+            .call(Command::plane(self.id(), PlaneOp::Destroy))?;
         self.shared.alive.set(false);
         self.client.forget_plane(self.id());
         Ok(())

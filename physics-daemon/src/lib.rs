@@ -1,24 +1,33 @@
 //! The physics daemon: owns every plane of a domain, steps them, publishes their body states
 //! into shared memory and serves command batches from client processes.
 //!
-//! - [`server`]: the iceoryx2 node, the WaitSet loop and request dispatch.
-//! - [`clients`]: who is connected, and noticing clients that died.
-//! - [`plane`]: one rapier world with stable handles and the plane options.
+//! - [`server`]: the iceoryx2 node, the WaitSet loop, clients, and routing by plane id.
+//! - [`backend`]: the seam every plane kind implements, and the reusable [`backend::SlotTable`].
+//! - [`rapier3d`]: the 3D plane kind (a rapier world with stable handles and the options).
 //! - [`publish`]: writing a plane's tick into loaned shared-memory samples.
 
-pub mod clients;
-pub mod plane;
+#![warn(missing_docs)]
+
+pub mod backend;
 pub mod publish;
+pub mod rapier3d;
 pub mod server;
 
 pub use server::{cleanup_domain, run, wake, Daemon};
 
+/// Failures of the daemon as a whole (not of one command).
 #[derive(Debug, thiserror::Error)]
 pub enum DaemonError {
+    /// The domain name is not usable.
     #[error("invalid domain: {0}")]
     Domain(#[from] shm_layout::names::DomainError),
+    /// Another daemon serves the domain.
     #[error("another physics daemon is already serving domain {domain:?}")]
-    AlreadyRunning { domain: String },
+    AlreadyRunning {
+        /// The domain.
+        domain: String,
+    },
+    /// iceoryx2 failed.
     #[error("shared-memory transport: {0}")]
     Ipc(String),
 }

@@ -7,18 +7,20 @@ use std::hint::black_box;
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use shm_layout::codec;
-use shm_layout::{Command, Handle, ObjectProp, Reply, Request, Response};
+use shm_layout::{Command, Handle, ObjectOp, ObjectProp, Reply, Request, Response};
 
 fn batch(n: usize) -> Request {
     Request {
         commands: (0..n as u32)
-            .map(|i| Command::SetObject {
-                plane: 1,
-                object: Handle {
-                    slot: i,
-                    generation: 1,
-                },
-                prop: ObjectProp::Velocity([i as f32, 0.5, -1.0]),
+            .map(|i| {
+                Command::object(
+                    1,
+                    Handle {
+                        slot: i,
+                        generation: 1,
+                    },
+                    ObjectOp::Set(ObjectProp::Velocity([i as f32, 0.5, -1.0])),
+                )
             })
             .collect(),
     }

@@ -113,23 +113,22 @@ pub fn encode_request_with_version(request: &Request, version: u32) -> Vec<u8> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::{Command, CommandError, ErrorKind, Handle, ObjectProp, Pose, Reply, Shape};
+    use crate::{Command, CommandError, ErrorKind, Handle, ObjectProp, PlaneOp, Pose, Reply, Shape};
 
     fn sample_request() -> Request {
         Request {
             commands: vec![
-                Command::AddObject {
-                    plane: 1,
-                    shape: Shape::Cube {
-                        size: [1.0, 2.0, 3.0],
+                Command::plane(
+                    1,
+                    PlaneOp::AddObject {
+                        shape: Shape::Cube {
+                            size: [1.0, 2.0, 3.0],
+                        },
+                        pose: Pose::at([0.0, 5.0, 0.0]),
+                        props: vec![ObjectProp::Anchored(true)],
                     },
-                    pose: Pose::at([0.0, 5.0, 0.0]),
-                    props: vec![ObjectProp::Anchored(true)],
-                },
-                Command::Step {
-                    plane: 1,
-                    dt: 1.0 / 60.0,
-                },
+                ),
+                Command::plane(1, PlaneOp::Step { dt: 1.0 / 60.0 }),
             ],
         }
     }

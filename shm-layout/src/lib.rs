@@ -1,25 +1,42 @@
 //! The wire between the physics daemon and its clients.
 //!
 //! - [`records`]: `#[repr(C)]` zero-copy records published every tick in shared memory.
-//! - [`command`]: the serde command / reply enums carried over request-response.
+//! - [`command`]: the request / reply enums carried over request-response, nested by target:
+//!   [`Command`] → [`PlaneOp`] ([`plane_op`]) → [`ObjectOp`] ([`object_op`]).
+//! - [`settings`]: every plane option and object property with its default and its check,
+//!   defined once for the SDK and the daemon.
+//! - [`shape`]: collision shapes; [`error`]: command errors that name their field.
 //! - [`codec`]: framing of those enums into bytes (version header + postcard body).
 //! - [`names`]: domain validation and the iceoryx2 service names of one deployment.
+//! - [`validate`]: the checks and limits shared by both sides.
 //!
 //! No simulation code and no I/O live here, so both sides agree on one definition.
 
+#![warn(missing_docs)]
+
 pub mod codec;
 pub mod command;
+pub mod error;
 pub mod names;
+pub mod object_op;
+pub mod plane_op;
 pub mod records;
+pub mod settings;
+pub mod shape;
 pub mod validate;
 
 pub use codec::{DecodeError, Frame};
 pub use command::*;
+pub use error::{CommandError, ErrorKind};
+pub use object_op::ObjectOp;
+pub use plane_op::{PlaneKind, PlaneOp};
 pub use records::*;
+pub use settings::{ObjectProp, ObjectSettings, Pin, PlaneProp, PlaneSettings, Restraint, RotateTo};
+pub use shape::{Shape, ShapeKind};
 
 /// Bumped whenever a record layout or the command encoding changes. Client and daemon must
 /// agree on it; the handshake reports both values when they differ.
-pub const LAYOUT_VERSION: u32 = 2;
+pub const LAYOUT_VERSION: u32 = 3;
 
 /// The crate version both sides were built from; also checked by the handshake.
 pub const CRATE_VERSION: &str = env!("CARGO_PKG_VERSION");

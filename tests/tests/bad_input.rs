@@ -3,7 +3,7 @@
 use client_sdk::{ConnectOptions, Error, ErrorKind, Handle, PlaneOptions, Pose, Shape};
 use integration_tests::TestDaemon;
 use shm_layout::codec::{decode_response, encode_request};
-use shm_layout::{Command, ObjectProp, Request, Response, LAYOUT_VERSION};
+use shm_layout::{Command, ObjectOp, ObjectProp, PlaneOp, Request, Response, LAYOUT_VERSION};
 
 fn results(bytes: Vec<u8>) -> Vec<Result<shm_layout::Reply, shm_layout::CommandError>> {
     match decode_response(&bytes).unwrap() {
@@ -33,24 +33,18 @@ fn nan_and_negative_sizes_are_rejected_by_name() {
     let object = ball.handle();
     let request = Request {
         commands: vec![
-            Command::SetObject {
-                plane: plane.id(),
+            Command::object(
+                plane.id(),
                 object,
-                prop: ObjectProp::Velocity([f32::NAN, 0.0, 0.0]),
-            },
-            Command::SetObject {
-                plane: plane.id(),
+                ObjectOp::Set(ObjectProp::Velocity([f32::NAN, 0.0, 0.0])),
+            ),
+            Command::object(
+                plane.id(),
                 object,
-                prop: ObjectProp::Velocity([3.0, 0.0, 0.0]),
-            },
-            Command::Step {
-                plane: plane.id(),
-                dt: f32::INFINITY,
-            },
-            Command::Step {
-                plane: plane.id(),
-                dt: -0.1,
-            },
+                ObjectOp::Set(ObjectProp::Velocity([3.0, 0.0, 0.0])),
+            ),
+            Command::plane(plane.id(), PlaneOp::Step { dt: f32::INFINITY }),
+            Command::plane(plane.id(), PlaneOp::Step { dt: -0.1 }),
         ],
     };
     let r = results(client.raw_request(&encode_request(&request)).unwrap());

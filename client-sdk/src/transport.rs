@@ -1,0 +1,216 @@
+//! Every iceoryx2 port of the SDK is built here: the node, the request port with the
+//! daemon's wake-up event and our reply event, and per plane the body subscriber, the tick
+//! listener and the event subscriber. `Client` and `Plane` hold what this module returns
+//! and never name a service themselves.
+
+use std::time::{Duration, Instant};
+
+use iceoryx2::config::Config;
+use iceoryx2::node::NodeView;
+use iceoryx2::port::client::Client as RequestPort;
+use iceoryx2::port::listener::Listener;
+use iceoryx2::port::notifier::Notifier;
+use iceoryx2::port::subscriber::Subscriber;
+use iceoryx2::prelude::*;
+use iceoryx2::sample::Sample;
+use shm_layout::{names, BodyState, EventRecord, PlaneId, TickHeader};
+
+use crate::Error;
+
+/// How long `open` waits for a starting daemon to open its request server.
+const SERVER_WAIT: Duration = Duration::from_secs(2);
+
+/// A plane's body states: the newest tick's sample.
+pub(crate) type BodySample = Sample<ipc::Service, [BodyState], TickHeader>;
+/// Subscriber of a plane's body states.
+pub(crate) type BodySubscriber = Subscriber<ipc::Service, [BodyState], TickHeader>;
+/// Subscriber of a plane's per-tick events.
+pub(crate) type EventSubscriber = Subscriber<ipc::Service, [EventRecord], TickHeader>;
+/// Listener woken on every tick of a plane.
+pub(crate) type TickListener = Listener<ipc::Service>;
+
+/// The ports of one client process.
+pub(crate) struct Transport {
+    config: Config,
+    node: Node<ipc::Service>,
+    port: RequestPort<ipc::Service, [u8], u128, [u8], ()>,
+    daemon_wake: Notifier<ipc::Service>,
+    replies: Listener<ipc::Service>,
+    id: u128,
+}
+
+impl Transport {
+    /// Opens the ports of a client of `domain`'s daemon (waiting, bounded, for a starting
+    /// daemon's request server).
+    pub(crate) fn open(domain: &str) -> Result<Transport, Error> {
+        let config = names::config(domain).map_err(|e| Error::Invalid {
+            field: "domain".into(),
+            message: e.to_string(),
+        })?;
+        let no_daemon = |detail: String| Error::NoDaemon {
+            domain: domain.to_string(),
+            detail,
+        };
+        // A crashed daemon leaves its services behind: look for a live daemon process first.
+        if daemon_alive(&config, 0) == Some(false) {
+            return Err(no_daemon("no live daemon process in this domain".into()));
+        }
+        let node = NodeBuilder::new()
+            .name(&NodeName::new("physics-client").expect("valid node name"))
+            .config(&config)
+            .signal_handling_mode(SignalHandlingMode::Disabled)
+            .create::<ipc::Service>()
+            .map_err(|e| Error::ipc("cannot create node", e))?;
+        let id = node.id().value();
+        let control = node
+            .service_builder(&names::control())
+            .request_response::<[u8], [u8]>()
+            .request_user_header::<u128>()
+            .open()
+            .map_err(|e| no_daemon(format!("{e:?}")))?;
+        // A daemon that is starting has its node before its server port; a request sent in
+        // between would reach no one. Wait (bounded) until the server is there.
+        let deadline = Instant::now() + SERVER_WAIT;
+        while control.dynamic_config().number_of_servers() == 0 {
+            if Instant::now() >= deadline {
+                return Err(no_daemon("the control service has no server".into()));
+            }
+            std::thread::sleep(Duration::from_millis(2));
+        }
+        let port = control
+            .client_builder()
+            .initial_max_slice_len(4096)
+            .allocation_strategy(AllocationStrategy::PowerOfTwo)
+            .create()
+            .map_err(|e| Error::ipc("cannot create request port", e))?;
+        let daemon_wake = node
+            .service_builder(&names::control_wake())
+            .event()
+            .open()
+            .map_err(|e| no_daemon(format!("{e:?}")))?
+            .notifier_builder()
+            .create()
+            .map_err(|e| Error::ipc("cannot create notifier", e))?;
+        let replies = node
+            .service_builder(&names::client_wake(id))
+            .event()
+            .max_notifiers(2)
+            .max_listeners(1)
+            .create()
+            .map_err(|e| Error::ipc("cannot create reply event", e))?
+            .listener_builder()
+            .create()
+            .map_err(|e| Error::ipc("cannot create reply listener", e))?;
+        Ok(Transport {
+            config,
+            node,
+            port,
+            daemon_wake,
+            replies,
+            id,
+        })
+    }
+
+    /// Sends request bytes and wakes the daemon; then polls for the reply, sleeping on our
+    /// reply event up to `period` at a time and calling `check` between sleeps (liveness,
+    /// timeouts): a dead daemon is an error within a bounded time, not a hang.
+    pub(crate) fn exchange(
+        &self,
+        bytes: &[u8],
+        period: Duration,
+        mut check: impl FnMut(bool) -> Result<(), Error>,
+    ) -> Result<Vec<u8>, Error> {
+        let mut request = self
+            .port
+            .loan_slice_uninit(bytes.len())
+            .map_err(|e| Error::ipc("loan request", e))?;
+        *request.user_header_mut() = self.id;
+        let pending = request
+            .write_from_slice(bytes)
+            .send()
+            .map_err(|e| Error::ipc("send request", e))?;
+        self.daemon_wake
+            .notify()
+            .map_err(|e| Error::ipc("wake daemon", e))?;
+        loop {
+            if let Some(response) = pending
+                .receive()
+                .map_err(|e| Error::ipc("receive reply", e))?
+            {
+                return Ok(response.payload().to_vec());
+            }
+            check(pending.is_connected())?;
+            let _ = self.replies.timed_wait(|_| {}, period);
+        }
+    }
+
+    /// Whether the daemon node `daemon_node` (0: any node named like a daemon) is alive;
+    /// `None` when the node list cannot be read.
+    pub(crate) fn daemon_alive(&self, daemon_node: u128) -> Option<bool> {
+        daemon_alive(&self.config, daemon_node)
+    }
+
+    /// Subscribes to plane `id`'s body states (newest tick only).
+    pub(crate) fn plane_bodies(&self, id: PlaneId) -> Result<BodySubscriber, Error> {
+        self.node
+            .service_builder(&names::plane_bodies(id))
+            .publish_subscribe::<[BodyState]>()
+            .user_header::<TickHeader>()
+            .open()
+            .map_err(|e| Error::ipc("open plane body service", e))?
+            .subscriber_builder()
+            .buffer_size(1)
+            .create()
+            .map_err(|e| Error::ipc("create plane subscriber", e))
+    }
+
+    /// A listener woken by every tick of plane `id`.
+    pub(crate) fn plane_ticks(&self, id: PlaneId) -> Result<TickListener, Error> {
+        self.node
+            .service_builder(&names::plane_tick(id))
+            .event()
+            .open()
+            .map_err(|e| Error::ipc("open tick event", e))?
+            .listener_builder()
+            .create()
+            .map_err(|e| Error::ipc("create tick listener", e))
+    }
+
+    /// Subscribes to plane `id`'s per-tick events.
+    pub(crate) fn plane_events(&self, id: PlaneId) -> Result<EventSubscriber, Error> {
+        self.node
+            .service_builder(&names::plane_events(id))
+            .publish_subscribe::<[EventRecord]>()
+            .user_header::<TickHeader>()
+            .open()
+            .map_err(|e| Error::ipc("open event service", e))?
+            .subscriber_builder()
+            .create()
+            .map_err(|e| Error::ipc("create event subscriber", e))
+    }
+}
+
+/// Whether the daemon's node is alive: found by id once the handshake told us the id, by
+/// name before. `None` when the node list cannot be read (then we assume nothing).
+fn daemon_alive(config: &Config, daemon_node: u128) -> Option<bool> {
+    let mut alive = false;
+    Node::<ipc::Service>::list(config, |state| {
+        if daemon_node != 0 && state.node_id().value() == daemon_node {
+            alive = matches!(state, NodeState::Alive(_));
+            return CallbackProgression::Stop;
+        }
+        if let (0, NodeState::Alive(view)) = (daemon_node, &state) {
+            if view
+                .details()
+                .as_ref()
+                .is_some_and(|d| d.name().as_str() == names::DAEMON_NODE_NAME)
+            {
+                alive = true;
+                return CallbackProgression::Stop;
+            }
+        }
+        CallbackProgression::Continue
+    })
+    .ok()?;
+    Some(alive)
+}

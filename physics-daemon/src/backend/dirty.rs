@@ -1,0 +1,48 @@
+//! What changed in a plane since its states were last published: slots touched by ops
+//! (set, add, destroy, impulse, wake), or the whole plane. The plane marks, the publisher
+//! drains; the plane's force pass reads the slots marked since its last step.
+
+/// Slots changed since the last publish.
+#[derive(Debug, Default)]
+pub struct Dirty {
+    slots: Vec<u32>,
+    all: bool,
+    /// `slots[..stepped]` were already seen by a step.
+    stepped: usize,
+}
+
+impl Dirty {
+    /// Marks one slot as changed.
+    pub fn mark(&mut self, slot: u32) {
+        self.slots.push(slot);
+    }
+
+    /// Marks every slot as changed (a plane-wide change).
+    pub fn mark_all(&mut self) {
+        self.all = true;
+    }
+
+    /// Slots marked since the last step (possibly repeated).
+    pub fn since_step(&self) -> &[u32] {
+        &self.slots[self.stepped.min(self.slots.len())..]
+    }
+
+    /// A step has seen every slot marked so far. Planes stepped without being published
+    /// (in-process use) keep the list bounded: repeats are folded once it outgrows the
+    /// plane.
+    pub fn stepped(&mut self, slot_count: usize) {
+        if self.slots.len() > 2 * slot_count + 64 {
+            self.slots.sort_unstable();
+            self.slots.dedup();
+        }
+        self.stepped = self.slots.len();
+    }
+
+    /// Hands the marked slots to `into` (appended) and forgets them. Returns true when the
+    /// whole plane changed.
+    pub fn drain(&mut self, into: &mut Vec<u32>) -> bool {
+        into.append(&mut self.slots);
+        self.stepped = 0;
+        std::mem::take(&mut self.all)
+    }
+}

@@ -1,0 +1,104 @@
+//! The seam between the server / publisher and the simulation: every plane kind implements
+//! [`Backend`], and [`create`] is the one place that knows the kinds. The server routes ops
+//! by plane id and never looks inside them; the publisher asks the backend what changed.
+//!
+//! Adding a plane kind: a folder of its own (like `rapier3d/`) with a type implementing
+//! [`Backend`], a [`PlaneKind`] variant in shm-layout, and one line in [`create`].
+
+mod dirty;
+mod slot_table;
+
+use std::mem::MaybeUninit;
+
+pub use dirty::Dirty;
+pub use slot_table::SlotTable;
+
+use shm_layout::{
+    BodyState, CommandError, CommandResult, EventRecord, PlaneId, PlaneKind, PlaneOp, PlaneProp,
+    TickHeader,
+};
+
+/// Which slots [`Backend::write_states`] must write.
+#[derive(Debug, Clone, Copy)]
+pub enum SlotFilter<'a> {
+    /// Every slot.
+    All,
+    /// Only slots `i` with `changed_at[i] > written` (the rest of the sample already holds
+    /// their current state).
+    ChangedAfter {
+        /// Per slot: the publish from which on its state may differ.
+        changed_at: &'a [u64],
+        /// The publish that last wrote the whole sample.
+        written: u64,
+    },
+}
+
+impl SlotFilter<'_> {
+    /// Whether slot `i` must be written.
+    #[inline]
+    pub fn wants(&self, i: usize) -> bool {
+        match self {
+            SlotFilter::All => true,
+            SlotFilter::ChangedAfter {
+                changed_at,
+                written,
+            } => changed_at.get(i).is_none_or(|c| c > written),
+        }
+    }
+}
+
+/// A plane as the server and the publisher see it.
+pub trait Backend {
+    /// Which kind of plane this is.
+    fn kind(&self) -> PlaneKind;
+
+    /// Applies one op other than `Step` and `Destroy` (which the server handles through
+    /// [`Backend::step`] and by dropping the plane). Errors name the field and the value.
+    fn apply(&mut self, op: PlaneOp) -> CommandResult;
+
+    /// Advances by `dt` seconds. Returns false (and does nothing) when disabled.
+    fn step(&mut self, dt: f32) -> Result<bool, CommandError>;
+
+    /// Automatic ticks per second (0 = manual).
+    fn tick_rate(&self) -> f32;
+
+    /// Whether the plane advances at all.
+    fn enabled(&self) -> bool;
+
+    /// Ticks stepped so far.
+    fn tick(&self) -> u64;
+
+    /// The header of the newest tick.
+    fn header(&self) -> TickHeader;
+
+    /// Length of the published body array.
+    fn slot_count(&self) -> usize;
+
+    /// Number of slots that may move in the next step.
+    fn awake_count(&self) -> usize;
+
+    /// Calls `f` with every slot that may move in the next step (awake bodies). A slot
+    /// outside this set has not moved since the step that put it to rest.
+    fn for_each_awake(&self, f: &mut dyn FnMut(usize));
+
+    /// Appends the slots changed by ops since the last call to `into`; true when the whole
+    /// plane changed.
+    fn drain_dirty(&mut self, into: &mut Vec<u32>) -> bool;
+
+    /// Writes the state of the slots `filter` wants into `out` (one element per slot).
+    fn write_states(&self, out: &mut [MaybeUninit<BodyState>], filter: SlotFilter<'_>);
+
+    /// Events of the last step.
+    fn events(&self) -> &[EventRecord];
+}
+
+/// Creates a plane of `kind` with its defaults, then `props` applied in order.
+pub fn create(
+    kind: PlaneKind,
+    id: PlaneId,
+    props: &[PlaneProp],
+) -> Result<Box<dyn Backend>, CommandError> {
+    Ok(match kind {
+        PlaneKind::Rapier3d => Box::new(crate::rapier3d::Plane::new(id, props)?),
+    })
+}

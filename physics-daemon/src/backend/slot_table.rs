@@ -1,0 +1,203 @@
+//! Stable, stale-proof handles: a table of slots, each with a generation that grows every
+//! time the slot is reused. A handle `(slot, generation)` finds its value only while the
+//! slot still holds that generation, so a handle to a removed value is an error, never
+//! another value. Bodies, and later controllers, joints and GUI bodies, use it alike.
+
+use shm_layout::{CommandError, ErrorKind, Handle};
+
+struct Entry<T> {
+    generation: u32,
+    value: Option<T>,
+}
+
+/// Values addressed by generation-checked handles. Freed slots are reused (the published
+/// arrays stay dense); `what` names the values in error messages ("object").
+pub struct SlotTable<T> {
+    what: &'static str,
+    entries: Vec<Entry<T>>,
+    free: Vec<u32>,
+    live: u32,
+    max_slots: usize,
+}
+
+impl<T> SlotTable<T> {
+    /// An empty table of at most `max_slots` slots.
+    pub fn new(what: &'static str, max_slots: usize) -> Self {
+        SlotTable {
+            what,
+            entries: Vec::new(),
+            free: Vec::new(),
+            live: 0,
+            max_slots,
+        }
+    }
+
+    /// The slot the next [`SlotTable::insert`] will use, or `None` when the table is full.
+    pub fn next_slot(&self) -> Option<u32> {
+        match self.free.last() {
+            Some(s) => Some(*s),
+            None if self.entries.len() < self.max_slots => Some(self.entries.len() as u32),
+            None => None,
+        }
+    }
+
+    /// Stores `value` in a free slot with a new generation.
+    pub fn insert(&mut self, value: T) -> Result<Handle, CommandError> {
+        let slot = match self.free.pop() {
+            Some(s) => s,
+            None if self.entries.len() < self.max_slots => {
+                self.entries.push(Entry {
+                    generation: 0,
+                    value: None,
+                });
+                (self.entries.len() - 1) as u32
+            }
+            None => {
+                return Err(CommandError::new(
+                    ErrorKind::Internal,
+                    format!("full ({} {}s)", self.max_slots, self.what),
+                ))
+            }
+        };
+        let entry = &mut self.entries[slot as usize];
+        entry.generation = entry.generation.wrapping_add(1).max(1);
+        entry.value = Some(value);
+        self.live += 1;
+        Ok(Handle {
+            slot,
+            generation: entry.generation,
+        })
+    }
+
+    /// The value of `handle`, or a clear error for unknown and stale handles.
+    pub fn get(&self, handle: Handle) -> Result<&T, CommandError> {
+        let entry = self.entry(handle)?;
+        Ok(entry.value.as_ref().expect("checked by entry"))
+    }
+
+    /// The value of `handle`, mutably.
+    pub fn get_mut(&mut self, handle: Handle) -> Result<&mut T, CommandError> {
+        self.entry(handle)?;
+        let entry = &mut self.entries[handle.slot as usize];
+        Ok(entry.value.as_mut().expect("checked by entry"))
+    }
+
+    /// Removes the value of `handle`; its slot is reused with a new generation.
+    pub fn remove(&mut self, handle: Handle) -> Result<T, CommandError> {
+        self.entry(handle)?;
+        let value = self.entries[handle.slot as usize]
+            .value
+            .take()
+            .expect("checked by entry");
+        self.free.push(handle.slot);
+        self.live -= 1;
+        Ok(value)
+    }
+
+    fn entry(&self, handle: Handle) -> Result<&Entry<T>, CommandError> {
+        let what = self.what;
+        let entry = self.entries.get(handle.slot as usize).ok_or_else(|| {
+            CommandError::new(
+                ErrorKind::StaleHandle,
+                format!("{what} {handle:?} does not exist"),
+            )
+        })?;
+        match entry.value {
+            Some(_) if entry.generation == handle.generation => Ok(entry),
+            _ => Err(CommandError::new(
+                ErrorKind::StaleHandle,
+                format!(
+                    "{what} {handle:?} is stale: slot {} now holds generation {} ({})",
+                    handle.slot,
+                    entry.generation,
+                    if entry.value.is_some() {
+                        "alive"
+                    } else {
+                        "empty"
+                    }
+                ),
+            )),
+        }
+    }
+
+    /// The value in slot `slot` whatever its generation, if the slot is occupied.
+    pub fn at(&self, slot: usize) -> Option<&T> {
+        self.entries.get(slot)?.value.as_ref()
+    }
+
+    /// The value in slot `slot` mutably, if occupied.
+    pub fn at_mut(&mut self, slot: usize) -> Option<&mut T> {
+        self.entries.get_mut(slot)?.value.as_mut()
+    }
+
+    /// The handle of the value in slot `slot`, if occupied.
+    pub fn handle_at(&self, slot: usize) -> Option<Handle> {
+        let entry = self.entries.get(slot)?;
+        entry.value.as_ref().map(|_| Handle {
+            slot: slot as u32,
+            generation: entry.generation,
+        })
+    }
+
+    /// The generation of slot `slot` (of its value, or of the last value it held).
+    pub fn generation(&self, slot: usize) -> u32 {
+        self.entries.get(slot).map_or(0, |e| e.generation)
+    }
+
+    /// Slots ever used (occupied or free): the length of a published array.
+    pub fn slot_count(&self) -> usize {
+        self.entries.len()
+    }
+
+    /// Occupied slots.
+    pub fn live(&self) -> u32 {
+        self.live
+    }
+
+    /// Every occupied slot with its handle and value.
+    pub fn iter(&self) -> impl Iterator<Item = (Handle, &T)> + '_ {
+        self.entries.iter().enumerate().filter_map(|(i, e)| {
+            e.value.as_ref().map(|v| {
+                (
+                    Handle {
+                        slot: i as u32,
+                        generation: e.generation,
+                    },
+                    v,
+                )
+            })
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn reused_slots_get_new_generations_and_stale_handles_fail() {
+        let mut t = SlotTable::new("thing", 2);
+        let a = t.insert("a").unwrap();
+        let b = t.insert("b").unwrap();
+        assert!(t.insert("c").is_err(), "full at 2");
+        assert_eq!(t.remove(a).unwrap(), "a");
+        let c = t.insert("c").unwrap();
+        assert_eq!(c.slot, a.slot);
+        assert_eq!(c.generation, a.generation + 1);
+        let e = t.get(a).unwrap_err();
+        assert_eq!(e.kind, ErrorKind::StaleHandle);
+        assert!(e.message.contains("stale"), "{e}");
+        assert_eq!(*t.get(c).unwrap(), "c");
+        assert_eq!(*t.get(b).unwrap(), "b");
+        assert_eq!(t.live(), 2);
+        assert_eq!(t.slot_count(), 2);
+        let e = t
+            .get(Handle {
+                slot: 9,
+                generation: 1,
+            })
+            .unwrap_err();
+        assert!(e.message.contains("does not exist"), "{e}");
+        assert_eq!(t.iter().count(), 2);
+    }
+}

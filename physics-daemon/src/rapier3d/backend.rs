@@ -1,0 +1,96 @@
+//! The rapier3d plane behind the backend seam: routes each op to the plane's methods.
+
+use std::mem::MaybeUninit;
+
+use shm_layout::{
+    BodyState, CommandError, CommandResult, ErrorKind, EventRecord, ObjectOp, PlaneKind, PlaneOp,
+    Reply, TickHeader,
+};
+
+use super::Plane;
+use crate::backend::{Backend, SlotFilter};
+
+impl Backend for Plane {
+    fn kind(&self) -> PlaneKind {
+        PlaneKind::Rapier3d
+    }
+
+    fn apply(&mut self, op: PlaneOp) -> CommandResult {
+        let applied = |plane: &Plane| Reply::Applied { tick: plane.tick };
+        match op {
+            PlaneOp::Info => Ok(Reply::Plane(self.info())),
+            PlaneOp::Set(prop) => self.set(prop).map(|_| Reply::Done),
+            PlaneOp::AddObject { shape, pose, props } => {
+                let handle = self.add_object(&shape, pose, &props)?;
+                Ok(Reply::Object {
+                    handle,
+                    tick: self.tick,
+                })
+            }
+            PlaneOp::Object { handle, op } => match op {
+                ObjectOp::Set(prop) => self.set_object(handle, prop).map(|_| applied(self)),
+                ObjectOp::ApplyImpulse(j) => self.apply_impulse(handle, j).map(|_| applied(self)),
+                ObjectOp::Info => Ok(Reply::ObjectInfo(Box::new(self.object_info(handle)?))),
+                ObjectOp::RecalculateCenterOfMass => self
+                    .recalculate_center_of_mass(handle)
+                    .map(Reply::CenterOfMass),
+                ObjectOp::Wake => self.wake(handle).map(|_| applied(self)),
+                ObjectOp::Destroy => self.destroy_object(handle).map(|_| applied(self)),
+            },
+            PlaneOp::Step { .. } | PlaneOp::Destroy => Err(CommandError::new(
+                ErrorKind::Internal,
+                format!("{op:?} is handled by the server, not the plane"),
+            )),
+        }
+    }
+
+    fn step(&mut self, dt: f32) -> Result<bool, CommandError> {
+        Plane::step(self, dt)
+    }
+
+    fn tick_rate(&self) -> f32 {
+        Plane::tick_rate(self)
+    }
+
+    fn enabled(&self) -> bool {
+        Plane::enabled(self)
+    }
+
+    fn tick(&self) -> u64 {
+        self.tick
+    }
+
+    fn header(&self) -> TickHeader {
+        Plane::header(self)
+    }
+
+    fn slot_count(&self) -> usize {
+        Plane::slot_count(self)
+    }
+
+    fn awake_count(&self) -> usize {
+        Plane::awake_count(self)
+    }
+
+    fn for_each_awake(&self, f: &mut dyn FnMut(usize)) {
+        for slot in self.awake_slots() {
+            f(slot);
+        }
+    }
+
+    fn drain_dirty(&mut self, into: &mut Vec<u32>) -> bool {
+        self.dirty.drain(into)
+    }
+
+    fn write_states(&self, out: &mut [MaybeUninit<BodyState>], filter: SlotFilter<'_>) {
+        for (i, dst) in out.iter_mut().enumerate() {
+            if filter.wants(i) {
+                dst.write(self.body_state(i));
+            }
+        }
+    }
+
+    fn events(&self) -> &[EventRecord] {
+        Plane::events(self)
+    }
+}

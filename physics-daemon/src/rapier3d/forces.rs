@@ -1,0 +1,250 @@
+//! The force pass, run before every rapier step over the awake dynamic bodies (plus the ones
+//! touched by commands since the last step). Rapier integrates gravity and contacts; this
+//! pass adds what the API defines on top:
+//!
+//! - Buoyancy (acceleration), ConstantForce (plane + object, divided by mass),
+//!   ImpulseDirection (acceleration): exact for constant forces.
+//! - Drag `F = -Drag·|v|·v`, integrated with backward Euler solved in closed form, so it
+//!   never overshoots or reverses a velocity at any dt (unconditionally stable).
+//! - LinearDamping / AngularDamping: `v *= max(0, 1 - k·dt)`, as documented.
+//! - RotateTo and SetPin: controllers that set the velocities they need, capped.
+//!
+//! The linear part becomes one force for the step, handed to rapier's force accumulator:
+//! rapier spreads it over its substeps exactly like gravity, so Buoyancy = -Gravity.Y
+//! cancels gravity in every substep (a velocity kick before the step would not, and the
+//! body would drift). Angular changes are set directly: "direct rotation" must also turn
+//! bodies whose rotation is locked against contacts.
+//!
+//! A plane with no forces and no driven objects skips the pass entirely.
+
+use rapier3d::prelude::*;
+use shm_layout::{Pin, RotateTo};
+
+use super::part::Part;
+use super::Plane;
+
+/// Plane-wide inputs of one pass.
+struct Env {
+    dt: f32,
+    linear_keep: f32,
+    angular_keep: f32,
+    drag: f32,
+    acceleration: Vector,
+    force: Vector,
+    gravity: Vector,
+}
+
+impl Plane {
+    pub(super) fn apply_forces(&mut self, dt: f32) {
+        let s = &self.settings;
+        let env = Env {
+            dt,
+            linear_keep: (1.0 - s.linear_damping * dt).max(0.0),
+            angular_keep: (1.0 - s.angular_damping * dt).max(0.0),
+            drag: s.drag,
+            acceleration: Vector::new(0.0, s.buoyancy, 0.0),
+            force: Vector::from(s.constant_force),
+            gravity: self.world.gravity,
+        };
+        let idle = env.linear_keep == 1.0
+            && env.angular_keep == 1.0
+            && env.drag == 0.0
+            && env.acceleration == Vector::ZERO
+            && env.force == Vector::ZERO
+            && self.driven == 0;
+        // Forces of the previous pass stay in rapier's accumulators until reset.
+        for h in self.forced.drain(..) {
+            if let Some(body) = self.world.bodies.get_mut(h) {
+                body.reset_forces(false);
+            }
+        }
+        if idle {
+            return;
+        }
+        let mut handles = std::mem::take(&mut self.scratch);
+        handles.clear();
+        handles.extend(self.world.islands.active_bodies());
+        // Bodies changed by ops since the last step, awake or not yet listed as awake.
+        let bodies = &self.bodies;
+        handles.extend(
+            self.dirty
+                .since_step()
+                .iter()
+                .filter_map(|s| bodies.at(*s as usize).map(|b| b.handle)),
+        );
+        let stamp = self.tick + 1;
+        for h in &handles {
+            let Some(body) = self.world.bodies.get_mut(*h) else {
+                continue; // removed since it was marked
+            };
+            if !body.is_dynamic() {
+                continue;
+            }
+            let Some(part) = self
+                .bodies
+                .at_mut(body.user_data as usize)
+                .map(|b| &mut b.part)
+            else {
+                continue;
+            };
+            if part.forced_tick == stamp {
+                continue; // both awake and marked
+            }
+            part.forced_tick = stamp;
+            if drive(body, part, &env) {
+                self.forced.push(*h);
+            }
+        }
+        self.scratch = handles;
+    }
+}
+
+/// Applies one body's forces for the step. Returns whether it left a force in rapier's
+/// accumulator.
+fn drive(body: &mut RigidBody, part: &Part, env: &Env) -> bool {
+    let dt = env.dt;
+    let mass = body.mass();
+    let inv_mass = if mass > 0.0 { 1.0 / mass } else { 0.0 };
+    let (v0, w0) = (body.linvel(), body.angvel());
+    let forces = env.force + Vector::from(part.constant_force);
+    // The velocity this step should end at, before gravity and contacts.
+    let mut v =
+        v0 + (env.acceleration + Vector::from(part.impulse_direction) + forces * inv_mass) * dt;
+    let mut w = w0;
+    let mut w_driven = false;
+    if let Some(pin) = &part.pin {
+        (v, w) = pin_drive(body, part, pin, v, w, env);
+        w_driven = true;
+    }
+    if let Some(r) = &part.rotate_to {
+        w = rotate_drive(body, r, dt);
+        w_driven = true;
+    }
+    if env.drag > 0.0 {
+        v = implicit_drag(v, env.drag * inv_mass * dt);
+    }
+    v *= env.linear_keep;
+    if !w_driven {
+        w *= env.angular_keep;
+    }
+    // Locked rotation axes keep their velocity (locked translations are skipped by rapier,
+    // which applies forces through the effective inverse mass).
+    for i in 0..3 {
+        if part.locks[i + 3] {
+            w[i] = w0[i];
+        }
+    }
+    if w != w0 {
+        body.set_angvel(w, false);
+    }
+    let force = (v - v0) * (mass / dt);
+    if force == Vector::ZERO {
+        return false;
+    }
+    body.add_force(force, false);
+    true
+}
+
+/// Backward Euler on `dv/dt = -c·|v|·v`: the new speed s' solves `s' + c·dt·s'² = s`.
+/// `c_dt` is `Drag / mass · dt`. Written in the cancellation-free form of the root.
+fn implicit_drag(v: Vector, c_dt: f32) -> Vector {
+    let s = v.length();
+    if s == 0.0 || c_dt == 0.0 {
+        return v;
+    }
+    let s_new = 2.0 * s / (1.0 + (1.0 + 4.0 * c_dt * s).sqrt());
+    v * (s_new / s)
+}
+
+/// The rotation from `q` to `target` as a scaled axis (shortest way round).
+fn rotation_error(q: Rotation, target: Rotation) -> Vector {
+    let mut d = target * q.inverse();
+    if d.w < 0.0 {
+        d = -d;
+    }
+    d.to_scaled_axis()
+}
+
+/// Angular velocity of a proportional controller; the gain is capped at 1/dt so one step
+/// never rotates past the target.
+fn rotate_drive(body: &RigidBody, r: &RotateTo, dt: f32) -> Vector {
+    let err = rotation_error(body.position().rotation, Rotation::from_array(r.target));
+    err * r.strength.min(1.0 / dt)
+}
+
+/// Speed toward a target `dist` away that a controller with acceleration `accel` can still
+/// stop from at half that acceleration, and at most the whole way in one step.
+fn approach_speed(dist: f32, accel: f32, dt: f32) -> f32 {
+    (dist / dt).min((accel * dist).sqrt())
+}
+
+/// SetPin: the grab point's velocity is steered toward the target with an acceleration of
+/// at most `force / mass` (gravity included: a force that cannot lift the body leaves it on
+/// the ground); the orientation is turned toward the target's with a torque of at most
+/// `force × lever`.
+fn pin_drive(
+    body: &RigidBody,
+    part: &Part,
+    pin: &Pin,
+    v: Vector,
+    w: Vector,
+    env: &Env,
+) -> (Vector, Vector) {
+    let dt = env.dt;
+    let mass = body.mass().max(f32::EPSILON);
+    let pose = body.position();
+    let relative = Vector::from(pin.relative);
+    let grab = pose.translation + pose.rotation * relative;
+    let com = body.center_of_mass();
+    let accel = pin.force / mass;
+
+    let err = Vector::from(pin.target.position) - grab;
+    let dist = err.length();
+    let wanted = if dist > 0.0 {
+        err * (approach_speed(dist, accel, dt) / dist)
+    } else {
+        Vector::ZERO
+    };
+    let grab_velocity = v + w.cross(grab - com);
+    // Rapier adds gravity after this pass: ask for it to be cancelled too.
+    let needed = (wanted - grab_velocity) / dt - env.gravity;
+    let v = v + needed.clamp_length_max(accel) * dt;
+
+    let half_diagonal = 0.5 * Vector::from(part.size).length();
+    let lever = relative.length().max(half_diagonal).max(1e-3);
+    let alpha = pin.force / (mass * lever);
+    let err = rotation_error(pose.rotation, Rotation::from_array(pin.target.rotation));
+    let angle = err.length();
+    let wanted = if angle > 0.0 {
+        err * (approach_speed(angle, alpha, dt) / angle)
+    } else {
+        Vector::ZERO
+    };
+    let w = w + (wanted - w).clamp_length_max(alpha * dt);
+    (v, w)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn implicit_drag_never_reverses_and_matches_small_steps() {
+        // Huge drag and step: the speed shrinks but keeps its sign.
+        let v = implicit_drag(Vector::new(0.0, -100.0, 0.0), 1e6);
+        assert!(v.y < 0.0 && v.y > -0.1, "{v:?}");
+        // Small c·dt: s' ≈ s - c·dt·s².
+        let s = implicit_drag(Vector::new(10.0, 0.0, 0.0), 1e-4).x;
+        assert!((s - (10.0 - 1e-4 * 100.0)).abs() < 1e-3, "{s}");
+    }
+
+    #[test]
+    fn rotation_error_takes_the_short_way() {
+        let q = Rotation::from_rotation_y(0.1);
+        let t = Rotation::from_rotation_y(-0.2);
+        let e = rotation_error(q, t);
+        assert!((e.y + 0.3).abs() < 1e-5, "{e:?}");
+        let e = rotation_error(q, -t); // same orientation, other hemisphere
+        assert!((e.y + 0.3).abs() < 1e-5, "{e:?}");
+    }
+}

@@ -1,0 +1,313 @@
+//! The rapier3d backend: one 3D plane is a rapier world, the slot table that gives bodies
+//! stable handles, and the plane options. No I/O here: the server hands it ops and the
+//! publisher writes what it reports.
+//!
+//! - `backend`: the [`Backend`](crate::backend::Backend) implementation (op routing).
+//! - `objects`, `properties`, `part`: objects, their properties and their rapier mapping.
+//! - `forces`, `solver`, `contacts`: the per-tick force pass, solver tuning, contacts.
+
+mod backend;
+mod contacts;
+mod forces;
+mod objects;
+mod part;
+mod properties;
+mod solver;
+
+use std::sync::mpsc;
+use std::sync::Arc;
+use std::time::Instant;
+
+use rapier3d::prelude::*;
+use shm_layout::validate::{self, MAX_DT, MAX_HIT_BOX_QUALITY};
+use shm_layout::{
+    BodyState, CommandError, EventRecord, PlaneId, PlaneInfo, PlaneKind, PlaneProp,
+    PlaneSettings, TickHeader, FLAG_ALIVE, FLAG_ANCHORED, FLAG_SLEEPING, LAYOUT_VERSION,
+};
+
+use crate::backend::{Dirty, SlotTable};
+use part::Part;
+
+pub use objects::MAX_SLOTS;
+
+/// One object: its rapier body and what the API says about it.
+#[derive(Debug)]
+struct Body {
+    handle: RigidBodyHandle,
+    part: Part,
+}
+
+/// One rapier3d plane.
+pub struct Plane {
+    /// The plane's id (stamped into its tick headers).
+    pub id: PlaneId,
+    settings: PlaneSettings,
+    world: PhysicsWorld,
+    bodies: SlotTable<Body>,
+    /// Objects per HitBoxQuality value: the plane-wide solver scales with the maximum.
+    quality_counts: [u32; MAX_HIT_BOX_QUALITY as usize + 1],
+    /// Objects with a drive of their own (ImpulseDirection, ConstantForce, RotateTo, SetPin).
+    driven: u32,
+    /// Slots changed by ops: the publisher rewrites them, and the force pass sees them even
+    /// before rapier's island manager lists them as awake.
+    dirty: Dirty,
+    /// Bodies the last force pass left a force on (reset at the next pass).
+    forced: Vec<RigidBodyHandle>,
+    scratch: Vec<RigidBodyHandle>,
+    tick: u64,
+    sim_time: f64,
+    last_step_us: f32,
+    last_dt: f32,
+    max_penetration: f32,
+    contact_pairs: u32,
+    /// Objects asking for contact events; the event collector runs only when > 0.
+    reporting: u32,
+    collision_tx: mpsc::Sender<CollisionEvent>,
+    collision_rx: mpsc::Receiver<CollisionEvent>,
+    force_tx: mpsc::Sender<ContactForceEvent>,
+    tear_tx: mpsc::Sender<SoftBodyTearEvent>,
+    events: Vec<EventRecord>,
+}
+
+impl Plane {
+    /// A plane with default options, then `props` applied in order.
+    pub fn new(id: PlaneId, props: &[PlaneProp]) -> Result<Plane, CommandError> {
+        let settings = PlaneSettings::default();
+        let mut world = PhysicsWorld::new();
+        world.gravity = Vector::from(settings.gravity);
+        let (collision_tx, collision_rx) = mpsc::channel();
+        let (force_tx, _) = mpsc::channel();
+        let (tear_tx, _) = mpsc::channel();
+        let mut plane = Plane {
+            id,
+            settings,
+            world,
+            bodies: SlotTable::new("object", MAX_SLOTS),
+            quality_counts: [0; MAX_HIT_BOX_QUALITY as usize + 1],
+            driven: 0,
+            dirty: Dirty::default(),
+            forced: Vec::new(),
+            scratch: Vec::new(),
+            tick: 0,
+            sim_time: 0.0,
+            last_step_us: 0.0,
+            last_dt: 0.0,
+            max_penetration: 0.0,
+            contact_pairs: 0,
+            reporting: 0,
+            collision_tx,
+            collision_rx,
+            force_tx,
+            tear_tx,
+            events: Vec::new(),
+        };
+        for prop in props {
+            plane.apply_prop(*prop, true)?;
+        }
+        Ok(plane)
+    }
+
+    /// Applies one option; `creating` allows the construction-only ones.
+    pub fn set(&mut self, prop: PlaneProp) -> Result<(), CommandError> {
+        self.apply_prop(prop, false)
+    }
+
+    fn apply_prop(&mut self, prop: PlaneProp, creating: bool) -> Result<(), CommandError> {
+        let prop = self.settings.apply(prop, creating)?;
+        // Mapping onto rapier: options read at step time need nothing here.
+        match prop {
+            PlaneProp::Gravity(g) => self.world.gravity = Vector::from(g),
+            PlaneProp::Threads(n) => self.set_threads(n)?,
+            PlaneProp::NeverSleep(on) => self.set_never_sleep(on),
+            _ => {}
+        }
+        // Forces changed: resting bodies must feel them (sleeping ones would ignore them).
+        if prop.changes_forces() {
+            self.world.wake_up_all(true);
+        }
+        self.dirty.mark_all();
+        Ok(())
+    }
+
+    fn set_never_sleep(&mut self, on: bool) {
+        let template = if on {
+            RigidBodyActivation::cannot_sleep()
+        } else {
+            RigidBodyActivation::active()
+        };
+        for (_, body) in self.world.bodies.iter_mut() {
+            let activation = body.activation_mut();
+            activation.normalized_linear_threshold = template.normalized_linear_threshold;
+            activation.angular_threshold = template.angular_threshold;
+            body.wake_up(true);
+        }
+    }
+
+    fn set_threads(&mut self, n: u32) -> Result<(), CommandError> {
+        // Only a plane that asks for parallelism pays for a pool of its own.
+        let pool = if n > 1 {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(n as usize)
+                .thread_name(move |i| format!("plane-worker-{i}"))
+                .build()
+                .map_err(|e| CommandError::new(shm_layout::ErrorKind::Internal, e.to_string()))?;
+            Some(Arc::new(pool))
+        } else {
+            None
+        };
+        self.world.physics_pipeline.set_thread_pool(pool);
+        Ok(())
+    }
+
+    /// Automatic ticks per second (0 = manual).
+    pub fn tick_rate(&self) -> f32 {
+        self.settings.tick_rate
+    }
+
+    /// Whether the plane advances.
+    pub fn enabled(&self) -> bool {
+        self.settings.enabled
+    }
+
+    /// Ticks stepped so far.
+    pub fn tick(&self) -> u64 {
+        self.tick
+    }
+
+    /// Every option and figure of the plane.
+    pub fn info(&self) -> PlaneInfo {
+        let s = &self.settings;
+        PlaneInfo {
+            id: self.id,
+            kind: PlaneKind::Rapier3d,
+            gravity: s.gravity,
+            threads: s.threads,
+            tick_rate: s.tick_rate,
+            enabled: s.enabled,
+            tick: self.tick,
+            object_count: self.bodies.live(),
+            linear_damping: s.linear_damping,
+            angular_damping: s.angular_damping,
+            drag: s.drag,
+            buoyancy: s.buoyancy,
+            constant_force: s.constant_force,
+            rest_threshold: s.rest_threshold,
+            solver_iterations: s.solver_iterations,
+            loop_solver: s.loop_solver,
+            never_sleep: s.never_sleep,
+            effective_solver_iterations: self.solver_settings().iterations as u32,
+            max_hit_box_quality: self.max_quality(),
+        }
+    }
+
+    /// Advances by `dt`. Returns false (and does nothing) when the plane is disabled.
+    pub fn step(&mut self, dt: f32) -> Result<bool, CommandError> {
+        let dt = validate::positive("dt", dt)?;
+        if dt > MAX_DT {
+            return Err(CommandError::invalid(format!(
+                "dt must be at most {MAX_DT} s, got {dt}"
+            )));
+        }
+        if !self.settings.enabled {
+            return Ok(false);
+        }
+        let started = Instant::now();
+        self.world.integration_parameters.dt = dt;
+        self.tune_solver();
+        self.apply_forces(dt);
+        let hooks = contacts::RestThreshold(self.settings.rest_threshold);
+        if self.reporting > 0 {
+            let collector = ChannelEventCollector::new(
+                self.collision_tx.clone(),
+                self.force_tx.clone(),
+                self.tear_tx.clone(),
+            );
+            self.world.step_with_events(&hooks, &collector);
+        } else {
+            self.world.step_with_events(&hooks, &());
+        }
+        self.dirty.stepped(self.bodies.slot_count());
+        self.tick += 1;
+        self.sim_time += dt as f64;
+        self.last_dt = dt;
+        (self.max_penetration, self.contact_pairs) = self.contact_figures();
+        self.collect_events();
+        self.last_step_us = started.elapsed().as_secs_f32() * 1e6;
+        Ok(true)
+    }
+
+    /// Events of the last step (contact started / stopped).
+    pub fn events(&self) -> &[EventRecord] {
+        &self.events
+    }
+
+    /// The header of the newest tick.
+    pub fn header(&self) -> TickHeader {
+        TickHeader {
+            layout_version: LAYOUT_VERSION,
+            plane_id: self.id,
+            tick: self.tick,
+            sim_time: self.sim_time,
+            tick_end_ns: 0,
+            step_time_us: self.last_step_us,
+            dt: self.last_dt,
+            slot_count: self.bodies.slot_count() as u32,
+            body_count: self.bodies.live(),
+            max_penetration: self.max_penetration,
+            max_joint_error: 0.0,
+            contact_pairs: self.contact_pairs,
+            _reserved: 0,
+        }
+    }
+
+    /// Length of the published body array.
+    pub fn slot_count(&self) -> usize {
+        self.bodies.slot_count()
+    }
+
+    /// Slots of the bodies rapier simulates now (awake dynamic and kinematic ones). A body
+    /// outside this set has not moved since the step that put it to sleep.
+    pub fn awake_slots(&self) -> impl Iterator<Item = usize> + '_ {
+        // Every body carries its slot in user_data (set in add_object).
+        self.world
+            .active_bodies()
+            .map(|(_, body)| body.user_data as usize)
+    }
+
+    /// Number of bodies in [`Plane::awake_slots`].
+    pub fn awake_count(&self) -> usize {
+        self.world.islands.num_active_bodies()
+    }
+
+    /// The published state of slot `i` (dead slots carry only their generation).
+    pub fn body_state(&self, i: usize) -> BodyState {
+        let generation = self.bodies.generation(i);
+        let Some(body) = self
+            .bodies
+            .at(i)
+            .and_then(|b| self.world.bodies.get(b.handle))
+        else {
+            return BodyState {
+                generation,
+                ..BodyState::default()
+            };
+        };
+        let pose = body.position();
+        let mut flags = FLAG_ALIVE;
+        if body.is_sleeping() {
+            flags |= FLAG_SLEEPING;
+        }
+        if body.is_fixed() {
+            flags |= FLAG_ANCHORED;
+        }
+        BodyState {
+            position: pose.translation.into(),
+            flags,
+            rotation: pose.rotation.into(),
+            linear_velocity: body.linvel().into(),
+            generation,
+            angular_velocity: body.angvel().into(),
+            _reserved: 0,
+        }
+    }
+}

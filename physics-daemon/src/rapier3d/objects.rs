@@ -1,0 +1,164 @@
+//! Objects of a plane: creation, removal and reading back, all addressed by
+//! generation-checked handles from the plane's [`SlotTable`](crate::backend::SlotTable).
+
+use rapier3d::prelude::*;
+use shm_layout::{CommandError, ErrorKind, Handle, ObjectInfo, ObjectProp, Pose, Shape, Vec3};
+
+use super::part::Part;
+use super::{Body, Plane};
+
+/// Slots per plane; bounds memory a misbehaving client can make the daemon allocate.
+pub const MAX_SLOTS: usize = 1 << 20;
+
+pub(super) fn rapier_pose(p: Pose) -> rapier3d::math::Pose {
+    rapier3d::math::Pose::from_parts(Vector::from(p.position), Rotation::from_array(p.rotation))
+}
+
+impl Plane {
+    /// Adds an object of `shape` at `pose`, then applies `props` in order. Every value is
+    /// checked before the world changes, so a bad one adds nothing.
+    pub fn add_object(
+        &mut self,
+        shape: &Shape,
+        pose: Pose,
+        props: &[ObjectProp],
+    ) -> Result<Handle, CommandError> {
+        let pose = shm_layout::validate::pose("CFrame", pose)?;
+        shape.check()?;
+        let props = props
+            .iter()
+            .map(|p| p.checked())
+            .collect::<Result<Vec<_>, _>>()?;
+        let part = Part::new(shape);
+        let mut collider = ColliderBuilder::new(part.collider_shape()?).build();
+        part.configure_collider(&mut collider)?;
+        let slot = self.bodies.next_slot().ok_or_else(|| {
+            CommandError::new(
+                ErrorKind::Internal,
+                format!("plane {} is full ({MAX_SLOTS} objects)", self.id),
+            )
+        })?;
+        let mut body = RigidBodyBuilder::dynamic()
+            .pose(rapier_pose(pose))
+            .user_data(slot as u128)
+            .build();
+        if self.settings.never_sleep {
+            *body.activation_mut() = RigidBodyActivation::cannot_sleep();
+        }
+        let h = self.world.insert_body(body);
+        self.world.insert_collider(collider, Some(h));
+        part.configure_body(&mut self.world.bodies[h], &self.world.colliders);
+        self.quality_counts[part.hit_box_quality as usize] += 1;
+        let handle = self.bodies.insert(Body { handle: h, part })?;
+        debug_assert_eq!(handle.slot, slot);
+        self.dirty.mark(handle.slot);
+        for prop in props {
+            self.set_object(handle, prop)?;
+        }
+        Ok(handle)
+    }
+
+    /// The rapier body behind a handle, or a clear error for unknown and stale handles.
+    pub(super) fn body_of(&self, handle: Handle) -> Result<RigidBodyHandle, CommandError> {
+        self.bodies
+            .get(handle)
+            .map(|b| b.handle)
+            .map_err(|e| self.in_plane(e))
+    }
+
+    /// Adds "in plane N" to a slot-table error.
+    fn in_plane(&self, mut e: CommandError) -> CommandError {
+        e.message = format!("{} (plane {})", e.message, self.id);
+        e
+    }
+
+    pub(super) fn handle_of_collider(&self, collider: ColliderHandle) -> Option<Handle> {
+        let body = self.world.colliders.get(collider)?.parent()?;
+        let slot = self.world.bodies.get(body)?.user_data as usize;
+        self.bodies.handle_at(slot)
+    }
+
+    /// Velocity-space impulse: `Δv = impulse / mass`; anchored bodies absorb it.
+    pub fn apply_impulse(&mut self, handle: Handle, impulse: Vec3) -> Result<(), CommandError> {
+        let impulse = shm_layout::validate::finite3("impulse", impulse)?;
+        let h = self.body_of(handle)?;
+        // Rapier divides by the mass in effect and skips locked axes; fixed bodies absorb it.
+        self.world.bodies[h].apply_impulse(Vector::from(impulse), true);
+        self.dirty.mark(handle.slot);
+        Ok(())
+    }
+
+    /// Wakes the object up (rapier wakes what rests on it at the next step).
+    pub fn wake(&mut self, handle: Handle) -> Result<(), CommandError> {
+        let h = self.body_of(handle)?;
+        self.world.bodies[h].wake_up(true);
+        self.dirty.mark(handle.slot);
+        Ok(())
+    }
+
+    /// Removes the object; its handle becomes stale.
+    pub fn destroy_object(&mut self, handle: Handle) -> Result<(), CommandError> {
+        let Body { handle: h, part } = self.bodies.remove(handle).map_err(|e| self.in_plane(e))?;
+        if part.report_contacts {
+            self.reporting -= 1;
+        }
+        self.quality_counts[part.hit_box_quality as usize] -= 1;
+        if part.is_driven() {
+            self.driven -= 1;
+        }
+        self.world.remove_body(h);
+        self.dirty.mark(handle.slot);
+        Ok(())
+    }
+
+    /// Every property of the object.
+    pub fn object_info(&self, handle: Handle) -> Result<ObjectInfo, CommandError> {
+        let h = self.body_of(handle)?;
+        let body = &self.world.bodies[h];
+        let part = self.part(handle);
+        let volume = body.colliders().first().map_or(1.0, |c| {
+            self.world.colliders[*c].shape().mass_properties(1.0).mass()
+        });
+        let mass = part.mass(volume);
+        Ok(ObjectInfo {
+            handle,
+            shape: part.shape,
+            size: part.size,
+            anchored: body.is_fixed(),
+            sleeping: body.is_sleeping(),
+            weight: part.weight,
+            density: mass / volume,
+            mass,
+            bounciness: part.bounciness,
+            friction: part.friction,
+            can_collide: part.can_collide,
+            hit_box_quality: part.hit_box_quality,
+            center_of_mass: part.center_of_mass,
+            impulse_direction: part.impulse_direction,
+            constant_force: part.constant_force,
+            locks: part.locks,
+            rotation_locked_by_quality: part.rotation_locked_by_quality(),
+            ccd: body.is_ccd_enabled(),
+            rotate_to: part.rotate_to,
+            pin: part.pin,
+        })
+    }
+
+    /// Sets CenterOfMass to the mesh's vertex centroid (mesh parts only) and returns the
+    /// centre of mass in effect.
+    pub fn recalculate_center_of_mass(&mut self, handle: Handle) -> Result<Vec3, CommandError> {
+        self.body_of(handle)?;
+        match self.part(handle).mesh_centroid() {
+            Some(c) => {
+                self.set_object(handle, ObjectProp::CenterOfMass(c))?;
+                Ok(c)
+            }
+            None => Ok(self.part(handle).center_of_mass),
+        }
+    }
+
+    /// The part of a live handle (checked by the caller).
+    pub(super) fn part(&self, handle: Handle) -> &Part {
+        &self.bodies.get(handle).expect("checked handle").part
+    }
+}

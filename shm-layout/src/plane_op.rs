@@ -1,0 +1,51 @@
+//! What a command does to a plane: the plane kinds, and the ops every kind understands.
+//! The server handles only the lifecycle ops (`Step`, `Destroy`); everything else is handed
+//! to the plane's backend unread.
+
+use serde::{Deserialize, Serialize};
+
+use crate::object_op::ObjectOp;
+use crate::records::Handle;
+use crate::settings::{ObjectProp, PlaneProp};
+use crate::shape::Shape;
+use crate::Pose;
+
+/// Which backend simulates a plane. Chosen at creation.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum PlaneKind {
+    /// A 3D plane simulated by rapier3d on the CPU.
+    #[default]
+    Rapier3d,
+}
+
+/// An op on one plane.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub enum PlaneOp {
+    /// Describes the plane (any client may ask; used to attach to planes of other clients).
+    Info,
+    /// Changes one option.
+    Set(PlaneProp),
+    /// Advances the plane by `dt` seconds; the reply comes after the new tick is published.
+    Step {
+        /// Seconds to advance.
+        dt: f32,
+    },
+    /// Removes the plane and all its objects.
+    Destroy,
+    /// Adds an object.
+    AddObject {
+        /// Its shape.
+        shape: Shape,
+        /// Where it starts.
+        pose: Pose,
+        /// Properties applied after the defaults.
+        props: Vec<ObjectProp>,
+    },
+    /// An op on one object of the plane.
+    Object {
+        /// The object.
+        handle: Handle,
+        /// What to do to it.
+        op: ObjectOp,
+    },
+}

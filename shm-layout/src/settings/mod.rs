@@ -1,0 +1,13 @@
+//! Every plane option and object property, defined once: its wire variant, its default,
+//! its range (checked or clamped) and whether it may change after creation. The SDK runs
+//! these checks to fail early, the daemon runs them again because it trusts no client, and
+//! both read the defaults from here.
+//!
+//! Adding a property: one variant plus its check and default in [`plane`] or [`object`],
+//! one mapping onto the engine in the daemon's backend, one row in lua-client's `props/`.
+
+pub mod object;
+pub mod plane;
+
+pub use object::{ObjectProp, ObjectSettings, Pin, Restraint, RotateTo};
+pub use plane::{PlaneProp, PlaneSettings};

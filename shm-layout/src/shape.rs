@@ -1,0 +1,98 @@
+//! Collision shapes of objects and their checks.
+
+use serde::{Deserialize, Serialize};
+
+use crate::validate::{finite3, positive, size, MAX_MESH_TRIANGLES, MAX_MESH_VERTICES};
+use crate::{CommandError, Vec3};
+
+/// Collision shape of an object.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub enum Shape {
+    /// A box with the given full size along x, y, z.
+    Cube {
+        /// Full size along x, y, z.
+        size: Vec3,
+    },
+    /// A sphere with the given radius.
+    Sphere {
+        /// Radius.
+        radius: f32,
+    },
+    /// A part that carries a mesh (body-local vertices, triangles as vertex indices). It
+    /// collides as the convex hull of its vertices.
+    Mesh {
+        /// Body-local vertices.
+        vertices: Vec<Vec3>,
+        /// Triangles as indices into `vertices`.
+        triangles: Vec<[u32; 3]>,
+    },
+}
+
+/// The kind of an object's shape, as reported back.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum ShapeKind {
+    /// A box.
+    Cube,
+    /// A sphere.
+    Sphere,
+    /// A convex hull of mesh vertices.
+    Mesh,
+}
+
+impl Shape {
+    /// The kind of this shape.
+    pub fn kind(&self) -> ShapeKind {
+        match self {
+            Shape::Cube { .. } => ShapeKind::Cube,
+            Shape::Sphere { .. } => ShapeKind::Sphere,
+            Shape::Mesh { .. } => ShapeKind::Mesh,
+        }
+    }
+
+    /// Positive sizes, finite vertices, triangle indices in range, bounded mesh size.
+    pub fn check(&self) -> Result<(), CommandError> {
+        match self {
+            Shape::Cube { size: s } => size("Size", *s).map(|_| ()),
+            Shape::Sphere { radius } => positive("radius", *radius).map(|_| ()),
+            Shape::Mesh {
+                vertices,
+                triangles,
+            } => {
+                if vertices.len() < 4 || vertices.len() > MAX_MESH_VERTICES {
+                    return Err(CommandError::invalid_field(
+                        "Mesh.vertices",
+                        format!(
+                            "Mesh.vertices must hold 4 to {MAX_MESH_VERTICES} points, got {}",
+                            vertices.len()
+                        ),
+                    ));
+                }
+                if triangles.len() > MAX_MESH_TRIANGLES {
+                    return Err(CommandError::invalid_field(
+                        "Mesh.triangles",
+                        format!(
+                            "Mesh.triangles must hold at most {MAX_MESH_TRIANGLES} triangles, \
+                             got {}",
+                            triangles.len()
+                        ),
+                    ));
+                }
+                for (i, v) in vertices.iter().enumerate() {
+                    finite3(&format!("Mesh.vertices[{i}]"), *v)?;
+                }
+                let n = vertices.len() as u32;
+                if let Some((i, t)) = triangles
+                    .iter()
+                    .enumerate()
+                    .find(|(_, t)| t.iter().any(|&k| k >= n))
+                {
+                    return Err(CommandError::invalid_field(
+                        format!("Mesh.triangles[{i}]"),
+                        format!("Mesh.triangles[{i}] = {t:?} indexes past the {n} vertices"),
+                    ));
+                }
+                Ok(())
+            }
+        }
+    }
+}
