@@ -15,7 +15,7 @@ fn main() -> Result<(), client_sdk::Error> {
         Pose::at([0.0, -0.5, 0.0]),
         &[],
     )?;
-    floor.set_anchored(true);
+    floor.set_anchored(true)?;
     let ball = plane.add(
         Shape::Sphere { radius: 0.5 },
         Pose::at([0.0, 10.0, 0.0]),

@@ -68,7 +68,7 @@ fn resting_on_an_anchored_floor_reports_small_penetration() {
             &[],
         )
         .unwrap();
-    floor.set_anchored(true);
+    floor.set_anchored(true).unwrap();
     let ball = plane
         .add(
             Shape::Sphere { radius: 0.5 },

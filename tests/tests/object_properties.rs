@@ -230,7 +230,7 @@ fn anchored_parts_never_move_and_anchoring_zeroes_velocity() {
         "b rests on the anchored part: {yb}"
     );
     b.set_velocity([3.0, 0.0, 0.0]).unwrap();
-    b.set_anchored(true);
+    b.set_anchored(true).unwrap();
     scene.run(1.0 / 60.0, 10);
     assert_eq!(b.velocity().unwrap(), [0.0; 3]);
     assert!((b.position().unwrap()[1] - yb).abs() < 1e-6);
