@@ -9,8 +9,7 @@ pub mod plane;
 
 use mlua::{Error as LuaError, Lua, Value};
 
-use crate::convert::{describe, number, vector};
-use crate::primitives::CFrame;
+use crate::values::{describe, number, vector, CFrame};
 
 /// The Lua type a property takes, with its accepted range.
 #[derive(Debug, Clone, Copy)]

@@ -6,8 +6,8 @@ use client_sdk::{ObjectInfo, ObjectProp};
 use mlua::{Error as LuaError, Value};
 
 use super::{Get, Kind, Props, Row, Set};
-use crate::convert::{new_vector, sdk_error};
-use crate::object::PhysicsObject;
+use crate::api::object::PhysicsObject;
+use crate::values::{new_vector, sdk_error};
 
 fn info(o: &PhysicsObject, what: &str) -> Result<ObjectInfo, LuaError> {
     o.live(what)?
@@ -48,9 +48,9 @@ pub static OBJECT: Props<PhysicsObject> = Props {
                     .live("CFrame")?
                     .pose()
                     .map_err(|e| sdk_error("PhysicsObject.CFrame", e))?;
-                Ok(Value::UserData(lua.create_userdata(
-                    crate::primitives::CFrame::from_pose(pose),
-                )?))
+                Ok(Value::UserData(
+                    lua.create_userdata(crate::values::CFrame::from_pose(pose))?,
+                ))
             }),
             set: Set::Fn(|_, o, a| {
                 o.live("CFrame")?

@@ -3,8 +3,8 @@
 use mlua::{Error as LuaError, Value};
 
 use super::{Get, Kind, Props, Row, Set};
-use crate::convert::sdk_error;
-use crate::part::BasePart;
+use crate::api::part::BasePart;
+use crate::values::{new_vector, sdk_error};
 
 pub static PART: Props<BasePart> = Props {
     owner: "BasePart",
@@ -31,7 +31,7 @@ pub static PART: Props<BasePart> = Props {
         Row {
             name: "Size",
             kind: Kind::PositiveVector,
-            get: Get::Fn(|_, p| Ok(crate::convert::new_vector(p.0.size()))),
+            get: Get::Fn(|_, p| Ok(new_vector(p.0.size()))),
             set: Set::Fn(|lua, p, a| {
                 let size = a.vector()?;
                 if p.0.object().is_some() {
@@ -42,7 +42,7 @@ pub static PART: Props<BasePart> = Props {
                     )));
                 }
                 p.0.set_size(size);
-                p.0.changed(lua, "Size", crate::convert::new_vector(size))
+                p.0.changed(lua, "Size", new_vector(size))
             }),
         },
         Row {

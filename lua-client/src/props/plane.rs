@@ -7,8 +7,8 @@ use client_sdk::{PlaneInfo, PlaneOptions, PlaneProp};
 use mlua::{Error as LuaError, Value};
 
 use super::{Arg, Get, Kind, Props, Row, Set};
-use crate::convert::{new_vector, sdk_error};
-use crate::plane::PlaneState;
+use crate::api::plane::PlaneState;
+use crate::values::{new_vector, sdk_error};
 
 fn info(p: &PlaneState, what: &str) -> Result<PlaneInfo, LuaError> {
     p.plane

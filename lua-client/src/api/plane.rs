@@ -8,11 +8,11 @@ use mlua::{Lua, MetaMethod, Table, UserData, UserDataMethods, Value};
 
 use client_sdk::validate::MAX_DT;
 
-use crate::convert::{describe, expected, finite_number, sdk_error};
-use crate::object::PhysicsObject;
-use crate::part::{BasePart, Link, PartState};
+use super::object::PhysicsObject;
+use super::part::{BasePart, Link, PartState};
 use crate::props::plane::{AT_CREATION, NOT_YET_METHODS, PLANE};
 use crate::props::{not_yet_methods, Set};
+use crate::values::{describe, expected, finite_number, sdk_error};
 
 pub struct PlaneState {
     pub plane: Plane,
