@@ -11,7 +11,7 @@ use std::rc::Rc;
 use client_sdk::Client;
 use mlua::{Function, Lua, Table, Value};
 
-use crate::props::Props;
+use crate::props::{Props, Target};
 
 /// The modules `import` knows, in the order error messages list them.
 pub const MODULES: [&str; 3] = ["PhysicsService", "Renderable", "Primitives"];
@@ -49,7 +49,7 @@ pub fn modules(lua: &Lua, client: Client) -> mlua::Result<Table> {
 /// `__index` of a type whose methods live in a table consulted after its properties: with
 /// no mlua-registered methods, mlua installs this `__index` as is, sparing every property
 /// read a Lua-side method lookup.
-pub fn index<T: 'static>(
+pub fn index<T: Target>(
     lua: &Lua,
     props: &Props<T>,
     methods: fn(&MethodTables) -> &Table,

@@ -3,12 +3,12 @@
 
 use std::rc::Rc;
 
-use client_sdk::{Object, Pin, Restraint};
+use client_sdk::{Object, ObjectProp, Pin, Restraint};
 use mlua::{AnyUserData, Lua, MetaMethod, Table, UserData, UserDataMethods, Value};
 
 use super::part::PartState;
 use crate::props::object::OBJECT;
-use crate::props::Kind;
+use crate::props::{Kind, Target};
 use crate::values::{describe, expected, new_vector, rotation, sdk_error};
 
 /// RotateTo's documented default strength.
@@ -77,6 +77,16 @@ impl PhysicsObject {
     /// Whether the body still exists and still belongs to the part.
     pub fn alive(&self) -> bool {
         self.part.is_linked_to(&self.object) && self.object.is_alive().unwrap_or(false)
+    }
+}
+
+impl Target for PhysicsObject {
+    type Prop = ObjectProp;
+
+    fn write(&self, name: &str, prop: ObjectProp) -> mlua::Result<()> {
+        self.live(name)?
+            .set(prop)
+            .map_err(|e| sdk_error(&format!("PhysicsObject.{name}"), e))
     }
 }
 

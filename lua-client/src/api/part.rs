@@ -12,6 +12,7 @@ use crate::host::scheduler::scheduler;
 use crate::host::signal::Signal;
 use crate::host::Watched;
 use crate::props::part::PART;
+use crate::props::Target;
 use crate::values::{describe, expected, CFrame, DESCRIBE};
 
 /// Shapes a BasePart can have (the collider the plane builds from it).
@@ -228,6 +229,15 @@ impl Watched for PartState {
 /// The Lua handle of a part.
 #[derive(Clone)]
 pub struct BasePart(pub Rc<PartState>);
+
+impl Target for BasePart {
+    /// A part's properties are its own state: none is one SDK write.
+    type Prop = std::convert::Infallible;
+
+    fn write(&self, _: &str, prop: Self::Prop) -> mlua::Result<()> {
+        match prop {}
+    }
+}
 
 /// `self` of a method called on a BasePart, or an error saying how it was called.
 fn this_part(what: &str, v: &Value) -> mlua::Result<Rc<PartState>> {

@@ -1,4 +1,6 @@
-//! BasePart properties.
+//! BasePart properties: the host's own state of the part (name, size, shape, and the pose
+//! while not simulated); the pose of a simulated part is its body's, read from the newest
+//! tick and written as a teleport.
 
 use mlua::{Error as LuaError, Value};
 
@@ -6,6 +8,7 @@ use super::{Get, Kind, Props, Row, Set};
 use crate::api::part::BasePart;
 use crate::values::{new_vector, sdk_error};
 
+/// The rows of `BasePart`.
 pub static PART: Props<BasePart> = Props {
     owner: "BasePart",
     rows: &[
