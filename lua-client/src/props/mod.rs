@@ -1,7 +1,15 @@
 //! The property layer: each Lua-visible property is one row (name → expected Lua type with
-//! its converter → SDK read / write). A documented property the SDK cannot do yet is a row
-//! marked `NotYet`, so wiring it later is editing one row, and using it meanwhile is a clear
-//! error instead of a silent no-op.
+//! its converter → one read source → the write). Adding a property is adding one row.
+//!
+//! - A row reads from one place: the daemon's info, the SDK's read-your-writes view of the
+//!   newest tick (pose, velocities, Anchored), or the state the host itself owns (a part's
+//!   name). No row keeps a script-side copy of what another row reads from the daemon.
+//! - A writable row turns the converted value into one SDK property write ([`Set::Prop`]),
+//!   which is also what the type's creation options use (`PhysicsService.New(opts)`); a row
+//!   flagged [`Set::CreationOnly`] (`Threads`) is an option of the creation call and
+//!   read-only afterwards. Rows with work beyond one SDK write are [`Set::Fn`].
+//! - A documented property the SDK cannot do yet is a row marked `NotYet`, so wiring it later
+//!   is editing one row, and using it meanwhile is a clear error instead of a silent no-op.
 
 pub mod object;
 pub mod part;
@@ -9,37 +17,59 @@ pub mod plane;
 
 use mlua::{Error as LuaError, Lua, Value};
 
-use crate::convert::{describe, number, vector};
-use crate::primitives::CFrame;
+use crate::values::{describe, number, vector, CFrame};
+
+/// A Lua type whose properties are rows, and how one of its property writes reaches the SDK.
+pub trait Target: 'static {
+    /// One property write as the SDK takes it (`PlaneProp`, `ObjectProp`); a type with no SDK
+    /// writes of its own uses [`std::convert::Infallible`].
+    type Prop;
+
+    /// Sends (queues) one property write; `name` is the property, for error messages.
+    fn write(&self, name: &str, prop: Self::Prop) -> Result<(), LuaError>;
+}
 
 /// The Lua type a property takes, with its accepted range.
 #[derive(Debug, Clone, Copy)]
 pub enum Kind {
+    /// A finite number in `[min, max]`.
     Number {
+        /// Smallest accepted value (may be -inf: no bound).
         min: f64,
+        /// Largest accepted value (may be inf: no bound).
         max: f64,
     },
+    /// A whole number in `[min, max]`.
     Integer {
+        /// Smallest accepted value.
         min: i64,
+        /// Largest accepted value.
         max: i64,
     },
+    /// `true` or `false`.
     Boolean,
+    /// A Vector with finite components.
     Vector,
     /// A Vector whose components are all > 0 (sizes).
     PositiveVector,
+    /// A CFrame userdata.
     CFrame,
+    /// A Lua string.
     String,
 }
 
 impl Kind {
+    /// Any finite number.
     pub const ANY_NUMBER: Kind = Kind::Number {
         min: f64::NEG_INFINITY,
         max: f64::INFINITY,
     };
+    /// A finite number >= 0.
     pub const NON_NEGATIVE: Kind = Kind::Number {
         min: 0.0,
         max: f64::INFINITY,
     };
+    /// A number in [0, 1].
     pub const UNIT: Kind = Kind::Number { min: 0.0, max: 1.0 };
 
     /// What the error message says was expected.
@@ -110,11 +140,17 @@ impl Kind {
 /// A converted property value. Each variant is what one `Kind` produces.
 #[derive(Debug, Clone)]
 pub enum Arg {
+    /// From [`Kind::Number`].
     Number(f64),
+    /// From [`Kind::Integer`].
     Integer(i64),
+    /// From [`Kind::Boolean`].
     Bool(bool),
+    /// From [`Kind::Vector`] and [`Kind::PositiveVector`].
     Vector([f32; 3]),
+    /// From [`Kind::CFrame`].
     CFrame(CFrame),
+    /// From [`Kind::String`].
     String(String),
 }
 
@@ -126,6 +162,7 @@ fn mismatch(arg: &Arg, want: &str) -> LuaError {
 }
 
 impl Arg {
+    /// The number (integers too).
     pub fn number(&self) -> Result<f64, LuaError> {
         match *self {
             Arg::Number(n) => Ok(n),
@@ -133,30 +170,35 @@ impl Arg {
             _ => Err(mismatch(self, "a number")),
         }
     }
+    /// The integer.
     pub fn integer(&self) -> Result<i64, LuaError> {
         match *self {
             Arg::Integer(i) => Ok(i),
             _ => Err(mismatch(self, "an integer")),
         }
     }
+    /// The boolean.
     pub fn bool(&self) -> Result<bool, LuaError> {
         match *self {
             Arg::Bool(b) => Ok(b),
             _ => Err(mismatch(self, "a boolean")),
         }
     }
+    /// The vector.
     pub fn vector(&self) -> Result<[f32; 3], LuaError> {
         match *self {
             Arg::Vector(v) => Ok(v),
             _ => Err(mismatch(self, "a Vector")),
         }
     }
+    /// The CFrame.
     pub fn cframe(&self) -> Result<CFrame, LuaError> {
         match *self {
             Arg::CFrame(cf) => Ok(cf),
             _ => Err(mismatch(self, "a CFrame")),
         }
     }
+    /// The string.
     pub fn string(self) -> Result<String, LuaError> {
         match self {
             Arg::String(s) => Ok(s),
@@ -165,30 +207,51 @@ impl Arg {
     }
 }
 
+/// Reads a property of `T`.
 pub type Getter<T> = fn(&Lua, &T) -> Result<Value, LuaError>;
+/// Writes a property of `T` with work beyond one SDK write.
 pub type Setter<T> = fn(&Lua, &T, Arg) -> Result<(), LuaError>;
+/// The SDK property write a converted value stands for.
+pub type ToProp<T> = fn(Arg) -> Result<<T as Target>::Prop, LuaError>;
 
+/// How a row reads.
 pub enum Get<T> {
+    /// Read through this function (from the row's one source).
     Fn(Getter<T>),
     /// Documented, but the SDK cannot read it yet.
     NotYet,
 }
 
-pub enum Set<T> {
+/// How a row writes.
+pub enum Set<T: Target> {
+    /// Writable: the value becomes one SDK property write, at any time and as a creation
+    /// option.
+    Prop(ToProp<T>),
+    /// The creation-only flag: an option of the creation call (`PhysicsService.New`), which
+    /// writes it as part of the creation request; read-only afterwards.
+    CreationOnly(ToProp<T>),
+    /// Writable, with work beyond one SDK write (the host's own state, change signals).
+    /// Not a creation option.
     Fn(Setter<T>),
+    /// Never written by scripts.
     ReadOnly,
     /// Documented, but the SDK cannot write it yet.
     NotYet,
 }
 
-pub struct Row<T: 'static> {
+/// One property of a Lua type.
+pub struct Row<T: Target> {
+    /// The Lua name.
     pub name: &'static str,
+    /// What a write takes.
     pub kind: Kind,
+    /// How it reads.
     pub get: Get<T>,
+    /// How it writes.
     pub set: Set<T>,
 }
 
-impl<T> Row<T> {
+impl<T: Target> Row<T> {
     /// A documented property the SDK does not support yet (neither read nor write).
     pub const fn not_yet(name: &'static str, kind: Kind) -> Row<T> {
         Row {
@@ -201,8 +264,10 @@ impl<T> Row<T> {
 }
 
 /// A table of rows for one Lua type (`owner` is its Lua name, e.g. "PhysicsObject").
-pub struct Props<T: 'static> {
+pub struct Props<T: Target> {
+    /// The Lua type's name, as error messages spell it.
     pub owner: &'static str,
+    /// One row per property.
     pub rows: &'static [Row<T>],
 }
 
@@ -213,7 +278,8 @@ fn key_text(key: &Value) -> String {
     }
 }
 
-impl<T> Props<T> {
+impl<T: Target> Props<T> {
+    /// The row named by `key`, if `key` is one of its property names.
     pub fn row(&self, key: &Value) -> Option<&'static Row<T>> {
         let Value::String(s) = key else {
             return None;
@@ -222,10 +288,12 @@ impl<T> Props<T> {
         self.rows.iter().find(|r| r.name.as_bytes() == &*key)
     }
 
+    /// The error for a documented property the SDK cannot do yet.
     pub fn not_supported(&self, name: &str) -> LuaError {
         LuaError::runtime(format!("{}.{name} is not supported yet", self.owner))
     }
 
+    /// The error for reading a property the type does not have.
     pub fn unknown(&self, key: &Value) -> LuaError {
         LuaError::runtime(format!(
             "{} has no property \"{}\"",
@@ -234,6 +302,7 @@ impl<T> Props<T> {
         ))
     }
 
+    /// Reads the property `key` of `target`.
     pub fn get(&self, lua: &Lua, target: &T, key: &Value) -> Result<Value, LuaError> {
         let row = self.row(key).ok_or_else(|| self.unknown(key))?;
         match row.get {
@@ -242,6 +311,7 @@ impl<T> Props<T> {
         }
     }
 
+    /// Writes `value` to the property `key` of `target` (script assignment).
     pub fn set(&self, lua: &Lua, target: &T, key: &Value, value: &Value) -> Result<(), LuaError> {
         let Some(row) = self.row(key) else {
             return Err(LuaError::runtime(format!(
@@ -251,14 +321,14 @@ impl<T> Props<T> {
                 describe(value)
             )));
         };
+        let arg = || {
+            row.kind
+                .convert(&format!("{}.{}", self.owner, row.name), value)
+        };
         match row.set {
-            Set::Fn(f) => {
-                let arg = row
-                    .kind
-                    .convert(&format!("{}.{}", self.owner, row.name), value)?;
-                f(lua, target, arg)
-            }
-            Set::ReadOnly => Err(LuaError::runtime(format!(
+            Set::Prop(to_prop) => target.write(row.name, to_prop(arg()?)?),
+            Set::Fn(f) => f(lua, target, arg()?),
+            Set::ReadOnly | Set::CreationOnly(_) => Err(LuaError::runtime(format!(
                 "{}.{} is read-only (assigned {})",
                 self.owner,
                 row.name,
@@ -274,6 +344,32 @@ impl<T> Props<T> {
                 Get::NotYet => self.not_supported(row.name),
             }),
         }
+    }
+
+    /// `key = value` of a creation call's options (`what` names the call, e.g.
+    /// `PhysicsService.New`) as the SDK write the creation request carries. Every writable
+    /// row and every creation-only row is an option.
+    pub fn option(&self, what: &str, key: &Value, value: &Value) -> Result<T::Prop, LuaError> {
+        let not_an_option = |name: &str, why: &str| {
+            LuaError::runtime(format!("{what}: {name} {why} (given {})", describe(value)))
+        };
+        let Some(row) = self.row(key) else {
+            return Err(LuaError::runtime(format!(
+                "{what}: unknown option {} (given {})",
+                describe(key),
+                describe(value)
+            )));
+        };
+        let to_prop = match row.set {
+            Set::Prop(f) | Set::CreationOnly(f) => f,
+            Set::NotYet => return Err(self.not_supported(row.name)),
+            Set::ReadOnly => return Err(not_an_option(row.name, "is read-only, not an option")),
+            Set::Fn(_) => return Err(not_an_option(row.name, "cannot be given at creation")),
+        };
+        to_prop(
+            row.kind
+                .convert(&format!("{what} option {}", row.name), value)?,
+        )
     }
 }
 

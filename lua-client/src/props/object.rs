@@ -1,23 +1,28 @@
-//! PhysicsObject properties. Pose and velocities read zero-copy from shared memory; the
-//! other properties are read back from the daemon (`object.info()`, one round trip).
+//! PhysicsObject properties. Pose, velocities and Anchored read the SDK's read-your-writes
+//! view of the newest tick in shared memory (no request); the other properties read back
+//! from the daemon (`object.info()`, one round trip); Size reads through to the wrapped part.
+//! Every SDK write is one `ObjectProp`.
 
 use client_sdk::validate::MAX_HIT_BOX_QUALITY;
-use client_sdk::{ObjectInfo, ObjectProp};
+use client_sdk::{BodyState, ObjectInfo, ObjectProp, Pose};
 use mlua::{Error as LuaError, Value};
 
-use super::{Get, Kind, Props, Row, Set};
-use crate::convert::{new_vector, sdk_error};
-use crate::object::PhysicsObject;
+use super::{Get, Kind, Props, Row, Set, Target};
+use crate::api::object::PhysicsObject;
+use crate::values::{new_vector, sdk_error, CFrame};
 
+/// The object's properties as the daemon holds them (one round trip).
 fn info(o: &PhysicsObject, what: &str) -> Result<ObjectInfo, LuaError> {
     o.live(what)?
         .info()
         .map_err(|e| sdk_error(&format!("PhysicsObject.{what}"), e))
 }
 
-fn set(o: &PhysicsObject, what: &str, prop: ObjectProp) -> Result<(), LuaError> {
+/// The object's published state: the newest tick with this process's unconfirmed writes on
+/// top (no request).
+fn state(o: &PhysicsObject, what: &str) -> Result<BodyState, LuaError> {
     o.live(what)?
-        .set(prop)
+        .state()
         .map_err(|e| sdk_error(&format!("PhysicsObject.{what}"), e))
 }
 
@@ -32,76 +37,58 @@ macro_rules! info_row {
                 let $i = info(o, $name)?;
                 Ok($read)
             }),
-            set: Set::Fn(|_, o, $a| set(o, $name, $write)),
+            set: Set::Prop(|$a| Ok($write)),
         }
     };
 }
 
+/// A property of the published state (read-your-writes, no request): `$read` maps the
+/// object's `BodyState` to a Lua value, `$write` the converted argument to the property.
+macro_rules! state_row {
+    ($name:literal, $kind:expr, |$lua:tt, $s:ident| $read:expr, |$a:ident| $write:expr) => {
+        Row {
+            name: $name,
+            kind: $kind,
+            get: Get::Fn(|$lua, o| {
+                let $s = state(o, $name)?;
+                Ok($read)
+            }),
+            set: Set::Prop(|$a| Ok($write)),
+        }
+    };
+}
+
+/// The rows of `PhysicsObject`.
 pub static OBJECT: Props<PhysicsObject> = Props {
     owner: "PhysicsObject",
     rows: &[
-        Row {
-            name: "CFrame",
-            kind: Kind::CFrame,
-            get: Get::Fn(|lua, o| {
-                let pose = o
-                    .live("CFrame")?
-                    .pose()
-                    .map_err(|e| sdk_error("PhysicsObject.CFrame", e))?;
-                Ok(Value::UserData(lua.create_userdata(
-                    crate::primitives::CFrame::from_pose(pose),
-                )?))
-            }),
-            set: Set::Fn(|_, o, a| {
-                o.live("CFrame")?
-                    .set_pose(a.cframe()?.pose())
-                    .map_err(|e| sdk_error("PhysicsObject.CFrame", e))
-            }),
-        },
-        Row {
-            name: "Velocity",
-            kind: Kind::Vector,
-            get: Get::Fn(|_, o| {
-                let v = o.live("Velocity")?.velocity();
-                Ok(new_vector(
-                    v.map_err(|e| sdk_error("PhysicsObject.Velocity", e))?,
-                ))
-            }),
-            set: Set::Fn(|_, o, a| {
-                o.live("Velocity")?
-                    .set_velocity(a.vector()?)
-                    .map_err(|e| sdk_error("PhysicsObject.Velocity", e))
-            }),
-        },
-        Row {
-            name: "AngularVelocity",
-            kind: Kind::Vector,
-            get: Get::Fn(|_, o| {
-                let w = o.live("AngularVelocity")?.angular_velocity();
-                Ok(new_vector(w.map_err(|e| {
-                    sdk_error("PhysicsObject.AngularVelocity", e)
-                })?))
-            }),
-            set: Set::Fn(|_, o, a| {
-                o.live("AngularVelocity")?
-                    .set_angular_velocity(a.vector()?)
-                    .map_err(|e| sdk_error("PhysicsObject.AngularVelocity", e))
-            }),
-        },
-        Row {
-            name: "Anchored",
-            kind: Kind::Boolean,
-            get: Get::Fn(|_, o| {
-                let a = o.live("Anchored")?.is_anchored();
-                Ok(Value::Boolean(
-                    a.map_err(|e| sdk_error("PhysicsObject.Anchored", e))?,
-                ))
-            }),
-            set: Set::Fn(|_, o, a| {
-                o.live("Anchored")?.set_anchored(a.bool()?);
-                Ok(())
-            }),
-        },
+        state_row!(
+            "CFrame",
+            Kind::CFrame,
+            |lua, s| Value::UserData(lua.create_userdata(CFrame::from_pose(Pose {
+                position: s.position,
+                rotation: s.rotation,
+            }))?),
+            |a| ObjectProp::Pose(a.cframe()?.pose())
+        ),
+        state_row!(
+            "Velocity",
+            Kind::Vector,
+            |_, s| new_vector(s.linear_velocity),
+            |a| ObjectProp::Velocity(a.vector()?)
+        ),
+        state_row!(
+            "AngularVelocity",
+            Kind::Vector,
+            |_, s| new_vector(s.angular_velocity),
+            |a| ObjectProp::AngularVelocity(a.vector()?)
+        ),
+        state_row!(
+            "Anchored",
+            Kind::Boolean,
+            |_, s| Value::Boolean(s.is_anchored()),
+            |a| ObjectProp::Anchored(a.bool()?)
+        ),
         Row {
             name: "Alive",
             kind: Kind::Boolean,
@@ -115,7 +102,7 @@ pub static OBJECT: Props<PhysicsObject> = Props {
             get: Get::Fn(|_, o| Ok(new_vector(o.part.size()))),
             set: Set::Fn(|lua, o, a| {
                 let size = a.vector()?;
-                set(o, "Size", ObjectProp::Size(size))?;
+                o.write("Size", ObjectProp::Size(size))?;
                 o.part.set_size(size);
                 o.part.changed(lua, "Size", new_vector(size))
             }),

@@ -1,11 +1,14 @@
-//! BasePart properties.
+//! BasePart properties: the host's own state of the part (name, size, shape, and the pose
+//! while not simulated); the pose of a simulated part is its body's, read from the newest
+//! tick and written as a teleport.
 
 use mlua::{Error as LuaError, Value};
 
 use super::{Get, Kind, Props, Row, Set};
-use crate::convert::sdk_error;
-use crate::part::BasePart;
+use crate::api::part::BasePart;
+use crate::values::{new_vector, sdk_error};
 
+/// The rows of `BasePart`.
 pub static PART: Props<BasePart> = Props {
     owner: "BasePart",
     rows: &[
@@ -31,7 +34,7 @@ pub static PART: Props<BasePart> = Props {
         Row {
             name: "Size",
             kind: Kind::PositiveVector,
-            get: Get::Fn(|_, p| Ok(crate::convert::new_vector(p.0.size()))),
+            get: Get::Fn(|_, p| Ok(new_vector(p.0.size()))),
             set: Set::Fn(|lua, p, a| {
                 let size = a.vector()?;
                 if p.0.object().is_some() {
@@ -42,7 +45,7 @@ pub static PART: Props<BasePart> = Props {
                     )));
                 }
                 p.0.set_size(size);
-                p.0.changed(lua, "Size", crate::convert::new_vector(size))
+                p.0.changed(lua, "Size", new_vector(size))
             }),
         },
         Row {

@@ -1,20 +1,15 @@
-//! PhysicsPlane properties (also the options of `PhysicsService.New`). Options the script
-//! does not cache are read back from the daemon (`plane.info()`, one round trip). Rows marked
+//! PhysicsPlane properties, which are also the options of `PhysicsService.New`. Every option
+//! reads back from the daemon (`plane.info()`, one round trip that sends the queued writes
+//! first, so a script reads what it wrote) and writes one `PlaneProp`. Rows marked
 //! `not_yet` are documented but belong to a backend not built yet.
 
 use client_sdk::validate::{MAX_SOLVER_ITERATIONS, MAX_THREADS, MAX_TICK_RATE};
-use client_sdk::{PlaneInfo, PlaneOptions, PlaneProp};
-use mlua::{Error as LuaError, Value};
+use client_sdk::PlaneProp;
+use mlua::Value;
 
-use super::{Arg, Get, Kind, Props, Row, Set};
-use crate::convert::{new_vector, sdk_error};
-use crate::plane::PlaneState;
-
-fn info(p: &PlaneState, what: &str) -> Result<PlaneInfo, LuaError> {
-    p.plane
-        .info()
-        .map_err(|e| sdk_error(&format!("PhysicsPlane.{what}"), e))
-}
+use super::{Get, Kind, Props, Row, Set};
+use crate::api::plane::PlaneState;
+use crate::values::{new_vector, sdk_error};
 
 /// A number option read back from the daemon's plane info.
 macro_rules! number_row {
@@ -22,70 +17,59 @@ macro_rules! number_row {
         Row {
             name: $name,
             kind: $kind,
-            get: Get::Fn(|_, p| Ok(Value::Number(info(p, $name)?.$field as f64))),
-            set: Set::Fn(|_, p, a| p.set($prop(a.number()? as f32))),
+            get: Get::Fn(|_, p| Ok(Value::Number(p.info($name)?.$field as f64))),
+            set: Set::Prop(|a| Ok($prop(a.number()? as f32))),
         }
     };
 }
 
+/// A boolean option read back from the daemon's plane info.
 macro_rules! bool_row {
     ($name:literal, $field:ident, $prop:path) => {
         Row {
             name: $name,
             kind: Kind::Boolean,
-            get: Get::Fn(|_, p| Ok(Value::Boolean(info(p, $name)?.$field))),
-            set: Set::Fn(|_, p, a| p.set($prop(a.bool()?))),
+            get: Get::Fn(|_, p| Ok(Value::Boolean(p.info($name)?.$field))),
+            set: Set::Prop(|a| Ok($prop(a.bool()?))),
         }
     };
 }
 
+/// A Vector option read back from the daemon's plane info.
+macro_rules! vector_row {
+    ($name:literal, $field:ident, $prop:path) => {
+        Row {
+            name: $name,
+            kind: Kind::Vector,
+            get: Get::Fn(|_, p| Ok(new_vector(p.info($name)?.$field))),
+            set: Set::Prop(|a| Ok($prop(a.vector()?))),
+        }
+    };
+}
+
+/// The rows of `PhysicsPlane`.
 pub static PLANE: Props<PlaneState> = Props {
     owner: "PhysicsPlane",
     rows: &[
-        Row {
-            name: "Gravity",
-            kind: Kind::Vector,
-            get: Get::Fn(|_, p| Ok(new_vector(p.gravity.get()))),
-            set: Set::Fn(|_, p, a| {
-                let g = a.vector()?;
-                p.set(PlaneProp::Gravity(g))?;
-                p.gravity.set(g);
-                Ok(())
-            }),
-        },
-        Row {
-            name: "Enabled",
-            kind: Kind::Boolean,
-            get: Get::Fn(|_, p| Ok(Value::Boolean(p.enabled.get()))),
-            set: Set::Fn(|_, p, a| {
-                let on = a.bool()?;
-                p.set(PlaneProp::Enabled(on))?;
-                p.enabled.set(on);
-                Ok(())
-            }),
-        },
-        Row {
-            name: "TickRate",
-            kind: Kind::Number {
+        vector_row!("Gravity", gravity, PlaneProp::Gravity),
+        bool_row!("Enabled", enabled, PlaneProp::Enabled),
+        number_row!(
+            "TickRate",
+            Kind::Number {
                 min: 0.0,
                 max: MAX_TICK_RATE as f64,
             },
-            get: Get::Fn(|_, p| Ok(Value::Number(p.tick_rate.get() as f64))),
-            set: Set::Fn(|_, p, a| {
-                let hz = a.number()? as f32;
-                p.set(PlaneProp::TickRate(hz))?;
-                p.tick_rate.set(hz);
-                Ok(())
-            }),
-        },
+            tick_rate,
+            PlaneProp::TickRate
+        ),
         Row {
             name: "Threads",
             kind: Kind::Integer {
                 min: 1,
                 max: MAX_THREADS as i64,
             },
-            get: Get::Fn(|_, p| Ok(Value::Number(p.threads as f64))),
-            set: Set::ReadOnly,
+            get: Get::Fn(|_, p| Ok(Value::Number(p.info("Threads")?.threads as f64))),
+            set: Set::CreationOnly(|a| Ok(PlaneProp::Threads(a.integer()? as u32))),
         },
         Row {
             name: "Alive",
@@ -127,12 +111,7 @@ pub static PLANE: Props<PlaneState> = Props {
             rest_threshold,
             PlaneProp::RestThreshold
         ),
-        Row {
-            name: "ConstantForce",
-            kind: Kind::Vector,
-            get: Get::Fn(|_, p| Ok(new_vector(info(p, "ConstantForce")?.constant_force))),
-            set: Set::Fn(|_, p, a| p.set(PlaneProp::ConstantForce(a.vector()?))),
-        },
+        vector_row!("ConstantForce", constant_force, PlaneProp::ConstantForce),
         Row {
             // Documented as clamped to [1, 64]: any integer is accepted and clamped.
             name: "SolverIterations",
@@ -142,11 +121,11 @@ pub static PLANE: Props<PlaneState> = Props {
             },
             get: Get::Fn(|_, p| {
                 Ok(Value::Number(
-                    info(p, "SolverIterations")?.solver_iterations as f64,
+                    p.info("SolverIterations")?.solver_iterations as f64,
                 ))
             }),
-            set: Set::Fn(|_, p, a| {
-                p.set(PlaneProp::SolverIterations(
+            set: Set::Prop(|a| {
+                Ok(PlaneProp::SolverIterations(
                     a.integer()?.clamp(1, MAX_SOLVER_ITERATIONS as i64) as u32,
                 ))
             }),
@@ -156,29 +135,6 @@ pub static PLANE: Props<PlaneState> = Props {
         Row::not_yet("DeferGpu", Kind::Boolean),
     ],
 };
-
-type CreateFn = fn(&mut PlaneOptions, &Arg) -> Result<(), LuaError>;
-
-/// Options that must be part of the creation request (a manual plane must never tick on
-/// its own, Threads is fixed at creation). Every other option is set right after creation.
-pub static AT_CREATION: &[(&str, CreateFn)] = &[
-    ("Gravity", |o, a| {
-        o.gravity = Some(a.vector()?);
-        Ok(())
-    }),
-    ("Threads", |o, a| {
-        o.threads = Some(a.integer()? as u32);
-        Ok(())
-    }),
-    ("TickRate", |o, a| {
-        o.tick_rate = Some(a.number()? as f32);
-        Ok(())
-    }),
-    ("Enabled", |o, a| {
-        o.enabled = Some(a.bool()?);
-        Ok(())
-    }),
-];
 
 /// Documented methods the SDK cannot do yet.
 pub const NOT_YET_METHODS: &[&str] = &["NewController", "NewControlledController"];

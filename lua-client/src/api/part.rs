@@ -7,23 +7,28 @@ use std::rc::{Rc, Weak};
 use client_sdk::{Object, Shape};
 use mlua::{Lua, MetaMethod, MultiValue, Table, UserData, UserDataMethods, Value};
 
-use crate::convert::{describe, expected};
-use crate::plane::PlaneState;
-use crate::primitives::CFrame;
+use super::plane::PlaneState;
+use crate::host::scheduler::scheduler;
+use crate::host::signal::Signal;
+use crate::host::Watched;
 use crate::props::part::PART;
-use crate::scheduler::scheduler;
-use crate::signal::Signal;
+use crate::props::Target;
+use crate::values::{describe, expected, CFrame, DESCRIBE};
 
 /// Shapes a BasePart can have (the collider the plane builds from it).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum PartShape {
+    /// A box of the part's size.
     Cube,
+    /// The largest sphere that fits in the part's size.
     Sphere,
 }
 
 impl PartShape {
+    /// The accepted names, as error messages list them.
     pub const NAMES: &'static str = "\"Cube\" or \"Sphere\"";
 
+    /// The Lua name (also a new part's default name).
     pub fn name(self) -> &'static str {
         match self {
             PartShape::Cube => "Cube",
@@ -45,11 +50,15 @@ impl PartShape {
 
 /// A simulated part's body and the plane it is in.
 pub struct Link {
+    /// The body.
     pub object: Object,
+    /// The plane the body is in.
     pub plane: Weak<PlaneState>,
 }
 
+/// A part: the host's own state of it, and its body while simulated.
 pub struct PartState {
+    /// Fixed when the part is made.
     pub shape: PartShape,
     name: RefCell<String>,
     size: Cell<[f32; 3]>,
@@ -76,22 +85,27 @@ impl PartState {
         }
     }
 
+    /// The part's name.
     pub fn name(&self) -> String {
         self.name.borrow().clone()
     }
 
+    /// Renames the part.
     pub fn set_name(&self, name: String) {
         *self.name.borrow_mut() = name;
     }
 
+    /// The part's size.
     pub fn size(&self) -> [f32; 3] {
         self.size.get()
     }
 
+    /// Resizes the part (not its body: see PhysicsObject.Size).
     pub fn set_size(&self, size: [f32; 3]) {
         self.size.set(size);
     }
 
+    /// Whether `:Destroy()` was called.
     pub fn is_destroyed(&self) -> bool {
         self.destroyed.get()
     }
@@ -101,12 +115,14 @@ impl PartState {
         self.link.borrow().as_ref().map(|l| l.object.clone())
     }
 
+    /// Whether `object` is this part's body now.
     pub fn is_linked_to(&self, object: &Object) -> bool {
         self.link.borrow().as_ref().is_some_and(|l| {
             l.object.handle() == object.handle() && l.object.plane().id() == object.plane().id()
         })
     }
 
+    /// Makes `link` the part's body (the part is simulated from now on).
     pub fn link(&self, link: Link) {
         self.last_fired.set(None);
         *self.link.borrow_mut() = Some(link);
@@ -146,6 +162,7 @@ impl PartState {
         }
     }
 
+    /// Removes the body, disconnects every change signal and marks the part destroyed.
     pub fn destroy(self: &Rc<Self>) {
         self.detach();
         self.destroyed.set(true);
@@ -172,6 +189,7 @@ impl PartState {
             .map(|(_, s)| s.clone())
     }
 
+    /// Handlers connected to the CFrame change signal.
     pub fn cframe_listeners(&self) -> usize {
         self.existing_signal("CFrame").map_or(0, |s| s.listeners())
     }
@@ -198,9 +216,28 @@ impl PartState {
     }
 }
 
+impl Watched for PartState {
+    fn listeners(&self) -> usize {
+        self.cframe_listeners()
+    }
+
+    fn fire_if_changed(&self, lua: &Lua) -> mlua::Result<()> {
+        self.fire_cframe_if_moved(lua)
+    }
+}
+
 /// The Lua handle of a part.
 #[derive(Clone)]
 pub struct BasePart(pub Rc<PartState>);
+
+impl Target for BasePart {
+    /// A part's properties are its own state: none is one SDK write.
+    type Prop = std::convert::Infallible;
+
+    fn write(&self, _: &str, prop: Self::Prop) -> mlua::Result<()> {
+        match prop {}
+    }
+}
 
 /// `self` of a method called on a BasePart, or an error saying how it was called.
 fn this_part(what: &str, v: &Value) -> mlua::Result<Rc<PartState>> {
@@ -225,7 +262,7 @@ pub fn methods(lua: &Lua) -> mlua::Result<Table> {
             })?;
             let (signal, created) = part.signal(row.name);
             if created && row.name == "CFrame" {
-                scheduler(lua).watch(&part);
+                scheduler(lua).watch(part.clone());
             }
             Ok(signal)
         }
@@ -248,28 +285,25 @@ pub fn methods(lua: &Lua) -> mlua::Result<Table> {
     Ok(t)
 }
 
+impl BasePart {
+    /// `BasePart "Name"`: how `tostring` and error messages show a part.
+    fn describe(&self) -> String {
+        format!("BasePart \"{}\"", self.0.name())
+    }
+}
+
 impl UserData for BasePart {
-    // Methods live in a table `__index` consults after the properties: with no mlua-registered
-    // methods, mlua installs this `__index` as is, sparing every property read a Lua-side
-    // method lookup.
+    // Methods live in a table `__index` consults after the properties (see `api::index`).
     fn add_methods<M: UserDataMethods<Self>>(methods: &mut M) {
         methods.add_meta_method(MetaMethod::Index, |lua, part, key: Value| {
-            match PART.row(&key) {
-                Some(_) => PART.get(lua, part, &key),
-                None => crate::method_tables(lua)
-                    .part
-                    .raw_get::<Option<mlua::Function>>(key.clone())?
-                    .map(Value::Function)
-                    .ok_or_else(|| PART.unknown(&key)),
-            }
+            super::index(lua, &PART, |m| &m.part, part, key)
         });
         methods.add_meta_method(
             MetaMethod::NewIndex,
             |lua, part, (key, value): (Value, Value)| PART.set(lua, part, &key, &value),
         );
-        methods.add_meta_method(MetaMethod::ToString, |_, part, ()| {
-            Ok(format!("BasePart \"{}\"", part.0.name()))
-        });
+        methods.add_meta_method(MetaMethod::ToString, |_, part, ()| Ok(part.describe()));
+        methods.add_meta_method(DESCRIBE, |_, part, ()| Ok(part.describe()));
         methods.add_meta_method(MetaMethod::Eq, |_, part, other: Value| {
             Ok(match other {
                 Value::UserData(ud) => ud

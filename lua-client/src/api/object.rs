@@ -3,15 +3,13 @@
 
 use std::rc::Rc;
 
-use client_sdk::{Object, Pin, Restraint};
+use client_sdk::{Object, ObjectProp, Pin, Restraint};
 use mlua::{AnyUserData, Lua, MetaMethod, Table, UserData, UserDataMethods, Value};
 
-use crate::convert::{describe, expected, new_vector, sdk_error};
-
-use crate::part::PartState;
-use crate::primitives::rotation;
+use super::part::PartState;
 use crate::props::object::OBJECT;
-use crate::props::Kind;
+use crate::props::{Kind, Target};
+use crate::values::{describe, expected, new_vector, rotation, sdk_error};
 
 /// RotateTo's documented default strength.
 const DEFAULT_STRENGTH: f64 = 8.0;
@@ -54,8 +52,11 @@ fn restraint(opts: &Value) -> mlua::Result<Restraint> {
     })
 }
 
+/// A part's body in a plane, as scripts hold it.
 pub struct PhysicsObject {
+    /// The body.
     pub object: Object,
+    /// The wrapped part.
     pub part: Rc<PartState>,
     /// The wrapped part's own userdata, so `obj:BasePart() == part`.
     pub part_ud: AnyUserData,
@@ -73,8 +74,19 @@ impl PhysicsObject {
         }
     }
 
+    /// Whether the body still exists and still belongs to the part.
     pub fn alive(&self) -> bool {
         self.part.is_linked_to(&self.object) && self.object.is_alive().unwrap_or(false)
+    }
+}
+
+impl Target for PhysicsObject {
+    type Prop = ObjectProp;
+
+    fn write(&self, name: &str, prop: ObjectProp) -> mlua::Result<()> {
+        self.live(name)?
+            .set(prop)
+            .map_err(|e| sdk_error(&format!("PhysicsObject.{name}"), e))
     }
 }
 
@@ -206,17 +218,10 @@ pub fn methods(lua: &Lua) -> mlua::Result<Table> {
 }
 
 impl UserData for PhysicsObject {
-    // Methods come from `__index` after the properties (see BasePart for why).
+    // Methods come from `__index` after the properties (see `api::index`).
     fn add_methods<M: UserDataMethods<Self>>(methods: &mut M) {
         methods.add_meta_method(MetaMethod::Index, |lua, o, key: Value| {
-            match OBJECT.row(&key) {
-                Some(_) => OBJECT.get(lua, o, &key),
-                None => crate::method_tables(lua)
-                    .object
-                    .raw_get::<Option<mlua::Function>>(key.clone())?
-                    .map(Value::Function)
-                    .ok_or_else(|| OBJECT.unknown(&key)),
-            }
+            super::index(lua, &OBJECT, |m| &m.object, o, key)
         });
         methods.add_meta_method(
             MetaMethod::NewIndex,

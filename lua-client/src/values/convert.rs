@@ -1,10 +1,24 @@
 //! Lua values to Rust values, and the error messages that name what was expected and what
 //! was given.
 
-use mlua::{Error as LuaError, Value};
+use mlua::{AnyUserData, Error as LuaError, Function, Value};
 
-use crate::part::BasePart;
-use crate::primitives::{CFrame, Dim};
+use super::{CFrame, Dim};
+
+/// The metatable field of a userdata type that describes its values in error messages: a
+/// function of the value returning a string (e.g. `BasePart "Ball"`). Types without one are
+/// described by their type name.
+pub const DESCRIBE: &str = "__describe";
+
+/// What a userdata type's [`DESCRIBE`] entry says about `ud`, if it has one.
+fn described(ud: &AnyUserData) -> Option<String> {
+    let describe = ud
+        .metatable()
+        .ok()?
+        .get::<Option<Function>>(DESCRIBE)
+        .ok()??;
+    describe.call::<String>(ud.clone()).ok()
+}
 
 /// A short description of a Lua value for error messages: its type and, when small, itself.
 pub fn describe(value: &Value) -> String {
@@ -31,8 +45,8 @@ pub fn describe(value: &Value) -> String {
                 cf.to_string()
             } else if let Ok(d) = ud.borrow::<Dim>() {
                 d.to_string()
-            } else if let Ok(p) = ud.borrow::<BasePart>() {
-                format!("BasePart \"{}\"", p.0.name())
+            } else if let Some(text) = described(ud) {
+                text
             } else {
                 match ud.type_name() {
                     Ok(Some(name)) => name,
@@ -49,6 +63,7 @@ pub fn expected(what: &str, expected: &str, got: &Value) -> LuaError {
     LuaError::runtime(format!("{what} expects {expected}, got {}", describe(got)))
 }
 
+/// A Lua number (integer or float) as `f64`.
 pub fn number(value: &Value) -> Option<f64> {
     match *value {
         Value::Number(n) => Some(n),
@@ -87,6 +102,7 @@ pub fn sdk_error(what: &str, e: client_sdk::Error) -> LuaError {
     LuaError::runtime(format!("{what}: {e}"))
 }
 
+/// A native Luau vector of `v`.
 pub fn new_vector(v: [f32; 3]) -> Value {
     Value::Vector(mlua::Vector::new(v[0], v[1], v[2]))
 }

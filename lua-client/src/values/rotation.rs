@@ -4,9 +4,12 @@
 //! so a point is turned about Z first, then Y, then X (the order Roblox's `CFrame.Angles`
 //! uses). `to_euler` inverts it, with `b` in [-π/2, π/2].
 
+/// A unit quaternion `[x, y, z, w]`.
 pub type Quat = [f32; 4];
+/// A 3D vector.
 pub type V3 = [f32; 3];
 
+/// No rotation.
 pub const IDENTITY: Quat = [0.0, 0.0, 0.0, 1.0];
 
 fn axis(i: usize, angle: f64) -> [f64; 4] {
@@ -27,6 +30,7 @@ fn mul64(a: [f64; 4], b: [f64; 4]) -> [f64; 4] {
     ]
 }
 
+/// The rotation of Euler radians `e` (Rx · Ry · Rz).
 pub fn from_euler(e: V3) -> Quat {
     let q = mul64(
         mul64(axis(0, e[0] as f64), axis(1, e[1] as f64)),
@@ -35,6 +39,7 @@ pub fn from_euler(e: V3) -> Quat {
     q.map(|c| c as f32)
 }
 
+/// Euler radians of `q`, the inverse of [`from_euler`].
 pub fn to_euler(q: Quat) -> V3 {
     let m = matrix(q);
     // atan2 rather than asin(m02): asin loses half the digits near ±90°.
@@ -71,14 +76,17 @@ fn matrix(q: Quat) -> [[f64; 3]; 3] {
     ]
 }
 
+/// `a · b`: `b` applied first, then `a`.
 pub fn mul(a: Quat, b: Quat) -> Quat {
     mul64(a.map(|c| c as f64), b.map(|c| c as f64)).map(|c| c as f32)
 }
 
+/// The inverse rotation of a unit quaternion.
 pub fn conjugate(q: Quat) -> Quat {
     [-q[0], -q[1], -q[2], q[3]]
 }
 
+/// `v` turned by `q`.
 pub fn rotate(q: Quat, v: V3) -> V3 {
     let m = matrix(q);
     let v = v.map(|c| c as f64);

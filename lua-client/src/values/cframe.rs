@@ -6,21 +6,26 @@ use std::fmt;
 use client_sdk::Pose;
 use mlua::{Lua, MetaMethod, UserData, UserDataFields, UserDataMethods, Value, Variadic};
 
+use super::convert::{describe, expected, finite_vector, new_vector, number, vector};
 use super::rotation::{self, Quat, V3};
-use crate::convert::{describe, expected, finite_vector, new_vector, number, vector};
 
+/// A pose: position and rotation.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CFrame {
+    /// World-space position.
     pub position: V3,
+    /// Rotation as a unit quaternion.
     pub rotation: Quat,
 }
 
 impl CFrame {
+    /// At the origin, not rotated.
     pub const IDENTITY: CFrame = CFrame {
         position: [0.0; 3],
         rotation: rotation::IDENTITY,
     };
 
+    /// As the SDK's pose.
     pub fn pose(&self) -> Pose {
         Pose {
             position: self.position,
@@ -28,6 +33,7 @@ impl CFrame {
         }
     }
 
+    /// From the SDK's pose.
     pub fn from_pose(p: Pose) -> CFrame {
         CFrame {
             position: p.position,
@@ -43,6 +49,7 @@ impl CFrame {
         }
     }
 
+    /// The frame that undoes this one: `cf * cf:Inverse()` is the identity.
     pub fn inverse(&self) -> CFrame {
         let inv = rotation::conjugate(self.rotation);
         let p = rotation::rotate(inv, self.position);
@@ -52,6 +59,7 @@ impl CFrame {
         }
     }
 
+    /// `v`, given in this frame's local space, in world space.
     pub fn point_to_world(&self, v: V3) -> V3 {
         let r = rotation::rotate(self.rotation, v);
         [
@@ -200,7 +208,7 @@ pub fn new(_: &Lua, args: Variadic<Value>) -> mlua::Result<CFrame> {
 pub fn angles(_: &Lua, (rx, ry, rz): (Value, Value, Value)) -> mlua::Result<CFrame> {
     let mut e = [0.0f32; 3];
     for (i, (v, name)) in [(rx, "rx"), (ry, "ry"), (rz, "rz")].iter().enumerate() {
-        e[i] = crate::convert::finite_number(&format!("CFrame.Angles {name}"), v)? as f32;
+        e[i] = super::convert::finite_number(&format!("CFrame.Angles {name}"), v)? as f32;
     }
     Ok(CFrame {
         position: [0.0; 3],

@@ -8,8 +8,8 @@ use mlua::{
     Function, Lua, MetaMethod, MultiValue, UserData, UserDataFields, UserDataMethods, Value,
 };
 
-use crate::convert::expected;
-use crate::scheduler;
+use super::scheduler;
+use crate::values::expected;
 
 struct Slot {
     id: u64,
@@ -17,6 +17,7 @@ struct Slot {
     once: bool,
 }
 
+/// The connections of a signal, shared by its clones.
 #[derive(Default)]
 pub struct SignalInner {
     name: String,
@@ -29,6 +30,7 @@ pub struct SignalInner {
 pub struct Signal(pub Rc<SignalInner>);
 
 impl Signal {
+    /// A signal with no connections; `name` is what `tostring` shows.
     pub fn new(name: impl Into<String>) -> Signal {
         Signal(Rc::new(SignalInner {
             name: name.into(),
@@ -41,6 +43,7 @@ impl Signal {
         self.0.slots.borrow().len()
     }
 
+    /// Drops every connection.
     pub fn disconnect_all(&self) {
         self.0.slots.borrow_mut().clear();
     }

@@ -9,9 +9,9 @@ use std::time::Instant;
 
 use mlua::{Function, LightUserData, Lua, MultiValue, Thread, ThreadStatus, Value};
 
-use crate::convert::{expected, number};
-use crate::part::PartState;
-use crate::signal::Signal;
+use super::signal::Signal;
+use super::Watched;
+use crate::values::{expected, number};
 
 static WAIT_MARK: u8 = 0;
 
@@ -25,15 +25,19 @@ struct Waiting {
     thread: Thread,
 }
 
+/// The frame loop's state: pending waits, `Heart`, and what is watched each frame.
 pub struct Scheduler {
     started: Instant,
     waiting: RefCell<Vec<Waiting>>,
+    /// The global `Heart` signal, fired once per frame with dt.
     pub heart: Signal,
-    /// Parts whose CFrame change signal exists; probed each frame for listeners.
-    watched: RefCell<Vec<Weak<PartState>>>,
+    /// Values with per-frame change signals (simulated parts' CFrame); probed each frame
+    /// for listeners.
+    watched: RefCell<Vec<Weak<dyn Watched>>>,
 }
 
 impl Scheduler {
+    /// A scheduler with nothing pending; its clock starts now.
     pub fn new() -> Scheduler {
         Scheduler {
             started: Instant::now(),
@@ -47,10 +51,12 @@ impl Scheduler {
         self.started.elapsed().as_secs_f64()
     }
 
-    pub fn watch(&self, part: &Rc<PartState>) {
-        self.watched.borrow_mut().push(Rc::downgrade(part));
+    /// Probes `watched` every frame until it is dropped.
+    pub fn watch(&self, watched: Rc<dyn Watched>) {
+        self.watched.borrow_mut().push(Rc::downgrade(&watched));
     }
 
+    /// How many script threads wait to be resumed.
     pub fn pending_waits(&self) -> usize {
         self.waiting.borrow().len()
     }
@@ -71,22 +77,22 @@ impl Scheduler {
             .borrow()
             .iter()
             .filter_map(Weak::upgrade)
-            .any(|p| p.cframe_listeners() > 0)
+            .any(|w| w.listeners() > 0)
     }
 
     /// One frame. Physics results come first: the change signals of simulated parts with
     /// listeners fire when their pose moved; then due waits resume and `Heart` fires with
     /// `dt`, so scripts see this frame's poses.
     pub fn frame(&self, lua: &Lua, dt: f64) -> mlua::Result<()> {
-        let parts: Vec<Rc<PartState>> = {
+        let watched: Vec<Rc<dyn Watched>> = {
             let mut watched = self.watched.borrow_mut();
             watched.retain(|w| w.strong_count() > 0);
             watched.iter().filter_map(Weak::upgrade).collect()
         };
-        for part in parts {
-            // The empty-listener probe: parts nobody listens to cost one length check.
-            if part.cframe_listeners() > 0 {
-                part.fire_cframe_if_moved(lua)?;
+        for w in watched {
+            // The empty-listener probe: what nobody listens to costs one length check.
+            if w.listeners() > 0 {
+                w.fire_if_changed(lua)?;
             }
         }
         let now = self.clock();
@@ -122,6 +128,7 @@ impl IntoMulti for f64 {
     }
 }
 
+/// The scheduler `install` registered in `lua`.
 pub fn scheduler(lua: &Lua) -> Rc<Scheduler> {
     lua.app_data_ref::<Rc<Scheduler>>()
         .expect("lua_client::install registers the scheduler")

@@ -3,45 +3,45 @@
 use std::cell::{Cell, RefCell};
 use std::rc::Rc;
 
-use client_sdk::{Client, Plane, PlaneOptions, PlaneProp};
+use client_sdk::validate::MAX_DT;
+use client_sdk::{Client, Plane, PlaneInfo, PlaneOptions, PlaneProp};
 use mlua::{Lua, MetaMethod, Table, UserData, UserDataMethods, Value};
 
-use client_sdk::validate::MAX_DT;
+use super::object::PhysicsObject;
+use super::part::{BasePart, Link, PartState};
+use crate::props::plane::{NOT_YET_METHODS, PLANE};
+use crate::props::{not_yet_methods, Target};
+use crate::values::{describe, expected, finite_number, sdk_error};
 
-use crate::convert::{describe, expected, finite_number, sdk_error};
-use crate::object::PhysicsObject;
-use crate::part::{BasePart, Link, PartState};
-use crate::props::plane::{AT_CREATION, NOT_YET_METHODS, PLANE};
-use crate::props::{not_yet_methods, Set};
-
+/// A plane as the host holds it. Its options live in the daemon alone: the property rows
+/// read them back from there.
 pub struct PlaneState {
+    /// The SDK's plane.
     pub plane: Plane,
     alive: Cell<bool>,
-    // Option values as last written by this script (the daemon applies them in order).
-    pub gravity: Cell<[f32; 3]>,
-    pub enabled: Cell<bool>,
-    pub tick_rate: Cell<f32>,
-    pub threads: u32,
     parts: RefCell<Vec<Rc<PartState>>>,
 }
 
 impl PlaneState {
+    /// False once `:Destroy()` was called.
     pub fn alive(&self) -> bool {
         self.alive.get()
     }
 
-    /// Queues an option change for the frame's batch.
-    pub fn set(&self, prop: PlaneProp) -> mlua::Result<()> {
+    /// The plane's options and counters as the daemon holds them (one round trip, which
+    /// sends the queued writes first); `what` names the property read, for errors.
+    pub fn info(&self, what: &str) -> mlua::Result<PlaneInfo> {
         if !self.alive() {
             return Err(mlua::Error::runtime(format!(
-                "PhysicsPlane: cannot set {prop:?} on a destroyed plane"
+                "PhysicsPlane.{what}: the plane was destroyed"
             )));
         }
         self.plane
-            .set(prop)
-            .map_err(|e| sdk_error("PhysicsPlane", e))
+            .info()
+            .map_err(|e| sdk_error(&format!("PhysicsPlane.{what}"), e))
     }
 
+    /// Live objects of the plane; 0 once destroyed.
     pub fn object_count(&self) -> Result<u32, client_sdk::Error> {
         if !self.alive() {
             return Ok(0);
@@ -49,6 +49,7 @@ impl PlaneState {
         Ok(self.plane.info()?.object_count)
     }
 
+    /// Forgets `part` (its body left the plane).
     pub fn forget(&self, part: &Rc<PartState>) {
         self.parts.borrow_mut().retain(|p| !Rc::ptr_eq(p, part));
     }
@@ -65,13 +66,31 @@ impl PlaneState {
     }
 }
 
+impl Target for PlaneState {
+    type Prop = PlaneProp;
+
+    /// Queues an option change for the frame's batch.
+    fn write(&self, _: &str, prop: PlaneProp) -> mlua::Result<()> {
+        if !self.alive() {
+            return Err(mlua::Error::runtime(format!(
+                "PhysicsPlane: cannot set {prop:?} on a destroyed plane"
+            )));
+        }
+        self.plane
+            .set(prop)
+            .map_err(|e| sdk_error("PhysicsPlane", e))
+    }
+}
+
 /// Planes stay alive until `:Destroy()`, whether or not the script keeps a reference.
 pub struct Context {
+    /// The connection to the daemon.
     pub client: Client,
     planes: RefCell<Vec<Rc<PlaneState>>>,
 }
 
 impl Context {
+    /// No planes yet.
     pub fn new(client: Client) -> Context {
         Context {
             client,
@@ -86,6 +105,7 @@ fn context(lua: &Lua) -> Rc<Context> {
         .clone()
 }
 
+/// The Lua handle of a plane.
 #[derive(Clone)]
 pub struct PhysicsPlane(pub Rc<PlaneState>);
 
@@ -194,59 +214,44 @@ fn new_plane(lua: &Lua, opts: Value) -> mlua::Result<PhysicsPlane> {
         Value::Table(t) => Some(t),
         other => return Err(expected(WHAT, "a table of options or nil", &other)),
     };
+    // Every option is part of the creation request: the plane never ticks before all of
+    // them apply (a manual plane never ticks on its own at all).
     let mut options = PlaneOptions::default();
-    let mut later = Vec::new();
     for pair in opts.iter().flat_map(|t| t.pairs::<Value, Value>()) {
         let (key, value) = pair?;
-        let row = PLANE.row(&key).ok_or_else(|| {
-            mlua::Error::runtime(format!(
-                "{WHAT}: unknown option {} (given {})",
-                describe(&key),
-                describe(&value)
-            ))
-        })?;
-        let creation = AT_CREATION.iter().find(|(n, _)| *n == row.name);
-        match (&row.set, creation) {
-            (Set::NotYet, _) => return Err(PLANE.not_supported(row.name)),
-            (Set::ReadOnly, None) => {
-                return Err(mlua::Error::runtime(format!(
-                    "{WHAT}: {} is read-only, not an option (given {})",
-                    row.name,
-                    describe(&value)
-                )))
-            }
-            _ => {}
-        }
-        let arg = row
-            .kind
-            .convert(&format!("{WHAT} option {}", row.name), &value)?;
-        match creation {
-            Some((_, apply)) => apply(&mut options, &arg)?,
-            None => later.push((row, arg)),
-        }
+        option(&mut options, PLANE.option(WHAT, &key, &value)?);
     }
     let ctx = context(lua);
     let plane = ctx
         .client
         .create_plane(&options)
         .map_err(|e| sdk_error(WHAT, e))?;
-    let info = plane.info().map_err(|e| sdk_error(WHAT, e))?;
     let state = Rc::new(PlaneState {
         plane,
         alive: Cell::new(true),
-        gravity: Cell::new(info.gravity),
-        enabled: Cell::new(info.enabled),
-        tick_rate: Cell::new(info.tick_rate),
-        threads: info.threads,
         parts: RefCell::default(),
     });
-    for (row, arg) in later {
-        if let Set::Fn(set) = row.set {
-            set(lua, &state, arg)?;
-        }
-    }
     ctx.planes.borrow_mut().push(state.clone());
     Ok(PhysicsPlane(state))
+}
+
+/// Puts `prop` into the field of the creation request that carries it.
+fn option(o: &mut PlaneOptions, prop: PlaneProp) {
+    match prop {
+        PlaneProp::Gravity(v) => o.gravity = Some(v),
+        PlaneProp::Threads(v) => o.threads = Some(v),
+        PlaneProp::TickRate(v) => o.tick_rate = Some(v),
+        PlaneProp::Enabled(v) => o.enabled = Some(v),
+        PlaneProp::LinearDamping(v) => o.linear_damping = Some(v),
+        PlaneProp::AngularDamping(v) => o.angular_damping = Some(v),
+        PlaneProp::Drag(v) => o.drag = Some(v),
+        PlaneProp::Buoyancy(v) => o.buoyancy = Some(v),
+        PlaneProp::ConstantForce(v) => o.constant_force = Some(v),
+        PlaneProp::RestThreshold(v) => o.rest_threshold = Some(v),
+        PlaneProp::SolverIterations(v) => o.solver_iterations = Some(v),
+        PlaneProp::LoopSolver(v) => o.loop_solver = Some(v),
+        PlaneProp::NeverSleep(v) => o.never_sleep = Some(v),
+    }
 }
 
 /// The `PhysicsService` module.

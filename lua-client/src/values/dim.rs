@@ -5,11 +5,14 @@ use std::fmt;
 
 use mlua::{Lua, MetaMethod, UserData, UserDataFields, UserDataMethods, Value};
 
-use crate::convert::{expected, finite_number, number};
+use super::convert::{expected, finite_number, number};
 
+/// A 2D value: pixel offsets or sizes.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Dim {
+    /// Horizontal component.
     pub x: f64,
+    /// Vertical component.
     pub y: f64,
 }
 

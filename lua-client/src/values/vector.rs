@@ -1,20 +1,13 @@
-//! Host stand-ins for the `Primitives` module: `Vector` (Luau's native vector type, so
-//! `vector.create` values are Vectors too), `CFrame` and `Dim`.
-
-mod cframe;
-mod dim;
-pub mod rotation;
-
-pub use cframe::CFrame;
-pub use dim::Dim;
+//! `Vector`: Luau's native vector type (so `vector.create` values are Vectors too), with the
+//! members the host adds through the vector type's metatable.
 
 use mlua::{Lua, Table, Value};
 
-use crate::convert::{finite_number, new_vector, vector};
+use super::convert::{expected, finite_number, new_vector, vector};
 
-/// Builds the `Primitives` table and gives every vector its methods.
+/// Builds the `Primitives.Vector` table and installs the vector metatable.
 pub fn module(lua: &Lua) -> mlua::Result<Table> {
-    install_vector_metatable(lua)?;
+    install_metatable(lua)?;
     let vector_mod = lua.create_table()?;
     vector_mod.set(
         "new",
@@ -28,25 +21,12 @@ pub fn module(lua: &Lua) -> mlua::Result<Table> {
     )?;
     vector_mod.set("zero", new_vector([0.0; 3]))?;
     vector_mod.set("one", new_vector([1.0; 3]))?;
-
-    let cframe_mod = lua.create_table()?;
-    cframe_mod.set("new", lua.create_function(cframe::new)?)?;
-    cframe_mod.set("Angles", lua.create_function(cframe::angles)?)?;
-    cframe_mod.set("identity", CFrame::IDENTITY)?;
-
-    let dim_mod = lua.create_table()?;
-    dim_mod.set("new", lua.create_function(dim::new)?)?;
-
-    let primitives = lua.create_table()?;
-    primitives.set("Vector", vector_mod)?;
-    primitives.set("CFrame", cframe_mod)?;
-    primitives.set("Dim", dim_mod)?;
-    Ok(primitives)
+    Ok(vector_mod)
 }
 
 /// `.X/.Y/.Z` (any case) and arithmetic are native to Luau vectors; this adds `Magnitude`,
 /// `Unit`, `:Dot`, `:Cross` and `:Lerp` through the vector type's metatable.
-fn install_vector_metatable(lua: &Lua) -> mlua::Result<()> {
+fn install_metatable(lua: &Lua) -> mlua::Result<()> {
     let dot = lua.create_function(|_, (a, b): (Value, Value)| {
         let (a, b) = (vec_arg("Vector:Dot", &a)?, vec_arg("Vector:Dot", &b)?);
         Ok(a[0] * b[0] + a[1] * b[1] + a[2] * b[2])
@@ -87,5 +67,5 @@ fn install_vector_metatable(lua: &Lua) -> mlua::Result<()> {
 }
 
 fn vec_arg(what: &str, v: &Value) -> mlua::Result<[f32; 3]> {
-    vector(v).ok_or_else(|| crate::convert::expected(what, "a Vector", v))
+    vector(v).ok_or_else(|| expected(what, "a Vector", v))
 }

@@ -1,0 +1,66 @@
+//! The Luau API types, one file each: `PhysicsService` and its planes ([`plane`]), the
+//! `PhysicsObject` a plane's `:Add` returns ([`object`]), and `Renderable.BasePart`
+//! ([`part`]). Their properties are the rows in `props`; values come from `values`.
+
+pub mod object;
+pub mod part;
+pub mod plane;
+
+use std::rc::Rc;
+
+use client_sdk::Client;
+use mlua::{Function, Lua, Table, Value};
+
+use crate::props::{Props, Target};
+
+/// The modules `import` knows, in the order error messages list them.
+pub const MODULES: [&str; 3] = ["PhysicsService", "Renderable", "Primitives"];
+
+/// Methods of the types whose `__index` is ours alone (see [`index`]).
+pub struct MethodTables {
+    /// BasePart's methods.
+    pub part: Table,
+    /// PhysicsObject's methods.
+    pub object: Table,
+}
+
+/// The method tables [`modules`] registered in `lua`.
+pub fn method_tables(lua: &Lua) -> Rc<MethodTables> {
+    lua.app_data_ref::<Rc<MethodTables>>()
+        .expect("lua_client::install registers the method tables")
+        .clone()
+}
+
+/// Registers the API's state in `lua` (talking to the daemon through `client`) and returns
+/// the modules by name.
+pub fn modules(lua: &Lua, client: Client) -> mlua::Result<Table> {
+    lua.set_app_data(Rc::new(plane::Context::new(client)));
+    lua.set_app_data(Rc::new(MethodTables {
+        part: part::methods(lua)?,
+        object: object::methods(lua)?,
+    }));
+    let modules = lua.create_table()?;
+    modules.set("PhysicsService", plane::module(lua)?)?;
+    modules.set("Renderable", part::module(lua)?)?;
+    modules.set("Primitives", crate::values::module(lua)?)?;
+    Ok(modules)
+}
+
+/// `__index` of a type whose methods live in a table consulted after its properties: with
+/// no mlua-registered methods, mlua installs this `__index` as is, sparing every property
+/// read a Lua-side method lookup.
+pub fn index<T: Target>(
+    lua: &Lua,
+    props: &Props<T>,
+    methods: fn(&MethodTables) -> &Table,
+    target: &T,
+    key: Value,
+) -> mlua::Result<Value> {
+    match props.row(&key) {
+        Some(_) => props.get(lua, target, &key),
+        None => methods(&method_tables(lua))
+            .raw_get::<Option<Function>>(key.clone())?
+            .map(Value::Function)
+            .ok_or_else(|| props.unknown(&key)),
+    }
+}

@@ -1,0 +1,80 @@
+//! The host side of the API: the frame loop ([`Host`]), the scheduler behind `wait` and
+//! coroutines, and signals. Nothing here knows an API type: what changes per frame (a
+//! simulated part's CFrame) is [`Watched`] through a trait object.
+
+pub mod scheduler;
+pub mod signal;
+
+use std::rc::Rc;
+
+use client_sdk::Client;
+use mlua::{Function, Lua, MultiValue};
+
+use crate::values::sdk_error;
+use scheduler::Scheduler;
+
+/// Something with a per-frame change signal: probed each frame, fired when it changed.
+pub trait Watched {
+    /// How many handlers listen; at zero the frame skips it.
+    fn listeners(&self) -> usize;
+    /// Fires the change signal if the value moved since it last fired.
+    fn fire_if_changed(&self, lua: &Lua) -> mlua::Result<()>;
+}
+
+/// A host's handle on the installed API: drives frames.
+pub struct Host {
+    lua: Lua,
+    scheduler: Rc<Scheduler>,
+    client: Client,
+}
+
+impl Host {
+    /// The handle `install` returns for `lua`.
+    pub(crate) fn new(lua: &Lua, scheduler: Rc<Scheduler>, client: Client) -> Host {
+        Host {
+            lua: lua.clone(),
+            scheduler,
+            client,
+        }
+    }
+
+    /// Runs `f` as a script thread: until it finishes or first waits.
+    pub fn spawn(&self, f: Function) -> mlua::Result<()> {
+        scheduler::spawn(&self.lua, f, MultiValue::new())
+    }
+
+    /// One frame of `dt` seconds, ending with the flush of every write it made.
+    pub fn frame(&self, dt: f64) -> mlua::Result<()> {
+        self.scheduler.frame(&self.lua, dt)?;
+        self.flush()
+    }
+
+    /// Sends the queued writes as one request.
+    pub fn flush(&self) -> mlua::Result<()> {
+        self.client
+            .flush()
+            .map_err(|e| sdk_error("the physics daemon rejected a write", e))
+    }
+
+    /// Whether frames still have work: `Heart` handlers, pending waits, or change listeners.
+    pub fn busy(&self) -> bool {
+        self.scheduler.heart.listeners() > 0
+            || self.scheduler.pending_waits() > 0
+            || self.scheduler.change_listeners()
+    }
+
+    /// Whether the next frame is needed regardless of waits (Heart or change listeners).
+    pub fn busy_every_frame(&self) -> bool {
+        self.scheduler.heart.listeners() > 0 || self.scheduler.change_listeners()
+    }
+
+    /// Seconds until the earliest pending `wait` is due.
+    pub fn next_wake_in(&self) -> Option<f64> {
+        self.scheduler.next_wake_in()
+    }
+
+    /// The client the API talks to the daemon through.
+    pub fn client(&self) -> &Client {
+        &self.client
+    }
+}
