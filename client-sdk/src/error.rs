@@ -1,26 +1,52 @@
+//! The error type of every client operation.
+
 use shm_layout::CommandError;
 
+/// Why a client operation failed.
 #[derive(Debug, thiserror::Error)]
 pub enum Error {
+    /// No daemon answers in the domain (none runs, or one could not be started).
     #[error("no physics daemon is serving domain {domain:?} ({detail})")]
-    NoDaemon { domain: String, detail: String },
+    NoDaemon {
+        /// The domain that was tried.
+        domain: String,
+        /// What went wrong.
+        detail: String,
+    },
+    /// The daemon this client was connected to no longer exists.
     #[error(
         "the physics daemon of domain {domain:?} is gone (process {pid} exited or was killed)"
     )]
-    DaemonGone { domain: String, pid: u32 },
+    DaemonGone {
+        /// The domain of the daemon.
+        domain: String,
+        /// Process id of the daemon.
+        pid: u32,
+    },
+    /// The daemon speaks another layout version; the message names both versions.
     #[error("{0}")]
     VersionMismatch(String),
+    /// The daemon refused a command.
     #[error("{0}")]
     Command(#[from] CommandError),
     /// Some commands of a flushed batch failed; the others were applied.
     #[error("{} command(s) of the batch failed; first: {}", .0.len(), .0[0])]
     Batch(Vec<CommandError>),
+    /// A value was refused before anything was sent.
     #[error("invalid {field}: {message}")]
-    Invalid { field: String, message: String },
+    Invalid {
+        /// The field or property that was refused.
+        field: String,
+        /// Why it was refused.
+        message: String,
+    },
+    /// No reply, or no new tick, came within the given time.
     #[error("timed out after {0:?}")]
     Timeout(std::time::Duration),
+    /// The shared-memory transport failed.
     #[error("shared-memory transport: {0}")]
     Ipc(String),
+    /// The daemon's reply could not be decoded or was not the one expected.
     #[error("protocol: {0}")]
     Protocol(String),
 }

@@ -24,10 +24,12 @@ impl Object {
         Object::new(plane.clone(), handle)
     }
 
+    /// The object's handle.
     pub fn handle(&self) -> Handle {
         self.handle
     }
 
+    /// The plane the object belongs to.
     pub fn plane(&self) -> &Plane {
         &self.plane
     }
@@ -46,10 +48,12 @@ impl Object {
         })
     }
 
+    /// Whether the object still exists (newest tick, with pending writes on top).
     pub fn is_alive(&self) -> Result<bool, Error> {
         Ok(self.plane.body(self.handle)?.is_some())
     }
 
+    /// The current position and rotation.
     pub fn pose(&self) -> Result<Pose, Error> {
         let s = self.state()?;
         Ok(Pose {
@@ -58,18 +62,22 @@ impl Object {
         })
     }
 
+    /// The current position.
     pub fn position(&self) -> Result<Vec3, Error> {
         Ok(self.state()?.position)
     }
 
+    /// The current linear velocity.
     pub fn velocity(&self) -> Result<Vec3, Error> {
         Ok(self.state()?.linear_velocity)
     }
 
+    /// The current angular velocity (rad/s).
     pub fn angular_velocity(&self) -> Result<Vec3, Error> {
         Ok(self.state()?.angular_velocity)
     }
 
+    /// Whether the object is anchored.
     pub fn is_anchored(&self) -> Result<bool, Error> {
         Ok(self.state()?.is_anchored())
     }
@@ -95,10 +103,12 @@ impl Object {
         self.set(ObjectProp::Pose(pose))
     }
 
+    /// Sets the linear velocity.
     pub fn set_velocity(&self, v: Vec3) -> Result<(), Error> {
         self.set(ObjectProp::Velocity(v))
     }
 
+    /// Sets the angular velocity (rad/s).
     pub fn set_angular_velocity(&self, w: Vec3) -> Result<(), Error> {
         self.set(ObjectProp::AngularVelocity(w))
     }
@@ -123,26 +133,33 @@ impl Object {
         self.set(ObjectProp::Density(density))
     }
 
+    /// Restitution, clamped to [0, 1]; a pair uses the higher value.
     pub fn set_bounciness(&self, e: f32) -> Result<(), Error> {
         self.set(ObjectProp::Bounciness(e))
     }
 
+    /// Coulomb friction in [0, 1]; a pair uses `sqrt(a·b)`.
     pub fn set_friction(&self, mu: f32) -> Result<(), Error> {
         self.set(ObjectProp::Friction(mu))
     }
 
+    /// When false the object passes through everything.
     pub fn set_can_collide(&self, on: bool) -> Result<(), Error> {
         self.set(ObjectProp::CanCollide(on))
     }
 
+    /// Fidelity dial, clamped to [1, 32].
     pub fn set_hit_box_quality(&self, quality: u32) -> Result<(), Error> {
         self.set(ObjectProp::HitBoxQuality(quality))
     }
 
+    /// Full size of the object's box (a sphere takes the smallest half-extent as radius;
+    /// a mesh is scaled to it).
     pub fn set_size(&self, size: Vec3) -> Result<(), Error> {
         self.set(ObjectProp::Size(size))
     }
 
+    /// Body-local centre of mass; non-zero switches to the real inertia of the shape.
     pub fn set_center_of_mass(&self, com: Vec3) -> Result<(), Error> {
         self.set(ObjectProp::CenterOfMass(com))
     }
@@ -167,6 +184,8 @@ impl Object {
         self.set(ObjectProp::RotateTo(Some(RotateTo { target, strength })))
     }
 
+    /// Stops the [`rotate_to`](Object::rotate_to) controller (angular velocity is left as
+    /// it is).
     pub fn stop_rotate_to(&self) -> Result<(), Error> {
         self.set(ObjectProp::RotateTo(None))
     }
@@ -187,7 +206,11 @@ impl Object {
     /// CenterOfMass := vertex centroid of the object's mesh (no-op for cubes and spheres).
     /// Returns the centre of mass in effect.
     pub fn recalculate_center_of_mass(&self) -> Result<Vec3, Error> {
-        match self.plane.client().call(self.op(ObjectOp::RecalculateCenterOfMass))? {
+        match self
+            .plane
+            .client()
+            .call(self.op(ObjectOp::RecalculateCenterOfMass))?
+        {
             Reply::CenterOfMass(c) => Ok(c),
             other => Err(Error::Protocol(format!("unexpected reply {other:?}"))),
         }

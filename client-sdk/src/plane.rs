@@ -294,7 +294,10 @@ impl Plane {
     /// Advances a plane by `dt` seconds (with the queue sent first) and returns once the
     /// new tick is visible in [`Plane::snapshot`]. Returns the tick number.
     pub fn step(&self, dt: f32) -> Result<u64, Error> {
-        match self.client.call(Command::plane(self.id(), PlaneOp::Step { dt }))? {
+        match self
+            .client
+            .call(Command::plane(self.id(), PlaneOp::Step { dt }))?
+        {
             Reply::Stepped { tick } => {
                 // The daemon sends the sample before the reply, so it is already here.
                 self.shared.refresh()?;

@@ -12,6 +12,7 @@ pub struct DaemonChild {
 }
 
 impl DaemonChild {
+    /// Process id of the daemon.
     pub fn pid(&self) -> u32 {
         self.child.id()
     }
@@ -53,7 +54,9 @@ pub fn daemon_executable() -> PathBuf {
 /// A client plus the daemon it started, if it had to. Dropping it says goodbye to the
 /// daemon first, then stops the daemon it started (fields drop in declaration order).
 pub struct Session {
+    /// The connected client.
     pub client: Client,
+    /// The daemon this session started, `None` when one was already running.
     pub daemon: Option<DaemonChild>,
 }
 

@@ -7,8 +7,8 @@ use std::hint::black_box;
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use iceoryx2::prelude::*;
-use physics_daemon::rapier3d::Plane;
 use physics_daemon::publish::PlaneOutput;
+use physics_daemon::rapier3d::Plane;
 use shm_layout::{names, ObjectProp, PlaneProp, Pose, Shape};
 
 const DT: f32 = 1.0 / 60.0;

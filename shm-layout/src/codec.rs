@@ -9,35 +9,54 @@ use serde::{de::DeserializeOwned, Serialize};
 
 use crate::{Request, Response, CRATE_VERSION, LAYOUT_VERSION};
 
+/// The four bytes every frame starts with.
 pub const MAGIC: [u8; 4] = *b"PHYS";
 const HEADER_LEN: usize = 8;
 
+/// Why a frame could not be decoded.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum DecodeError {
     #[error("frame of {len} bytes is shorter than the {HEADER_LEN}-byte header")]
-    TooShort { len: usize },
+    /// The frame does not even hold the header.
+    TooShort {
+        /// Length of the frame in bytes.
+        len: usize,
+    },
     #[error("bad magic {found:02x?}, expected {MAGIC:02x?}")]
-    BadMagic { found: [u8; 4] },
+    /// The frame does not start with [`MAGIC`].
+    BadMagic {
+        /// The first four bytes of the frame.
+        found: [u8; 4],
+    },
     #[error(
         "layout version mismatch: this side has LAYOUT_VERSION {ours} (crate {CRATE_VERSION}), \
          the peer has LAYOUT_VERSION {theirs} (crate {their_crate})"
     )]
+    /// The peer speaks another layout version.
     VersionMismatch {
+        /// Our `LAYOUT_VERSION`.
         ours: u32,
+        /// The `LAYOUT_VERSION` in the peer's frame header.
         theirs: u32,
+        /// The start of the body read as text: the peer's crate version when the frame is a
+        /// version-mismatch reply.
         their_crate: String,
     },
+    /// The body is not a valid postcard encoding of the expected type.
     #[error("malformed body: {0}")]
     Body(String),
 }
 
 /// A decoded frame header plus the untouched body.
 pub struct Frame<'a> {
+    /// The `LAYOUT_VERSION` the sender wrote.
     pub version: u32,
+    /// Everything after the header.
     pub body: &'a [u8],
 }
 
 impl<'a> Frame<'a> {
+    /// Checks the length and magic and splits off the header; the version is not checked.
     pub fn parse(bytes: &'a [u8]) -> Result<Frame<'a>, DecodeError> {
         if bytes.len() < HEADER_LEN {
             return Err(DecodeError::TooShort { len: bytes.len() });
@@ -77,18 +96,22 @@ fn encode<T: Serialize>(value: &T) -> Vec<u8> {
     out
 }
 
+/// Frames a request batch.
 pub fn encode_request(request: &Request) -> Vec<u8> {
     encode(request)
 }
 
+/// Decodes a request frame (header, version, then body).
 pub fn decode_request(bytes: &[u8]) -> Result<Request, DecodeError> {
     Frame::parse(bytes)?.decode()
 }
 
+/// Frames a response.
 pub fn encode_response(response: &Response) -> Vec<u8> {
     encode(response)
 }
 
+/// Decodes a response frame (header, version, then body).
 pub fn decode_response(bytes: &[u8]) -> Result<Response, DecodeError> {
     Frame::parse(bytes)?.decode()
 }
@@ -113,7 +136,9 @@ pub fn encode_request_with_version(request: &Request, version: u32) -> Vec<u8> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::{Command, CommandError, ErrorKind, Handle, ObjectProp, PlaneOp, Pose, Reply, Shape};
+    use crate::{
+        Command, CommandError, ErrorKind, Handle, ObjectProp, PlaneOp, Pose, Reply, Shape,
+    };
 
     fn sample_request() -> Request {
         Request {

@@ -11,7 +11,7 @@ use crate::error::CommandError;
 use crate::object_op::ObjectOp;
 use crate::plane_op::{PlaneKind, PlaneOp};
 use crate::records::Handle;
-use crate::settings::{PlaneProp, Pin, RotateTo};
+use crate::settings::{Pin, PlaneProp, RotateTo};
 use crate::shape::ShapeKind;
 
 /// Identifies a plane within one daemon.

@@ -31,7 +31,9 @@ pub use error::{CommandError, ErrorKind};
 pub use object_op::ObjectOp;
 pub use plane_op::{PlaneKind, PlaneOp};
 pub use records::*;
-pub use settings::{ObjectProp, ObjectSettings, Pin, PlaneProp, PlaneSettings, Restraint, RotateTo};
+pub use settings::{
+    ObjectProp, ObjectSettings, Pin, PlaneProp, PlaneSettings, Restraint, RotateTo,
+};
 pub use shape::{Shape, ShapeKind};
 
 /// Bumped whenever a record layout or the command encoding changes. Client and daemon must

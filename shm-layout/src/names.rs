@@ -9,16 +9,20 @@ use iceoryx2::prelude::{FileName, SemanticString, ServiceName};
 
 use crate::{PlaneId, LAYOUT_VERSION};
 
+/// The domain used when neither `--domain` nor [`DOMAIN_ENV`] names one.
 pub const DEFAULT_DOMAIN: &str = "physics";
 /// Environment variable naming the domain when no `--domain` is given.
 pub const DOMAIN_ENV: &str = "PHYSICS_DOMAIN";
 /// iceoryx2 node name of the daemon.
 pub const DAEMON_NODE_NAME: &str = "physics-daemon";
 
+/// A domain name that cannot be used.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[error("invalid domain {domain:?}: {reason}")]
 pub struct DomainError {
+    /// The refused domain name.
     pub domain: String,
+    /// What is wrong with it.
     pub reason: &'static str,
 }
 

@@ -15,7 +15,9 @@ pub const FLAG_ANCHORED: u32 = 1 << 2;
     Debug, Clone, Copy, PartialEq, Eq, Hash, Default, serde::Serialize, serde::Deserialize,
 )]
 pub struct Handle {
+    /// Index of the body's slot in the published array.
     pub slot: u32,
+    /// Generation of the body in that slot.
     pub generation: u32,
 }
 
@@ -24,25 +26,32 @@ pub struct Handle {
 #[type_name("physics::BodyState")]
 #[repr(C)]
 pub struct BodyState {
+    /// World-space position of the body's origin.
     pub position: [f32; 3],
     /// `FLAG_*` bits.
     pub flags: u32,
     /// Unit quaternion `[x, y, z, w]`.
     pub rotation: [f32; 4],
+    /// Linear velocity (units/s).
     pub linear_velocity: [f32; 3],
     /// Generation of the body in this slot (matches [`Handle::generation`]).
     pub generation: u32,
+    /// Angular velocity (rad/s).
     pub angular_velocity: [f32; 3],
+    /// Padding to 64 bytes; always 0.
     pub _reserved: u32,
 }
 
 impl BodyState {
+    /// Whether the slot holds a live body ([`FLAG_ALIVE`]).
     pub fn is_alive(&self) -> bool {
         self.flags & FLAG_ALIVE != 0
     }
+    /// Whether the body is asleep ([`FLAG_SLEEPING`]).
     pub fn is_sleeping(&self) -> bool {
         self.flags & FLAG_SLEEPING != 0
     }
+    /// Whether the body is anchored ([`FLAG_ANCHORED`]).
     pub fn is_anchored(&self) -> bool {
         self.flags & FLAG_ANCHORED != 0
     }
@@ -66,7 +75,9 @@ impl BodyState {
 #[type_name("physics::TickHeader")]
 #[repr(C)]
 pub struct TickHeader {
+    /// `LAYOUT_VERSION` of the daemon that wrote the sample.
     pub layout_version: u32,
+    /// The plane the sample belongs to.
     pub plane_id: u32,
     /// Number of steps taken so far (0 before the first step).
     pub tick: u64,
@@ -89,11 +100,13 @@ pub struct TickHeader {
     pub max_joint_error: f32,
     /// Number of contact pairs with at least one contact point.
     pub contact_pairs: u32,
+    /// Padding to 64 bytes; always 0.
     pub _reserved: u32,
 }
 
-/// Kinds of per-tick events.
+/// Event kind: two objects started touching.
 pub const EVENT_CONTACT_STARTED: u32 = 1;
+/// Event kind: two objects stopped touching.
 pub const EVENT_CONTACT_STOPPED: u32 = 2;
 
 /// One per-tick event (published in the plane's event service).
@@ -103,21 +116,29 @@ pub const EVENT_CONTACT_STOPPED: u32 = 2;
 pub struct EventRecord {
     /// `EVENT_*` kind.
     pub kind: u32,
+    /// Slot of the first object.
     pub a_slot: u32,
+    /// Generation of the first object.
     pub a_generation: u32,
+    /// Slot of the second object.
     pub b_slot: u32,
+    /// Generation of the second object.
     pub b_generation: u32,
+    /// Padding; always 0.
     pub _reserved: u32,
+    /// The tick in which the event happened.
     pub tick: u64,
 }
 
 impl EventRecord {
+    /// Handle of the first object.
     pub fn a(&self) -> Handle {
         Handle {
             slot: self.a_slot,
             generation: self.a_generation,
         }
     }
+    /// Handle of the second object.
     pub fn b(&self) -> Handle {
         Handle {
             slot: self.b_slot,

@@ -29,9 +29,10 @@ pub fn finite3(field: &str, v: Vec3) -> Result<Vec3, CommandError> {
     if v.iter().all(|c| c.is_finite()) {
         Ok(v)
     } else {
-        Err(CommandError::invalid_field(field, format!(
-            "{field} must have finite components, got {v:?}"
-        )))
+        Err(CommandError::invalid_field(
+            field,
+            format!("{field} must have finite components, got {v:?}"),
+        ))
     }
 }
 
@@ -40,9 +41,10 @@ pub fn positive(field: &str, v: f32) -> Result<f32, CommandError> {
     if v.is_finite() && v > 0.0 {
         Ok(v)
     } else {
-        Err(CommandError::invalid_field(field, format!(
-            "{field} must be a positive finite number, got {v}"
-        )))
+        Err(CommandError::invalid_field(
+            field,
+            format!("{field} must be a positive finite number, got {v}"),
+        ))
     }
 }
 
@@ -51,9 +53,10 @@ pub fn in_range(field: &str, v: f32, lo: f32, hi: f32) -> Result<f32, CommandErr
     if v.is_finite() && (lo..=hi).contains(&v) {
         Ok(v)
     } else {
-        Err(CommandError::invalid_field(field, format!(
-            "{field} must be within [{lo}, {hi}], got {v}"
-        )))
+        Err(CommandError::invalid_field(
+            field,
+            format!("{field} must be within [{lo}, {hi}], got {v}"),
+        ))
     }
 }
 
@@ -70,9 +73,10 @@ pub fn non_negative(field: &str, v: f32) -> Result<f32, CommandError> {
     if v.is_finite() && v >= 0.0 {
         Ok(v)
     } else {
-        Err(CommandError::invalid_field(field, format!(
-            "{field} must be a finite number >= 0, got {v}"
-        )))
+        Err(CommandError::invalid_field(
+            field,
+            format!("{field} must be a finite number >= 0, got {v}"),
+        ))
     }
 }
 
@@ -81,9 +85,10 @@ pub fn clamped(field: &str, v: f32, lo: f32, hi: f32) -> Result<f32, CommandErro
     if v.is_finite() {
         Ok(v.clamp(lo, hi))
     } else {
-        Err(CommandError::invalid_field(field, format!(
-            "{field} must be a finite number, got {v}"
-        )))
+        Err(CommandError::invalid_field(
+            field,
+            format!("{field} must be a finite number, got {v}"),
+        ))
     }
 }
 
@@ -91,9 +96,10 @@ pub fn clamped(field: &str, v: f32, lo: f32, hi: f32) -> Result<f32, CommandErro
 pub fn rotation(field: &str, q: [f32; 4]) -> Result<[f32; 4], CommandError> {
     let norm = q.iter().map(|c| c * c).sum::<f32>().sqrt();
     if !q.iter().all(|c| c.is_finite()) || norm < 1e-6 {
-        return Err(CommandError::invalid_field(field, format!(
-            "{field} must be a finite non-zero quaternion, got {q:?}"
-        )));
+        return Err(CommandError::invalid_field(
+            field,
+            format!("{field} must be a finite non-zero quaternion, got {q:?}"),
+        ));
     }
     Ok(q.map(|c| c / norm))
 }
@@ -111,9 +117,10 @@ pub fn finite(field: &str, v: f32) -> Result<f32, CommandError> {
     if v.is_finite() {
         Ok(v)
     } else {
-        Err(CommandError::invalid_field(field, format!(
-            "{field} must be a finite number, got {v}"
-        )))
+        Err(CommandError::invalid_field(
+            field,
+            format!("{field} must be a finite number, got {v}"),
+        ))
     }
 }
 

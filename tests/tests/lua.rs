@@ -260,3 +260,18 @@ fn reference_examples_run() {
         assert!(*v <= kick && *v > 0.985 * kick, "density {density}: {line}");
     }
 }
+
+#[test]
+fn sleeping_reads_the_published_flag_and_wake_wakes() {
+    let daemon = TestDaemon::start("lua-sleeping");
+    let r = run(&daemon, "tests/lua/sleeping.luau");
+    r.assert_ok();
+    let ticks: u32 = r
+        .stdout()
+        .trim()
+        .strip_prefix("sleeping ok\t")
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("unexpected output {:?}", r.stdout()));
+    // Rapier puts a body to sleep after 0.5 s below its thresholds (30 ticks at 60 Hz).
+    assert!((30..360).contains(&ticks), "asleep after {ticks} ticks");
+}

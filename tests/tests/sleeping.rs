@@ -13,10 +13,14 @@ fn a_resting_box_falls_asleep_and_wakes_on_request() {
     scene.floor();
     let b = scene
         .plane
-        .add(Shape::Cube { size: [1.0; 3] }, Pose::at([0.0, 0.5, 0.0]), &[])
+        .add(
+            Shape::Cube { size: [1.0; 3] },
+            Pose::at([0.0, 0.5, 0.0]),
+            &[],
+        )
         .unwrap();
     assert!(!b.is_sleeping().unwrap(), "a new body is awake");
-    // Rapier puts a body to sleep after ~2 s below its thresholds: allow 6 s of sim time.
+    // Rapier puts a body to sleep after 0.5 s below its thresholds: allow 6 s of sim time.
     let mut ticks = 0;
     while !b.is_sleeping().unwrap() {
         scene.plane.step(DT).unwrap();
@@ -31,7 +35,10 @@ fn a_resting_box_falls_asleep_and_wakes_on_request() {
     scene.client.flush().unwrap();
     assert!(!b.info().unwrap().sleeping, "awake right after the wake");
     scene.plane.step(DT).unwrap();
-    assert!(!b.is_sleeping().unwrap(), "the next tick publishes it awake");
+    assert!(
+        !b.is_sleeping().unwrap(),
+        "the next tick publishes it awake"
+    );
     // It stays put: waking adds no motion.
     let p = b.position().unwrap();
     assert!((p[1] - at_rest[1]).abs() < 1e-3, "{p:?} vs {at_rest:?}");

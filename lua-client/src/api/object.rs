@@ -201,6 +201,14 @@ pub fn methods(lua: &Lua) -> mlua::Result<Table> {
             },
         )?,
     )?;
+    t.set(
+        "Wake",
+        lua.create_function(|_, o: Value| {
+            let what = "PhysicsObject:Wake";
+            let o = this(what, &o)?;
+            o.live("Wake")?.wake().map_err(|e| sdk_error(what, e))
+        })?,
+    )?;
     // Lua parts are Cube / Sphere (no mesh): this returns the CenterOfMass unchanged.
     t.set(
         "RecalculateCenterOfMass",

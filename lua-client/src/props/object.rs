@@ -90,6 +90,14 @@ pub static OBJECT: Props<PhysicsObject> = Props {
             |a| ObjectProp::Anchored(a.bool()?)
         ),
         Row {
+            // The published sleeping flag (no request): true once the engine put the body
+            // to rest; `Wake()` or any write wakes it.
+            name: "Sleeping",
+            kind: Kind::Boolean,
+            get: Get::Fn(|_, o| Ok(Value::Boolean(state(o, "Sleeping")?.is_sleeping()))),
+            set: Set::ReadOnly,
+        },
+        Row {
             name: "Alive",
             kind: Kind::Boolean,
             get: Get::Fn(|_, o| Ok(Value::Boolean(o.alive()))),

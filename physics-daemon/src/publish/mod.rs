@@ -34,6 +34,8 @@ pub struct PlaneOutput {
 }
 
 impl PlaneOutput {
+    /// Opens (or creates) the plane's body and event services and its tick event, with a
+    /// publisher or notifier on each.
     pub fn new(node: &Node<ipc::Service>, plane: PlaneId) -> Result<PlaneOutput, DaemonError> {
         let ipc = |what: &str, e: &dyn core::fmt::Debug| {
             DaemonError::Ipc(format!("plane {plane}: cannot create the {what}: {e:?}"))
@@ -129,17 +131,19 @@ impl PlaneOutput {
             .map_err(|e| DaemonError::Ipc(format!("plane {id}: send failed: {e:?}")))?;
         let events = plane.events();
         if !events.is_empty() {
-            let mut sample = self.events.loan_slice_uninit(events.len()).map_err(|e| {
-                DaemonError::Ipc(format!("plane {id}: event loan failed: {e:?}"))
-            })?;
+            let mut sample = self
+                .events
+                .loan_slice_uninit(events.len())
+                .map_err(|e| DaemonError::Ipc(format!("plane {id}: event loan failed: {e:?}")))?;
             *sample.user_header_mut() = header;
-            sample.write_from_slice(events).send().map_err(|e| {
-                DaemonError::Ipc(format!("plane {id}: event send failed: {e:?}"))
-            })?;
+            sample
+                .write_from_slice(events)
+                .send()
+                .map_err(|e| DaemonError::Ipc(format!("plane {id}: event send failed: {e:?}")))?;
         }
-        self.tick.notify().map_err(|e| {
-            DaemonError::Ipc(format!("plane {id}: tick notify failed: {e:?}"))
-        })?;
+        self.tick
+            .notify()
+            .map_err(|e| DaemonError::Ipc(format!("plane {id}: tick notify failed: {e:?}")))?;
         Ok(())
     }
 }
@@ -206,13 +210,7 @@ mod tests {
             };
             if let Some(op) = op {
                 let destroyed = op == ObjectOp::Destroy;
-                apply(
-                    &mut plane,
-                    PlaneOp::Object {
-                        handle: victim,
-                        op,
-                    },
-                );
+                apply(&mut plane, PlaneOp::Object { handle: victim, op });
                 if destroyed {
                     handles.retain(|h| *h != victim);
                     let free = plane.slot_count(); // the freed slot is reused below

@@ -21,8 +21,8 @@ use std::time::Instant;
 use rapier3d::prelude::*;
 use shm_layout::validate::{self, MAX_DT, MAX_HIT_BOX_QUALITY};
 use shm_layout::{
-    BodyState, CommandError, EventRecord, PlaneId, PlaneInfo, PlaneKind, PlaneProp,
-    PlaneSettings, TickHeader, FLAG_ALIVE, FLAG_ANCHORED, FLAG_SLEEPING, LAYOUT_VERSION,
+    BodyState, CommandError, EventRecord, PlaneId, PlaneInfo, PlaneKind, PlaneProp, PlaneSettings,
+    TickHeader, FLAG_ALIVE, FLAG_ANCHORED, FLAG_SLEEPING, LAYOUT_VERSION,
 };
 
 use crate::backend::{Dirty, SlotTable};

@@ -101,7 +101,9 @@ impl Part {
     /// Low-quality non-spheres without a centre of mass translate but do not spin from
     /// contacts (the documented HitBoxQuality behaviour).
     pub fn rotation_locked_by_quality(&self) -> bool {
-        self.hit_box_quality < 2 && self.shape != ShapeKind::Sphere && self.center_of_mass == [0.0; 3]
+        self.hit_box_quality < 2
+            && self.shape != ShapeKind::Sphere
+            && self.center_of_mass == [0.0; 3]
     }
 
     pub fn locked_axes(&self) -> LockedAxes {

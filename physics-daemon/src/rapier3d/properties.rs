@@ -47,7 +47,9 @@ impl Plane {
                 }
                 shape_changed = true;
             }
-            ObjectProp::ReportContacts(_) => collider_changed = was_reporting != part.report_contacts,
+            ObjectProp::ReportContacts(_) => {
+                collider_changed = was_reporting != part.report_contacts
+            }
             ObjectProp::Weight(_)
             | ObjectProp::Density(_)
             | ObjectProp::Bounciness(_)
@@ -64,7 +66,10 @@ impl Plane {
             | ObjectProp::RotateTo(_)
             | ObjectProp::Pin(_) => {}
         }
-        debug_assert_eq!(stored, !prop.is_published() && !matches!(prop, ObjectProp::Size(_)));
+        debug_assert_eq!(
+            stored,
+            !prop.is_published() && !matches!(prop, ObjectProp::Size(_))
+        );
         let part = &self.bodies.get(handle)?.part;
         if shape_changed {
             // Rapier recycles the contacts of pairs whose poses did not move, even when a

@@ -12,21 +12,26 @@ use shm_layout::names;
 /// Clients one daemon serves at once.
 pub const MAX_CLIENTS: usize = 64;
 
+/// One connected client.
 pub struct Client {
+    /// Process id the client gave in its handshake.
     pub pid: u32,
     notifier: Notifier<ipc::Service>,
 }
 
+/// The connected clients, by iceoryx2 node id.
 #[derive(Default)]
 pub struct Clients {
     connected: HashMap<u128, Client>,
 }
 
 impl Clients {
+    /// Whether the client `id` has completed its handshake.
     pub fn is_connected(&self, id: u128) -> bool {
         self.connected.contains_key(&id)
     }
 
+    /// Whether no client is connected.
     pub fn is_empty(&self) -> bool {
         self.connected.is_empty()
     }
@@ -41,6 +46,7 @@ impl Clients {
         Ok(())
     }
 
+    /// Forgets the client `id`; returns whether it was connected.
     pub fn disconnect(&mut self, id: u128) -> bool {
         self.connected.remove(&id).is_some()
     }

@@ -6,8 +6,8 @@ use std::time::Instant;
 
 use shm_layout::codec::{self, Frame};
 use shm_layout::{
-    Command, CommandError, CommandResult, ErrorKind, PlaneId, PlaneKind, PlaneOp, PlaneProp,
-    Reply, Response, CRATE_VERSION, LAYOUT_VERSION,
+    Command, CommandError, CommandResult, ErrorKind, PlaneId, PlaneKind, PlaneOp, PlaneProp, Reply,
+    Response, CRATE_VERSION, LAYOUT_VERSION,
 };
 
 use super::{Daemon, PlaneEntry, MAX_PLANES};

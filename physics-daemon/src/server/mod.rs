@@ -241,7 +241,6 @@ fn remove_dead_nodes(config: &Config) {
     }
 }
 
-
 impl Daemon {
     fn next_tick(&self) -> Option<Instant> {
         self.planes.values().filter_map(|p| p.next_tick).min()

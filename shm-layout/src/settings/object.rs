@@ -3,8 +3,8 @@
 use serde::{Deserialize, Serialize};
 
 use crate::validate::{
-    clamped, finite3, in_range, non_negative, pose, positive, rotation, size,
-    MAX_HIT_BOX_QUALITY, MIN_MASS,
+    clamped, finite3, in_range, non_negative, pose, positive, rotation, size, MAX_HIT_BOX_QUALITY,
+    MIN_MASS,
 };
 use crate::{CommandError, Pose, Vec3};
 
