@@ -17,6 +17,9 @@ use crate::{Error, Plane};
 
 /// How often a waiting client checks that the daemon process is still alive.
 pub(crate) const LIVENESS_PERIOD: Duration = Duration::from_millis(100);
+/// A daemon whose heartbeat (a few beats a second, from a thread of its own) has been
+/// silent this long while a request waits is stalled (stopped or hung), not slow.
+pub const STALL_AFTER: Duration = Duration::from_secs(1);
 
 /// How to connect.
 #[derive(Debug, Clone)]
@@ -299,6 +302,9 @@ impl Inner {
     fn exchange(&self, bytes: &[u8]) -> Result<Vec<u8>, Error> {
         let started = Instant::now();
         let mut last_check = started;
+        let mut last_beat = started;
+        // Beats that arrived before this request say nothing about now.
+        let _ = self.transport.heartbeat_arrived();
         self.transport
             .exchange(bytes, LIVENESS_PERIOD, |connected| {
                 if !connected {
@@ -308,6 +314,17 @@ impl Inner {
                 if now.duration_since(last_check) >= LIVENESS_PERIOD {
                     self.check_daemon()?;
                     last_check = now;
+                    if self.transport.heartbeat_arrived() != Some(false) {
+                        last_beat = now;
+                    }
+                }
+                let silent = now.duration_since(last_beat);
+                if silent > STALL_AFTER && self.daemon_node != 0 {
+                    return Err(Error::Stalled {
+                        domain: self.options.domain.clone(),
+                        pid: self.daemon_pid,
+                        silent,
+                    });
                 }
                 if now.duration_since(started) > self.options.request_timeout {
                     return Err(Error::Timeout(self.options.request_timeout));

@@ -43,6 +43,20 @@ pub enum Error {
     /// No reply, or no new tick, came within the given time.
     #[error("timed out after {0:?}")]
     Timeout(std::time::Duration),
+    /// The daemon process exists but its heartbeat stopped while a request waited: it is
+    /// stopped (SIGSTOP) or hung, not merely slow.
+    #[error(
+        "the physics daemon of domain {domain:?} (process {pid}) is stalled: no heartbeat for \
+         {silent:.1?} while a request waited (stopped or hung)"
+    )]
+    Stalled {
+        /// The domain.
+        domain: String,
+        /// The daemon's process id.
+        pid: u32,
+        /// How long the heartbeat has been silent.
+        silent: std::time::Duration,
+    },
     /// The shared-memory transport failed.
     #[error("shared-memory transport: {0}")]
     Ipc(String),

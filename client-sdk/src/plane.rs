@@ -45,6 +45,8 @@ pub struct PlaneOptions {
     pub loop_solver: Option<bool>,
     /// `NeverSleep`.
     pub never_sleep: Option<bool>,
+    /// `Shared` (creation only): other clients may change the plane, not only read it.
+    pub shared: Option<bool>,
 }
 
 impl PlaneOptions {
@@ -72,6 +74,7 @@ impl PlaneOptions {
             o.solver_iterations.map(PlaneProp::SolverIterations),
             o.loop_solver.map(PlaneProp::LoopSolver),
             o.never_sleep.map(PlaneProp::NeverSleep),
+            o.shared.map(PlaneProp::Shared),
         ]
         .into_iter()
         .flatten()

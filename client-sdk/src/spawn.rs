@@ -86,12 +86,16 @@ pub fn connect_or_start(domain: &str) -> Result<Session, Error> {
 }
 
 /// Starts a daemon for `domain` as a child process and waits (up to 10 s) until it answers.
-/// Returns it with a connected client.
+/// Returns it with a connected client. The daemon exits by itself once this process is gone
+/// and no client is left (`--starter-pid`), so a starter killed without cleanup leaves no
+/// daemon behind.
 pub fn start_daemon(domain: &str) -> Result<(DaemonChild, Client), Error> {
     let exe = daemon_executable();
     let child = Command::new(&exe)
         .arg("--domain")
         .arg(domain)
+        .arg("--starter-pid")
+        .arg(std::process::id().to_string())
         .stdin(Stdio::null())
         .spawn()
         .map_err(|e| Error::NoDaemon {

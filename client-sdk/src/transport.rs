@@ -3,6 +3,7 @@
 //! listener and the event subscriber. `Client` and `Plane` hold what this module returns
 //! and never name a service themselves.
 
+use std::cell::RefCell;
 use std::time::{Duration, Instant};
 
 use iceoryx2::config::Config;
@@ -37,6 +38,8 @@ pub(crate) struct Transport {
     daemon_wake: Notifier<ipc::Service>,
     replies: Listener<ipc::Service>,
     id: u128,
+    /// The daemon's heartbeat, opened on first use (a starting daemon may not beat yet).
+    heartbeat: RefCell<Option<Subscriber<ipc::Service, u64, ()>>>,
 }
 
 impl Transport {
@@ -108,6 +111,7 @@ impl Transport {
             daemon_wake,
             replies,
             id,
+            heartbeat: RefCell::new(None),
         })
     }
 
@@ -124,6 +128,9 @@ impl Transport {
             .port
             .loan_slice_uninit(bytes.len())
             .map_err(|e| Error::ipc("loan request", e))?;
+        // The daemon identifies us by the transport's node id; this copy in the user header
+        // only keeps the control service's layout the same for every version (so a
+        // version mismatch still reaches the handshake).
         *request.user_header_mut() = self.id;
         let pending = request
             .write_from_slice(bytes)
@@ -142,6 +149,28 @@ impl Transport {
             check(pending.is_connected())?;
             let _ = self.replies.timed_wait(|_| {}, period);
         }
+    }
+
+    /// Whether a heartbeat of the daemon arrived since the last call; `None` when the
+    /// heartbeat service cannot be opened (then nothing can be said).
+    pub(crate) fn heartbeat_arrived(&self) -> Option<bool> {
+        let mut slot = self.heartbeat.borrow_mut();
+        if slot.is_none() {
+            let opened = self
+                .node
+                .service_builder(&names::heartbeat())
+                .publish_subscribe::<u64>()
+                .open()
+                .ok()
+                .and_then(|s| s.subscriber_builder().buffer_size(1).create().ok());
+            *slot = Some(opened?);
+        }
+        let sub = slot.as_ref()?;
+        let mut arrived = false;
+        while let Ok(Some(_)) = sub.receive() {
+            arrived = true;
+        }
+        Some(arrived)
     }
 
     /// Whether the daemon node `daemon_node` (0: any node named like a daemon) is alive;

@@ -16,6 +16,11 @@ struct Args {
     /// Deployment domain; every process of one deployment uses the same one.
     #[arg(long, env = names::DOMAIN_ENV, default_value = names::DEFAULT_DOMAIN)]
     domain: String,
+    /// Started on demand by this process: exit once it is gone and no client is left.
+    #[arg(long)]
+    starter_pid: Option<u32>,
+    #[command(flatten)]
+    limits: physics_daemon::server::Limits,
 }
 
 fn main() -> ExitCode {
@@ -48,7 +53,15 @@ fn main() -> ExitCode {
         .num_threads(1)
         .build_global();
 
-    match physics_daemon::run(&args.domain, &shutdown) {
+    let options = physics_daemon::server::Options {
+        limits: args.limits,
+        starter_pid: args.starter_pid,
+        // Fault injection for tests: a Step with this exact dt panics inside its plane.
+        panic_on_step_dt: std::env::var("PHYSICS_FAULT_PANIC_DT")
+            .ok()
+            .and_then(|v| v.parse().ok()),
+    };
+    match physics_daemon::server::run_with(&args.domain, &shutdown, options) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             tracing::error!("{e}");

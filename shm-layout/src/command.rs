@@ -131,6 +131,8 @@ pub struct PlaneInfo {
     pub loop_solver: bool,
     /// `NeverSleep`.
     pub never_sleep: bool,
+    /// `Shared`: other clients may change the plane.
+    pub shared: bool,
     /// Iterations the solver runs now: LoopSolver, SolverIterations and HitBoxQuality scaling.
     pub effective_solver_iterations: u32,
     /// Largest HitBoxQuality among the plane's objects (1 when empty).

@@ -18,8 +18,14 @@ pub enum ErrorKind {
     VersionMismatch,
     /// A command came before `Hello`.
     NotConnected,
-    /// The daemon could not do it (resource exhaustion, shared-memory failure).
+    /// The daemon could not do it (resource exhaustion, shared-memory failure, a plane
+    /// that failed).
     Internal,
+    /// A per-client quota of the daemon would be exceeded; the message names the quota,
+    /// its value and the daemon flag that sets it.
+    Quota,
+    /// The plane belongs to another client, which did not allow this.
+    NotOwner,
 }
 
 /// The failure of one command. `message` is complete on its own ("Friction must be within

@@ -29,7 +29,7 @@ pub use codec::{DecodeError, Frame};
 pub use command::*;
 pub use error::{CommandError, ErrorKind};
 pub use object_op::ObjectOp;
-pub use plane_op::{PlaneKind, PlaneOp};
+pub use plane_op::{OpCost, PlaneKind, PlaneOp};
 pub use records::*;
 pub use settings::{
     ObjectProp, ObjectSettings, Pin, PlaneProp, PlaneSettings, Restraint, RotateTo,

@@ -91,6 +91,12 @@ pub fn plane_events(plane: PlaneId) -> ServiceName {
     service(format!("physics/v{LAYOUT_VERSION}/plane/{plane}/events"))
 }
 
+/// Publish-subscribe `u64`: the daemon's heartbeat counter, sent a few times a second by a
+/// thread of its own, so clients tell a stopped or hung daemon from a slow request.
+pub fn heartbeat() -> ServiceName {
+    service("physics/heartbeat".into())
+}
+
 /// Event notified after every published tick of the plane.
 pub fn plane_tick(plane: PlaneId) -> ServiceName {
     service(format!("physics/plane/{plane}/tick"))

@@ -49,3 +49,37 @@ pub enum PlaneOp {
         op: ObjectOp,
     },
 }
+
+/// What an op may add to a plane, for the daemon's per-client quotas.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct OpCost {
+    /// Objects the op adds.
+    pub objects: u32,
+    /// Mesh vertices the op adds.
+    pub mesh_vertices: u64,
+}
+
+impl PlaneOp {
+    /// Whether the op only reads (allowed to any client on any plane).
+    pub fn is_read_only(&self) -> bool {
+        matches!(
+            self,
+            PlaneOp::Info
+                | PlaneOp::Object {
+                    op: ObjectOp::Info,
+                    ..
+                }
+        )
+    }
+
+    /// What the op may add to the plane.
+    pub fn cost(&self) -> OpCost {
+        match self {
+            PlaneOp::AddObject { shape, .. } => OpCost {
+                objects: 1,
+                mesh_vertices: shape.mesh_vertices() as u64,
+            },
+            _ => OpCost::default(),
+        }
+    }
+}

@@ -49,6 +49,14 @@ impl Shape {
         }
     }
 
+    /// Number of mesh vertices the shape carries (0 for primitives).
+    pub fn mesh_vertices(&self) -> usize {
+        match self {
+            Shape::Mesh { vertices, .. } => vertices.len(),
+            _ => 0,
+        }
+    }
+
     /// Positive sizes, finite vertices, triangle indices in range, bounded mesh size.
     pub fn check(&self) -> Result<(), CommandError> {
         match self {

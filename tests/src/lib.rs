@@ -43,10 +43,21 @@ impl TestDaemon {
 
     /// Starts a daemon in an existing domain (e.g. after the previous one crashed).
     pub fn start_in(domain: &str) -> TestDaemon {
+        Self::start_with_in(domain, &[], &[])
+    }
+
+    /// Starts a daemon with extra flags and environment (quotas, fault injection).
+    pub fn start_with(tag: &str, args: &[&str], env: &[(&str, &str)]) -> TestDaemon {
+        Self::start_with_in(&unique_domain(tag), args, env)
+    }
+
+    fn start_with_in(domain: &str, args: &[&str], env: &[(&str, &str)]) -> TestDaemon {
         let domain = domain.to_string();
         let child = Command::new(daemon_bin())
             .args(["--domain", &domain])
+            .args(args)
             .env("PHYSICS_LOG", "warn")
+            .envs(env.iter().copied())
             .stdin(Stdio::null())
             .spawn()
             .expect("spawn physics-daemon");
@@ -66,6 +77,13 @@ impl TestDaemon {
         }
     }
 
+    /// Whether the daemon process still runs.
+    pub fn is_running(&mut self) -> bool {
+        self.child
+            .as_mut()
+            .is_some_and(|c| matches!(c.try_wait(), Ok(None)))
+    }
+
     pub fn client(&self) -> Client {
         Client::connect(&self.domain).expect("connect to test daemon")
     }
@@ -74,7 +92,8 @@ impl TestDaemon {
         self.child.as_ref().expect("daemon running").id()
     }
 
-    fn signal(&self, sig: i32) {
+    /// Sends `sig` to the daemon.
+    pub fn signal(&self, sig: i32) {
         // SAFETY: kill(2) on our own child.
         unsafe { libc::kill(self.pid() as i32, sig) };
     }

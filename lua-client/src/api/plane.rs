@@ -251,6 +251,7 @@ fn option(o: &mut PlaneOptions, prop: PlaneProp) {
         PlaneProp::SolverIterations(v) => o.solver_iterations = Some(v),
         PlaneProp::LoopSolver(v) => o.loop_solver = Some(v),
         PlaneProp::NeverSleep(v) => o.never_sleep = Some(v),
+        PlaneProp::Shared(v) => o.shared = Some(v),
     }
 }
 

@@ -72,6 +72,13 @@ pub static PLANE: Props<PlaneState> = Props {
             set: Set::CreationOnly(|a| Ok(PlaneProp::Threads(a.integer()? as u32))),
         },
         Row {
+            // Other clients (processes) may change the plane, not only read it.
+            name: "Shared",
+            kind: Kind::Boolean,
+            get: Get::Fn(|_, p| Ok(Value::Boolean(p.info("Shared")?.shared))),
+            set: Set::CreationOnly(|a| Ok(PlaneProp::Shared(a.bool()?))),
+        },
+        Row {
             name: "Alive",
             kind: Kind::Boolean,
             get: Get::Fn(|_, p| Ok(Value::Boolean(p.alive()))),

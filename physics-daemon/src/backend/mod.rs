@@ -47,6 +47,15 @@ impl SlotFilter<'_> {
     }
 }
 
+/// What a plane holds, for the daemon's per-client quotas.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Usage {
+    /// Live objects.
+    pub objects: u64,
+    /// Mesh vertices of all its parts.
+    pub mesh_vertices: u64,
+}
+
 /// A plane as the server and the publisher see it.
 pub trait Backend {
     /// Which kind of plane this is.
@@ -90,6 +99,9 @@ pub trait Backend {
 
     /// Events of the last step.
     fn events(&self) -> &[EventRecord];
+
+    /// What the plane holds now.
+    fn usage(&self) -> Usage;
 }
 
 /// Creates a plane of `kind` with its defaults, then `props` applied in order.

@@ -8,7 +8,7 @@ use shm_layout::{
 };
 
 use super::Plane;
-use crate::backend::{Backend, SlotFilter};
+use crate::backend::{Backend, SlotFilter, Usage};
 
 impl Backend for Plane {
     fn kind(&self) -> PlaneKind {
@@ -92,5 +92,12 @@ impl Backend for Plane {
 
     fn events(&self) -> &[EventRecord] {
         Plane::events(self)
+    }
+
+    fn usage(&self) -> Usage {
+        Usage {
+            objects: self.bodies.live() as u64,
+            mesh_vertices: self.mesh_vertices,
+        }
     }
 }

@@ -48,6 +48,8 @@ pub struct Plane {
     quality_counts: [u32; MAX_HIT_BOX_QUALITY as usize + 1],
     /// Objects with a drive of their own (ImpulseDirection, ConstantForce, RotateTo, SetPin).
     driven: u32,
+    /// Mesh vertices of all parts (for quotas).
+    mesh_vertices: u64,
     /// Slots changed by ops: the publisher rewrites them, and the force pass sees them even
     /// before rapier's island manager lists them as awake.
     dirty: Dirty,
@@ -85,6 +87,7 @@ impl Plane {
             bodies: SlotTable::new("object", MAX_SLOTS),
             quality_counts: [0; MAX_HIT_BOX_QUALITY as usize + 1],
             driven: 0,
+            mesh_vertices: 0,
             dirty: Dirty::default(),
             forced: Vec::new(),
             scratch: Vec::new(),
@@ -195,6 +198,7 @@ impl Plane {
             solver_iterations: s.solver_iterations,
             loop_solver: s.loop_solver,
             never_sleep: s.never_sleep,
+            shared: s.shared,
             effective_solver_iterations: self.solver_settings().iterations as u32,
             max_hit_box_quality: self.max_quality(),
         }

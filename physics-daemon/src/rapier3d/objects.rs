@@ -49,6 +49,7 @@ impl Plane {
         self.world.insert_collider(collider, Some(h));
         part.configure_body(&mut self.world.bodies[h], &self.world.colliders);
         self.quality_counts[part.hit_box_quality as usize] += 1;
+        self.mesh_vertices += shape.mesh_vertices() as u64;
         let handle = self.bodies.insert(Body { handle: h, part })?;
         debug_assert_eq!(handle.slot, slot);
         self.dirty.mark(handle.slot);
@@ -103,6 +104,7 @@ impl Plane {
             self.reporting -= 1;
         }
         self.quality_counts[part.hit_box_quality as usize] -= 1;
+        self.mesh_vertices -= part.mesh_vertex_count() as u64;
         if part.is_driven() {
             self.driven -= 1;
         }

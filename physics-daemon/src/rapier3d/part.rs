@@ -65,6 +65,11 @@ impl Part {
         }
     }
 
+    /// Vertices of the part's mesh (0 for primitives).
+    pub fn mesh_vertex_count(&self) -> usize {
+        self.mesh.as_ref().map_or(0, |m| m.vertices.len())
+    }
+
     /// The collision shape for the current Size.
     pub fn collider_shape(&self) -> Result<SharedShape, CommandError> {
         let [x, y, z] = self.size;

@@ -14,8 +14,10 @@ pub const MAX_CLIENTS: usize = 64;
 
 /// One connected client.
 pub struct Client {
-    /// Process id the client gave in its handshake.
+    /// Process id of the client's node (from the transport, not from the client's words).
     pub pid: u32,
+    /// Planes the client owns.
+    pub planes: Vec<shm_layout::PlaneId>,
     notifier: Notifier<ipc::Service>,
 }
 
@@ -36,14 +38,55 @@ impl Clients {
         self.connected.is_empty()
     }
 
-    /// Registers a client after its handshake. Fails when the client has no wake-up event.
-    pub fn connect(&mut self, node: &Node<ipc::Service>, id: u128, pid: u32) -> Result<(), String> {
-        if self.connected.len() >= MAX_CLIENTS && !self.is_connected(id) {
-            return Err(format!("the daemon already serves {MAX_CLIENTS} clients"));
+    /// Registers a client after its handshake. Fails when the daemon is full, when the
+    /// client's process already holds `per_process` clients, or when the client has no
+    /// wake-up event.
+    pub fn connect(
+        &mut self,
+        node: &Node<ipc::Service>,
+        id: u128,
+        pid: u32,
+        per_process: usize,
+    ) -> Result<(), shm_layout::CommandError> {
+        if self.is_connected(id) {
+            return Ok(());
         }
-        let notifier = open_notifier(node, id)?;
-        self.connected.insert(id, Client { pid, notifier });
+        if self.connected.len() >= MAX_CLIENTS {
+            return Err(shm_layout::CommandError::new(
+                shm_layout::ErrorKind::Quota,
+                format!("the daemon already serves {MAX_CLIENTS} clients"),
+            ));
+        }
+        let same_process = self.connected.values().filter(|c| c.pid == pid).count();
+        if same_process >= per_process {
+            return Err(super::limits::exceeded(
+                "clients per process",
+                per_process,
+                "max-clients-per-process",
+                format!("{} for process {pid}", same_process + 1),
+            ));
+        }
+        let notifier = open_notifier(node, id)
+            .map_err(|e| shm_layout::CommandError::new(shm_layout::ErrorKind::Internal, e))?;
+        self.connected.insert(
+            id,
+            Client {
+                pid,
+                planes: Vec::new(),
+                notifier,
+            },
+        );
         Ok(())
+    }
+
+    /// The connected client `id`.
+    pub fn get(&self, id: u128) -> Option<&Client> {
+        self.connected.get(&id)
+    }
+
+    /// The connected client `id`, mutably.
+    pub fn get_mut(&mut self, id: u128) -> Option<&mut Client> {
+        self.connected.get_mut(&id)
     }
 
     /// Forgets the client `id`; returns whether it was connected.

@@ -2,6 +2,7 @@
 //! the lifecycle ops (create, step, destroy) are handled here; every other op goes to the
 //! backend unread, so a new op family never changes this file.
 
+use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::time::Instant;
 
 use shm_layout::codec::{self, Frame};
@@ -10,14 +11,24 @@ use shm_layout::{
     Response, CRATE_VERSION, LAYOUT_VERSION,
 };
 
-use super::{Daemon, PlaneEntry, MAX_PLANES};
+use super::limits::exceeded;
+use super::{Daemon, Origin, PlaneEntry, MAX_PLANES};
 use crate::backend;
 use crate::publish::PlaneOutput;
 use crate::DaemonError;
 
 impl Daemon {
     /// Decodes one request and executes its commands. Never panics on any input.
-    pub fn handle_bytes(&mut self, client: u128, bytes: &[u8]) -> Vec<u8> {
+    pub fn handle_bytes(&mut self, origin: Origin, bytes: &[u8]) -> Vec<u8> {
+        let limits = &self.options.limits;
+        if bytes.len() > limits.request_bytes {
+            return codec::encode_response(&Response::Rejected(exceeded(
+                "request bytes",
+                limits.request_bytes,
+                "max-request-bytes",
+                bytes.len(),
+            )));
+        }
         let rejected = |e: String| {
             codec::encode_response(&Response::Rejected(CommandError::new(
                 ErrorKind::Malformed,
@@ -35,17 +46,27 @@ impl Daemon {
             Ok(r) => r,
             Err(e) => return rejected(e.to_string()),
         };
+        let max_commands = self.options.limits.commands_per_request;
+        if request.commands.len() > max_commands {
+            return codec::encode_response(&Response::Rejected(exceeded(
+                "commands per request",
+                max_commands,
+                "max-commands-per-request",
+                request.commands.len(),
+            )));
+        }
         let results: Vec<CommandResult> = request
             .commands
             .into_iter()
-            .map(|c| self.execute(client, c))
+            .map(|c| self.execute(origin, c))
             .collect();
         codec::encode_response(&Response::Results(results))
     }
 
-    fn execute(&mut self, client: u128, command: Command) -> CommandResult {
-        if let Command::Hello { crate_version, pid } = &command {
-            return self.hello(client, crate_version, *pid);
+    fn execute(&mut self, origin: Origin, command: Command) -> CommandResult {
+        let client = origin.id;
+        if let Command::Hello { crate_version, .. } = &command {
+            return self.hello(origin, crate_version);
         }
         if !self.clients.is_connected(client) {
             return Err(CommandError::new(
@@ -62,26 +83,107 @@ impl Daemon {
             Command::CreatePlane { kind, props } => {
                 self.create_plane(client, kind, &props, Instant::now())
             }
-            Command::Plane { plane, op } => self.plane_op(plane, op),
+            Command::Plane { plane, op } => {
+                self.check_access(client, plane, &op)?;
+                self.check_quota(plane, &op)?;
+                self.plane_op(plane, op)
+            }
         }
     }
 
-    /// Routes `op` to plane `id`.
-    fn plane_op(&mut self, id: PlaneId, op: PlaneOp) -> CommandResult {
+    /// Any client may read any plane; only the owner changes it unless the owner shared
+    /// it; only the owner destroys it.
+    fn check_access(
+        &mut self,
+        client: u128,
+        id: PlaneId,
+        op: &PlaneOp,
+    ) -> Result<(), CommandError> {
         let entry = self.plane(id)?;
+        if entry.owner == client || op.is_read_only() {
+            return Ok(());
+        }
+        let refused = |why: &str| {
+            Err(CommandError::new(
+                ErrorKind::NotOwner,
+                format!("plane {id} belongs to another client: {why}"),
+            ))
+        };
         match op {
+            PlaneOp::Destroy => refused("only its owner may destroy it"),
+            _ if entry.shared => Ok(()),
+            _ => refused(
+                "it is not shared, so other clients may only read it (its owner can create it \
+                 with Shared = true)",
+            ),
+        }
+    }
+
+    /// What `op` adds must fit the quotas of the plane's owner.
+    fn check_quota(&mut self, id: PlaneId, op: &PlaneOp) -> Result<(), CommandError> {
+        let cost = op.cost();
+        if cost == Default::default() {
+            return Ok(());
+        }
+        let limits = &self.options.limits;
+        if cost.mesh_vertices > limits.mesh_vertices_per_object {
+            return Err(exceeded(
+                "mesh vertices per object",
+                limits.mesh_vertices_per_object,
+                "max-mesh-vertices",
+                cost.mesh_vertices,
+            ));
+        }
+        let owner = self.plane(id)?.owner;
+        let (mut objects, mut vertices) = (cost.objects as u64, cost.mesh_vertices);
+        for p in self.clients.get(owner).map_or(&[][..], |c| &c.planes[..]) {
+            if let Some(entry) = self.planes.get(p) {
+                let usage = entry.plane.usage();
+                objects += usage.objects;
+                vertices += usage.mesh_vertices;
+            }
+        }
+        let limits = &self.options.limits;
+        if objects > limits.objects_per_client {
+            return Err(exceeded(
+                "objects per client",
+                limits.objects_per_client,
+                "max-objects-per-client",
+                objects,
+            ));
+        }
+        if vertices > limits.mesh_vertices_per_client {
+            return Err(exceeded(
+                "mesh vertices per client",
+                limits.mesh_vertices_per_client,
+                "max-mesh-vertices-per-client",
+                vertices,
+            ));
+        }
+        Ok(())
+    }
+
+    /// Routes `op` to plane `id`. A panic inside the plane fails that plane alone: it is
+    /// removed, the command gets an error naming it, and the daemon serves on.
+    fn plane_op(&mut self, id: PlaneId, op: PlaneOp) -> CommandResult {
+        if op == PlaneOp::Destroy {
+            self.remove_plane(id);
+            tracing::info!(plane = id, "plane destroyed");
+            return Ok(Reply::Done);
+        }
+        let panic_dt = self.options.panic_on_step_dt;
+        let entry = self.plane(id)?;
+        let outcome = catch_unwind(AssertUnwindSafe(|| match op {
             PlaneOp::Step { dt } => {
+                if panic_dt == Some(dt) {
+                    panic!("injected fault: Step({dt})");
+                }
                 if entry.plane.step(dt)? {
                     entry.out.publish(entry.plane.as_mut()).map_err(internal)?;
                 }
                 Ok(Reply::Stepped {
                     tick: entry.plane.tick(),
                 })
-            }
-            PlaneOp::Destroy => {
-                self.planes.remove(&id);
-                tracing::info!(plane = id, "plane destroyed");
-                Ok(Reply::Done)
             }
             op => {
                 if op == PlaneOp::Info {
@@ -92,10 +194,12 @@ impl Daemon {
                 entry.reschedule_if_changed(Instant::now());
                 result
             }
-        }
+        }));
+        outcome.unwrap_or_else(|panic| Err(self.fail_plane(id, panic)))
     }
 
-    fn hello(&mut self, client: u128, crate_version: &str, pid: u32) -> CommandResult {
+    fn hello(&mut self, origin: Origin, crate_version: &str) -> CommandResult {
+        let (client, pid) = (origin.id, origin.pid);
         if crate_version != CRATE_VERSION {
             return Err(CommandError::new(
                 ErrorKind::VersionMismatch,
@@ -105,9 +209,12 @@ impl Daemon {
                 ),
             ));
         }
-        self.clients
-            .connect(&self.node, client, pid)
-            .map_err(|e| CommandError::new(ErrorKind::Internal, e))?;
+        self.clients.connect(
+            &self.node,
+            client,
+            pid,
+            self.options.limits.clients_per_process,
+        )?;
         tracing::info!(client = format!("{client:032x}"), pid, "client connected");
         Ok(Reply::Welcome {
             daemon_pid: std::process::id(),
@@ -134,12 +241,28 @@ impl Daemon {
     ) -> CommandResult {
         if self.planes.len() >= MAX_PLANES {
             return Err(CommandError::new(
-                ErrorKind::Internal,
+                ErrorKind::Quota,
                 format!("the daemon already hosts {MAX_PLANES} planes"),
             ));
         }
+        let owned = self.clients.get(owner).map_or(0, |c| c.planes.len());
+        let max = self.options.limits.planes_per_client;
+        if owned >= max {
+            return Err(exceeded(
+                "planes per client",
+                max,
+                "max-planes-per-client",
+                owned + 1,
+            ));
+        }
         let id = self.next_plane_id;
-        let mut plane = backend::create(kind, id, props)?;
+        let created = catch_unwind(AssertUnwindSafe(|| backend::create(kind, id, props)));
+        let mut plane = created.unwrap_or_else(|panic| {
+            Err(CommandError::new(
+                ErrorKind::Internal,
+                format!("creating plane {id} failed: {}", panic_message(&panic)),
+            ))
+        })?;
         let out = PlaneOutput::new(&self.node, id).map_err(internal)?;
         // Publish tick 0 so readers see the plane (and late joiners get history) at once.
         out.publish(plane.as_mut()).map_err(internal)?;
@@ -147,12 +270,16 @@ impl Daemon {
         let mut entry = PlaneEntry {
             plane,
             owner,
+            shared: PlaneProp::shared_in(props),
             out,
             period: None,
             next_tick: None,
         };
         entry.reschedule_if_changed(now);
         self.planes.insert(id, entry);
+        if let Some(c) = self.clients.get_mut(owner) {
+            c.planes.push(id);
+        }
         self.next_plane_id += 1;
         tracing::info!(plane = id, ?kind, ?info, "plane created");
         Ok(info)
@@ -162,4 +289,13 @@ impl Daemon {
 /// A daemon failure as the error of the command that met it.
 pub(super) fn internal(e: DaemonError) -> CommandError {
     CommandError::new(ErrorKind::Internal, e.to_string())
+}
+
+/// The text of a caught panic.
+pub(super) fn panic_message(panic: &(dyn std::any::Any + Send)) -> String {
+    panic
+        .downcast_ref::<&str>()
+        .map(|s| s.to_string())
+        .or_else(|| panic.downcast_ref::<String>().cloned())
+        .unwrap_or_else(|| "a panic without a message".to_string())
 }

@@ -9,20 +9,38 @@
 
 pub mod clients;
 mod dispatch;
+pub mod heartbeat;
+pub mod limits;
 
 use std::collections::BTreeMap;
+use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
 use iceoryx2::config::Config;
 use iceoryx2::port::server::Server;
 use iceoryx2::prelude::*;
-use shm_layout::{names, PlaneId};
+use iceoryx2::service::header::payload_header::PayloadHeader;
+use shm_layout::{names, CommandError, ErrorKind, PlaneId};
 
 use crate::backend::Backend;
 use crate::publish::{PlaneOutput, MAX_NODES};
 use crate::DaemonError;
 use clients::{Clients, MAX_CLIENTS};
+pub use limits::Limits;
+
+/// How the daemon runs beyond its domain.
+#[derive(Debug, Clone, Default)]
+pub struct Options {
+    /// Per-client quotas.
+    pub limits: Limits,
+    /// The process that started this daemon on demand: once it is gone and no client is
+    /// left, the daemon exits.
+    pub starter_pid: Option<u32>,
+    /// Fault injection for tests: a `Step` with exactly this dt panics inside the plane.
+    #[doc(hidden)]
+    pub panic_on_step_dt: Option<f32>,
+}
 
 /// How often dead clients are looked for while clients are connected. Without clients the
 /// daemon has nothing to look for and sleeps until a request (or a shutdown wake-up).
@@ -30,12 +48,16 @@ const HOUSEKEEPING: Duration = Duration::from_millis(500);
 /// Planes one daemon hosts at once.
 pub const MAX_PLANES: usize = 1024;
 
+/// The user header (u128) is what older clients sent as their id; it is ignored (identity
+/// comes from the transport) but kept so the service layout never changes across versions.
 type ControlServer = Server<ipc::Service, [u8], u128, [u8], ()>;
 
 struct PlaneEntry {
     plane: Box<dyn Backend>,
     /// Client that created the plane; the plane is released when that client goes away.
     owner: u128,
+    /// Other clients may change the plane (only the owner destroys it).
+    shared: bool,
     out: PlaneOutput,
     /// The tick period the schedule was made for; `None` for manual or disabled planes.
     period: Option<Duration>,
@@ -76,6 +98,7 @@ pub struct Daemon {
     clients: Clients,
     planes: BTreeMap<PlaneId, PlaneEntry>,
     next_plane_id: PlaneId,
+    options: Options,
 }
 
 /// Wakes the loop of the daemon of `domain` (e.g. from a signal handler thread after setting
@@ -103,9 +126,20 @@ pub fn wake(domain: &str) -> Result<(), DaemonError> {
 
 /// Runs the daemon of `domain` until `shutdown` becomes true; then releases every resource.
 pub fn run(domain: &str, shutdown: &AtomicBool) -> Result<(), DaemonError> {
+    run_with(domain, shutdown, Options::default())
+}
+
+/// [`run`] with explicit options (quotas, the on-demand starter).
+pub fn run_with(domain: &str, shutdown: &AtomicBool, options: Options) -> Result<(), DaemonError> {
     let config = names::config(domain)?;
     remove_dead_nodes(&config);
-    serve(domain, &config, shutdown)?;
+    let stop_beating = AtomicBool::new(false);
+    std::thread::scope(|s| {
+        s.spawn(|| heartbeat::run(&config, &stop_beating));
+        let served = serve(domain, &config, shutdown, options);
+        stop_beating.store(true, Ordering::Relaxed);
+        served
+    })?;
     release_domain(&config);
     Ok(())
 }
@@ -143,7 +177,12 @@ fn release_domain(config: &Config) {
     }
 }
 
-fn serve(domain: &str, config: &Config, shutdown: &AtomicBool) -> Result<(), DaemonError> {
+fn serve(
+    domain: &str,
+    config: &Config,
+    shutdown: &AtomicBool,
+    options: Options,
+) -> Result<(), DaemonError> {
     let node = NodeBuilder::new()
         .name(&NodeName::new(names::DAEMON_NODE_NAME).expect("valid node name"))
         .config(config)
@@ -154,7 +193,7 @@ fn serve(domain: &str, config: &Config, shutdown: &AtomicBool) -> Result<(), Dae
         .service_builder(&names::control_wake())
         .event()
         .max_listeners(2)
-        .max_notifiers(MAX_CLIENTS + 8)
+        .max_notifiers(MAX_CLIENTS * 4)
         .max_nodes(MAX_NODES)
         .open_or_create()
         .map_err(|e| DaemonError::Ipc(format!("cannot create the request event: {e:?}")))?
@@ -166,7 +205,9 @@ fn serve(domain: &str, config: &Config, shutdown: &AtomicBool) -> Result<(), Dae
         .request_response::<[u8], [u8]>()
         .request_user_header::<u128>()
         .max_servers(1)
-        .max_clients(MAX_CLIENTS + 8)
+        // Room beyond MAX_CLIENTS: ports that never say Hello (or a process at its
+        // per-process limit) leave ports for other processes.
+        .max_clients(MAX_CLIENTS * 4)
         .max_nodes(MAX_NODES)
         .max_active_requests_per_client(4)
         .open_or_create()
@@ -194,6 +235,7 @@ fn serve(domain: &str, config: &Config, shutdown: &AtomicBool) -> Result<(), Dae
         clients: Clients::default(),
         planes: BTreeMap::new(),
         next_plane_id: 1,
+        options,
     };
     tracing::info!(domain, pid = std::process::id(), "physics daemon ready");
 
@@ -216,6 +258,13 @@ fn serve(domain: &str, config: &Config, shutdown: &AtomicBool) -> Result<(), Dae
         daemon.serve_requests();
         daemon.tick_due_planes(Instant::now());
         if daemon.clients.is_empty() {
+            if Instant::now() >= next_housekeeping && daemon.starter_gone() {
+                tracing::info!(
+                    starter = daemon.options.starter_pid,
+                    "the process that started this daemon is gone and no client is left"
+                );
+                break;
+            }
             next_housekeeping = Instant::now() + HOUSEKEEPING;
         } else if Instant::now() >= next_housekeeping {
             daemon.release_gone_clients();
@@ -241,6 +290,15 @@ fn remove_dead_nodes(config: &Config) {
     }
 }
 
+/// The sender of a request, as the transport reports it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Origin {
+    /// The sender's iceoryx2 node id.
+    pub id: u128,
+    /// The sender's process id.
+    pub pid: u32,
+}
+
 impl Daemon {
     fn next_tick(&self) -> Option<Instant> {
         self.planes.values().filter_map(|p| p.next_tick).min()
@@ -256,8 +314,12 @@ impl Daemon {
                     break;
                 }
             };
-            let client = *request.user_header();
-            let reply = self.handle_bytes(client, request.payload());
+            // Who sent it comes from the transport (the request's origin node), never from
+            // the payload: a client cannot speak for another.
+            let node = request.header().node_id();
+            let client = node.value();
+            let pid = node.pid::<ipc::Service>().map_or(0, |p| p.value() as u32);
+            let reply = self.handle_bytes(Origin { id: client, pid }, request.payload());
             let sent = request
                 .loan_slice_uninit(reply.len())
                 .map_err(|e| format!("{e:?}"))
@@ -274,22 +336,30 @@ impl Daemon {
     }
 
     fn tick_due_planes(&mut self, now: Instant) {
+        let mut failed = Vec::new();
         for (id, entry) in self.planes.iter_mut() {
             let (Some(due), Some(period)) = (entry.next_tick.filter(|t| *t <= now), entry.period)
             else {
                 continue;
             };
-            let result = entry.plane.step(period.as_secs_f32()).and_then(|stepped| {
-                if stepped {
-                    entry
-                        .out
-                        .publish(entry.plane.as_mut())
-                        .map_err(dispatch::internal)?;
+            let stepped = catch_unwind(AssertUnwindSafe(|| {
+                entry.plane.step(period.as_secs_f32()).and_then(|stepped| {
+                    if stepped {
+                        entry
+                            .out
+                            .publish(entry.plane.as_mut())
+                            .map_err(dispatch::internal)?;
+                    }
+                    Ok(())
+                })
+            }));
+            match stepped {
+                Ok(Ok(())) => {}
+                Ok(Err(e)) => tracing::warn!(plane = id, "tick failed: {e}"),
+                Err(panic) => {
+                    failed.push((*id, panic));
+                    continue;
                 }
-                Ok(())
-            });
-            if let Err(e) = result {
-                tracing::warn!(plane = id, "tick failed: {e}");
             }
             // Keep the cadence; after a stall, restart from now instead of catching up.
             let next = due + period;
@@ -298,6 +368,30 @@ impl Daemon {
             } else {
                 next
             });
+        }
+        for (id, panic) in failed {
+            self.fail_plane(id, panic);
+        }
+    }
+
+    /// Removes a plane whose code panicked (its state cannot be trusted) and returns the
+    /// error its clients get. The daemon and every other plane serve on.
+    fn fail_plane(&mut self, id: PlaneId, panic: Box<dyn std::any::Any + Send>) -> CommandError {
+        let message = dispatch::panic_message(panic.as_ref());
+        tracing::error!(plane = id, "plane failed and was removed: {message}");
+        self.remove_plane(id);
+        CommandError::new(
+            ErrorKind::Internal,
+            format!("plane {id} failed and was removed: {message}"),
+        )
+    }
+
+    /// Drops a plane and forgets it in its owner's list.
+    fn remove_plane(&mut self, id: PlaneId) {
+        if let Some(entry) = self.planes.remove(&id) {
+            if let Some(c) = self.clients.get_mut(entry.owner) {
+                c.planes.retain(|p| *p != id);
+            }
         }
     }
 
@@ -310,6 +404,21 @@ impl Daemon {
             planes_released = before - self.planes.len(),
             "client released"
         );
+    }
+
+    /// Whether this daemon was started on demand by a process that no longer runs (a
+    /// zombie counts as gone).
+    fn starter_gone(&self) -> bool {
+        let Some(pid) = self.options.starter_pid else {
+            return false;
+        };
+        match std::fs::read_to_string(format!("/proc/{pid}/stat")) {
+            // The state follows the parenthesised command name.
+            Ok(stat) => stat
+                .rsplit_once(") ")
+                .is_some_and(|(_, rest)| rest.starts_with('Z') || rest.starts_with('X')),
+            Err(_) => true,
+        }
     }
 
     fn release_gone_clients(&mut self) {

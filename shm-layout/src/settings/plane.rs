@@ -35,6 +35,9 @@ pub enum PlaneProp {
     LoopSolver(bool),
     /// Keeps every body awake.
     NeverSleep(bool),
+    /// Other clients may change the plane (set options, add and change objects, step it);
+    /// without it they may only read. Only the owner may destroy it. Creation only.
+    Shared(bool),
 }
 
 /// Every option of a plane, as set. [`Default`] holds the documented defaults.
@@ -66,6 +69,8 @@ pub struct PlaneSettings {
     pub loop_solver: bool,
     /// `NeverSleep`, default false.
     pub never_sleep: bool,
+    /// `Shared`, default false (creation only).
+    pub shared: bool,
 }
 
 impl Default for PlaneSettings {
@@ -84,6 +89,7 @@ impl Default for PlaneSettings {
             solver_iterations: 4,
             loop_solver: false,
             never_sleep: false,
+            shared: false,
         }
     }
 }
@@ -117,6 +123,7 @@ impl PlaneSettings {
             PlaneProp::SolverIterations(n) => self.solver_iterations = n,
             PlaneProp::LoopSolver(on) => self.loop_solver = on,
             PlaneProp::NeverSleep(on) => self.never_sleep = on,
+            PlaneProp::Shared(on) => self.shared = on,
         }
         Ok(prop)
     }
@@ -139,12 +146,18 @@ impl PlaneProp {
             PlaneProp::SolverIterations(_) => "SolverIterations",
             PlaneProp::LoopSolver(_) => "LoopSolver",
             PlaneProp::NeverSleep(_) => "NeverSleep",
+            PlaneProp::Shared(_) => "Shared",
         }
     }
 
     /// Options that only `CreatePlane` may set.
     pub fn creation_only(&self) -> bool {
-        matches!(self, PlaneProp::Threads(_))
+        matches!(self, PlaneProp::Threads(_) | PlaneProp::Shared(_))
+    }
+
+    /// Whether creation options `props` share the plane with other clients.
+    pub fn shared_in(props: &[PlaneProp]) -> bool {
+        props.iter().any(|p| *p == PlaneProp::Shared(true))
     }
 
     /// Options that change the forces on resting bodies (which must then wake up).
@@ -165,9 +178,10 @@ impl PlaneProp {
             | PlaneProp::Drag(x)
             | PlaneProp::Buoyancy(x)
             | PlaneProp::RestThreshold(x) => x.to_string(),
-            PlaneProp::Enabled(b) | PlaneProp::LoopSolver(b) | PlaneProp::NeverSleep(b) => {
-                b.to_string()
-            }
+            PlaneProp::Enabled(b)
+            | PlaneProp::LoopSolver(b)
+            | PlaneProp::NeverSleep(b)
+            | PlaneProp::Shared(b) => b.to_string(),
         }
     }
 

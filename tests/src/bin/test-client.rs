@@ -2,6 +2,8 @@
 //!
 //! test-client hold DOMAIN                  create a plane + ball, print "plane=ID", then sleep
 //! test-client read DOMAIN PLANE SLOT GEN   attach, print "tick=T x y z" of that body
+//! test-client hold-once DOMAIN             create a plane, print "plane=ID", exit
+//! test-client start-and-hold DOMAIN        start a daemon on demand, print "daemon=PID", sleep
 
 use std::io::Write;
 
@@ -9,6 +11,14 @@ use client_sdk::{Client, Handle, Object, PlaneOptions, Pose, Shape};
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
+    if args[1] == "start-and-hold" {
+        let session = client_sdk::connect_or_start(&args[2]).expect("connect or start");
+        let pid = session.daemon.as_ref().expect("a daemon was started").pid();
+        println!("daemon={pid}");
+        std::io::stdout().flush().unwrap();
+        std::thread::sleep(std::time::Duration::from_secs(3600));
+        return;
+    }
     let client = Client::connect(&args[2]).expect("connect");
     match args[1].as_str() {
         "hold" => {
@@ -25,6 +35,12 @@ fn main() {
             println!("plane={}", plane.id());
             std::io::stdout().flush().unwrap();
             std::thread::sleep(std::time::Duration::from_secs(3600));
+        }
+        "hold-once" => {
+            let plane = client
+                .create_plane(&PlaneOptions::manual())
+                .expect("create plane");
+            println!("plane={}", plane.id());
         }
         "read" => {
             let n = |i: usize| args[i].parse::<u32>().expect("number");

@@ -1,0 +1,69 @@
+//! Per-client quotas: defaults no game reaches but an attack does. Each is a daemon flag;
+//! an exceeded quota is a `Quota` error naming the quota, its value and the flag.
+
+use shm_layout::{CommandError, ErrorKind};
+
+/// The daemon's per-client and per-request limits.
+#[derive(Debug, Clone, PartialEq, clap::Args)]
+pub struct Limits {
+    /// Clients (connections) one process may hold at once.
+    #[arg(long = "max-clients-per-process", default_value_t = Limits::DEFAULT.clients_per_process)]
+    pub clients_per_process: usize,
+    /// Planes one client may own at once.
+    #[arg(long = "max-planes-per-client", default_value_t = Limits::DEFAULT.planes_per_client)]
+    pub planes_per_client: usize,
+    /// Objects in the planes one client owns, all planes together.
+    #[arg(long = "max-objects-per-client", default_value_t = Limits::DEFAULT.objects_per_client)]
+    pub objects_per_client: u64,
+    /// Vertices of one mesh part.
+    #[arg(long = "max-mesh-vertices", default_value_t = Limits::DEFAULT.mesh_vertices_per_object)]
+    pub mesh_vertices_per_object: u64,
+    /// Mesh vertices in the planes one client owns, all parts together.
+    #[arg(
+        long = "max-mesh-vertices-per-client",
+        default_value_t = Limits::DEFAULT.mesh_vertices_per_client
+    )]
+    pub mesh_vertices_per_client: u64,
+    /// Bytes of one request.
+    #[arg(long = "max-request-bytes", default_value_t = Limits::DEFAULT.request_bytes)]
+    pub request_bytes: usize,
+    /// Commands in one request.
+    #[arg(
+        long = "max-commands-per-request",
+        default_value_t = Limits::DEFAULT.commands_per_request
+    )]
+    pub commands_per_request: usize,
+}
+
+impl Limits {
+    /// The defaults: far above a game's needs (the benchmarks run 50,000 bodies in one
+    /// plane and 1,000 writes per frame), far below what exhausts the daemon.
+    pub const DEFAULT: Limits = Limits {
+        clients_per_process: 16,
+        planes_per_client: 64,
+        objects_per_client: 250_000,
+        mesh_vertices_per_object: 16_384,
+        mesh_vertices_per_client: 1_000_000,
+        request_bytes: 16 << 20,
+        commands_per_request: 262_144,
+    };
+}
+
+impl Default for Limits {
+    fn default() -> Self {
+        Limits::DEFAULT
+    }
+}
+
+/// The error for an exceeded quota: names it, its value and its flag.
+pub fn exceeded(
+    what: &str,
+    limit: impl std::fmt::Display,
+    flag: &str,
+    got: impl std::fmt::Display,
+) -> CommandError {
+    CommandError::new(
+        ErrorKind::Quota,
+        format!("quota exceeded: {what} is limited to {limit} (daemon flag --{flag}), this would make {got}"),
+    )
+}

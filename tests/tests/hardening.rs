@@ -1,0 +1,375 @@
+//! Reliability and security through real daemon processes: inputs that used to crash the
+//! daemon, a panic inside one plane, per-client quotas, plane ownership, identity from the
+//! transport, per-process client limits, a stalled daemon, and an on-demand daemon whose
+//! starter is gone.
+
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+use client_sdk::{
+    Client, ConnectOptions, Error, ErrorKind, Handle, PlaneOptions, PlaneProp, Pose, Shape,
+};
+use integration_tests::{eventually, TestDaemon};
+use shm_layout::codec::{decode_response, encode_request};
+use shm_layout::{Command as Cmd, PlaneOp, Request, Response};
+
+fn results(bytes: Vec<u8>) -> Vec<shm_layout::CommandResult> {
+    match decode_response(&bytes).expect("decodable reply") {
+        Response::Results(r) => r,
+        Response::Rejected(e) => panic!("rejected: {e}"),
+    }
+}
+
+fn command_error(e: Error) -> client_sdk::CommandError {
+    match e {
+        Error::Command(e) => e,
+        Error::Batch(mut v) => v.remove(0),
+        other => panic!("expected a command error, got {other}"),
+    }
+}
+
+fn cube() -> Shape {
+    Shape::Cube { size: [1.0; 3] }
+}
+
+#[test]
+fn tiny_tick_rates_are_refused_and_the_daemon_serves_on() {
+    let daemon = TestDaemon::start("tickrate");
+    let client = daemon.client();
+    let plane = client.create_plane(&PlaneOptions::manual()).unwrap();
+    for rate in [1e-20f32, 1e-45, 1.17e-38, 1e-3] {
+        // Bypass the SDK's own check: the daemon must refuse on its own.
+        let request = Request {
+            commands: vec![Cmd::plane(
+                plane.id(),
+                PlaneOp::Set(PlaneProp::TickRate(rate)),
+            )],
+        };
+        let r = results(client.raw_request(&encode_request(&request)).unwrap());
+        let e = r[0].as_ref().unwrap_err();
+        assert_eq!(e.kind, ErrorKind::InvalidValue, "{e}");
+        assert!(e.message.contains("TickRate"), "{e}");
+        assert_eq!(e.field.as_deref(), Some("TickRate"));
+        // The same at creation.
+        let create = Request {
+            commands: vec![Cmd::CreatePlane {
+                kind: Default::default(),
+                props: vec![PlaneProp::TickRate(rate)],
+            }],
+        };
+        let r = results(client.raw_request(&encode_request(&create)).unwrap());
+        assert!(r[0].is_err(), "TickRate {rate} accepted at creation");
+    }
+    // A slow but valid rate works.
+    plane.set(PlaneProp::TickRate(0.01)).unwrap();
+    client.flush().unwrap();
+    assert_eq!(plane.info().unwrap().tick_rate, 0.01);
+    let other = daemon.client();
+    assert!(other.create_plane(&PlaneOptions::manual()).is_ok());
+}
+
+#[test]
+fn a_panic_inside_one_plane_fails_that_plane_only() {
+    let daemon = TestDaemon::start_with("panic", &[], &[("PHYSICS_FAULT_PANIC_DT", "0.0123")]);
+    let a = daemon.client();
+    let b = daemon.client();
+    let doomed = a.create_plane(&PlaneOptions::manual()).unwrap();
+    let fine = b.create_plane(&PlaneOptions::manual()).unwrap();
+    let ball = fine
+        .add(
+            Shape::Sphere { radius: 0.5 },
+            Pose::at([0.0, 5.0, 0.0]),
+            &[],
+        )
+        .unwrap();
+    let e = command_error(doomed.step(0.0123).unwrap_err());
+    assert_eq!(e.kind, ErrorKind::Internal);
+    assert!(
+        e.message.contains(&format!("plane {}", doomed.id())) && e.message.contains("failed"),
+        "{e}"
+    );
+    // The failed plane is gone; everything else keeps working.
+    let e = command_error(doomed.info().unwrap_err());
+    assert_eq!(e.kind, ErrorKind::UnknownPlane);
+    fine.step(1.0 / 60.0).unwrap();
+    assert!(ball.position().unwrap()[1] < 5.0);
+    assert!(a.create_plane(&PlaneOptions::manual()).is_ok());
+    let mut daemon = daemon;
+    assert!(daemon.is_running());
+}
+
+#[test]
+fn quotas_refuse_with_the_quota_and_its_flag() {
+    let daemon = TestDaemon::start_with(
+        "quota",
+        &[
+            "--max-objects-per-client",
+            "10",
+            "--max-planes-per-client",
+            "2",
+            "--max-mesh-vertices",
+            "100",
+            "--max-mesh-vertices-per-client",
+            "150",
+            "--max-commands-per-request",
+            "50",
+            "--max-request-bytes",
+            "100000",
+        ],
+        &[],
+    );
+    let client = daemon.client();
+    let p1 = client.create_plane(&PlaneOptions::manual()).unwrap();
+    let p2 = client.create_plane(&PlaneOptions::manual()).unwrap();
+    let e = command_error(client.create_plane(&PlaneOptions::manual()).unwrap_err());
+    assert_eq!(e.kind, ErrorKind::Quota);
+    assert!(e.message.contains("--max-planes-per-client"), "{e}");
+
+    // Objects count over all the client's planes.
+    for i in 0..6 {
+        p1.add(cube(), Pose::at([i as f32 * 2.0, 0.0, 0.0]), &[])
+            .unwrap();
+    }
+    for i in 0..4 {
+        p2.add(cube(), Pose::at([i as f32 * 2.0, 0.0, 0.0]), &[])
+            .unwrap();
+    }
+    let e = command_error(p2.add(cube(), Pose::IDENTITY, &[]).unwrap_err());
+    assert_eq!(e.kind, ErrorKind::Quota);
+    assert!(
+        e.message.contains("objects per client") && e.message.contains("--max-objects-per-client"),
+        "{e}"
+    );
+    // Destroying one frees room for one.
+    p2.destroy().unwrap();
+    let p3 = client.create_plane(&PlaneOptions::manual()).unwrap();
+
+    let sphere = |n: usize| {
+        let vertices: Vec<[f32; 3]> = (0..n)
+            .map(|i| {
+                let t = i as f32 * 2.399_963; // golden angle
+                let y = 1.0 - 2.0 * (i as f32 + 0.5) / n as f32;
+                let r = (1.0 - y * y).sqrt();
+                [r * t.cos(), y, r * t.sin()]
+            })
+            .collect();
+        Shape::Mesh {
+            vertices,
+            triangles: vec![],
+        }
+    };
+    let e = command_error(p3.add(sphere(101), Pose::IDENTITY, &[]).unwrap_err());
+    assert!(e.message.contains("--max-mesh-vertices"), "{e}");
+    p3.add(sphere(100), Pose::IDENTITY, &[]).unwrap();
+    let e = command_error(p3.add(sphere(60), Pose::IDENTITY, &[]).unwrap_err());
+    assert!(e.message.contains("--max-mesh-vertices-per-client"), "{e}");
+
+    // Per request: commands and bytes.
+    let many = Request {
+        commands: (0..51)
+            .map(|_| Cmd::plane(p3.id(), PlaneOp::Info))
+            .collect(),
+    };
+    match decode_response(&client.raw_request(&encode_request(&many)).unwrap()).unwrap() {
+        Response::Rejected(e) => {
+            assert_eq!(e.kind, ErrorKind::Quota);
+            assert!(e.message.contains("--max-commands-per-request"), "{e}");
+        }
+        other => panic!("51 commands accepted: {other:?}"),
+    }
+    let big = Request {
+        commands: vec![Cmd::plane(
+            p3.id(),
+            PlaneOp::AddObject {
+                shape: Shape::Mesh {
+                    vertices: vec![[0.5; 3]; 10_000],
+                    triangles: vec![],
+                },
+                pose: Pose::IDENTITY,
+                props: vec![],
+            },
+        )],
+    };
+    match decode_response(&client.raw_request(&encode_request(&big)).unwrap()).unwrap() {
+        Response::Rejected(e) => assert!(e.message.contains("--max-request-bytes"), "{e}"),
+        other => panic!("a 120 kB request accepted: {other:?}"),
+    }
+    // The client still works.
+    assert!(p3.info().is_ok());
+}
+
+#[test]
+fn planes_belong_to_their_creator() {
+    let daemon = TestDaemon::start("owner");
+    let owner = daemon.client();
+    let other = daemon.client();
+    let private = owner.create_plane(&PlaneOptions::manual()).unwrap();
+    let ball = private
+        .add(
+            Shape::Sphere { radius: 0.5 },
+            Pose::at([0.0, 5.0, 0.0]),
+            &[],
+        )
+        .unwrap();
+    // Published with the next tick: other processes read what the daemon publishes.
+    private.step(1.0 / 60.0).unwrap();
+    let seen = other.attach_plane(private.id()).unwrap();
+    // Reading is allowed: info, snapshots, object info.
+    assert_eq!(seen.info().unwrap().object_count, 1);
+    let remote = client_sdk::Object::from_handle(&seen, ball.handle());
+    assert!(remote.info().is_ok());
+    assert_eq!(remote.position().unwrap(), ball.position().unwrap());
+    // Writing, stepping and destroying are not.
+    for attempt in [
+        seen.step(1.0 / 60.0).map(|_| ()),
+        seen.add(cube(), Pose::IDENTITY, &[]).map(|_| ()),
+        seen.destroy(),
+        remote
+            .set_velocity([1.0, 0.0, 0.0])
+            .and_then(|_| other.flush()),
+        {
+            seen.set(PlaneProp::Gravity([0.0; 3])).unwrap();
+            other.flush()
+        },
+    ] {
+        let e = command_error(attempt.unwrap_err());
+        assert_eq!(e.kind, ErrorKind::NotOwner, "{e}");
+        assert!(e.message.contains("belongs to another client"), "{e}");
+    }
+    assert!(private.is_alive());
+    assert_eq!(private.info().unwrap().gravity, [0.0, -50.0, 0.0]);
+
+    // A shared plane takes writes from others, but only its owner destroys it.
+    let shared = owner
+        .create_plane(&PlaneOptions {
+            shared: Some(true),
+            ..PlaneOptions::manual()
+        })
+        .unwrap();
+    assert!(shared.info().unwrap().shared);
+    let joined = other.attach_plane(shared.id()).unwrap();
+    joined.add(cube(), Pose::IDENTITY, &[]).unwrap();
+    joined.step(1.0 / 60.0).unwrap();
+    let e = command_error(joined.destroy().unwrap_err());
+    assert_eq!(e.kind, ErrorKind::NotOwner);
+    shared.destroy().unwrap();
+}
+
+#[test]
+fn a_goodbye_releases_only_the_sender() {
+    let daemon = TestDaemon::start("identity");
+    let victim = daemon.client();
+    let plane = victim.create_plane(&PlaneOptions::manual()).unwrap();
+    let attacker = daemon.client();
+    // The attacker's Goodbye (whatever it writes in the request's user header) is its own.
+    let bye = Request {
+        commands: vec![Cmd::Goodbye],
+    };
+    let r = results(attacker.raw_request(&encode_request(&bye)).unwrap());
+    assert!(r[0].is_ok());
+    assert!(
+        plane.is_alive(),
+        "another client's Goodbye released the victim's plane"
+    );
+    plane.step(1.0 / 60.0).unwrap();
+}
+
+#[test]
+fn one_process_cannot_take_every_client_slot() {
+    let daemon = TestDaemon::start_with("slots", &["--max-clients-per-process", "4"], &[]);
+    // The harness's own probe connection is gone; four clients fit, the fifth does not.
+    let held: Vec<Client> = (0..4).map(|_| daemon.client()).collect();
+    match Client::connect(&daemon.domain) {
+        Err(Error::Command(e)) => {
+            assert_eq!(e.kind, ErrorKind::Quota);
+            assert!(e.message.contains("--max-clients-per-process"), "{e}");
+        }
+        other => panic!("a fifth client of one process connected: {other:?}"),
+    }
+    // Another process still gets in.
+    let out = Command::new(env!("CARGO_BIN_EXE_test-client"))
+        .args(["hold-once", &daemon.domain])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success() && String::from_utf8_lossy(&out.stdout).contains("plane="),
+        "{out:?}"
+    );
+    drop(held);
+}
+
+#[test]
+fn a_stopped_daemon_is_reported_stalled_within_about_a_second() {
+    let daemon = TestDaemon::start("stalled");
+    let client = Client::connect_with(ConnectOptions {
+        request_timeout: Duration::from_secs(30),
+        ..ConnectOptions::new(&daemon.domain)
+    })
+    .unwrap();
+    let plane = client.create_plane(&PlaneOptions::manual()).unwrap();
+    daemon.signal(libc::SIGSTOP);
+    let started = Instant::now();
+    let err = plane.info().unwrap_err();
+    let took = started.elapsed();
+    daemon.signal(libc::SIGCONT);
+    assert!(matches!(err, Error::Stalled { .. }), "{err}");
+    assert!(err.to_string().contains("stalled"), "{err}");
+    assert!(took < Duration::from_secs(3), "noticed after {took:?}");
+    // Resumed, it answers again.
+    assert!(eventually(Duration::from_secs(5), || plane.info().ok()).is_some());
+}
+
+#[test]
+fn a_daemon_started_on_demand_exits_once_its_starter_is_gone() {
+    let domain = integration_tests::unique_domain("starter");
+    // A process that starts a daemon on demand, then is killed without any cleanup.
+    let mut starter = Command::new(env!("CARGO_BIN_EXE_test-client"))
+        .args(["start-and-hold", &domain])
+        .stdout(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut line = String::new();
+    {
+        use std::io::BufRead;
+        let stdout = starter.stdout.as_mut().unwrap();
+        std::io::BufReader::new(stdout)
+            .read_line(&mut line)
+            .unwrap();
+    }
+    let pid: i32 = line
+        .trim()
+        .strip_prefix("daemon=")
+        .and_then(|p| p.parse().ok())
+        .unwrap_or_else(|| panic!("unexpected output {line:?}"));
+    starter.kill().unwrap();
+    starter.wait().unwrap();
+    // SAFETY: kill(pid, 0) only probes whether the process exists.
+    let gone = eventually(Duration::from_secs(5), || {
+        (unsafe { libc::kill(pid, 0) } != 0).then_some(())
+    });
+    assert!(
+        gone.is_some(),
+        "the on-demand daemon {pid} outlived its starter"
+    );
+    let _ = physics_daemon::cleanup_domain(&domain);
+}
+
+#[test]
+fn stale_handles_name_the_object() {
+    let daemon = TestDaemon::start("stale2");
+    let client = daemon.client();
+    let plane = client.create_plane(&PlaneOptions::manual()).unwrap();
+    let o = plane.add(cube(), Pose::IDENTITY, &[]).unwrap();
+    o.destroy();
+    client.flush().unwrap();
+    let fake = client_sdk::Object::from_handle(
+        &plane,
+        Handle {
+            slot: 99,
+            generation: 1,
+        },
+    );
+    let e = command_error(fake.info().unwrap_err());
+    assert_eq!(e.kind, ErrorKind::StaleHandle);
+    assert!(e.message.contains("does not exist"), "{e}");
+}
