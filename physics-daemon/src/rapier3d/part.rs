@@ -8,10 +8,18 @@ use shm_layout::{CommandError, ObjectSettings, Shape, ShapeKind, Vec3};
 /// shrinks as 1 / quality.
 const BASE_CONTACT_SKIN: f32 = 0.01;
 
-/// A mesh part: vertices as given, and the size they span (Size rescales them).
+/// Most points a mesh part's collision hull is built from. Larger vertex sets are reduced
+/// to their support points along this many directions first (PhysX likewise caps convex
+/// hulls at 255 vertices), so the hull of any accepted mesh costs a bounded, small time and
+/// a Size change rescales the reduced set instead of recomputing from every vertex.
+pub const MAX_HULL_POINTS: usize = 384;
+
+/// A mesh part: vertices as given, the size they span (Size rescales them), and the points
+/// its hull is built from (all vertices, or their support points when there are many).
 #[derive(Debug)]
 pub(super) struct Mesh {
     vertices: Vec<Vec3>,
+    hull_points: Vec<Vec3>,
     extent: Vec3,
 }
 
@@ -51,6 +59,7 @@ impl Part {
                     extent,
                     Some(Mesh {
                         vertices: vertices.clone(),
+                        hull_points: hull_points(vertices),
                         extent,
                     }),
                 )
@@ -77,7 +86,7 @@ impl Part {
             (_, ShapeKind::Cube) => SharedShape::cuboid(x / 2.0, y / 2.0, z / 2.0),
             (_, ShapeKind::Sphere) => SharedShape::ball(x.min(y).min(z) / 2.0),
             (Some(mesh), ShapeKind::Mesh) => {
-                let points = mesh.scaled(self.size);
+                let points = mesh.scaled_hull_points(self.size);
                 let flat = || {
                     CommandError::invalid(format!(
                         "Mesh vertices span no volume (all coplanar?) at Size {:?}",
@@ -86,7 +95,8 @@ impl Part {
                 };
                 let hull = SharedShape::convex_hull(&points).ok_or_else(flat)?;
                 // A coplanar point set still yields a (flat) hull: it has no mass or inertia.
-                if hull.mass_properties(1.0).mass() <= 1e-9 {
+                // Flat relative to the part's own box, so tiny meshes are not refused.
+                if hull.mass_properties(1.0).mass() <= 1e-6 * x * y * z {
                     return Err(flat());
                 }
                 hull
@@ -197,13 +207,69 @@ impl Part {
 }
 
 impl Mesh {
+    fn scale(&self, size: Vec3) -> Vector {
+        Vector::from(size) / Vector::from(self.extent).max(Vector::splat(1e-12))
+    }
+
     fn scaled(&self, size: Vec3) -> Vec<Vector> {
-        let scale = Vector::from(size) / Vector::from(self.extent).max(Vector::splat(1e-12));
+        let scale = self.scale(size);
         self.vertices
             .iter()
             .map(|v| Vector::from(*v) * scale)
             .collect()
     }
+
+    /// The hull's input points at `size`. A diagonal scale maps the support points of the
+    /// unscaled set onto support points of the scaled set, so rescaling the reduced set is
+    /// exact for the hull it spans.
+    fn scaled_hull_points(&self, size: Vec3) -> Vec<Vector> {
+        let scale = self.scale(size);
+        self.hull_points
+            .iter()
+            .map(|v| Vector::from(*v) * scale)
+            .collect()
+    }
+}
+
+/// `vertices` when there are at most [`MAX_HULL_POINTS`], else their support points along
+/// [`MAX_HULL_POINTS`] directions spread evenly over the sphere (a Fibonacci lattice), the
+/// extremes along the axes included: the hull of these points is inscribed in the true hull
+/// and touches it in every sampled direction.
+fn hull_points(vertices: &[Vec3]) -> Vec<Vec3> {
+    if vertices.len() <= MAX_HULL_POINTS {
+        return vertices.to_vec();
+    }
+    let axes = [
+        Vector::X,
+        Vector::NEG_X,
+        Vector::Y,
+        Vector::NEG_Y,
+        Vector::Z,
+        Vector::NEG_Z,
+    ];
+    let n = MAX_HULL_POINTS - axes.len();
+    let golden = std::f32::consts::PI * (3.0 - 5f32.sqrt());
+    let directions = axes.into_iter().chain((0..n).map(|i| {
+        let y = 1.0 - 2.0 * (i as f32 + 0.5) / n as f32;
+        let r = (1.0 - y * y).max(0.0).sqrt();
+        let t = golden * i as f32;
+        Vector::new(r * t.cos(), y, r * t.sin())
+    }));
+    let mut picked: Vec<usize> = directions
+        .map(|d| {
+            let mut best = (f32::NEG_INFINITY, 0);
+            for (i, v) in vertices.iter().enumerate() {
+                let s = d.dot(Vector::from(*v));
+                if s > best.0 {
+                    best = (s, i);
+                }
+            }
+            best.1
+        })
+        .collect();
+    picked.sort_unstable();
+    picked.dedup();
+    picked.into_iter().map(|i| vertices[i]).collect()
 }
 
 fn extent_of(vertices: &[Vec3]) -> Vec3 {
@@ -214,4 +280,57 @@ fn extent_of(vertices: &[Vec3]) -> Vec3 {
         hi = hi.max(Vector::from(*v));
     }
     (hi - lo).into()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `n` points on a unit sphere (a Fibonacci lattice).
+    fn sphere(n: usize) -> Vec<Vec3> {
+        let golden = std::f32::consts::PI * (3.0 - 5f32.sqrt());
+        (0..n)
+            .map(|i| {
+                let y = 1.0 - 2.0 * (i as f32 + 0.5) / n as f32;
+                let r = (1.0 - y * y).sqrt();
+                let t = golden * i as f32;
+                [r * t.cos(), y, r * t.sin()]
+            })
+            .collect()
+    }
+
+    #[test]
+    fn a_large_point_sphere_gets_a_bounded_correct_hull() {
+        let part = Part::new(&Shape::Mesh {
+            vertices: sphere(65_536),
+            triangles: vec![],
+        });
+        let hull = part.collider_shape().expect("a sphere of points is a solid");
+        let volume = hull.mass_properties(1.0).mass();
+        let exact = 4.0 / 3.0 * std::f32::consts::PI;
+        // An inscribed polytope of ~380 support points holds > 97 % of the ball's volume.
+        assert!(volume < exact && volume > 0.97 * exact, "volume {volume}");
+        assert!(part.mesh.as_ref().unwrap().hull_points.len() <= MAX_HULL_POINTS);
+        // Rescaling reuses the reduced set, and the rescaled hull is the scaled ball.
+        let mut part = part;
+        part.size = [4.0, 2.0, 2.0];
+        let stretched = part.collider_shape().unwrap().mass_properties(1.0).mass();
+        assert!((stretched / volume - 2.0).abs() < 1e-3, "{stretched} vs 2 × {volume}");
+    }
+
+    #[test]
+    fn flat_point_sets_are_refused_and_tiny_solids_are_not() {
+        let flat = Part::new(&Shape::Mesh {
+            vertices: (0..1000)
+                .map(|i| [(i % 10) as f32, (i / 10) as f32, 0.0])
+                .collect(),
+            triangles: vec![],
+        });
+        assert!(flat.collider_shape().is_err());
+        let tiny = Part::new(&Shape::Mesh {
+            vertices: sphere(100).iter().map(|v| v.map(|c| c * 1e-3)).collect(),
+            triangles: vec![],
+        });
+        assert!(tiny.collider_shape().is_ok());
+    }
 }
