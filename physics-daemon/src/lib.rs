@@ -27,6 +27,20 @@ pub enum DaemonError {
         /// The domain.
         domain: String,
     },
+    /// Another user owns files of the domain (planted or left behind): no node of the
+    /// domain could start safely.
+    #[error(
+        "another user (uid {uid}) owns {path}, a file of domain {domain:?}: remove it (as that \
+         user or root) or use another domain"
+    )]
+    ForeignFiles {
+        /// The domain.
+        domain: String,
+        /// The file.
+        path: String,
+        /// Its owner.
+        uid: u32,
+    },
     /// iceoryx2 failed.
     #[error("shared-memory transport: {0}")]
     Ipc(String),

@@ -51,14 +51,25 @@ pub fn prefix(domain: &str) -> String {
     format!("phys_{domain}_")
 }
 
+/// The directory of the domain's sockets and node records: one per user, so another local
+/// user cannot take the shared default directory away (`/tmp/iceoryx2-UID/`).
+pub fn root_path() -> String {
+    // SAFETY: getuid(2) cannot fail and has no side effects.
+    let uid = unsafe { libc::getuid() };
+    format!("/tmp/iceoryx2-{uid}/")
+}
+
 /// The iceoryx2 configuration of a domain.
 pub fn config(domain: &str) -> Result<Config, DomainError> {
     validate_domain(domain)?;
-    let mut config = Config::default();
-    config.global.prefix = FileName::new(prefix(domain).as_bytes()).map_err(|_| DomainError {
+    let unusable = || DomainError {
         domain: domain.to_string(),
         reason: "is not usable as a file name",
-    })?;
+    };
+    let mut config = Config::default();
+    config.global.prefix = FileName::new(prefix(domain).as_bytes()).map_err(|_| unusable())?;
+    let root = iceoryx2::prelude::Path::new(root_path().as_bytes()).map_err(|_| unusable())?;
+    config.global.set_root_path(&root);
     Ok(config)
 }
 

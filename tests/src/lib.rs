@@ -144,7 +144,7 @@ impl Drop for TestDaemon {
 pub fn domain_files(domain: &str) -> Vec<PathBuf> {
     let prefix = names::prefix(domain);
     let mut found = Vec::new();
-    let mut dirs = vec![PathBuf::from("/dev/shm"), PathBuf::from("/tmp/iceoryx2")];
+    let mut dirs = vec![PathBuf::from("/dev/shm"), PathBuf::from(names::root_path())];
     while let Some(dir) = dirs.pop() {
         let Ok(entries) = std::fs::read_dir(&dir) else {
             continue;

@@ -373,3 +373,52 @@ fn stale_handles_name_the_object() {
     assert_eq!(e.kind, ErrorKind::StaleHandle);
     assert!(e.message.contains("does not exist"), "{e}");
 }
+
+#[test]
+fn no_file_of_a_domain_is_writable_by_other_users() {
+    let daemon = TestDaemon::start("perms");
+    let client = daemon.client();
+    let plane = client.create_plane(&PlaneOptions::manual()).unwrap();
+    plane.step(1.0 / 60.0).unwrap();
+    let files = integration_tests::domain_files(&daemon.domain);
+    assert!(files.len() > 5, "{files:?}");
+    for f in files {
+        use std::os::unix::fs::PermissionsExt;
+        let mode = std::fs::symlink_metadata(&f).unwrap().permissions().mode();
+        assert_eq!(
+            mode & 0o022,
+            0,
+            "{} is writable by others: {mode:o}",
+            f.display()
+        );
+    }
+}
+
+#[test]
+fn files_planted_by_another_user_stop_the_daemon_with_a_clear_error() {
+    // SAFETY: geteuid(2) has no side effects.
+    assert_eq!(
+        unsafe { libc::geteuid() },
+        0,
+        "planting a file owned by another user needs root"
+    );
+    let domain = integration_tests::unique_domain("squat");
+    let planted = format!(
+        "/dev/shm/{}0000_node.0_10_0.global_mgmt",
+        shm_layout::names::prefix(&domain)
+    );
+    std::fs::write(&planted, [0u8; 16]).unwrap();
+    std::os::unix::fs::chown(&planted, Some(65534), Some(65534)).unwrap();
+    let out = Command::new(client_sdk::daemon_executable())
+        .args(["--domain", &domain])
+        .env("PHYSICS_LOG", "error")
+        .output()
+        .unwrap();
+    let _ = std::fs::remove_file(&planted);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "{stderr}");
+    assert!(
+        stderr.contains(&planted) && stderr.contains("uid 65534"),
+        "{stderr}"
+    );
+}

@@ -305,7 +305,9 @@ mod tests {
             vertices: sphere(65_536),
             triangles: vec![],
         });
-        let hull = part.collider_shape().expect("a sphere of points is a solid");
+        let hull = part
+            .collider_shape()
+            .expect("a sphere of points is a solid");
         let volume = hull.mass_properties(1.0).mass();
         let exact = 4.0 / 3.0 * std::f32::consts::PI;
         // An inscribed polytope of ~380 support points holds > 97 % of the ball's volume.
@@ -315,7 +317,10 @@ mod tests {
         let mut part = part;
         part.size = [4.0, 2.0, 2.0];
         let stretched = part.collider_shape().unwrap().mass_properties(1.0).mass();
-        assert!((stretched / volume - 2.0).abs() < 1e-3, "{stretched} vs 2 × {volume}");
+        assert!(
+            (stretched / volume - 2.0).abs() < 1e-3,
+            "{stretched} vs 2 × {volume}"
+        );
     }
 
     #[test]

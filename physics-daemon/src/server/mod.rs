@@ -9,6 +9,7 @@
 
 pub mod clients;
 mod dispatch;
+pub mod files;
 pub mod heartbeat;
 pub mod limits;
 
@@ -132,6 +133,7 @@ pub fn run(domain: &str, shutdown: &AtomicBool) -> Result<(), DaemonError> {
 /// [`run`] with explicit options (quotas, the on-demand starter).
 pub fn run_with(domain: &str, shutdown: &AtomicBool, options: Options) -> Result<(), DaemonError> {
     let config = names::config(domain)?;
+    files::check_ownership(domain)?;
     remove_dead_nodes(&config);
     let stop_beating = AtomicBool::new(false);
     std::thread::scope(|s| {
@@ -237,6 +239,8 @@ fn serve(
         next_plane_id: 1,
         options,
     };
+    // iceoryx2 creates its node-counter segment world-writable: narrow it to this user.
+    files::restrict(domain);
     tracing::info!(domain, pid = std::process::id(), "physics daemon ready");
 
     let mut next_housekeeping = Instant::now() + HOUSEKEEPING;

@@ -1,0 +1,88 @@
+//! The domain's files under /dev/shm and its per-user root directory: no file of a domain is
+//! writable by another user. iceoryx2 creates its node-counter segment (`*.global_mgmt`)
+//! world-writable; the daemon narrows it to its owner, and refuses to start, with a message
+//! naming the file and its owner, when another user planted files of the domain (which
+//! would otherwise break every node of the domain with `UnableToGenerateUniqueNodeId`).
+
+use std::os::unix::fs::{MetadataExt, PermissionsExt};
+use std::path::PathBuf;
+
+use shm_layout::names;
+
+use crate::DaemonError;
+
+/// The domain's files (and the root directory) owned by another user.
+pub fn foreign(domain: &str) -> Vec<(PathBuf, u32)> {
+    // SAFETY: getuid(2) cannot fail and has no side effects.
+    let me = unsafe { libc::getuid() };
+    let mut found = Vec::new();
+    let root = PathBuf::from(names::root_path());
+    if let Ok(meta) = std::fs::metadata(&root) {
+        if meta.uid() != me {
+            found.push((root, meta.uid()));
+        }
+    }
+    for path in domain_files(domain) {
+        if let Ok(meta) = std::fs::symlink_metadata(&path) {
+            if meta.uid() != me {
+                found.push((path, meta.uid()));
+            }
+        }
+    }
+    found
+}
+
+/// Fails with a clear error when another user owns files of the domain.
+pub fn check_ownership(domain: &str) -> Result<(), DaemonError> {
+    match foreign(domain).first() {
+        None => Ok(()),
+        Some((path, uid)) => Err(DaemonError::ForeignFiles {
+            domain: domain.to_string(),
+            path: path.display().to_string(),
+            uid: *uid,
+        }),
+    }
+}
+
+/// Takes write access to the domain's files away from everyone but their owner.
+pub fn restrict(domain: &str) {
+    let root = PathBuf::from(names::root_path());
+    for path in std::iter::once(root).chain(domain_files(domain)) {
+        let Ok(meta) = std::fs::symlink_metadata(&path) else {
+            continue;
+        };
+        let mode = meta.permissions().mode();
+        if meta.file_type().is_symlink() || mode & 0o022 == 0 {
+            continue;
+        }
+        let narrowed = mode & !0o077;
+        if let Err(e) = std::fs::set_permissions(&path, PermissionsExt::from_mode(narrowed)) {
+            tracing::warn!(path = %path.display(), "cannot restrict permissions: {e}");
+        }
+    }
+}
+
+/// Files of `domain` in /dev/shm and in the root directory (one level of subdirectories).
+fn domain_files(domain: &str) -> Vec<PathBuf> {
+    let prefix = names::prefix(domain);
+    let mut found = Vec::new();
+    let mut dirs = vec![
+        (PathBuf::from("/dev/shm"), 0),
+        (PathBuf::from(names::root_path()), 0),
+    ];
+    while let Some((dir, depth)) = dirs.pop() {
+        let Ok(entries) = std::fs::read_dir(&dir) else {
+            continue;
+        };
+        for entry in entries.flatten() {
+            let path = entry.path();
+            let is_dir = entry.file_type().is_ok_and(|t| t.is_dir());
+            if is_dir && depth < 1 {
+                dirs.push((path, depth + 1));
+            } else if entry.file_name().to_string_lossy().starts_with(&prefix) {
+                found.push(path);
+            }
+        }
+    }
+    found
+}
