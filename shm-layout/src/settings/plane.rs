@@ -157,7 +157,7 @@ impl PlaneProp {
 
     /// Whether creation options `props` share the plane with other clients.
     pub fn shared_in(props: &[PlaneProp]) -> bool {
-        props.iter().any(|p| *p == PlaneProp::Shared(true))
+        props.contains(&PlaneProp::Shared(true))
     }
 
     /// Options that change the forces on resting bodies (which must then wake up).
