@@ -5,10 +5,10 @@ use std::time::Duration;
 
 use client_sdk::{PlaneOptions, Pose, Shape};
 
-use crate::bench::daemon::DaemonProcess;
-use crate::bench::error::BenchResult;
-use crate::bench::procfs::cpu_percent_over;
-use crate::bench::progress::Progress;
+use crate::daemon::DaemonProcess;
+use crate::error::BenchResult;
+use crate::procfs::cpu_percent_over;
+use crate::progress::Progress;
 
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct IdleCpu {

@@ -4,9 +4,9 @@
 use std::time::{Duration, Instant};
 
 use client_sdk::{BodyState, Handle, ObjectProp, PlaneProp, Pose, Shape, TickHeader};
-use physics_daemon::plane::Plane;
+use physics_scenes::{LocalPlane, SceneTarget};
 
-use super::error::BenchResult;
+use super::error::{BenchError, BenchResult};
 
 /// The knobs a user trades accuracy for time with.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize)]
@@ -59,13 +59,13 @@ impl Config {
 
     /// Contact gap a resting pair keeps at this quality: 0.01/q skin per collider.
     pub fn pair_gap(&self) -> f32 {
-        0.02 / self.hit_box_quality as f32
+        physics_scenes::pair_gap(self.hit_box_quality)
     }
 }
 
 /// A manual plane stepped at `config.dt()`.
 pub struct Sim {
-    pub plane: Plane,
+    pub plane: LocalPlane,
     pub config: Config,
     pub dt: f32,
     steps: u64,
@@ -84,7 +84,7 @@ impl Sim {
         ];
         all.extend_from_slice(props);
         Ok(Sim {
-            plane: Plane::new(1, 0, &all)?,
+            plane: LocalPlane::new(1, 0, &all)?,
             config,
             dt: config.dt(),
             steps: 0,
@@ -99,19 +99,6 @@ impl Sim {
         let mut all = vec![ObjectProp::HitBoxQuality(self.config.hit_box_quality)];
         all.extend_from_slice(props);
         Ok(self.plane.add_object(&shape, pose, &all)?)
-    }
-
-    /// An anchored box whose top face is at height `top`, `size` wide and deep.
-    pub fn floor(&mut self, top: f32, size: f32, props: &[ObjectProp]) -> BenchResult<Handle> {
-        let mut all = vec![ObjectProp::Anchored(true)];
-        all.extend_from_slice(props);
-        self.add(
-            Shape::Cube {
-                size: [size, 1.0, size],
-            },
-            Pose::at([0.0, top - 0.5, 0.0]),
-            &all,
-        )
     }
 
     /// One timed step.
@@ -159,6 +146,17 @@ impl Sim {
     /// Whether every body's pose and velocities are finite.
     pub fn all_finite(&self) -> bool {
         (0..self.plane.slot_count()).all(|i| self.plane.body_state(i).is_finite())
+    }
+}
+
+/// The shared scene builders add through [`Sim::add`]: every object at the config's
+/// HitBoxQuality.
+impl SceneTarget for Sim {
+    type Handle = Handle;
+    type Error = BenchError;
+
+    fn add(&mut self, shape: Shape, pose: Pose, props: &[ObjectProp]) -> BenchResult<Handle> {
+        Sim::add(self, shape, pose, props)
     }
 }
 

@@ -4,10 +4,10 @@
 
 use client_sdk::Plane;
 
-use crate::bench::daemon::DaemonProcess;
-use crate::bench::error::{BenchError, BenchResult};
-use crate::bench::scene::{Kind, Scene, DT};
-use crate::bench::stats::median;
+use crate::daemon::DaemonProcess;
+use crate::error::{BenchError, BenchResult};
+use crate::scene::{Kind, Scene, DT};
+use crate::stats::median;
 
 /// Ticks skipped before timing (the first contacts are being found).
 const SKIP: usize = 10;

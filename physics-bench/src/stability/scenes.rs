@@ -5,10 +5,11 @@
 //! contact analogue: a column of light boxes carrying a heavy one (the load runs through
 //! every light body, as it would through chain links).
 
-use client_sdk::{Handle, ObjectProp, Pin, PlaneProp, Pose, Shape};
+use client_sdk::{Handle, ObjectProp, Pin, PlaneProp, Pose};
+use physics_scenes::{ball, column, floor, launched_box, overlapping_pile, thin_wall};
 
-use crate::bench::error::BenchResult;
-use crate::bench::sim::{distance, Config, Sim};
+use crate::error::BenchResult;
+use crate::sim::{distance, Config, Sim};
 
 /// What one run of a scene measured.
 #[derive(Debug, Clone, Copy, serde::Serialize)]
@@ -213,33 +214,6 @@ pub const SCENES: &[Scene] = &[
 
 const G: f64 = 50.0;
 
-fn cube(side: f32) -> Shape {
-    Shape::Cube {
-        size: [side, side, side],
-    }
-}
-
-/// A column of `n` boxes of `side` on the floor at (x, z), each at its rest height, offset
-/// sideways by ±`jitter` alternately. Returns the boxes bottom to top.
-fn column(
-    sim: &mut Sim,
-    at: [f32; 2],
-    floor_top: f32,
-    side: f32,
-    n: usize,
-    jitter: f32,
-    props: impl Fn(usize) -> Vec<ObjectProp>,
-) -> BenchResult<Vec<Handle>> {
-    let gap = sim.config.pair_gap();
-    (0..n)
-        .map(|i| {
-            let y = floor_top + side / 2.0 + gap + i as f32 * (side + gap);
-            let dx = if i % 2 == 0 { jitter } else { -jitter };
-            sim.add(cube(side), Pose::at([at[0] + dx, y, at[1]]), &props(i))
-        })
-        .collect()
-}
-
 /// Largest sideways (x, z) distance between two positions.
 fn sideways(a: [f32; 3], b: [f32; 3]) -> f64 {
     distance([a[0], 0.0, a[2]], [b[0], 0.0, b[2]])
@@ -249,8 +223,8 @@ fn sideways(a: [f32; 3], b: [f32; 3]) -> f64 {
 /// more than half a box: the stack fell).
 pub fn stack(c: Config, n: usize, seconds: f32) -> BenchResult<Check> {
     let mut sim = Sim::new(c, &[])?;
-    sim.floor(0.0, 100.0, &[])?;
-    let boxes = column(&mut sim, [0.0, 0.0], 0.0, 1.0, n, 0.01, |_| vec![])?;
+    floor(&mut sim, 100.0, &[])?;
+    let boxes = column(&mut sim, [0.0; 3], 1.0, n, 0.01, c.pair_gap(), |_| vec![])?;
     let top = *boxes.last().expect("n > 0");
     let start = sim.state(top).position;
     sim.run_for(seconds)?;
@@ -265,21 +239,9 @@ pub fn stack(c: Config, n: usize, seconds: f32) -> BenchResult<Check> {
 }
 
 fn pyramid(c: Config) -> BenchResult<Check> {
-    let base = 20;
     let mut sim = Sim::new(c, &[])?;
-    sim.floor(0.0, 100.0, &[])?;
-    let gap = c.pair_gap();
-    // Side gaps larger than the contact gap: neighbours in a row do not touch.
-    let pitch = 1.0 + gap + 0.03;
-    let mut boxes = Vec::new();
-    for row in 0..base {
-        let count = base - row;
-        let x0 = -(count as f32 - 1.0) * pitch / 2.0;
-        let y = 0.5 + gap + row as f32 * (1.0 + gap);
-        for i in 0..count {
-            boxes.push(sim.add(cube(1.0), Pose::at([x0 + i as f32 * pitch, y, 0.0]), &[])?);
-        }
-    }
+    floor(&mut sim, 100.0, &[])?;
+    let boxes = physics_scenes::pyramid(&mut sim, 20, c.pair_gap())?;
     sim.run_for(1.0)?;
     let settled: Vec<[f32; 3]> = boxes.iter().map(|h| sim.state(*h).position).collect();
     sim.run_for(9.0)?;
@@ -295,8 +257,8 @@ fn pyramid(c: Config) -> BenchResult<Check> {
 /// heavy box sank below its rest height after 3 s (∞ when it fell off).
 pub fn heavy_on_light(c: Config, ratio: f64, light: usize) -> BenchResult<Check> {
     let mut sim = Sim::new(c, &[])?;
-    sim.floor(0.0, 100.0, &[])?;
-    let boxes = column(&mut sim, [0.0, 0.0], 0.0, 1.0, light + 1, 0.0, |i| {
+    floor(&mut sim, 100.0, &[])?;
+    let boxes = column(&mut sim, [0.0; 3], 1.0, light + 1, 0.0, c.pair_gap(), |i| {
         if i == light {
             vec![ObjectProp::Weight(ratio as f32)]
         } else {
@@ -320,18 +282,8 @@ pub fn heavy_on_light(c: Config, ratio: f64, light: usize) -> BenchResult<Check>
 /// half-size and contact gap (≤ 0: it stayed in front).
 pub fn fast_box(c: Config, speed: f64) -> BenchResult<Check> {
     let mut sim = Sim::new(c, &[PlaneProp::Gravity([0.0; 3])])?;
-    sim.add(
-        Shape::Cube {
-            size: [0.1, 10.0, 10.0],
-        },
-        Pose::at([0.05, 0.0, 0.0]),
-        &[ObjectProp::Anchored(true)],
-    )?;
-    let b = sim.add(
-        cube(0.5),
-        Pose::at([-30.0, 0.0, 0.0]),
-        &[ObjectProp::Velocity([speed as f32, 0.0, 0.0])],
-    )?;
+    thin_wall(&mut sim, &[])?;
+    let b = launched_box(&mut sim, -30.0, speed as f32, &[])?;
     sim.run_for(1.0)?;
     let x = sim.state(b).position[0] as f64;
     let past = x + 0.25;
@@ -341,11 +293,7 @@ pub fn fast_box(c: Config, speed: f64) -> BenchResult<Check> {
 
 fn speed_cap(c: Config) -> BenchResult<Check> {
     let mut sim = Sim::new(c, &[PlaneProp::Gravity([0.0; 3])])?;
-    let b = sim.add(
-        cube(0.5),
-        Pose::at([0.0; 3]),
-        &[ObjectProp::Velocity([1000.0, 0.0, 0.0])],
-    )?;
+    let b = launched_box(&mut sim, 0.0, 1000.0, &[])?;
     sim.step()?;
     let v = sim.state(b).linear_velocity;
     let speed = distance(v, [0.0; 3]);
@@ -354,18 +302,8 @@ fn speed_cap(c: Config) -> BenchResult<Check> {
 
 fn overlap(c: Config) -> BenchResult<Check> {
     let mut sim = Sim::new(c, &[])?;
-    sim.floor(0.0, 100.0, &[])?;
-    // Unit boxes 0.75 apart on every axis: each overlaps its neighbours by 25 %.
-    let pitch = 0.75;
-    let mut boxes = Vec::new();
-    for i in 0..3 {
-        for j in 0..3 {
-            for k in 0..3 {
-                let p = [i as f32 * pitch, 0.5 + j as f32 * pitch, k as f32 * pitch];
-                boxes.push(sim.add(cube(1.0), Pose::at(p), &[])?);
-            }
-        }
-    }
+    floor(&mut sim, 100.0, &[])?;
+    let boxes = overlapping_pile(&mut sim)?;
     let mut fastest = 0.0f64;
     for _ in 0..sim.steps_for(3.0) {
         sim.step()?;
@@ -391,31 +329,9 @@ fn stack_and_ball_at(
 ) -> BenchResult<Check> {
     let mut sim = Sim::new(c, &[])?;
     let [ox, oy, oz] = origin;
-    sim.add(
-        Shape::Cube {
-            size: [100.0 * side, side, 100.0 * side],
-        },
-        Pose::at([ox, oy - side / 2.0, oz]),
-        &[ObjectProp::Anchored(true)],
-    )?;
-    let boxes = column(
-        &mut sim,
-        [ox, oz],
-        oy,
-        side,
-        if side < 1.0 { 3 } else { 5 },
-        0.0,
-        |_| vec![],
-    )?;
-    let ball = sim.add(
-        Shape::Sphere { radius: side / 2.0 },
-        Pose::at([
-            ox + 10.0 * side,
-            oy + if side < 1.0 { 1.0 } else { 5.0 },
-            oz,
-        ]),
-        &[],
-    )?;
+    let (n, drop) = if side < 1.0 { (3, 1.0) } else { (5, 5.0) };
+    let built = physics_scenes::stack_and_ball(&mut sim, origin, side, n, drop, c.pair_gap(), &[])?;
+    let (boxes, ball) = (built.boxes, built.ball);
     sim.run_for(1.0)?;
     let settled: Vec<[f32; 3]> = boxes.iter().map(|h| sim.state(*h).position).collect();
     sim.run_for(seconds - 1.0)?;
@@ -445,11 +361,7 @@ fn stack_and_ball(c: Config) -> BenchResult<Check> {
 }
 
 fn falling_ball(sim: &mut Sim) -> BenchResult<Handle> {
-    sim.add(
-        Shape::Sphere { radius: 0.5 },
-        Pose::at([0.0, 100.0, 0.0]),
-        &[],
-    )
+    ball(sim, [0.0, 100.0, 0.0], &[])
 }
 
 fn extreme_drag(c: Config) -> BenchResult<Check> {
@@ -502,11 +414,7 @@ fn extreme_constant_force(c: Config) -> BenchResult<Check> {
 
 fn extreme_pin(c: Config) -> BenchResult<Check> {
     let mut sim = Sim::new(c, &[])?;
-    let b = sim.add(
-        Shape::Sphere { radius: 0.5 },
-        Pose::at([0.0, 10.0, 0.0]),
-        &[],
-    )?;
+    let b = ball(&mut sim, [0.0, 10.0, 0.0], &[])?;
     let target = [10.0, 10.0, 0.0];
     sim.plane.set_object(
         b,

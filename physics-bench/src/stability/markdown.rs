@@ -4,9 +4,9 @@
 use std::fmt::Write as _;
 
 use super::Entry;
-use crate::bench::accuracy::markdown::sci;
-use crate::bench::report::Table;
-use crate::bench::sim::Config;
+use crate::accuracy::markdown::sci;
+use crate::report::Table;
+use crate::sim::Config;
 
 pub fn render(entries: &[Entry]) -> String {
     let mut md = String::from("# Stability: stiff and extreme scenes\n\n");

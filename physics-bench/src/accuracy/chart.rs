@@ -8,7 +8,7 @@ use plotters::prelude::*;
 
 use super::sweep::Family;
 use super::Point;
-use crate::bench::error::{BenchError, BenchResult};
+use crate::error::{BenchError, BenchResult};
 
 const COLORS: [RGBColor; 3] = [
     RGBColor(31, 119, 180),

@@ -7,10 +7,11 @@
 //! include that gap; a pair's friction is `sqrt(a·b)`, so both sides carry the same μ.
 
 use client_sdk::{ObjectProp, PlaneProp, Pose, Shape};
+use physics_scenes::{anchored_box, ball, column, cube, floor};
 use rapier3d::glamx::{DQuat, DVec3};
 
-use crate::bench::error::BenchResult;
-use crate::bench::sim::{about_z, distance, Config, Sim};
+use crate::error::BenchResult;
+use crate::sim::{about_z, distance, Config, Sim};
 
 const G: f64 = 50.0;
 
@@ -98,16 +99,6 @@ const UNDAMPED: [PlaneProp; 2] = [
     PlaneProp::AngularDamping(0.0),
 ];
 
-fn ball() -> Shape {
-    Shape::Sphere { radius: 0.5 }
-}
-
-fn unit_box() -> Shape {
-    Shape::Cube {
-        size: [1.0, 1.0, 1.0],
-    }
-}
-
 fn outcome(sim: &Sim, error: f64) -> BenchResult<Outcome> {
     Ok(Outcome {
         error: if sim.went_nonfinite { f64::NAN } else { error },
@@ -118,7 +109,7 @@ fn outcome(sim: &Sim, error: f64) -> BenchResult<Outcome> {
 fn free_fall(c: Config) -> BenchResult<Outcome> {
     let mut sim = Sim::new(c, &UNDAMPED)?;
     let y0 = 1000.0;
-    let b = sim.add(ball(), Pose::at([0.0, y0 as f32, 0.0]), &[])?;
+    let b = ball(&mut sim, [0.0, y0 as f32, 0.0], &[])?;
     for _ in 0..sim.steps_for(2.0) {
         sim.step()?;
     }
@@ -138,7 +129,7 @@ fn projectile_damping(c: Config) -> BenchResult<Outcome> {
     )?;
     let x0 = [0.0, 1000.0, 0.0];
     let v0 = [20.0, 30.0, 0.0];
-    let b = sim.add(ball(), Pose::at(x0), &[ObjectProp::Velocity(v0)])?;
+    let b = ball(&mut sim, x0, &[ObjectProp::Velocity(v0)])?;
     for _ in 0..sim.steps_for(2.0) {
         sim.step()?;
     }
@@ -160,7 +151,7 @@ fn terminal_velocity(c: Config) -> BenchResult<Outcome> {
     let mut props = UNDAMPED.to_vec();
     props.push(PlaneProp::Drag(drag as f32));
     let mut sim = Sim::new(c, &props)?;
-    let b = sim.add(ball(), Pose::at([0.0, 1000.0, 0.0]), &[])?;
+    let b = ball(&mut sim, [0.0, 1000.0, 0.0], &[])?;
     // m·dv/dt = m·g − Drag·v² from rest (m = 1): v = v_t·tanh(g·t/v_t), v_t = sqrt(g/Drag).
     let vt = (G / drag).sqrt();
     let mut worst = 0.0f64;
@@ -176,11 +167,11 @@ fn bouncing_ball(c: Config) -> BenchResult<Outcome> {
     let e = 0.8f64;
     let h0 = 10.0f64;
     let mut sim = Sim::new(c, &UNDAMPED)?;
-    sim.floor(0.0, 50.0, &[])?;
+    floor(&mut sim, 50.0, &[])?;
     let rest = 0.5 + c.pair_gap() as f64;
-    let b = sim.add(
-        ball(),
-        Pose::at([0.0, (rest + h0) as f32, 0.0]),
+    let b = ball(
+        &mut sim,
+        [0.0, (rest + h0) as f32, 0.0],
         &[ObjectProp::Bounciness(e as f32)],
     )?;
     // Apex = highest sampled height of each rising-then-falling phase after a bounce.
@@ -218,10 +209,10 @@ fn friction(mu: f64) -> ObjectProp {
 fn sliding_block(c: Config) -> BenchResult<Outcome> {
     let (mu, v0) = (0.5f64, 10.0f64);
     let mut sim = Sim::new(c, &UNDAMPED)?;
-    sim.floor(0.0, 100.0, &[friction(mu)])?;
+    floor(&mut sim, 100.0, &[friction(mu)])?;
     let y = 0.5 + c.pair_gap();
     let b = sim.add(
-        unit_box(),
+        cube(1.0),
         Pose::at([0.0, y, 0.0]),
         &[friction(mu), ObjectProp::Velocity([v0 as f32, 0.0, 0.0])],
     )?;
@@ -245,19 +236,18 @@ fn incline(sim: &mut Sim, theta: f64, mu: f64) -> BenchResult<(client_sdk::Handl
         let p: Vec<f32> = normal.iter().map(|n| (n * d) as f32).collect();
         [p[0], p[1], p[2]]
     };
-    sim.add(
-        Shape::Cube {
-            size: [60.0, 1.0, 10.0],
-        },
+    anchored_box(
+        sim,
+        [60.0, 1.0, 10.0],
         Pose {
             position: at(-0.5),
             rotation,
         },
-        &[ObjectProp::Anchored(true), friction(mu)],
+        &[friction(mu)],
     )?;
     let gap = sim.config.pair_gap() as f64;
     let b = sim.add(
-        unit_box(),
+        cube(1.0),
         Pose {
             position: at(0.5 + gap),
             rotation,
@@ -348,13 +338,8 @@ fn momentum_energy(s: &client_sdk::BodyState, inertia: [f64; 3]) -> (DVec3, f64)
 /// skin, and 3 s) and the deepest penetration seen over the 3 s.
 fn resting_stack(c: Config) -> BenchResult<(Sim, f64, f64)> {
     let mut sim = Sim::new(c, &[])?;
-    sim.floor(0.0, 50.0, &[])?;
-    let gap = c.pair_gap();
-    let mut boxes = Vec::new();
-    for i in 0..5 {
-        let y = 0.5 + gap + i as f32 * (1.0 + gap);
-        boxes.push(sim.add(unit_box(), Pose::at([0.0, y, 0.0]), &[])?);
-    }
+    floor(&mut sim, 50.0, &[])?;
+    let boxes = column(&mut sim, [0.0; 3], 1.0, 5, 0.0, c.pair_gap(), |_| vec![])?;
     let mut deepest = 0.0f64;
     let mut settled = Vec::new();
     for _ in 0..sim.steps_for(3.0) {

@@ -6,10 +6,10 @@ use std::io::{Read, Write};
 use std::os::unix::net::UnixStream;
 use std::time::Duration;
 
-use physics_daemon::plane::Plane as LocalPlane;
+use physics_scenes::LocalPlane;
 use shm_layout::monotonic_ns;
 
-use crate::bench::error::{BenchError, BenchResult};
+use crate::error::{BenchError, BenchResult};
 
 /// What a typical state message carries per body.
 #[derive(Debug, Clone, Copy, serde::Serialize, serde::Deserialize)]

@@ -6,9 +6,31 @@
 //! `physics-bench accuracy [--quick] [--out DIR]` writes DIR/accuracy.json, DIR/accuracy.md
 //! and DIR/accuracy-*.svg: error against cost of reference scenes, in process.
 //! `physics-bench stability [--out DIR]` writes DIR/stability.json and DIR/stability.md.
+//!
+//! Its parts, shared by the subcommands:
+//!
+//! - [`daemon`]: real daemon processes in throw-away domains.
+//! - [`procfs`]: CPU time, RSS and shared-memory size of a process / domain.
+//! - [`scene`]: the benchmark scenes, built identically in the daemon and in process.
+//! - [`stats`]: medians and percentiles.
+//! - [`progress`]: the progress bar and its log lines.
+//! - [`report`]: writing the JSON and markdown reports.
+//! - [`ipc`]: the `ipc` subcommand (daemon overhead, delivery, requests, idle, memory).
+//! - [`sim`]: an in-process plane stepped at a fixed dt with its step time accumulated.
+//! - [`accuracy`]: the `accuracy` subcommand (error against run time).
+//! - [`stability`]: the `stability` subcommand (stiff and extreme scenes, pass/fail).
 
-#[path = "../bench/mod.rs"]
-mod bench;
+mod accuracy;
+mod daemon;
+mod error;
+mod ipc;
+mod procfs;
+mod progress;
+mod report;
+mod scene;
+mod sim;
+mod stability;
+mod stats;
 
 use std::process::ExitCode;
 
@@ -25,13 +47,13 @@ struct Cli {
 enum Bench {
     /// Daemon overhead over in-process rapier, zero-copy vs socket delivery, request round
     /// trips, threads, idle CPU and memory.
-    Ipc(bench::ipc::IpcArgs),
+    Ipc(ipc::IpcArgs),
     /// Error against run time on reference scenes with exact answers, swept over TickRate,
     /// SolverIterations / LoopSolver and HitBoxQuality.
-    Accuracy(bench::accuracy::AccuracyArgs),
+    Accuracy(accuracy::AccuracyArgs),
     /// Stress scenes (tall stacks, mass ratios, fast bodies, overlap, far from the origin,
     /// tiny objects, extreme forces and tick rates), each with a pass criterion.
-    Stability(bench::stability::StabilityArgs),
+    Stability(stability::StabilityArgs),
 }
 
 fn main() -> ExitCode {
@@ -47,9 +69,9 @@ fn main() -> ExitCode {
         .num_threads(1)
         .build_global();
     let result = match &cli.command {
-        Bench::Ipc(args) => bench::ipc::run(args),
-        Bench::Accuracy(args) => bench::accuracy::run(args),
-        Bench::Stability(args) => bench::stability::run(args),
+        Bench::Ipc(args) => ipc::run(args),
+        Bench::Accuracy(args) => accuracy::run(args),
+        Bench::Stability(args) => stability::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -24,7 +24,7 @@ pub fn mark(points: &mut [Point]) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::bench::sim::Config;
+    use crate::sim::Config;
 
     fn point(error: f64, cost: f64) -> Point {
         Point {

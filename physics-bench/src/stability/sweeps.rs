@@ -2,8 +2,8 @@
 //! that still pass, at the defaults and at the strongest configuration.
 
 use super::scenes::{fast_box, heavy_on_light, stack, Check};
-use crate::bench::error::BenchResult;
-use crate::bench::sim::Config;
+use crate::error::BenchResult;
+use crate::sim::Config;
 
 pub struct Sweep {
     pub name: &'static str,

@@ -6,17 +6,17 @@ use std::time::{Duration, Instant};
 
 use client_sdk::{PlaneProp, Snapshot};
 use iceoryx2::prelude::*;
-use physics_daemon::plane::Plane as LocalPlane;
 use physics_daemon::publish::PlaneOutput;
+use physics_scenes::LocalPlane;
 use shm_layout::{monotonic_ns, names};
 
 use super::{socket, Plan};
-use crate::bench::daemon::{unique_domain, DaemonProcess};
-use crate::bench::error::{BenchError, BenchResult};
-use crate::bench::procfs;
-use crate::bench::progress::Progress;
-use crate::bench::scene::{asleep_fraction, touch, Kind, Scene, DT};
-use crate::bench::stats::median;
+use crate::daemon::{unique_domain, DaemonProcess};
+use crate::error::{BenchError, BenchResult};
+use crate::procfs;
+use crate::progress::Progress;
+use crate::scene::{asleep_fraction, touch, Kind, Scene, DT};
+use crate::stats::median;
 
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct Overhead {
@@ -74,7 +74,7 @@ pub struct Memory {
 /// Round trips and batches, measured on the plane of one scene.
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct Requests {
-    pub round_trip_us: crate::bench::stats::Spread,
+    pub round_trip_us: crate::stats::Spread,
     pub round_trips: usize,
     pub batched_writes_per_s: f64,
     pub batch_size: usize,
@@ -340,7 +340,7 @@ fn requests(
         rates.push(plan.batch_size as f64 / started.elapsed().as_secs_f64());
     }
     Ok(Requests {
-        round_trip_us: crate::bench::stats::spread(&round_trips)
+        round_trip_us: crate::stats::spread(&round_trips)
             .ok_or_else(|| BenchError::Failed("no round trip was measured".into()))?,
         round_trips: plan.round_trips,
         batched_writes_per_s: median(&rates).unwrap_or(f64::NAN),

@@ -1,7 +1,7 @@
 //! Which configurations run: families that vary one knob with the others at their defaults,
 //! and (outside `--quick`) the full cross product.
 
-use crate::bench::sim::Config;
+use crate::sim::Config;
 
 pub const TICK_RATES: [u32; 5] = [30, 60, 120, 240, 480];
 /// 64 is LoopSolver (which pins 64 iterations).

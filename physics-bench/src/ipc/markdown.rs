@@ -4,8 +4,8 @@ use std::collections::BTreeMap;
 use std::fmt::Write as _;
 
 use super::{IpcReport, GOAL_BODIES};
-use crate::bench::report::{num, verdict, Table};
-use crate::bench::scene::Kind;
+use crate::report::{num, verdict, Table};
+use crate::scene::Kind;
 
 /// How each figure is obtained (also stored in the JSON).
 pub fn method() -> BTreeMap<&'static str, &'static str> {

@@ -1,5 +1,5 @@
 //! `physics-bench accuracy`: error against run time. Reference scenes with exact answers run
-//! in process through the daemon's own plane code (`physics_daemon::plane::Plane`, what the
+//! in process through the daemon's own plane code (`physics_scenes::LocalPlane`, what the
 //! daemon steps), so the cost is the step calls alone, without IPC.
 
 mod chart;

@@ -2,19 +2,13 @@
 //! a daemon plane (through the client) and in an in-process plane (the daemon's own plane
 //! code), so both sides step exactly the same world with exactly the same settings.
 
-use client_sdk::{BodyState, ObjectProp, PlaneProp, Pose, Shape};
-use physics_daemon::plane::Plane as LocalPlane;
+use client_sdk::{BodyState, PlaneProp};
+use physics_scenes::{LocalPlane, SceneTarget};
 
 use super::error::BenchResult;
 
 /// Every tick advances by the same dt: rapier's sleep logic wants a fixed step.
 pub const DT: f32 = 1.0 / 60.0;
-/// Cubes per column of the pile.
-const PILE_HEIGHT: usize = 5;
-/// Distance between pile columns (cubes are 1 unit wide; columns do not touch).
-const PILE_SPACING: f32 = 1.25;
-/// Distance between free-flying bodies.
-const FREE_SPACING: f32 = 3.0;
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, serde::Serialize)]
 #[serde(rename_all = "lowercase")]
@@ -43,13 +37,6 @@ pub struct Scene {
     pub bodies: usize,
 }
 
-/// One object to create.
-pub struct Spawn {
-    pub shape: Shape,
-    pub pose: Pose,
-    pub props: Vec<ObjectProp>,
-}
-
 impl Scene {
     /// Manual planes: the bench decides when a tick happens.
     pub fn plane_props(&self, threads: u32) -> Vec<PlaneProp> {
@@ -69,62 +56,18 @@ impl Scene {
         }
     }
 
-    pub fn spawns(&self) -> Vec<Spawn> {
+    /// The scene's objects, added to `target` (the pile's floor first).
+    fn build<T: SceneTarget>(&self, target: &mut T) -> Result<Vec<T::Handle>, T::Error> {
         match self.kind {
-            Kind::Pile => self.pile(),
-            Kind::Free => self.free(),
+            Kind::Pile => physics_scenes::pile(target, self.bodies),
+            Kind::Free => physics_scenes::free_bodies(target, self.bodies),
         }
-    }
-
-    fn pile(&self) -> Vec<Spawn> {
-        let columns = self.bodies.div_ceil(PILE_HEIGHT);
-        let side = (columns as f64).sqrt().ceil() as usize;
-        let width = side as f32 * PILE_SPACING;
-        let mut out = Vec::with_capacity(self.bodies + 1);
-        out.push(Spawn {
-            shape: Shape::Cube {
-                size: [width + 2.0, 1.0, width + 2.0],
-            },
-            pose: Pose::at([width / 2.0, -0.5, width / 2.0]),
-            props: vec![ObjectProp::Anchored(true)],
-        });
-        for i in 0..self.bodies {
-            let (column, layer) = (i / PILE_HEIGHT, i % PILE_HEIGHT);
-            let x = (column % side) as f32 * PILE_SPACING + 0.5;
-            let z = (column / side) as f32 * PILE_SPACING + 0.5;
-            out.push(Spawn {
-                shape: Shape::Cube { size: [1.0; 3] },
-                pose: Pose::at([x, 0.5 + layer as f32, z]),
-                props: Vec::new(),
-            });
-        }
-        out
-    }
-
-    fn free(&self) -> Vec<Spawn> {
-        let side = (self.bodies as f64).cbrt().ceil() as usize;
-        let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
-        (0..self.bodies)
-            .map(|i| {
-                let (x, y, z) = (i % side, (i / side) % side, i / (side * side));
-                Spawn {
-                    shape: Shape::Cube { size: [1.0; 3] },
-                    pose: Pose::at([x as f32, y as f32, z as f32].map(|c| c * FREE_SPACING)),
-                    props: vec![
-                        ObjectProp::Velocity([rng.unit(), rng.unit(), rng.unit()]),
-                        ObjectProp::AngularVelocity([rng.unit(), rng.unit(), rng.unit()]),
-                    ],
-                }
-            })
-            .collect()
     }
 
     /// The same scene in process, with the daemon's own plane code.
     pub fn build_local(&self, threads: u32) -> BenchResult<LocalPlane> {
         let mut plane = LocalPlane::new(1, 0, &self.plane_props(threads))?;
-        for s in self.spawns() {
-            plane.add_object(&s.shape, s.pose, &s.props)?;
-        }
+        self.build(&mut plane)?;
         Ok(plane)
     }
 
@@ -145,10 +88,7 @@ impl Scene {
             ..Default::default()
         };
         let plane = client.create_plane(&options)?;
-        let mut objects = Vec::with_capacity(self.bodies + 1);
-        for s in self.spawns() {
-            objects.push(plane.add(s.shape, s.pose, &s.props)?);
-        }
+        let objects = self.build(&mut &plane)?;
         Ok((plane, objects))
     }
 }
@@ -174,46 +114,21 @@ pub fn asleep_fraction(bodies: &[BodyState]) -> f64 {
     }
 }
 
-/// xorshift64*: deterministic velocities without a dependency.
-struct Rng(u64);
-
-impl Rng {
-    /// Uniform in [-1, 1).
-    fn unit(&mut self) -> f32 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        let bits = self.0.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 40;
-        bits as f32 / (1u64 << 23) as f32 - 1.0
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use physics_scenes::Spawn;
 
     #[test]
     fn scenes_have_the_asked_body_count() {
         for n in [1, 7, 100, 1000] {
-            let pile = Scene {
-                kind: Kind::Pile,
-                bodies: n,
+            let count = |kind| {
+                let mut spawns: Vec<Spawn> = Vec::new();
+                let _ = Scene { kind, bodies: n }.build(&mut spawns);
+                spawns.len()
             };
-            assert_eq!(pile.spawns().len(), n + 1, "pile has a floor on top");
-            let free = Scene {
-                kind: Kind::Free,
-                bodies: n,
-            };
-            assert_eq!(free.spawns().len(), n);
-        }
-    }
-
-    #[test]
-    fn random_velocities_stay_in_range() {
-        let mut rng = Rng(1);
-        for _ in 0..10_000 {
-            let v = rng.unit();
-            assert!((-1.0..1.0).contains(&v), "{v}");
+            assert_eq!(count(Kind::Pile), n + 1, "pile has a floor on top");
+            assert_eq!(count(Kind::Free), n);
         }
     }
 }

@@ -4,7 +4,7 @@
 use std::fmt::Write as _;
 
 use super::{scene_info, Point};
-use crate::bench::report::Table;
+use crate::report::Table;
 
 /// Three significant digits, scientific: errors and costs span many decades.
 pub fn sci(v: f64) -> String {
