@@ -203,17 +203,11 @@ impl Scene {
 
     /// An anchored 200 × 1 × 200 slab whose top face is y = 0.
     pub fn floor(&self) -> client_sdk::Object {
-        self.anchored_box([200.0, 1.0, 200.0], client_sdk::Pose::at([0.0, -0.5, 0.0]))
+        physics_scenes::floor(&mut &self.plane, 200.0, &[]).expect("add floor")
     }
 
     pub fn anchored_box(&self, size: [f32; 3], pose: client_sdk::Pose) -> client_sdk::Object {
-        self.plane
-            .add(
-                client_sdk::Shape::Cube { size },
-                pose,
-                &[client_sdk::ObjectProp::Anchored(true)],
-            )
-            .expect("add anchored box")
+        physics_scenes::anchored_box(&mut &self.plane, size, pose, &[]).expect("add anchored box")
     }
 
     /// Steps `n` times by `dt`.

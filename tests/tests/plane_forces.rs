@@ -1,17 +1,14 @@
 //! Plane-wide forces against closed forms: LinearDamping, Drag, Buoyancy, ConstantForce,
 //! live Gravity. Gravity is the default (0, -50, 0) unless a test says otherwise.
 
-use client_sdk::{ObjectProp, PlaneOptions, PlaneProp, Pose, Shape};
+use client_sdk::{ObjectProp, PlaneOptions, PlaneProp};
 use integration_tests::Scene;
 
 const G: f32 = 50.0;
 
 /// A ball of radius 0.5 at `x`, `y`; tests keep balls 5 apart so they never touch.
 fn ball(scene: &Scene, x: f32, y: f32, props: &[ObjectProp]) -> client_sdk::Object {
-    scene
-        .plane
-        .add(Shape::Sphere { radius: 0.5 }, Pose::at([x, y, 0.0]), props)
-        .unwrap()
+    physics_scenes::ball(&mut &scene.plane, [x, y, 0.0], props).unwrap()
 }
 
 #[test]
@@ -212,10 +209,7 @@ fn a_threaded_plane_simulates_the_same_physics() {
         let balls: Vec<_> = (0..100)
             .map(|i| {
                 let (x, z) = ((i % 10) as f32 * 1.5, (i / 10) as f32 * 1.5);
-                scene
-                    .plane
-                    .add(Shape::Sphere { radius: 0.5 }, Pose::at([x, 5.0, z]), &[])
-                    .unwrap()
+                physics_scenes::ball(&mut &scene.plane, [x, 5.0, z], &[]).unwrap()
             })
             .collect();
         scene.run(1.0 / 60.0, 60);

@@ -3,14 +3,12 @@
 //! The full sweeps (tallest stack, largest mass ratio, highest speed) are in
 //! `physics-bench stability`.
 
-use client_sdk::{BodyState, Object, ObjectProp, Pin, PlaneOptions, Pose, Shape};
+use client_sdk::{BodyState, Object, ObjectProp, Pin, PlaneOptions, Pose};
 use integration_tests::Scene;
-
-fn cube(side: f32) -> Shape {
-    Shape::Cube {
-        size: [side, side, side],
-    }
-}
+use physics_scenes::{
+    ball, column, floor, launched_box, overlapping_pile, pair_gap, pyramid, stack_and_ball,
+    thin_wall,
+};
 
 /// Steps `n` times, asserting after each step that every body is finite.
 fn run_finite(scene: &Scene, dt: f32, n: u32) {
@@ -24,46 +22,40 @@ fn run_finite(scene: &Scene, dt: f32, n: u32) {
     }
 }
 
-/// A column of `n` boxes of `side` on a floor whose top is at `floor_y`, each placed at its
-/// rest height (a resting pair keeps 0.02/q apart), x offset alternating ±`jitter`.
-fn column(
+/// A column of `n` unit boxes at HitBoxQuality `quality` on a floor whose top is y = 0, each
+/// placed at its rest height, x offset alternating ±`jitter`; box `i` also gets `props(i)`.
+fn quality_column(
     scene: &Scene,
-    at: [f32; 3],
-    side: f32,
     n: usize,
     jitter: f32,
     quality: u32,
     props: impl Fn(usize) -> Vec<ObjectProp>,
 ) -> Vec<Object> {
-    let gap = 0.02 / quality as f32;
-    (0..n)
-        .map(|i| {
-            let y = at[1] + side / 2.0 + gap + i as f32 * (side + gap);
-            let dx = if i % 2 == 0 { jitter } else { -jitter };
-            let mut all = vec![ObjectProp::HitBoxQuality(quality)];
-            all.extend(props(i));
-            scene
-                .plane
-                .add(cube(side), Pose::at([at[0] + dx, y, at[2]]), &all)
-                .unwrap()
-        })
-        .collect()
+    let with_quality = |i| {
+        let mut all = vec![ObjectProp::HitBoxQuality(quality)];
+        all.extend(props(i));
+        all
+    };
+    column(
+        &mut &scene.plane,
+        [0.0; 3],
+        1.0,
+        n,
+        jitter,
+        pair_gap(quality),
+        with_quality,
+    )
+    .unwrap()
 }
 
-fn floor(scene: &Scene, quality: u32) {
-    scene
-        .plane
-        .add(
-            Shape::Cube {
-                size: [100.0, 1.0, 100.0],
-            },
-            Pose::at([0.0, -0.5, 0.0]),
-            &[
-                ObjectProp::Anchored(true),
-                ObjectProp::HitBoxQuality(quality),
-            ],
-        )
-        .unwrap();
+/// The 100-wide floor at HitBoxQuality `quality`.
+fn quality_floor(scene: &Scene, quality: u32) {
+    floor(
+        &mut &scene.plane,
+        100.0,
+        &[ObjectProp::HitBoxQuality(quality)],
+    )
+    .unwrap();
 }
 
 fn sideways(a: [f32; 3], b: [f32; 3]) -> f32 {
@@ -82,8 +74,8 @@ fn fifteen_box_stack_stands_ten_seconds() {
     // rotation locked (quality 1, the default) and free (quality 4).
     for quality in [1, 4] {
         let scene = Scene::new("stack15", PlaneOptions::default());
-        floor(&scene, quality);
-        let boxes = column(&scene, [0.0; 3], 1.0, 15, 0.01, quality, |_| vec![]);
+        quality_floor(&scene, quality);
+        let boxes = quality_column(&scene, 15, 0.01, quality, |_| vec![]);
         let top = boxes.last().unwrap();
         let start = top.position().unwrap();
         run_finite(&scene, DT, 600);
@@ -102,18 +94,9 @@ fn pyramid_of_base_twenty_stands_ten_seconds() {
     // Criterion: no box moves more than 0.1 between t = 1 s (settled into the contact skin)
     // and t = 10 s.
     let scene = Scene::new("pyramid", PlaneOptions::default());
-    floor(&scene, 1);
-    let pitch = 1.05; // neighbours in a row do not touch
-    let mut boxes = Vec::new();
-    for row in 0..20 {
-        let count = 20 - row;
-        let x0 = -(count as f32 - 1.0) * pitch / 2.0;
-        let y = 0.52 + row as f32 * 1.02;
-        for i in 0..count {
-            let at = Pose::at([x0 + i as f32 * pitch, y, 0.0]);
-            boxes.push(scene.plane.add(cube(1.0), at, &[]).unwrap());
-        }
-    }
+    quality_floor(&scene, 1);
+    // Rows 0.02 apart (their rest height), neighbours in a row 1.05 apart: they do not touch.
+    let boxes = pyramid(&mut &scene.plane, 20, pair_gap(1)).unwrap();
     assert_eq!(boxes.len(), 210);
     run_finite(&scene, DT, 60);
     let settled: Vec<_> = boxes.iter().map(|b| b.position().unwrap()).collect();
@@ -130,8 +113,8 @@ fn pyramid_of_base_twenty_stands_ten_seconds() {
 /// rest height in 3 s.
 fn heavy_box_sink(ratio: f32, light: usize, quality: u32) -> f32 {
     let scene = Scene::new("ratio", PlaneOptions::default());
-    floor(&scene, quality);
-    let boxes = column(&scene, [0.0; 3], 1.0, light + 1, 0.0, quality, |i| {
+    quality_floor(&scene, quality);
+    let boxes = quality_column(&scene, light + 1, 0.0, quality, |i| {
         if i == light {
             vec![ObjectProp::Weight(ratio)]
         } else {
@@ -170,24 +153,8 @@ fn fast_box_past_wall(speed: f32, quality: u32) -> f32 {
         },
     );
     let q = ObjectProp::HitBoxQuality(quality);
-    scene
-        .plane
-        .add(
-            Shape::Cube {
-                size: [0.1, 10.0, 10.0],
-            },
-            Pose::at([0.05, 0.0, 0.0]),
-            &[ObjectProp::Anchored(true), q],
-        )
-        .unwrap();
-    let b = scene
-        .plane
-        .add(
-            cube(0.5),
-            Pose::at([-30.0, 0.0, 0.0]),
-            &[q, ObjectProp::Velocity([speed, 0.0, 0.0])],
-        )
-        .unwrap();
+    thin_wall(&mut &scene.plane, &[q]).unwrap();
+    let b = launched_box(&mut &scene.plane, -30.0, speed, &[q]).unwrap();
     run_finite(&scene, DT, 60);
     b.position().unwrap()[0] + 0.25
 }
@@ -213,14 +180,7 @@ fn linear_speed_is_capped_at_400() {
             ..Default::default()
         },
     );
-    let b = scene
-        .plane
-        .add(
-            cube(0.5),
-            Pose::at([0.0; 3]),
-            &[ObjectProp::Velocity([1000.0, 0.0, 0.0])],
-        )
-        .unwrap();
+    let b = launched_box(&mut &scene.plane, 0.0, 1000.0, &[]).unwrap();
     run_finite(&scene, DT, 1);
     let v = b.velocity().unwrap()[0];
     assert!(v > 390.0 && v <= 400.0 * (1.0 + 1e-5), "v = {v}");
@@ -231,16 +191,8 @@ fn a_pile_started_with_25_percent_overlap_separates_gently() {
     // Criterion: no body ever faster than 10 units/s (the speed of a 1-unit fall under
     // gravity 50), and the deepest penetration the tick header reports is ≤ 0.05 after 3 s.
     let scene = Scene::new("overlap", PlaneOptions::default());
-    floor(&scene, 1);
-    let mut boxes = Vec::new();
-    for i in 0..3 {
-        for j in 0..3 {
-            for k in 0..3 {
-                let p = [i as f32 * 0.75, 0.5 + j as f32 * 0.75, k as f32 * 0.75];
-                boxes.push(scene.plane.add(cube(1.0), Pose::at(p), &[]).unwrap());
-            }
-        }
-    }
+    quality_floor(&scene, 1);
+    let boxes = overlapping_pile(&mut &scene.plane).unwrap();
     scene.plane.step(DT).unwrap();
     let first = *scene.plane.snapshot().unwrap().header();
     assert!(
@@ -267,28 +219,21 @@ fn a_pile_started_with_25_percent_overlap_separates_gently() {
 /// A stack of `n` boxes of `side` and a ball of the same diameter dropped from `drop`, on a
 /// floor at `origin`, stepped for `seconds` at `dt`. Returns the stack's largest drift from
 /// 1 s to the end, after checking that the ball rests on the floor.
-fn stack_and_ball(origin: [f32; 3], side: f32, n: usize, drop: f32, dt: f32) -> f32 {
+fn stack_and_ball_drift(origin: [f32; 3], side: f32, n: usize, drop: f32, dt: f32) -> f32 {
     let scene = Scene::new("rest", PlaneOptions::default());
-    let [ox, oy, oz] = origin;
-    scene
-        .plane
-        .add(
-            Shape::Cube {
-                size: [100.0 * side, side, 100.0 * side],
-            },
-            Pose::at([ox, oy - side / 2.0, oz]),
-            &[ObjectProp::Anchored(true)],
-        )
-        .unwrap();
-    let boxes = column(&scene, origin, side, n, 0.0, 1, |_| vec![]);
-    let ball = scene
-        .plane
-        .add(
-            Shape::Sphere { radius: side / 2.0 },
-            Pose::at([ox + 10.0 * side, oy + drop, oz]),
-            &[],
-        )
-        .unwrap();
+    let oy = origin[1];
+    let quality = [ObjectProp::HitBoxQuality(1)];
+    let built = stack_and_ball(
+        &mut &scene.plane,
+        origin,
+        side,
+        n,
+        drop,
+        pair_gap(1),
+        &quality,
+    )
+    .unwrap();
+    let (boxes, ball) = (built.boxes, built.ball);
     let per_second = (1.0 / dt).round() as u32;
     run_finite(&scene, dt, per_second);
     let settled: Vec<_> = boxes.iter().map(|b| b.position().unwrap()).collect();
@@ -308,14 +253,14 @@ fn stack_and_ball(origin: [f32; 3], side: f32, n: usize, drop: f32, dt: f32) -> 
 #[test]
 fn a_scene_100000_units_from_the_origin_rests() {
     // f32 spacing at 1e5 is 0.0078. Criterion: the stack drifts ≤ 0.05.
-    let drift = stack_and_ball([100_000.0, 0.0, 100_000.0], 1.0, 5, 5.0, DT);
+    let drift = stack_and_ball_drift([100_000.0, 0.0, 100_000.0], 1.0, 5, 5.0, DT);
     assert!(drift <= 0.05, "drift {drift}");
 }
 
 #[test]
 fn five_centimetre_objects_rest() {
     // Criterion: a stack of 5 cm boxes drifts ≤ 10 % of a box, a 5 cm ball lands and rests.
-    let drift = stack_and_ball([0.0; 3], 0.05, 3, 1.0, DT);
+    let drift = stack_and_ball_drift([0.0; 3], 0.05, 3, 1.0, DT);
     assert!(drift <= 0.005, "drift {drift}");
 }
 
@@ -325,22 +270,15 @@ fn tick_rates_of_10_and_1000_stay_standing() {
     // (gravity adds 5 units/s a tick) rapier's stack jitters by ~0.13 (the bench's
     // tick-rate-10 scene fails its 0.05 bound); here it must stay standing within a quarter
     // box and the ball must come to rest.
-    let drift = stack_and_ball([0.0; 3], 1.0, 5, 5.0, 1.0 / 1000.0);
+    let drift = stack_and_ball_drift([0.0; 3], 1.0, 5, 5.0, 1.0 / 1000.0);
     assert!(drift <= 0.05, "1000 Hz drift {drift}");
-    let drift = stack_and_ball([0.0; 3], 1.0, 5, 5.0, 1.0 / 10.0);
+    let drift = stack_and_ball_drift([0.0; 3], 1.0, 5, 5.0, 1.0 / 10.0);
     assert!(drift <= 0.25, "10 Hz drift {drift}");
 }
 
 fn ball_in(options: PlaneOptions) -> (Scene, Object) {
     let scene = Scene::new("extreme", options);
-    let b = scene
-        .plane
-        .add(
-            Shape::Sphere { radius: 0.5 },
-            Pose::at([0.0, 100.0, 0.0]),
-            &[],
-        )
-        .unwrap();
+    let b = ball(&mut &scene.plane, [0.0, 100.0, 0.0], &[]).unwrap();
     (scene, b)
 }
 
@@ -387,14 +325,7 @@ fn an_extreme_pin_force_reaches_its_target_without_blowing_up() {
     // Criterion: SetPin with force 1e6 pulls a unit-mass ball 10 units and holds it within
     // 0.01 of the target after 2 s.
     let scene = Scene::new("pin", PlaneOptions::default());
-    let b = scene
-        .plane
-        .add(
-            Shape::Sphere { radius: 0.5 },
-            Pose::at([0.0, 10.0, 0.0]),
-            &[],
-        )
-        .unwrap();
+    let b = ball(&mut &scene.plane, [0.0, 10.0, 0.0], &[]).unwrap();
     let target = [10.0, 10.0, 0.0];
     b.set_pin(Some(Pin {
         force: 1e6,

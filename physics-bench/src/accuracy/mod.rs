@@ -1,0 +1,109 @@
+//! `physics-bench accuracy`: error against run time. Reference scenes with exact answers run
+//! in process through the daemon's own plane code (`physics_scenes::LocalPlane`, what the
+//! daemon steps), so the cost is the step calls alone, without IPC.
+
+mod chart;
+pub mod markdown;
+mod pareto;
+mod scenes;
+pub mod sweep;
+
+use std::path::PathBuf;
+
+use super::error::BenchResult;
+use super::progress::Progress;
+use super::report;
+use super::sim::Config;
+use super::stats::median;
+
+/// Options of the `accuracy` subcommand.
+#[derive(Debug, Clone, clap::Args)]
+pub struct AccuracyArgs {
+    /// The three families only, 5 repeats (under 2 minutes); otherwise also the full
+    /// TickRate × SolverIterations × HitBoxQuality cross product, 9 repeats.
+    #[arg(long)]
+    pub quick: bool,
+    /// Folder receiving accuracy.json, accuracy.md and accuracy-*.svg.
+    #[arg(long, default_value = "bench-out")]
+    pub out: PathBuf,
+}
+
+/// One scene at one configuration.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct Point {
+    pub scene: &'static str,
+    #[serde(flatten)]
+    pub config: Config,
+    pub dt: f32,
+    /// NaN (null in JSON) when a body went non-finite.
+    pub error: f64,
+    pub error_unit: &'static str,
+    /// Median wall seconds of step calls per simulated second.
+    pub cost: f64,
+    pub pareto: bool,
+    pub is_default: bool,
+}
+
+pub fn run(args: &AccuracyArgs) -> BenchResult<()> {
+    let configs = sweep::configs(!args.quick);
+    let repeats = if args.quick { 5 } else { 9 };
+    let progress = Progress::new((scenes::SCENES.len() * configs.len()) as u64);
+    progress.note(format!(
+        "accuracy: {} scenes × {} configurations × {repeats} repeats, in process",
+        scenes::SCENES.len(),
+        configs.len()
+    ));
+    let mut points = Vec::new();
+    for scene in scenes::SCENES {
+        let mut these = Vec::new();
+        for config in &configs {
+            progress.phase(format!("{} at {}", scene.name, config.label()));
+            let mut errors = Vec::new();
+            let mut costs = Vec::new();
+            for _ in 0..repeats {
+                let o = (scene.run)(*config)?;
+                errors.push(o.error);
+                costs.push(o.cost);
+            }
+            // The error is deterministic; the median also keeps a NaN run visible.
+            let error = if errors.iter().any(|e| e.is_nan()) {
+                f64::NAN
+            } else {
+                median(&errors).unwrap_or(f64::NAN)
+            };
+            these.push(Point {
+                scene: scene.name,
+                config: *config,
+                dt: config.dt(),
+                error,
+                error_unit: scene.unit,
+                cost: median(&costs).unwrap_or(f64::NAN),
+                pareto: false,
+                is_default: *config == Config::DEFAULT,
+            });
+            progress.done();
+        }
+        pareto::mark(&mut these);
+        if let Some(d) = these.iter().find(|p| p.is_default) {
+            progress.note(format!(
+                "{:<20} default: error {:.3e} {}, cost {:.2e}",
+                scene.name, d.error, scene.unit, d.cost
+            ));
+        }
+        points.extend(these);
+    }
+    progress.finish();
+    let md = markdown::render(&points, args.quick, repeats);
+    let (json, md_path) = report::write(&args.out, "accuracy", &points, &md)?;
+    let charts = chart::draw_all(&args.out, &points)?;
+    println!("wrote {}, {}", json.display(), md_path.display());
+    for c in charts {
+        println!("wrote {}", c.display());
+    }
+    Ok(())
+}
+
+/// The reference scenes, for the report's headings.
+pub fn scene_info(name: &str) -> Option<&'static scenes::Scene> {
+    scenes::SCENES.iter().find(|s| s.name == name)
+}

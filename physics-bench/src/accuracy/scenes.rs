@@ -1,0 +1,386 @@
+//! Reference scenes with exact answers. Each builds its world in an in-process plane at one
+//! configuration, steps it, and returns its error against the closed form and the cost.
+//!
+//! Conventions of the service that the closed forms account for: gravity (0, -50, 0);
+//! LinearDamping / AngularDamping are set to 0 wherever the closed form has none; a resting
+//! pair keeps `0.02 / HitBoxQuality` apart (0.01 contact skin per collider), so rest heights
+//! include that gap; a pair's friction is `sqrt(a·b)`, so both sides carry the same μ.
+
+use client_sdk::{ObjectProp, PlaneProp, Pose, Shape};
+use physics_scenes::{anchored_box, ball, column, cube, floor};
+use rapier3d::glamx::{DQuat, DVec3};
+
+use crate::error::BenchResult;
+use crate::sim::{about_z, distance, Config, Sim};
+
+const G: f64 = 50.0;
+
+/// One reference scene.
+pub struct Scene {
+    pub name: &'static str,
+    /// What `error` measures, for the report.
+    pub measures: &'static str,
+    pub unit: &'static str,
+    pub run: fn(Config) -> BenchResult<Outcome>,
+}
+
+pub struct Outcome {
+    pub error: f64,
+    /// Wall seconds of step calls per simulated second.
+    pub cost: f64,
+}
+
+pub const SCENES: &[Scene] = &[
+    Scene {
+        name: "free-fall",
+        measures: "|y − (y0 − g·t²/2)| of a ball after 2 s",
+        unit: "units",
+        run: free_fall,
+    },
+    Scene {
+        name: "projectile-damping",
+        measures: "distance from the closed-form position under LinearDamping 0.5 after 2 s",
+        unit: "units",
+        run: projectile_damping,
+    },
+    Scene {
+        name: "terminal-velocity",
+        measures: "largest |v − v_t·tanh(g·t/v_t)| over 1 s of fall under Drag 2 (v_t = 5)",
+        unit: "units/s",
+        run: terminal_velocity,
+    },
+    Scene {
+        name: "bouncing-ball",
+        measures: "largest |h_n − e^(2n)·h0| / (e^(2n)·h0) over the first 3 apexes (e = 0.8, h0 = 10)",
+        unit: "fraction",
+        run: bouncing_ball,
+    },
+    Scene {
+        name: "sliding-block",
+        measures: "|d − v0²/(2·μ·g)| of a block launched at 10 units/s with μ = 0.5 (d = 2)",
+        unit: "units",
+        run: sliding_block,
+    },
+    Scene {
+        name: "incline-hold",
+        measures: "distance a block slid in 2 s on a 20° incline with μ = 0.6 (must hold: 0)",
+        unit: "units",
+        run: incline_hold,
+    },
+    Scene {
+        name: "incline-slide",
+        measures: "|s − a·t²/2| after 1 s on a 40° incline with μ = 0.3, a = g(sinθ − μ·cosθ)",
+        unit: "units",
+        run: incline_slide,
+    },
+    Scene {
+        name: "free-rotation",
+        measures: "largest relative drift of the angular momentum vector or the kinetic energy over 5 s of a torque-free 1×2×3 box",
+        unit: "fraction",
+        run: free_rotation,
+    },
+    Scene {
+        name: "stack-drift",
+        measures: "largest displacement of any box of a resting 5-box stack from 1 s (settled) to 3 s",
+        unit: "units",
+        run: stack_drift,
+    },
+    Scene {
+        name: "stack-penetration",
+        measures: "deepest contact penetration (tick header) of a resting 5-box stack over 3 s",
+        unit: "units",
+        run: stack_penetration,
+    },
+];
+
+/// No damping: the closed forms have none.
+const UNDAMPED: [PlaneProp; 2] = [
+    PlaneProp::LinearDamping(0.0),
+    PlaneProp::AngularDamping(0.0),
+];
+
+fn outcome(sim: &Sim, error: f64) -> BenchResult<Outcome> {
+    Ok(Outcome {
+        error: if sim.went_nonfinite { f64::NAN } else { error },
+        cost: sim.cost(),
+    })
+}
+
+fn free_fall(c: Config) -> BenchResult<Outcome> {
+    let mut sim = Sim::new(c, &UNDAMPED)?;
+    let y0 = 1000.0;
+    let b = ball(&mut sim, [0.0, y0 as f32, 0.0], &[])?;
+    for _ in 0..sim.steps_for(2.0) {
+        sim.step()?;
+    }
+    let t = sim.time();
+    let exact = y0 - G * t * t / 2.0;
+    outcome(&sim, (sim.state(b).position[1] as f64 - exact).abs())
+}
+
+fn projectile_damping(c: Config) -> BenchResult<Outcome> {
+    let k = 0.5f64;
+    let mut sim = Sim::new(
+        c,
+        &[
+            PlaneProp::LinearDamping(k as f32),
+            PlaneProp::AngularDamping(0.0),
+        ],
+    )?;
+    let x0 = [0.0, 1000.0, 0.0];
+    let v0 = [20.0, 30.0, 0.0];
+    let b = ball(&mut sim, x0, &[ObjectProp::Velocity(v0)])?;
+    for _ in 0..sim.steps_for(2.0) {
+        sim.step()?;
+    }
+    // dv/dt = g − k·v: v∞ = g/k, x = x0 + v∞·t + (v0 − v∞)(1 − e^(−kt))/k.
+    let t = sim.time();
+    let g = [0.0, -G, 0.0];
+    let exact: Vec<f32> = (0..3)
+        .map(|i| {
+            let v_inf = g[i] / k;
+            (x0[i] as f64 + v_inf * t + (v0[i] as f64 - v_inf) * (1.0 - (-k * t).exp()) / k) as f32
+        })
+        .collect();
+    let exact = [exact[0], exact[1], exact[2]];
+    outcome(&sim, distance(sim.state(b).position, exact))
+}
+
+fn terminal_velocity(c: Config) -> BenchResult<Outcome> {
+    let drag = 2.0f64;
+    let mut props = UNDAMPED.to_vec();
+    props.push(PlaneProp::Drag(drag as f32));
+    let mut sim = Sim::new(c, &props)?;
+    let b = ball(&mut sim, [0.0, 1000.0, 0.0], &[])?;
+    // m·dv/dt = m·g − Drag·v² from rest (m = 1): v = v_t·tanh(g·t/v_t), v_t = sqrt(g/Drag).
+    let vt = (G / drag).sqrt();
+    let mut worst = 0.0f64;
+    for _ in 0..sim.steps_for(1.0) {
+        sim.step()?;
+        let exact = -vt * (G * sim.time() / vt).tanh();
+        worst = worst.max((sim.state(b).linear_velocity[1] as f64 - exact).abs());
+    }
+    outcome(&sim, worst)
+}
+
+fn bouncing_ball(c: Config) -> BenchResult<Outcome> {
+    let e = 0.8f64;
+    let h0 = 10.0f64;
+    let mut sim = Sim::new(c, &UNDAMPED)?;
+    floor(&mut sim, 50.0, &[])?;
+    let rest = 0.5 + c.pair_gap() as f64;
+    let b = ball(
+        &mut sim,
+        [0.0, (rest + h0) as f32, 0.0],
+        &[ObjectProp::Bounciness(e as f32)],
+    )?;
+    // Apex = highest sampled height of each rising-then-falling phase after a bounce.
+    let mut apexes = Vec::new();
+    let (mut rising, mut top) = (false, f64::MIN);
+    for _ in 0..sim.steps_for(3.2) {
+        sim.step()?;
+        let s = sim.state(b);
+        let (y, vy) = (s.position[1] as f64 - rest, s.linear_velocity[1]);
+        if vy > 0.0 {
+            rising = true;
+            top = top.max(y);
+        } else if rising {
+            apexes.push(top.max(y));
+            (rising, top) = (false, f64::MIN);
+        }
+    }
+    let worst = (1..=3)
+        .map(|n| {
+            let exact = e.powi(2 * n) * h0;
+            // A missing bounce is a 100 % error.
+            apexes
+                .get(n as usize - 1)
+                .map_or(1.0, |h| (h - exact).abs() / exact)
+        })
+        .fold(0.0, f64::max);
+    outcome(&sim, worst)
+}
+
+/// Both sides carry μ, so the pair's friction sqrt(μ·μ) is μ.
+fn friction(mu: f64) -> ObjectProp {
+    ObjectProp::Friction(mu as f32)
+}
+
+fn sliding_block(c: Config) -> BenchResult<Outcome> {
+    let (mu, v0) = (0.5f64, 10.0f64);
+    let mut sim = Sim::new(c, &UNDAMPED)?;
+    floor(&mut sim, 100.0, &[friction(mu)])?;
+    let y = 0.5 + c.pair_gap();
+    let b = sim.add(
+        cube(1.0),
+        Pose::at([0.0, y, 0.0]),
+        &[friction(mu), ObjectProp::Velocity([v0 as f32, 0.0, 0.0])],
+    )?;
+    // Stops after v0/(μ·g) = 0.4 s; 1 s leaves time to settle.
+    for _ in 0..sim.steps_for(1.0) {
+        sim.step()?;
+    }
+    let exact = v0 * v0 / (2.0 * mu * G);
+    outcome(&sim, (sim.state(b).position[0] as f64 - exact).abs())
+}
+
+/// A 60-long anchored slab tilted by `theta` (downhill toward +x) whose top face passes
+/// through the origin, and a unit box resting on it at the origin. Returns the box and the
+/// downhill unit vector.
+fn incline(sim: &mut Sim, theta: f64, mu: f64) -> BenchResult<(client_sdk::Handle, [f64; 3])> {
+    let (s, co) = (theta.sin(), theta.cos());
+    let normal = [s, co, 0.0];
+    let downhill = [co, -s, 0.0];
+    let rotation = about_z(-theta as f32);
+    let at = |d: f64| {
+        let p: Vec<f32> = normal.iter().map(|n| (n * d) as f32).collect();
+        [p[0], p[1], p[2]]
+    };
+    anchored_box(
+        sim,
+        [60.0, 1.0, 10.0],
+        Pose {
+            position: at(-0.5),
+            rotation,
+        },
+        &[friction(mu)],
+    )?;
+    let gap = sim.config.pair_gap() as f64;
+    let b = sim.add(
+        cube(1.0),
+        Pose {
+            position: at(0.5 + gap),
+            rotation,
+        },
+        &[friction(mu)],
+    )?;
+    Ok((b, downhill))
+}
+
+/// Distance travelled downhill since the start.
+fn downhill_travel(sim: &Sim, b: client_sdk::Handle, start: [f32; 3], dir: [f64; 3]) -> f64 {
+    let p = sim.state(b).position;
+    (0..3).map(|i| (p[i] - start[i]) as f64 * dir[i]).sum()
+}
+
+fn incline_hold(c: Config) -> BenchResult<Outcome> {
+    let mut sim = Sim::new(c, &UNDAMPED)?;
+    let (b, _) = incline(&mut sim, 20f64.to_radians(), 0.6)?;
+    let start = sim.state(b).position;
+    for _ in 0..sim.steps_for(2.0) {
+        sim.step()?;
+    }
+    outcome(&sim, distance(sim.state(b).position, start))
+}
+
+fn incline_slide(c: Config) -> BenchResult<Outcome> {
+    let (theta, mu) = (40f64.to_radians(), 0.3);
+    let mut sim = Sim::new(c, &UNDAMPED)?;
+    let (b, dir) = incline(&mut sim, theta, mu)?;
+    let start = sim.state(b).position;
+    for _ in 0..sim.steps_for(1.0) {
+        sim.step()?;
+    }
+    let a = G * (theta.sin() - mu * theta.cos());
+    let t = sim.time();
+    outcome(
+        &sim,
+        (downhill_travel(&sim, b, start, dir) - a * t * t / 2.0).abs(),
+    )
+}
+
+fn free_rotation(c: Config) -> BenchResult<Outcome> {
+    let mut props = UNDAMPED.to_vec();
+    props.push(PlaneProp::Gravity([0.0; 3]));
+    let mut sim = Sim::new(c, &props)?;
+    let (a, b_, c_) = (1.0f64, 2.0f64, 3.0f64);
+    // A CenterOfMass keeps rotation free at HitBoxQuality 1 (the plane keeps the shape's
+    // principal inertia; a 1 mm offset only moves the point it turns about).
+    let b = sim.add(
+        Shape::Cube {
+            size: [a as f32, b_ as f32, c_ as f32],
+        },
+        Pose::at([0.0; 3]),
+        &[
+            ObjectProp::CenterOfMass([0.0, 0.0, 1e-3]),
+            ObjectProp::AngularVelocity([0.4, 3.0, 0.3]),
+        ],
+    )?;
+    let inertia = [
+        (b_ * b_ + c_ * c_) / 12.0,
+        (a * a + c_ * c_) / 12.0,
+        (a * a + b_ * b_) / 12.0,
+    ];
+    let (l0, e0) = momentum_energy(&sim.state(b), inertia);
+    let mut worst = 0.0f64;
+    for _ in 0..sim.steps_for(5.0) {
+        sim.step()?;
+        let (l, e) = momentum_energy(&sim.state(b), inertia);
+        let dl = (l - l0).length() / l0.length();
+        worst = worst.max(dl).max((e - e0).abs() / e0);
+    }
+    outcome(&sim, worst)
+}
+
+/// World angular momentum `R·I·Rᵀ·ω` and kinetic energy `ω·L/2` of a body with principal
+/// inertia `inertia` (unit mass) along its local axes.
+fn momentum_energy(s: &client_sdk::BodyState, inertia: [f64; 3]) -> (DVec3, f64) {
+    let [x, y, z, w] = s.rotation.map(|v| v as f64);
+    let q = DQuat::from_xyzw(x, y, z, w);
+    let omega = DVec3::from(s.angular_velocity.map(|v| v as f64));
+    // Body frame: L_local = I·(Rᵀ·ω); back to the world with R.
+    let l = q * (DVec3::from(inertia) * (q.inverse() * omega));
+    (l, 0.5 * omega.dot(l))
+}
+
+/// A 5-box stack resting on a floor, each box placed at its rest height. Returns the drift
+/// (largest displacement of any box between 1 s, once the contacts have settled into their
+/// skin, and 3 s) and the deepest penetration seen over the 3 s.
+fn resting_stack(c: Config) -> BenchResult<(Sim, f64, f64)> {
+    let mut sim = Sim::new(c, &[])?;
+    floor(&mut sim, 50.0, &[])?;
+    let boxes = column(&mut sim, [0.0; 3], 1.0, 5, 0.0, c.pair_gap(), |_| vec![])?;
+    let mut deepest = 0.0f64;
+    let mut settled = Vec::new();
+    for _ in 0..sim.steps_for(3.0) {
+        sim.step()?;
+        deepest = deepest.max(sim.header().max_penetration as f64);
+        if settled.is_empty() && sim.time() >= 1.0 {
+            settled = boxes.iter().map(|h| sim.state(*h).position).collect();
+        }
+    }
+    let drift = boxes
+        .iter()
+        .zip(&settled)
+        .map(|(h, p)| distance(sim.state(*h).position, *p))
+        .fold(0.0, f64::max);
+    Ok((sim, drift, deepest))
+}
+
+fn stack_drift(c: Config) -> BenchResult<Outcome> {
+    let (sim, drift, _) = resting_stack(c)?;
+    outcome(&sim, drift)
+}
+
+fn stack_penetration(c: Config) -> BenchResult<Outcome> {
+    let (sim, _, deepest) = resting_stack(c)?;
+    outcome(&sim, deepest)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn angular_momentum_of_a_turned_body_is_rotated() {
+        // Body turned 90° about z, spinning about world x = its local −y axis.
+        let s = client_sdk::BodyState {
+            rotation: about_z(std::f32::consts::FRAC_PI_2),
+            angular_velocity: [2.0, 0.0, 0.0],
+            ..Default::default()
+        };
+        let (l, e) = momentum_energy(&s, [1.0, 3.0, 5.0]);
+        assert!((l[0] - 6.0).abs() < 1e-6 && l[1].abs() < 1e-6, "{l:?}");
+        assert!((e - 6.0).abs() < 1e-6, "{e}");
+    }
+}

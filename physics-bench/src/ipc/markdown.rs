@@ -1,0 +1,194 @@
+//! The human-readable `ipc.md`.
+
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+
+use super::{IpcReport, GOAL_BODIES};
+use crate::report::{num, verdict, Table};
+use crate::scene::Kind;
+
+/// How each figure is obtained (also stored in the JSON).
+pub fn method() -> BTreeMap<&'static str, &'static str> {
+    BTreeMap::from([
+        (
+            "scenes",
+            "pile: columns of 5 unit cubes on an anchored floor (one extra body), stepped 180 \
+             ticks so rapier puts them to sleep; free: unit cubes 3 units apart with random \
+             linear and angular velocities, no gravity, all awake. Manual planes, dt = 1/60 s, \
+             Threads = 1, rapier defaults otherwise.",
+        ),
+        (
+            "overhead_ratio",
+            "median over repeats of (wall time per tick when this process steps the daemon \
+             plane with Step and reads every pose of the published sample) / (wall time per \
+             tick stepping the same scene in this process with the daemon's own plane code, \
+             physics_daemon::rapier3d::Plane, and reading every pose from the rapier world); each \
+             pair of blocks timed back to back. Both use one core (global rayon pool of 1).",
+        ),
+        (
+            "delivery",
+            "zero_copy_us: the plane ticks at 60 Hz; this process waits for each tick; time \
+             from the header's tick_end_ns (taken before the daemon copies the poses into \
+             shared memory) until it holds the sample, i.e. every pose, readable in place \
+             (read_all_us: then reading every pose once, the reader's own work). \
+             socket_serde_us: the same poses gathered from the same world into a Vec, \
+             serialised with postcard, written to a Unix socket; another thread reads and \
+             deserialises them (then reads every pose, untimed). publish_us: \
+             the daemon's PlaneOutput::publish on the same world, timed in process; \
+             handover_us = zero_copy_us - publish_us. The *_poll figures repeat both with \
+             readers that poll instead of sleeping (Plane::wait_tick_spin on the shared-memory \
+             queue; a non-blocking socket read loop): the data path without the wake-up \
+             latency of the scheduler, which dominates the sleeping figures on this machine.",
+        ),
+        (
+            "round_trip_us",
+            "one SetVelocity queued, then flush timed (request, daemon applies, reply), on the \
+             10,000-body pile; batched_writes_per_s: 1,000 SetVelocity writes queued and \
+             flushed as one request, timed from the first write to the reply.",
+        ),
+        (
+            "threads",
+            "10,000-body pile while still awake (ticks 10-99 after building), Threads = 1 and \
+             Threads = 2 planes in one daemon stepped alternately; medians of the step time in \
+             the tick header.",
+        ),
+        (
+            "idle_cpu_percent",
+            "utime + stime of the daemon process from /proc/PID/stat over the window, with no \
+             client, then with one client holding a manual plane with one body.",
+        ),
+        (
+            "memory",
+            "daemon VmRSS and the size of the domain's /dev/shm files after the pile settled, \
+             per body = growth over the empty daemon / bodies; shm backed = pages really \
+             allocated in those files.",
+        ),
+    ])
+}
+
+pub fn render(r: &IpcReport) -> String {
+    let mut md = String::new();
+    let _ = writeln!(
+        md,
+        "# physics-bench ipc{}\n\n{} CPU(s), {:.0} s. Ratios are measured side by side in this \
+         run; absolute times depend on the machine's load.\n",
+        if r.quick { " --quick" } else { "" },
+        r.cpus,
+        r.seconds
+    );
+
+    md.push_str("## Goals\n\n");
+    let mut t = Table::new(&["goal", "measured", "verdict"]);
+    for g in &r.goals {
+        t.row(&[g.goal.clone(), g.value.clone(), verdict(g.met).into()]);
+    }
+    md.push_str(&t.finish());
+
+    md.push_str("\n## Overhead and delivery per scene\n\n");
+    let mut t = Table::new(&[
+        "bodies",
+        "scene",
+        "daemon µs/tick",
+        "in-process µs/tick",
+        "overhead_ratio",
+        "asleep",
+        "zero_copy_us",
+        "socket_serde_us",
+        "speedup",
+        "publish_us",
+        "handover_us",
+        "zero_copy_poll_us",
+        "socket_serde_poll_us",
+        "speedup_poll",
+        "handover_poll_us",
+        "read_all_us",
+    ]);
+    for s in &r.scenes {
+        for kind in [Kind::Pile, Kind::Free] {
+            let (Some(o), Some(d)) = (s.ticks.get(&kind), s.delivery.get(&kind)) else {
+                continue;
+            };
+            t.row(&[
+                s.bodies.to_string(),
+                kind.name().into(),
+                num(Some(o.daemon_tick_us)),
+                num(Some(o.in_process_tick_us)),
+                format!("{:.3}", o.overhead_ratio),
+                format!("{:.0} %", o.asleep_fraction * 100.0),
+                num(Some(d.zero_copy_us)),
+                num(Some(d.socket_serde_us)),
+                format!("{}×", num(Some(d.speedup))),
+                num(Some(d.publish_us)),
+                num(Some(d.handover_us)),
+                num(Some(d.zero_copy_poll_us)),
+                num(Some(d.socket_serde_poll_us)),
+                format!("{}×", num(Some(d.speedup_poll))),
+                num(Some(d.handover_poll_us)),
+                num(Some(d.read_all_us)),
+            ]);
+        }
+    }
+    md.push_str(&t.finish());
+
+    let q = &r.requests;
+    let _ = writeln!(
+        md,
+        "\n## Requests ({GOAL_BODIES}-body plane)\n\n\
+         - round_trip_us (one SetVelocity, {} samples): p50 {} / p99 {} / max {}\n\
+         - batched_writes_per_s ({}-command batch, median of {}): {}",
+        q.round_trips,
+        num(Some(q.round_trip_us.p50)),
+        num(Some(q.round_trip_us.p99)),
+        num(Some(q.round_trip_us.max)),
+        q.batch_size,
+        q.batches,
+        num(Some(q.batched_writes_per_s)),
+    );
+    let th = &r.threads;
+    let _ = writeln!(
+        md,
+        "\n## Threads ({}-body pile, awake)\n\n\
+         Step {} µs with Threads = 1, {} µs with Threads = 2: speedup {}× ({} ticks each).",
+        th.bodies,
+        num(Some(th.threads1_step_us)),
+        num(Some(th.threads2_step_us)),
+        num(Some(th.speedup)),
+        th.ticks
+    );
+    let idle = &r.idle_cpu_percent;
+    let _ = writeln!(
+        md,
+        "\n## Idle CPU ({} s windows)\n\n- no clients: {:.3} %\n- one idle manual plane: {:.3} %",
+        idle.window_s, idle.no_clients, idle.idle_manual_plane
+    );
+
+    md.push_str("\n## Memory (settled pile)\n\n");
+    let mut t = Table::new(&[
+        "bodies",
+        "daemon RSS MiB",
+        "RSS / body B",
+        "shm MiB",
+        "shm / body B",
+        "shm backed MiB",
+        "shm backed / body B",
+    ]);
+    let mib = |b: u64| num(Some(b as f64 / (1024.0 * 1024.0)));
+    for m in &r.memory {
+        t.row(&[
+            m.bodies.to_string(),
+            mib(m.rss_bytes),
+            num(Some(m.rss_per_body_bytes)),
+            mib(m.shm_bytes),
+            num(Some(m.shm_per_body_bytes)),
+            mib(m.shm_backed_bytes),
+            num(Some(m.shm_backed_per_body_bytes)),
+        ]);
+    }
+    md.push_str(&t.finish());
+
+    md.push_str("\n## Method\n\n");
+    for (name, text) in &r.method {
+        let _ = writeln!(md, "- **{name}**: {text}");
+    }
+    md
+}

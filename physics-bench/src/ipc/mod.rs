@@ -1,0 +1,301 @@
+//! `physics-bench ipc`: what running physics in the daemon costs over running rapier in the
+//! game process, and how delivery compares with the usual serialise-over-a-socket way.
+
+mod idle;
+mod markdown;
+mod scene_run;
+mod socket;
+mod threads;
+
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+use std::time::{Duration, Instant};
+
+use super::error::{BenchError, BenchResult};
+use super::progress::Progress;
+use super::report;
+use super::scene::{Kind, Scene};
+use super::stats::Spread;
+
+pub use idle::IdleCpu;
+pub use scene_run::{Delivery, Memory, Overhead, Requests};
+pub use threads::Threads;
+
+/// Options of the `ipc` subcommand.
+#[derive(Debug, Clone, clap::Args)]
+pub struct IpcArgs {
+    /// Every figure at 10,000 bodies only, with fewer repeats (under 2 minutes).
+    #[arg(long)]
+    pub quick: bool,
+    /// Folder receiving ipc.json and ipc.md.
+    #[arg(long, default_value = "bench-out")]
+    pub out: PathBuf,
+}
+
+/// The size at which the goals are judged (and the only size of `--quick`).
+pub const GOAL_BODIES: usize = 10_000;
+
+/// How much to measure.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct Plan {
+    pub sizes: Vec<usize>,
+    /// Timed blocks per scene and side (the figure is the median).
+    pub repeats: usize,
+    pub delivery_ticks: usize,
+    #[serde(skip)]
+    pub delivery_time_cap: Duration,
+    pub round_trips: usize,
+    pub batch_size: usize,
+    pub batches: usize,
+    pub idle_window_s: u64,
+}
+
+impl Plan {
+    pub fn new(quick: bool) -> Plan {
+        if quick {
+            Plan {
+                sizes: vec![GOAL_BODIES],
+                repeats: 3,
+                delivery_ticks: 30,
+                delivery_time_cap: Duration::from_secs(4),
+                round_trips: 1_000,
+                batch_size: 1_000,
+                batches: 10,
+                idle_window_s: 10,
+            }
+        } else {
+            Plan {
+                sizes: vec![100, 1_000, GOAL_BODIES, 50_000],
+                repeats: 7,
+                delivery_ticks: 60,
+                delivery_time_cap: Duration::from_secs(8),
+                round_trips: 5_000,
+                batch_size: 1_000,
+                batches: 30,
+                idle_window_s: 10,
+            }
+        }
+    }
+}
+
+/// Figures of one scene size, per scene kind.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct SizeReport {
+    pub bodies: usize,
+    pub overhead_ratio: BTreeMap<Kind, f64>,
+    pub delivery: BTreeMap<Kind, Delivery>,
+    /// Tick times behind the ratio.
+    pub ticks: BTreeMap<Kind, Overhead>,
+}
+
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct Goal {
+    pub goal: String,
+    pub value: String,
+    pub met: Option<bool>,
+}
+
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct IpcReport {
+    pub quick: bool,
+    pub plan: Plan,
+    pub method: BTreeMap<&'static str, &'static str>,
+    pub scenes: Vec<SizeReport>,
+    pub round_trip_us: Spread,
+    pub batched_writes_per_s: f64,
+    pub requests: Requests,
+    pub threads: Threads,
+    pub idle_cpu_percent: IdleCpu,
+    pub memory: Vec<Memory>,
+    pub goals: Vec<Goal>,
+    pub cpus: usize,
+    pub seconds: f64,
+}
+
+pub fn run(args: &IpcArgs) -> BenchResult<()> {
+    let started = Instant::now();
+    let plan = Plan::new(args.quick);
+    let kinds = [Kind::Pile, Kind::Free];
+    let phases = 2 + 1 + (plan.sizes.len() * kinds.len() * 4) as u64 + 1;
+    let progress = Progress::new(phases);
+
+    let idle = idle::run(Duration::from_secs(plan.idle_window_s), &progress)?;
+    progress.note(format!(
+        "idle CPU: {:.3} % without clients, {:.3} % with an idle manual plane",
+        idle.no_clients, idle.idle_manual_plane
+    ));
+
+    progress.phase(format!(
+        "threads: {GOAL_BODIES}-body pile, Threads = 1 vs 2"
+    ));
+    let threads = threads::run(GOAL_BODIES)?;
+    progress.done();
+    progress.note(format!(
+        "threads: step {:.0} µs with 1, {:.0} µs with 2 → {:.2}×",
+        threads.threads1_step_us, threads.threads2_step_us, threads.speedup
+    ));
+
+    let mut scenes = Vec::new();
+    let mut memory = Vec::new();
+    let mut requests = None;
+    for &bodies in &plan.sizes {
+        let mut size = SizeReport {
+            bodies,
+            overhead_ratio: BTreeMap::new(),
+            delivery: BTreeMap::new(),
+            ticks: BTreeMap::new(),
+        };
+        for kind in kinds {
+            let scene = Scene { kind, bodies };
+            let with_requests = bodies == GOAL_BODIES && kind == Kind::Pile;
+            let outcome = scene_run::run(scene, &plan, with_requests, &progress)?;
+            let (o, d) = (&outcome.overhead, &outcome.delivery);
+            progress.note(format!(
+                "{bodies:>6} {:<4}: tick {:>8.1} µs daemon / {:>8.1} µs in process = {:.3}  \
+                 delivery {:>7.1} µs zero-copy / {:>8.1} µs socket = {:.1}×",
+                kind.name(),
+                o.daemon_tick_us,
+                o.in_process_tick_us,
+                o.overhead_ratio,
+                d.zero_copy_us,
+                d.socket_serde_us,
+                d.speedup
+            ));
+            size.overhead_ratio.insert(kind, o.overhead_ratio);
+            size.delivery.insert(kind, outcome.delivery);
+            size.ticks.insert(kind, outcome.overhead);
+            if kind == Kind::Pile && (bodies == GOAL_BODIES || bodies == 50_000) {
+                memory.push(outcome.memory);
+            }
+            if let Some(r) = outcome.requests {
+                progress.done();
+                progress.note(format!(
+                    "round trip p50 {:.1} µs p99 {:.1} µs max {:.1} µs; {:.0} batched writes/s",
+                    r.round_trip_us.p50,
+                    r.round_trip_us.p99,
+                    r.round_trip_us.max,
+                    r.batched_writes_per_s
+                ));
+                requests = Some(r);
+            }
+        }
+        scenes.push(size);
+    }
+    progress.finish();
+    let requests = requests.ok_or_else(|| {
+        BenchError::Failed(format!("round trips are measured at {GOAL_BODIES} bodies"))
+    })?;
+
+    let mut report = IpcReport {
+        quick: args.quick,
+        method: markdown::method(),
+        round_trip_us: requests.round_trip_us,
+        batched_writes_per_s: requests.batched_writes_per_s,
+        requests,
+        threads,
+        idle_cpu_percent: idle,
+        memory,
+        goals: Vec::new(),
+        scenes,
+        plan,
+        cpus: std::thread::available_parallelism().map_or(1, |n| n.get()),
+        seconds: 0.0,
+    };
+    report.goals = goals(&report);
+    report.seconds = started.elapsed().as_secs_f64();
+    let md = markdown::render(&report);
+    let (json, md_path) = report::write(&args.out, "ipc", &report, &md)?;
+    println!("{md}");
+    eprintln!(
+        "wrote {} and {} in {:.0} s",
+        json.display(),
+        md_path.display(),
+        report.seconds
+    );
+    Ok(())
+}
+
+fn goals(r: &IpcReport) -> Vec<Goal> {
+    let mut goals = Vec::new();
+    let at_goal = r.scenes.iter().find(|s| s.bodies == GOAL_BODIES);
+    for kind in [Kind::Pile, Kind::Free] {
+        let ratio = at_goal.and_then(|s| s.overhead_ratio.get(&kind)).copied();
+        goals.push(Goal {
+            goal: format!("overhead_ratio ≤ 1.05 at 10,000 bodies ({})", kind.name()),
+            value: report::num(ratio),
+            met: ratio.map(|v| v <= 1.05),
+        });
+    }
+    // Sleeping readers include the scheduler's wake-up; polling readers show the data path.
+    for (mode, polled) in [("sleeping readers", false), ("polling readers", true)] {
+        for kind in [Kind::Pile, Kind::Free] {
+            let speedup = at_goal.and_then(|s| s.delivery.get(&kind)).map(|d| {
+                if polled {
+                    d.speedup_poll
+                } else {
+                    d.speedup
+                }
+            });
+            goals.push(Goal {
+                goal: format!(
+                    "delivery speedup ≥ 20× at 10,000 bodies ({}, {mode})",
+                    kind.name()
+                ),
+                value: format!("{}×", report::num(speedup)),
+                met: speedup.map(|v| v >= 20.0),
+            });
+        }
+        for kind in [Kind::Pile, Kind::Free] {
+            let handover: Vec<(usize, f64)> = r
+                .scenes
+                .iter()
+                .filter_map(|s| {
+                    let d = s.delivery.get(&kind)?;
+                    Some((
+                        s.bodies,
+                        if polled {
+                            d.handover_poll_us
+                        } else {
+                            d.handover_us
+                        },
+                    ))
+                })
+                .collect();
+            let (value, met) = match (handover.first(), handover.last()) {
+                (Some(a), Some(b)) if handover.len() > 1 => (
+                    format!(
+                        "{} µs at {} → {} µs at {} bodies",
+                        report::num(Some(a.1)),
+                        a.0,
+                        report::num(Some(b.1)),
+                        b.0
+                    ),
+                    // Flat: the largest scene's hand-over within 2× of the smallest's (+5 µs
+                    // of timer noise).
+                    Some(b.1 <= 2.0 * a.1 + 5.0),
+                ),
+                _ => ("one size only".to_string(), None),
+            };
+            goals.push(Goal {
+                goal: format!(
+                    "zero-copy hand-over flat in body count ({}, {mode})",
+                    kind.name()
+                ),
+                value,
+                met,
+            });
+        }
+    }
+    let idle = &r.idle_cpu_percent;
+    for (what, v) in [
+        ("no clients", idle.no_clients),
+        ("one idle manual plane", idle.idle_manual_plane),
+    ] {
+        goals.push(Goal {
+            goal: format!("idle CPU < 0.5 % ({what})"),
+            value: format!("{v:.3} %"),
+            met: Some(v < 0.5),
+        });
+    }
+    goals
+}

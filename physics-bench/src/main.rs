@@ -1,0 +1,83 @@
+//! `physics-bench`: measures the physics service against in-process physics.
+//!
+//! `physics-bench ipc [--quick] [--out DIR]` writes DIR/ipc.json and DIR/ipc.md. It starts
+//! real `physics-daemon` processes (the binary next to this one) in throw-away domains.
+//!
+//! `physics-bench accuracy [--quick] [--out DIR]` writes DIR/accuracy.json, DIR/accuracy.md
+//! and DIR/accuracy-*.svg: error against cost of reference scenes, in process.
+//! `physics-bench stability [--out DIR]` writes DIR/stability.json and DIR/stability.md.
+//!
+//! Its parts, shared by the subcommands:
+//!
+//! - [`daemon`]: real daemon processes in throw-away domains.
+//! - [`procfs`]: CPU time, RSS and shared-memory size of a process / domain.
+//! - [`scene`]: the benchmark scenes, built identically in the daemon and in process.
+//! - [`stats`]: medians and percentiles.
+//! - [`progress`]: the progress bar and its log lines.
+//! - [`report`]: writing the JSON and markdown reports.
+//! - [`ipc`]: the `ipc` subcommand (daemon overhead, delivery, requests, idle, memory).
+//! - [`sim`]: an in-process plane stepped at a fixed dt with its step time accumulated.
+//! - [`accuracy`]: the `accuracy` subcommand (error against run time).
+//! - [`stability`]: the `stability` subcommand (stiff and extreme scenes, pass/fail).
+
+mod accuracy;
+mod daemon;
+mod error;
+mod ipc;
+mod procfs;
+mod progress;
+mod report;
+mod scene;
+mod sim;
+mod stability;
+mod stats;
+
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+#[derive(Parser)]
+#[command(version, about = "Benchmarks of the physics service")]
+struct Cli {
+    #[command(subcommand)]
+    command: Bench,
+}
+
+#[derive(Subcommand)]
+enum Bench {
+    /// Daemon overhead over in-process rapier, zero-copy vs socket delivery, request round
+    /// trips, threads, idle CPU and memory.
+    Ipc(ipc::IpcArgs),
+    /// Error against run time on reference scenes with exact answers, swept over TickRate,
+    /// SolverIterations / LoopSolver and HitBoxQuality.
+    Accuracy(accuracy::AccuracyArgs),
+    /// Stress scenes (tall stacks, mass ratios, fast bodies, overlap, far from the origin,
+    /// tiny objects, extreme forces and tick rates), each with a pass criterion.
+    Stability(stability::StabilityArgs),
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    // The daemons it starts inherit this: warnings only, so their logs stay out of the
+    // progress display.
+    if std::env::var_os("PHYSICS_LOG").is_none() {
+        std::env::set_var("PHYSICS_LOG", "warn");
+    }
+    // In-process planes with Threads = 1 run on rayon's global pool: one worker, as in the
+    // daemon, so both sides of a comparison use one core.
+    let _ = rapier3d::rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build_global();
+    let result = match &cli.command {
+        Bench::Ipc(args) => ipc::run(args),
+        Bench::Accuracy(args) => accuracy::run(args),
+        Bench::Stability(args) => stability::run(args),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("physics-bench: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}

@@ -1,0 +1,237 @@
+//! `physics-bench stability`: stress scenes with automatic pass criteria, and sweeps for the
+//! critical values. In process, through the daemon's own plane code, like `accuracy`.
+
+mod markdown;
+pub mod scenes;
+mod sweeps;
+
+use std::path::PathBuf;
+
+use super::accuracy::sweep as configs;
+use super::error::BenchResult;
+use super::progress::Progress;
+use super::report;
+use super::sim::Config;
+use scenes::Check;
+use sweeps::SweepPoint;
+
+/// Options of the `stability` subcommand.
+#[derive(Debug, Clone, clap::Args)]
+pub struct StabilityArgs {
+    /// Folder receiving stability.json and stability.md.
+    #[arg(long, default_value = "bench-out")]
+    pub out: PathBuf,
+}
+
+/// A configuration that makes a failing scene pass, and what it costs.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct Remedy {
+    #[serde(flatten)]
+    pub config: Config,
+    pub figure: f64,
+    pub cost: f64,
+}
+
+/// One line of stability.json: a scene, or a sweep judged by its critical value.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct Entry {
+    pub scene: &'static str,
+    pub criterion: String,
+    pub pass: bool,
+    pub figure: f64,
+    pub bound: f64,
+    pub unit: &'static str,
+    pub config: Config,
+    pub finite: bool,
+    pub cost: f64,
+    /// For a scene failing at its configuration: the cheapest candidate that passes
+    /// (`None` with `remedy_searched` when none does).
+    pub remedy: Option<Remedy>,
+    /// Configurations tried for a remedy (0: the scene passed).
+    pub remedy_candidates: usize,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub critical_default: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub critical_strongest: Option<f64>,
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub points: Vec<SweepPoint>,
+}
+
+/// Configurations tried on a scene failing at `at`: the whole TickRate × SolverIterations ×
+/// HitBoxQuality grid of the accuracy bench (the strongest configuration included). A scene
+/// about a tick rate keeps its tick rate.
+fn candidates(at: Config) -> Vec<Config> {
+    let mut v = configs::configs(true);
+    if at.tick_rate != Config::DEFAULT.tick_rate {
+        for c in &mut v {
+            c.tick_rate = at.tick_rate;
+        }
+        v.sort();
+        v.dedup();
+    }
+    v
+}
+
+pub fn run(args: &StabilityArgs) -> BenchResult<()> {
+    let sweep_runs: usize = sweeps::SWEEPS.iter().map(|s| 2 * s.values.len()).sum();
+    let progress = Progress::new((scenes::SCENES.len() + sweep_runs) as u64);
+    progress.note("stability: in process, through the daemon's plane code");
+    let mut entries = Vec::new();
+    for scene in scenes::SCENES {
+        progress.phase(format!("{} at {}", scene.name, scene.config.label()));
+        let check = (scene.run)(scene.config)?;
+        let mut remedy = None;
+        if !check.pass {
+            progress.phase(format!(
+                "{}: searching a configuration that passes",
+                scene.name
+            ));
+            remedy = Some(find_remedy(scene.run, scene.config)?);
+        }
+        progress.note(format!(
+            "{:<24} {} ({:.3e} vs bound {:.3e})",
+            scene.name,
+            if check.pass { "pass" } else { "FAIL" },
+            check.figure,
+            check.bound
+        ));
+        entries.push(entry(
+            scene.name,
+            scene.criterion.into(),
+            scene.unit,
+            scene.config,
+            check,
+            remedy,
+        ));
+        progress.done();
+    }
+    for sweep in sweeps::SWEEPS {
+        let mut points = Vec::new();
+        for config in [Config::DEFAULT, Config::STRONGEST] {
+            for &value in sweep.values {
+                progress.phase(format!("{} = {value} at {}", sweep.name, config.label()));
+                let check = (sweep.run)(config, value)?;
+                points.push(SweepPoint {
+                    config,
+                    value,
+                    check,
+                });
+                progress.done();
+            }
+        }
+        let at = |c: Config| -> Vec<SweepPoint> {
+            points.iter().filter(|p| p.config == c).cloned().collect()
+        };
+        let (default, strongest) = (at(Config::DEFAULT), at(Config::STRONGEST));
+        let critical_default = sweeps::critical(&default);
+        let critical_strongest = sweeps::critical(&strongest);
+        let judged = if sweep.judged_at_default {
+            critical_default
+        } else {
+            critical_strongest
+        };
+        let judged_points = if sweep.judged_at_default {
+            &default
+        } else {
+            &strongest
+        };
+        let reached = judged.unwrap_or(0.0);
+        let cost = judged_points
+            .iter()
+            .find(|p| p.value == sweep.required)
+            .map_or(f64::NAN, |p| p.check.cost);
+        progress.note(format!(
+            "{:<24} critical {} at default, {} at strongest",
+            sweep.name,
+            critical_default.map_or("none".into(), |v| v.to_string()),
+            critical_strongest.map_or("none".into(), |v| v.to_string()),
+        ));
+        entries.push(Entry {
+            scene: sweep.name,
+            criterion: format!(
+                "{}: at least {} at {}",
+                sweep.what,
+                sweep.required,
+                if sweep.judged_at_default {
+                    "the defaults"
+                } else {
+                    "the strongest configuration"
+                }
+            ),
+            pass: reached >= sweep.required,
+            figure: reached,
+            bound: sweep.required,
+            unit: "critical value",
+            config: if sweep.judged_at_default {
+                Config::DEFAULT
+            } else {
+                Config::STRONGEST
+            },
+            finite: points.iter().all(|p| p.check.finite),
+            cost,
+            remedy: None,
+            remedy_candidates: 0,
+            critical_default,
+            critical_strongest,
+            points,
+        });
+    }
+    progress.finish();
+    let md = markdown::render(&entries);
+    let (json, md_path) = report::write(&args.out, "stability", &entries, &md)?;
+    println!("wrote {}, {}", json.display(), md_path.display());
+    let failed = entries.iter().filter(|e| !e.pass).count();
+    println!(
+        "{} of {} scenes pass",
+        entries.len() - failed,
+        entries.len()
+    );
+    Ok(())
+}
+
+fn entry(
+    scene: &'static str,
+    criterion: String,
+    unit: &'static str,
+    config: Config,
+    check: Check,
+    remedy: Option<(Option<Remedy>, usize)>,
+) -> Entry {
+    Entry {
+        scene,
+        criterion,
+        pass: check.pass,
+        figure: check.figure,
+        bound: check.bound,
+        unit,
+        config,
+        finite: check.finite,
+        cost: check.cost,
+        remedy_candidates: remedy.as_ref().map_or(0, |r| r.1),
+        remedy: remedy.and_then(|r| r.0),
+        critical_default: None,
+        critical_strongest: None,
+        points: Vec::new(),
+    }
+}
+
+/// The cheapest candidate configuration under which the scene passes, and how many were
+/// tried.
+fn find_remedy(
+    run: fn(Config) -> BenchResult<Check>,
+    at: Config,
+) -> BenchResult<(Option<Remedy>, usize)> {
+    let candidates = candidates(at);
+    let mut best: Option<Remedy> = None;
+    for config in &candidates {
+        let check = run(*config)?;
+        if check.pass && best.as_ref().is_none_or(|b| check.cost < b.cost) {
+            best = Some(Remedy {
+                config: *config,
+                figure: check.figure,
+                cost: check.cost,
+            });
+        }
+    }
+    Ok((best, candidates.len()))
+}
