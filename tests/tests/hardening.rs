@@ -422,3 +422,20 @@ fn files_planted_by_another_user_stop_the_daemon_with_a_clear_error() {
         "{stderr}"
     );
 }
+
+#[test]
+fn more_connections_of_one_process_share_its_quotas() {
+    let daemon = TestDaemon::start_with("quota-proc", &["--max-objects-per-client", "4"], &[]);
+    let first = daemon.client();
+    let second = daemon.client();
+    let a = first.create_plane(&PlaneOptions::manual()).unwrap();
+    let b = second.create_plane(&PlaneOptions::manual()).unwrap();
+    for i in 0..2 {
+        a.add(cube(), Pose::at([i as f32 * 2.0, 0.0, 0.0]), &[])
+            .unwrap();
+        b.add(cube(), Pose::at([i as f32 * 2.0, 0.0, 0.0]), &[])
+            .unwrap();
+    }
+    let e = command_error(b.add(cube(), Pose::IDENTITY, &[]).unwrap_err());
+    assert_eq!(e.kind, ErrorKind::Quota, "{e}");
+}

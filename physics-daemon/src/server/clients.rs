@@ -79,6 +79,16 @@ impl Clients {
         Ok(())
     }
 
+    /// Planes owned by the connections of the process of client `id` (quotas count per
+    /// process, so opening more connections does not multiply them).
+    pub fn planes_of_process(&self, id: u128) -> impl Iterator<Item = shm_layout::PlaneId> + '_ {
+        let pid = self.connected.get(&id).map(|c| c.pid);
+        self.connected
+            .values()
+            .filter(move |c| Some(c.pid) == pid)
+            .flat_map(|c| c.planes.iter().copied())
+    }
+
     /// The connected client `id`.
     pub fn get(&self, id: u128) -> Option<&Client> {
         self.connected.get(&id)

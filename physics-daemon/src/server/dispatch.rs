@@ -136,8 +136,8 @@ impl Daemon {
         }
         let owner = self.plane(id)?.owner;
         let (mut objects, mut vertices) = (cost.objects as u64, cost.mesh_vertices);
-        for p in self.clients.get(owner).map_or(&[][..], |c| &c.planes[..]) {
-            if let Some(entry) = self.planes.get(p) {
+        for p in self.clients.planes_of_process(owner) {
+            if let Some(entry) = self.planes.get(&p) {
                 let usage = entry.plane.usage();
                 objects += usage.objects;
                 vertices += usage.mesh_vertices;
@@ -245,7 +245,7 @@ impl Daemon {
                 format!("the daemon already hosts {MAX_PLANES} planes"),
             ));
         }
-        let owned = self.clients.get(owner).map_or(0, |c| c.planes.len());
+        let owned = self.clients.planes_of_process(owner).count();
         let max = self.options.limits.planes_per_client;
         if owned >= max {
             return Err(exceeded(

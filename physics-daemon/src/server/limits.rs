@@ -1,5 +1,7 @@
 //! Per-client quotas: defaults no game reaches but an attack does. Each is a daemon flag;
-//! an exceeded quota is a `Quota` error naming the quota, its value and the flag.
+//! an exceeded quota is a `Quota` error naming the quota, its value and the flag. A client
+//! is a process: all connections of one process share its quotas, so opening more
+//! connections does not multiply them.
 
 use shm_layout::{CommandError, ErrorKind};
 
