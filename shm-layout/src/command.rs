@@ -11,7 +11,7 @@ use crate::error::CommandError;
 use crate::object_op::ObjectOp;
 use crate::plane_op::{PlaneKind, PlaneOp};
 use crate::records::Handle;
-use crate::settings::{Pin, PlaneProp, RotateTo};
+use crate::settings::{ObjectSettings, PlaneProp, PlaneSettings};
 use crate::shape::ShapeKind;
 
 /// Identifies a plane within one daemon.
@@ -94,94 +94,64 @@ impl Command {
     }
 }
 
-/// What the daemon knows about a plane.
+/// What the daemon knows about a plane: its options as set (read through `Deref`, so
+/// `info.gravity` works) and the figures the plane computes.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct PlaneInfo {
     /// The plane's id.
     pub id: PlaneId,
     /// Which backend simulates it.
     pub kind: PlaneKind,
-    /// `Gravity`.
-    pub gravity: Vec3,
-    /// `Threads`.
-    pub threads: u32,
-    /// `TickRate`.
-    pub tick_rate: f32,
-    /// `Enabled`.
-    pub enabled: bool,
+    /// Every option as set.
+    pub settings: PlaneSettings,
     /// Ticks stepped so far.
     pub tick: u64,
     /// Live objects.
     pub object_count: u32,
-    /// `LinearDamping`.
-    pub linear_damping: f32,
-    /// `AngularDamping`.
-    pub angular_damping: f32,
-    /// `Drag`.
-    pub drag: f32,
-    /// `Buoyancy`.
-    pub buoyancy: f32,
-    /// `ConstantForce`.
-    pub constant_force: Vec3,
-    /// `RestThreshold`.
-    pub rest_threshold: f32,
-    /// As set (clamped to [1, 64]).
-    pub solver_iterations: u32,
-    /// `LoopSolver`.
-    pub loop_solver: bool,
-    /// `NeverSleep`.
-    pub never_sleep: bool,
-    /// `Shared`: other clients may change the plane.
-    pub shared: bool,
     /// Iterations the solver runs now: LoopSolver, SolverIterations and HitBoxQuality scaling.
     pub effective_solver_iterations: u32,
     /// Largest HitBoxQuality among the plane's objects (1 when empty).
     pub max_hit_box_quality: u32,
 }
 
-/// Every property of an object, as the daemon holds it.
+impl std::ops::Deref for PlaneInfo {
+    type Target = PlaneSettings;
+    fn deref(&self) -> &PlaneSettings {
+        &self.settings
+    }
+}
+
+/// Every property of an object, as the daemon holds it: the stored settings (read through
+/// `Deref`) and what lives in the engine or is derived.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ObjectInfo {
     /// The object's handle.
     pub handle: Handle,
     /// Its shape.
     pub shape: ShapeKind,
+    /// The stored properties as set (`settings.density` is the Density as set).
+    pub settings: ObjectSettings,
     /// `Size`.
     pub size: Vec3,
     /// `Anchored`.
     pub anchored: bool,
     /// Asleep in the engine now.
     pub sleeping: bool,
-    /// `Weight`.
-    pub weight: f32,
     /// The density in effect: the explicit value, or Weight ÷ volume.
     pub density: f32,
     /// The mass in effect.
     pub mass: f32,
-    /// `Bounciness`.
-    pub bounciness: f32,
-    /// `Friction`.
-    pub friction: f32,
-    /// `CanCollide`.
-    pub can_collide: bool,
-    /// `HitBoxQuality`.
-    pub hit_box_quality: u32,
-    /// `CenterOfMass`.
-    pub center_of_mass: Vec3,
-    /// `ImpulseDirection`.
-    pub impulse_direction: Vec3,
-    /// `ConstantForce`.
-    pub constant_force: Vec3,
-    /// LockX, LockY, LockZ, LockRotX, LockRotY, LockRotZ as set by FieldRestraint.
-    pub locks: [bool; 6],
     /// Rotation locked because the object is a low-quality non-sphere without CenterOfMass.
     pub rotation_locked_by_quality: bool,
     /// Continuous collision detection is on.
     pub ccd: bool,
-    /// `RotateTo`.
-    pub rotate_to: Option<RotateTo>,
-    /// `SetPin`.
-    pub pin: Option<Pin>,
+}
+
+impl std::ops::Deref for ObjectInfo {
+    type Target = ObjectSettings;
+    fn deref(&self) -> &ObjectSettings {
+        &self.settings
+    }
 }
 
 /// The successful result of one command.

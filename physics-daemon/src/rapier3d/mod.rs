@@ -179,26 +179,12 @@ impl Plane {
 
     /// Every option and figure of the plane.
     pub fn info(&self) -> PlaneInfo {
-        let s = &self.settings;
         PlaneInfo {
             id: self.id,
             kind: PlaneKind::Rapier3d,
-            gravity: s.gravity,
-            threads: s.threads,
-            tick_rate: s.tick_rate,
-            enabled: s.enabled,
+            settings: self.settings,
             tick: self.tick,
             object_count: self.bodies.live(),
-            linear_damping: s.linear_damping,
-            angular_damping: s.angular_damping,
-            drag: s.drag,
-            buoyancy: s.buoyancy,
-            constant_force: s.constant_force,
-            rest_threshold: s.rest_threshold,
-            solver_iterations: s.solver_iterations,
-            loop_solver: s.loop_solver,
-            never_sleep: s.never_sleep,
-            shared: s.shared,
             effective_solver_iterations: self.solver_settings().iterations as u32,
             max_hit_box_quality: self.max_quality(),
         }

@@ -125,24 +125,14 @@ impl Plane {
         Ok(ObjectInfo {
             handle,
             shape: part.shape,
+            settings: part.settings,
             size: part.size,
             anchored: body.is_fixed(),
             sleeping: body.is_sleeping(),
-            weight: part.weight,
             density: mass / volume,
             mass,
-            bounciness: part.bounciness,
-            friction: part.friction,
-            can_collide: part.can_collide,
-            hit_box_quality: part.hit_box_quality,
-            center_of_mass: part.center_of_mass,
-            impulse_direction: part.impulse_direction,
-            constant_force: part.constant_force,
-            locks: part.locks,
             rotation_locked_by_quality: part.rotation_locked_by_quality(),
             ccd: body.is_ccd_enabled(),
-            rotate_to: part.rotate_to,
-            pin: part.pin,
         })
     }
 
