@@ -41,7 +41,7 @@ fn beat(config: &Config, stop: &AtomicBool) -> Result<(), DaemonError> {
         .history_size(1)
         .subscriber_max_buffer_size(1)
         .max_publishers(1)
-        .max_subscribers(super::clients::MAX_CLIENTS * 4)
+        .max_subscribers(super::clients::MAX_CLIENTS * 2)
         .max_nodes(MAX_NODES)
         .open_or_create()
         .map_err(|e| ipc("service", &e))?

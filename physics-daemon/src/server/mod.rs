@@ -195,7 +195,7 @@ fn serve(
         .service_builder(&names::control_wake())
         .event()
         .max_listeners(2)
-        .max_notifiers(MAX_CLIENTS * 4)
+        .max_notifiers(MAX_CLIENTS * 2)
         .max_nodes(MAX_NODES)
         .open_or_create()
         .map_err(|e| DaemonError::Ipc(format!("cannot create the request event: {e:?}")))?
@@ -209,7 +209,7 @@ fn serve(
         .max_servers(1)
         // Room beyond MAX_CLIENTS: ports that never say Hello (or a process at its
         // per-process limit) leave ports for other processes.
-        .max_clients(MAX_CLIENTS * 4)
+        .max_clients(MAX_CLIENTS * 2)
         .max_nodes(MAX_NODES)
         .max_active_requests_per_client(4)
         .open_or_create()
