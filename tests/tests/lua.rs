@@ -275,3 +275,18 @@ fn sleeping_reads_the_published_flag_and_wake_wakes() {
     // Rapier puts a body to sleep after 0.5 s below its thresholds (30 ticks at 60 Hz).
     assert!((30..360).contains(&ticks), "asleep after {ticks} ticks");
 }
+
+/// Runs `script` against `daemon` and checks it printed `expect` at the start of its output.
+fn run_ok(daemon: &TestDaemon, script: &str, expect: &str) -> String {
+    let r = run(daemon, script);
+    r.assert_ok();
+    let out = r.stdout();
+    assert!(out.starts_with(expect), "{script}: {out}");
+    out
+}
+
+#[test]
+fn scripts_run_sandboxed_with_the_api_globals() {
+    let daemon = TestDaemon::start("lua-sandbox");
+    run_ok(&daemon, "tests/lua/sandbox.luau", "sandbox ok");
+}
