@@ -286,6 +286,16 @@ fn run_ok(daemon: &TestDaemon, script: &str, expect: &str) -> String {
 }
 
 #[test]
+fn api_errors_reach_pcall_as_strings_with_the_position() {
+    let daemon = TestDaemon::start("lua-error-strings");
+    run_ok(
+        &daemon,
+        "tests/lua/error_strings.luau",
+        "error strings ok\t6",
+    );
+}
+
+#[test]
 fn scripts_run_sandboxed_with_the_api_globals() {
     let daemon = TestDaemon::start("lua-sandbox");
     run_ok(&daemon, "tests/lua/sandbox.luau", "sandbox ok");

@@ -1,8 +1,9 @@
 //! The host side of the API: the frame loop ([`Host`]), the scheduler behind `wait` and
-//! coroutines, signals, and the watchdog that stops runaway scripts. Nothing here knows an
-//! API type: what changes per frame (a simulated part's CFrame) is [`Watched`] through a
-//! trait object.
+//! coroutines, signals, the watchdog that stops runaway scripts, and errors as scripts see
+//! them. Nothing here knows an API type: what changes per frame (a simulated part's CFrame)
+//! is [`Watched`] through a trait object.
 
+pub mod errors;
 pub mod scheduler;
 pub mod signal;
 pub mod watchdog;

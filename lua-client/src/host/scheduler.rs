@@ -188,6 +188,6 @@ pub fn wait_function(lua: &Lua) -> mlua::Result<Function> {
         "local mark, check, yield = ...\n\
          return function(seconds) return yield(mark, check(seconds)) end",
     )
-    .set_name("=wait")
+    .set_name("=[wait]")
     .call((wait_mark(), check, yield_fn))
 }
