@@ -296,6 +296,12 @@ fn api_errors_reach_pcall_as_strings_with_the_position() {
 }
 
 #[test]
+fn stale_objects_never_reach_the_parts_new_body() {
+    let daemon = TestDaemon::start("lua-stale");
+    run_ok(&daemon, "tests/lua/stale_objects.luau", "stale objects ok");
+}
+
+#[test]
 fn scripts_run_sandboxed_with_the_api_globals() {
     let daemon = TestDaemon::start("lua-sandbox");
     run_ok(&daemon, "tests/lua/sandbox.luau", "sandbox ok");

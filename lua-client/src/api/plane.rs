@@ -8,7 +8,7 @@ use client_sdk::{Client, Plane, PlaneInfo, PlaneOptions, PlaneProp};
 use mlua::{Lua, MetaMethod, Table, UserData, UserDataMethods, Value};
 
 use super::object::PhysicsObject;
-use super::part::{BasePart, Link, PartState};
+use super::part::{BasePart, Body, Ended, PartState};
 use crate::props::plane::{NOT_YET_METHODS, PLANE};
 use crate::props::{not_yet_methods, Target};
 use crate::values::{describe, expected, finite_number, sdk_error};
@@ -60,7 +60,7 @@ impl PlaneState {
             return Ok(());
         }
         for part in self.parts.take() {
-            part.unlink();
+            part.unlink(Ended::PlaneDestroyed);
         }
         self.plane.destroy()
     }
@@ -194,13 +194,11 @@ fn add(plane: &Rc<PlaneState>, part: Value) -> mlua::Result<PhysicsObject> {
         .plane
         .add(collider, state.cframe().pose(), &[])
         .map_err(|e| sdk_error(&what(), e))?;
-    state.link(Link {
-        object: object.clone(),
-        plane: Rc::downgrade(plane),
-    });
+    let body = Body::new(object, Rc::downgrade(plane));
+    state.link(body.clone());
     plane.parts.borrow_mut().push(state.clone());
     Ok(PhysicsObject {
-        object,
+        body,
         part: state,
         part_ud: ud.clone(),
     })

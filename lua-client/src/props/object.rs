@@ -13,7 +13,7 @@ use crate::values::{new_vector, sdk_error, CFrame};
 
 /// The object's properties as the daemon holds them (one round trip).
 fn info(o: &PhysicsObject, what: &str) -> Result<ObjectInfo, LuaError> {
-    o.live(what)?
+    o.live_for(|| format!("PhysicsObject.{what}"))?
         .info()
         .map_err(|e| sdk_error(&format!("PhysicsObject.{what}"), e))
 }
@@ -21,7 +21,7 @@ fn info(o: &PhysicsObject, what: &str) -> Result<ObjectInfo, LuaError> {
 /// The object's published state: the newest tick with this process's unconfirmed writes on
 /// top (no request).
 fn state(o: &PhysicsObject, what: &str) -> Result<BodyState, LuaError> {
-    o.live(what)?
+    o.live_for(|| format!("PhysicsObject.{what}"))?
         .state()
         .map_err(|e| sdk_error(&format!("PhysicsObject.{what}"), e))
 }
