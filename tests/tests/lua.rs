@@ -302,6 +302,12 @@ fn stale_objects_never_reach_the_parts_new_body() {
 }
 
 #[test]
+fn resizing_a_simulated_part_resizes_its_body() {
+    let daemon = TestDaemon::start("lua-resize");
+    run_ok(&daemon, "tests/lua/resize.luau", "resize ok");
+}
+
+#[test]
 fn scripts_run_sandboxed_with_the_api_globals() {
     let daemon = TestDaemon::start("lua-sandbox");
     run_ok(&daemon, "tests/lua/sandbox.luau", "sandbox ok");

@@ -4,7 +4,7 @@
 use std::cell::{Cell, RefCell};
 use std::rc::{Rc, Weak};
 
-use client_sdk::{Object, Shape};
+use client_sdk::{Object, ObjectProp, Shape};
 use mlua::{Lua, MetaMethod, MultiValue, Table, UserData, UserDataMethods, Value};
 
 use super::plane::PlaneState;
@@ -13,7 +13,7 @@ use crate::host::signal::Signal;
 use crate::host::Watched;
 use crate::props::part::PART;
 use crate::props::Target;
-use crate::values::{describe, expected, CFrame, DESCRIBE};
+use crate::values::{describe, expected, new_vector, sdk_error, CFrame, DESCRIBE};
 
 /// Shapes a BasePart can have (the collider the plane builds from it).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -142,9 +142,16 @@ impl PartState {
         self.size.get()
     }
 
-    /// Resizes the part (not its body: see PhysicsObject.Size).
-    pub fn set_size(&self, size: [f32; 3]) {
+    /// Resizes the part and, while it is simulated, its body (`what` names the property
+    /// written, for errors); fires the Size change signal.
+    pub fn resize(&self, lua: &Lua, what: &str, size: [f32; 3]) -> mlua::Result<()> {
+        if let Some(object) = self.object() {
+            object
+                .set(ObjectProp::Size(size))
+                .map_err(|e| sdk_error(what, e))?;
+        }
         self.size.set(size);
+        self.changed(lua, "Size", new_vector(size))
     }
 
     /// Whether `:Destroy()` was called.

@@ -7,7 +7,7 @@ use client_sdk::validate::MAX_HIT_BOX_QUALITY;
 use client_sdk::{BodyState, ObjectInfo, ObjectProp, Pose};
 use mlua::{Error as LuaError, Value};
 
-use super::{Get, Kind, Props, Row, Set, Target};
+use super::{Get, Kind, Props, Row, Set};
 use crate::api::object::PhysicsObject;
 use crate::values::{new_vector, sdk_error, CFrame};
 
@@ -109,10 +109,8 @@ pub static OBJECT: Props<PhysicsObject> = Props {
             kind: Kind::PositiveVector,
             get: Get::Fn(|_, o| Ok(new_vector(o.part.size()))),
             set: Set::Fn(|lua, o, a| {
-                let size = a.vector()?;
-                o.write("Size", ObjectProp::Size(size))?;
-                o.part.set_size(size);
-                o.part.changed(lua, "Size", new_vector(size))
+                o.live("PhysicsObject.Size")?;
+                o.part.resize(lua, "PhysicsObject.Size", a.vector()?)
             }),
         },
         info_row!(
