@@ -163,10 +163,7 @@ pub static OBJECT: Props<PhysicsObject> = Props {
         // Documented as clamped to [1, 32]: any integer is accepted.
         info_row!(
             "HitBoxQuality",
-            Kind::Integer {
-                min: i64::MIN,
-                max: i64::MAX,
-            },
+            Kind::ANY_INTEGER,
             |i| Value::Number(i.hit_box_quality as f64),
             |a| ObjectProp::HitBoxQuality(a.integer()?.clamp(1, MAX_HIT_BOX_QUALITY as i64) as u32)
         ),
