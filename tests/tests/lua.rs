@@ -308,6 +308,16 @@ fn resizing_a_simulated_part_resizes_its_body() {
 }
 
 #[test]
+fn a_destroyed_plane_refuses_every_option_alike() {
+    let daemon = TestDaemon::start("lua-destroyed");
+    run_ok(
+        &daemon,
+        "tests/lua/destroyed_plane.luau",
+        "destroyed plane ok\t13",
+    );
+}
+
+#[test]
 fn scripts_run_sandboxed_with_the_api_globals() {
     let daemon = TestDaemon::start("lua-sandbox");
     run_ok(&daemon, "tests/lua/sandbox.luau", "sandbox ok");

@@ -70,15 +70,15 @@ impl Target for PlaneState {
     type Prop = PlaneProp;
 
     /// Queues an option change for the frame's batch.
-    fn write(&self, _: &str, prop: PlaneProp) -> mlua::Result<()> {
+    fn write(&self, name: &str, prop: PlaneProp) -> mlua::Result<()> {
         if !self.alive() {
             return Err(mlua::Error::runtime(format!(
-                "PhysicsPlane: cannot set {prop:?} on a destroyed plane"
+                "PhysicsPlane.{name}: the plane was destroyed"
             )));
         }
         self.plane
             .set(prop)
-            .map_err(|e| sdk_error("PhysicsPlane", e))
+            .map_err(|e| sdk_error(&format!("PhysicsPlane.{name}"), e))
     }
 }
 
@@ -157,7 +157,10 @@ impl UserData for PhysicsPlane {
             |lua, p, (key, value): (Value, Value)| PLANE.set(lua, &p.0, &key, &value),
         );
         methods.add_meta_method(MetaMethod::ToString, |_, p, ()| {
-            Ok(format!("PhysicsPlane {}", p.0.plane.id()))
+            Ok(match p.0.alive() {
+                true => format!("PhysicsPlane {}", p.0.plane.id()),
+                false => format!("PhysicsPlane {} (destroyed)", p.0.plane.id()),
+            })
         });
     }
 }
