@@ -134,7 +134,7 @@ fn signals_fire_only_while_listened_to() {
     let daemon = TestDaemon::start("lua-signals");
     let r = run(&daemon, "tests/lua/signals.luau");
     r.assert_ok();
-    assert!(r.stdout().starts_with("signals ok\t4\t"), "{}", r.stdout());
+    assert!(r.stdout().starts_with("signals ok\t5\t"), "{}", r.stdout());
 }
 
 #[test]
@@ -314,6 +314,16 @@ fn a_destroyed_plane_refuses_every_option_alike() {
         &daemon,
         "tests/lua/destroyed_plane.luau",
         "destroyed plane ok\t13",
+    );
+}
+
+#[test]
+fn cframe_signals_fire_once_per_step() {
+    let daemon = TestDaemon::start("lua-step-signals");
+    run_ok(
+        &daemon,
+        "tests/lua/step_signals.luau",
+        "step signals ok\t10",
     );
 }
 

@@ -64,6 +64,19 @@ impl PlaneState {
         }
         self.plane.destroy()
     }
+
+    /// The post-tick pass of a step: every part of the plane whose CFrame signal has
+    /// listeners announces its new pose (handlers run before `Step` returns).
+    fn after_tick(&self, lua: &Lua) -> mlua::Result<()> {
+        // A copy: handlers may add, unlink or destroy parts.
+        let parts: Vec<Rc<PartState>> = self.parts.borrow().clone();
+        for part in parts {
+            if part.cframe_listeners() > 0 {
+                part.fire_cframe_if_moved(lua)?;
+            }
+        }
+        Ok(())
+    }
 }
 
 impl Target for PlaneState {
@@ -120,7 +133,7 @@ impl UserData for PhysicsPlane {
                 &on,
             )
         });
-        methods.add_method("Step", |_, p, dt: Value| {
+        methods.add_method("Step", |lua, p, dt: Value| {
             let dt = match finite_number("PhysicsPlane:Step", &dt) {
                 Ok(dt) if dt > 0.0 && dt <= MAX_DT as f64 => dt,
                 _ => {
@@ -137,8 +150,8 @@ impl UserData for PhysicsPlane {
             }
             p.0.plane
                 .step(dt as f32)
-                .map(|_| ())
-                .map_err(|e| sdk_error("PhysicsPlane:Step", e))
+                .map_err(|e| sdk_error("PhysicsPlane:Step", e))?;
+            p.0.after_tick(lua)
         });
         methods.add_method("Destroy", |lua, p, ()| {
             context(lua)
