@@ -11,7 +11,8 @@
 //!
 //! - `values`: Lua values and the value types (`Vector`, `CFrame`, `Dim`); knows no other
 //!   layer;
-//! - `host`: the frame loop, `wait` and coroutines, signals; knows only `values`;
+//! - `host`: the frame loop, `wait` and coroutines, signals, the watchdog (run-time limit,
+//!   deadline, stop flag) and errors as scripts see them; knows only `values`;
 //! - `api`: one file per Luau API type with its methods and handles;
 //! - `props`: the properties of each API type, one row each (Lua type, the one place it
 //!   reads from, the write).
@@ -27,12 +28,17 @@ use client_sdk::Client;
 use mlua::{Lua, Table, Value};
 
 use host::scheduler::{self, Scheduler};
-pub use host::Host;
+pub use host::{Host, Stop};
 
-/// Installs the API into `lua`, talking to the daemon through `client`.
+/// Installs the API into `lua`, talking to the daemon through `client`: the globals, the
+/// watchdog's interrupt (see [`Host::set_max_run_time`]) and `pcall`, `xpcall` and
+/// `coroutine.resume` wrapped so that they give API errors as `"chunk:line: message"`
+/// strings. Call it before `lua.sandbox(true)`: it sets globals and replaces builtins.
 pub fn install(lua: &Lua, client: Client) -> mlua::Result<Host> {
     let scheduler = Rc::new(Scheduler::new());
     lua.set_app_data(scheduler.clone());
+    scheduler.watchdog.install(lua);
+    host::errors::install(lua)?;
     let modules = api::modules(lua, client.clone())?;
     let import = lua.create_function(move |_, name: Value| {
         let found = match &name {

@@ -134,7 +134,7 @@ fn signals_fire_only_while_listened_to() {
     let daemon = TestDaemon::start("lua-signals");
     let r = run(&daemon, "tests/lua/signals.luau");
     r.assert_ok();
-    assert!(r.stdout().starts_with("signals ok\t4\t"), "{}", r.stdout());
+    assert!(r.stdout().starts_with("signals ok\t5\t"), "{}", r.stdout());
 }
 
 #[test]
@@ -274,4 +274,61 @@ fn sleeping_reads_the_published_flag_and_wake_wakes() {
         .unwrap_or_else(|| panic!("unexpected output {:?}", r.stdout()));
     // Rapier puts a body to sleep after 0.5 s below its thresholds (30 ticks at 60 Hz).
     assert!((30..360).contains(&ticks), "asleep after {ticks} ticks");
+}
+
+/// Runs `script` against `daemon` and checks it printed `expect` at the start of its output.
+fn run_ok(daemon: &TestDaemon, script: &str, expect: &str) -> String {
+    let r = run(daemon, script);
+    r.assert_ok();
+    let out = r.stdout();
+    assert!(out.starts_with(expect), "{script}: {out}");
+    out
+}
+
+#[test]
+fn api_errors_reach_pcall_as_strings_with_the_position() {
+    let daemon = TestDaemon::start("lua-error-strings");
+    run_ok(
+        &daemon,
+        "tests/lua/error_strings.luau",
+        "error strings ok\t6",
+    );
+}
+
+#[test]
+fn stale_objects_never_reach_the_parts_new_body() {
+    let daemon = TestDaemon::start("lua-stale");
+    run_ok(&daemon, "tests/lua/stale_objects.luau", "stale objects ok");
+}
+
+#[test]
+fn resizing_a_simulated_part_resizes_its_body() {
+    let daemon = TestDaemon::start("lua-resize");
+    run_ok(&daemon, "tests/lua/resize.luau", "resize ok");
+}
+
+#[test]
+fn a_destroyed_plane_refuses_every_option_alike() {
+    let daemon = TestDaemon::start("lua-destroyed");
+    run_ok(
+        &daemon,
+        "tests/lua/destroyed_plane.luau",
+        "destroyed plane ok\t13",
+    );
+}
+
+#[test]
+fn cframe_signals_fire_once_per_step() {
+    let daemon = TestDaemon::start("lua-step-signals");
+    run_ok(
+        &daemon,
+        "tests/lua/step_signals.luau",
+        "step signals ok\t10",
+    );
+}
+
+#[test]
+fn scripts_run_sandboxed_with_the_api_globals() {
+    let daemon = TestDaemon::start("lua-sandbox");
+    run_ok(&daemon, "tests/lua/sandbox.luau", "sandbox ok");
 }

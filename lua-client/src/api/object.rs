@@ -6,10 +6,10 @@ use std::rc::Rc;
 use client_sdk::{Object, ObjectProp, Pin, Restraint};
 use mlua::{AnyUserData, Lua, MetaMethod, Table, UserData, UserDataMethods, Value};
 
-use super::part::PartState;
+use super::part::{Body, Ended, PartState};
 use crate::props::object::OBJECT;
 use crate::props::{Kind, Target};
-use crate::values::{describe, expected, new_vector, rotation, sdk_error};
+use crate::values::{describe, expected, new_vector, rotation, sdk_error, DESCRIBE};
 
 /// RotateTo's documented default strength.
 const DEFAULT_STRENGTH: f64 = 8.0;
@@ -54,8 +54,9 @@ fn restraint(opts: &Value) -> mlua::Result<Restraint> {
 
 /// A part's body in a plane, as scripts hold it.
 pub struct PhysicsObject {
-    /// The body.
-    pub object: Object,
+    /// The body `plane:Add` made; it ends (and this object goes stale) on Unlink, Destroy
+    /// or the plane's Destroy, and is never replaced.
+    pub body: Rc<Body>,
     /// The wrapped part.
     pub part: Rc<PartState>,
     /// The wrapped part's own userdata, so `obj:BasePart() == part`.
@@ -63,20 +64,33 @@ pub struct PhysicsObject {
 }
 
 impl PhysicsObject {
-    /// The body, while this object still wraps its part in a plane.
+    /// The body, while it is still the part's; else an error for `what` (the property or
+    /// method, e.g. `PhysicsObject.Velocity`) naming the object and what happened to it.
     pub fn live(&self, what: &str) -> mlua::Result<&Object> {
-        if self.part.is_linked_to(&self.object) {
-            Ok(&self.object)
-        } else {
-            Err(mlua::Error::runtime(format!(
-                "PhysicsObject.{what}: the object was destroyed or unlinked"
-            )))
+        self.live_for(|| what.to_string())
+    }
+
+    /// [`live`](Self::live), naming `what` only when it fails.
+    pub fn live_for(&self, what: impl FnOnce() -> String) -> mlua::Result<&Object> {
+        match self.body.ended() {
+            None => Ok(&self.body.object),
+            Some(ended) => Err(mlua::Error::runtime(format!(
+                "{}: {} {}",
+                what(),
+                self.describe(),
+                ended.says()
+            ))),
         }
     }
 
-    /// Whether the body still exists and still belongs to the part.
+    /// Whether the body still exists and is still the part's.
     pub fn alive(&self) -> bool {
-        self.part.is_linked_to(&self.object) && self.object.is_alive().unwrap_or(false)
+        self.body.ended().is_none() && self.body.object.is_alive().unwrap_or(false)
+    }
+
+    /// `PhysicsObject "Name"`: how `tostring` and error messages show the object.
+    pub fn describe(&self) -> String {
+        format!("PhysicsObject \"{}\"", self.part.name())
     }
 }
 
@@ -84,9 +98,10 @@ impl Target for PhysicsObject {
     type Prop = ObjectProp;
 
     fn write(&self, name: &str, prop: ObjectProp) -> mlua::Result<()> {
-        self.live(name)?
+        let what = || format!("PhysicsObject.{name}");
+        self.live_for(what)?
             .set(prop)
-            .map_err(|e| sdk_error(&format!("PhysicsObject.{name}"), e))
+            .map_err(|e| sdk_error(&what(), e))
     }
 }
 
@@ -109,7 +124,7 @@ pub fn methods(lua: &Lua) -> mlua::Result<Table> {
             let j = Kind::Vector
                 .convert("PhysicsObject:ApplyImpulse", &v)?
                 .vector()?;
-            o.live("ApplyImpulse")?
+            o.live("PhysicsObject:ApplyImpulse")?
                 .apply_impulse(j)
                 .map_err(|e| sdk_error("PhysicsObject:ApplyImpulse", e))
         })?,
@@ -118,13 +133,15 @@ pub fn methods(lua: &Lua) -> mlua::Result<Table> {
         "BasePart",
         lua.create_function(|_, o: Value| Ok(this("PhysicsObject:BasePart", &o)?.part_ud.clone()))?,
     )?;
-    // The body leaves the plane; the part stays where the simulation left it.
+    // The body leaves the plane; the part stays where the simulation left it. On an object
+    // that is no longer its part's body (unlinked, destroyed, its plane destroyed) Unlink
+    // and Destroy do nothing: the part may be in a plane again, with another body.
     t.set(
         "Unlink",
         lua.create_function(|_, o: Value| {
             let o = this("PhysicsObject:Unlink", &o)?;
-            if o.part.is_linked_to(&o.object) {
-                o.part.detach();
+            if o.body.ended().is_none() {
+                o.part.detach(Ended::Unlinked);
             }
             Ok(())
         })?,
@@ -132,7 +149,10 @@ pub fn methods(lua: &Lua) -> mlua::Result<Table> {
     t.set(
         "Destroy",
         lua.create_function(|_, o: Value| {
-            this("PhysicsObject:Destroy", &o)?.part.destroy();
+            let o = this("PhysicsObject:Destroy", &o)?;
+            if o.body.ended().is_none() {
+                o.part.destroy();
+            }
             Ok(())
         })?,
     )?;
@@ -141,7 +161,7 @@ pub fn methods(lua: &Lua) -> mlua::Result<Table> {
         lua.create_function(|_, (o, opts): (Value, Value)| {
             let o = this("PhysicsObject:FieldRestraint", &o)?;
             let r = restraint(&opts)?;
-            o.live("FieldRestraint")?
+            o.live("PhysicsObject:FieldRestraint")?
                 .field_restraint(r)
                 .map_err(|e| sdk_error("PhysicsObject:FieldRestraint", e))
         })?,
@@ -160,7 +180,7 @@ pub fn methods(lua: &Lua) -> mlua::Result<Table> {
                     .convert(&format!("{what} strength"), &v)?
                     .number()?,
             };
-            o.live("RotateTo")?
+            o.live(what)?
                 .rotate_to(rotation::from_euler(euler), strength as f32)
                 .map_err(|e| sdk_error(what, e))
         })?,
@@ -169,7 +189,7 @@ pub fn methods(lua: &Lua) -> mlua::Result<Table> {
         "StopRotateTo",
         lua.create_function(|_, o: Value| {
             let o = this("PhysicsObject:StopRotateTo", &o)?;
-            o.live("StopRotateTo")?
+            o.live("PhysicsObject:StopRotateTo")?
                 .stop_rotate_to()
                 .map_err(|e| sdk_error("PhysicsObject:StopRotateTo", e))
         })?,
@@ -195,9 +215,7 @@ pub fn methods(lua: &Lua) -> mlua::Result<Table> {
                             .pose(),
                     }),
                 };
-                o.live("SetPin")?
-                    .set_pin(pin)
-                    .map_err(|e| sdk_error(what, e))
+                o.live(what)?.set_pin(pin).map_err(|e| sdk_error(what, e))
             },
         )?,
     )?;
@@ -206,7 +224,7 @@ pub fn methods(lua: &Lua) -> mlua::Result<Table> {
         lua.create_function(|_, o: Value| {
             let what = "PhysicsObject:Wake";
             let o = this(what, &o)?;
-            o.live("Wake")?.wake().map_err(|e| sdk_error(what, e))
+            o.live(what)?.wake().map_err(|e| sdk_error(what, e))
         })?,
     )?;
     // Lua parts are Cube / Sphere (no mesh): this returns the CenterOfMass unchanged.
@@ -216,7 +234,7 @@ pub fn methods(lua: &Lua) -> mlua::Result<Table> {
             let what = "PhysicsObject:RecalculateCenterOfMass";
             let o = this(what, &o)?;
             let com = o
-                .live("RecalculateCenterOfMass")?
+                .live(what)?
                 .recalculate_center_of_mass()
                 .map_err(|e| sdk_error(what, e))?;
             Ok(new_vector(com))
@@ -235,8 +253,7 @@ impl UserData for PhysicsObject {
             MetaMethod::NewIndex,
             |lua, o, (key, value): (Value, Value)| OBJECT.set(lua, o, &key, &value),
         );
-        methods.add_meta_method(MetaMethod::ToString, |_, o, ()| {
-            Ok(format!("PhysicsObject \"{}\"", o.part.name()))
-        });
+        methods.add_meta_method(MetaMethod::ToString, |_, o, ()| Ok(o.describe()));
+        methods.add_meta_method(DESCRIBE, |_, o, ()| Ok(o.describe()));
     }
 }

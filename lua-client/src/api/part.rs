@@ -4,7 +4,7 @@
 use std::cell::{Cell, RefCell};
 use std::rc::{Rc, Weak};
 
-use client_sdk::{Object, Shape};
+use client_sdk::{Object, ObjectProp, Shape};
 use mlua::{Lua, MetaMethod, MultiValue, Table, UserData, UserDataMethods, Value};
 
 use super::plane::PlaneState;
@@ -13,7 +13,7 @@ use crate::host::signal::Signal;
 use crate::host::Watched;
 use crate::props::part::PART;
 use crate::props::Target;
-use crate::values::{describe, expected, CFrame, DESCRIBE};
+use crate::values::{describe, expected, new_vector, sdk_error, CFrame, DESCRIBE};
 
 /// Shapes a BasePart can have (the collider the plane builds from it).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -48,12 +48,54 @@ impl PartShape {
     }
 }
 
-/// A simulated part's body and the plane it is in.
-pub struct Link {
+/// Why a body stopped being its part's.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Ended {
+    /// `obj:Unlink()`: the part left the plane.
+    Unlinked,
+    /// `obj:Destroy()` or `part:Destroy()`.
+    Destroyed,
+    /// `plane:Destroy()`.
+    PlaneDestroyed,
+}
+
+impl Ended {
+    /// What happened, as error messages say it ("PhysicsObject \"Ball\" ...").
+    pub fn says(self) -> &'static str {
+        match self {
+            Ended::Unlinked => "was unlinked from its plane",
+            Ended::Destroyed => "was destroyed",
+            Ended::PlaneDestroyed => "was destroyed with its plane",
+        }
+    }
+}
+
+/// One body a part had in a plane, shared by the part (while it is the part's body) and the
+/// PhysicsObject `plane:Add` returned. A body is its part's until it ends; a later `Add` of
+/// the same part makes a new one, so an old PhysicsObject can never reach the new body, even
+/// where the daemon reuses its slot or handle.
+pub struct Body {
     /// The body.
     pub object: Object,
     /// The plane the body is in.
     pub plane: Weak<PlaneState>,
+    ended: Cell<Option<Ended>>,
+}
+
+impl Body {
+    /// A live body of `plane`.
+    pub fn new(object: Object, plane: Weak<PlaneState>) -> Rc<Body> {
+        Rc::new(Body {
+            object,
+            plane,
+            ended: Cell::new(None),
+        })
+    }
+
+    /// Why it is no longer its part's body (`None` while it is).
+    pub fn ended(&self) -> Option<Ended> {
+        self.ended.get()
+    }
 }
 
 /// A part: the host's own state of it, and its body while simulated.
@@ -65,7 +107,7 @@ pub struct PartState {
     /// The pose while not simulated; the frozen last pose after the body went away.
     cframe: Cell<CFrame>,
     destroyed: Cell<bool>,
-    link: RefCell<Option<Link>>,
+    link: RefCell<Option<Rc<Body>>>,
     signals: RefCell<Vec<(&'static str, Signal)>>,
     /// The last pose the per-tick change pass announced.
     last_fired: Cell<Option<CFrame>>,
@@ -100,9 +142,16 @@ impl PartState {
         self.size.get()
     }
 
-    /// Resizes the part (not its body: see PhysicsObject.Size).
-    pub fn set_size(&self, size: [f32; 3]) {
+    /// Resizes the part and, while it is simulated, its body (`what` names the property
+    /// written, for errors); fires the Size change signal.
+    pub fn resize(&self, lua: &Lua, what: &str, size: [f32; 3]) -> mlua::Result<()> {
+        if let Some(object) = self.object() {
+            object
+                .set(ObjectProp::Size(size))
+                .map_err(|e| sdk_error(what, e))?;
+        }
         self.size.set(size);
+        self.changed(lua, "Size", new_vector(size))
     }
 
     /// Whether `:Destroy()` was called.
@@ -115,17 +164,10 @@ impl PartState {
         self.link.borrow().as_ref().map(|l| l.object.clone())
     }
 
-    /// Whether `object` is this part's body now.
-    pub fn is_linked_to(&self, object: &Object) -> bool {
-        self.link.borrow().as_ref().is_some_and(|l| {
-            l.object.handle() == object.handle() && l.object.plane().id() == object.plane().id()
-        })
-    }
-
-    /// Makes `link` the part's body (the part is simulated from now on).
-    pub fn link(&self, link: Link) {
+    /// Makes `body` the part's body (the part is simulated from now on).
+    pub fn link(&self, body: Rc<Body>) {
         self.last_fired.set(None);
-        *self.link.borrow_mut() = Some(link);
+        *self.link.borrow_mut() = Some(body);
     }
 
     /// The pose: the newest tick's for a simulated part, else the stored one.
@@ -143,28 +185,29 @@ impl PartState {
         self.cframe.set(cf);
     }
 
-    /// Leaves the plane: the part keeps its last simulated pose. Returns the body it had.
-    pub fn unlink(&self) -> Option<Object> {
+    /// Leaves the plane: the part keeps its last simulated pose; its body ends for `why`.
+    /// Returns the body it had.
+    pub fn unlink(&self, why: Ended) -> Option<Rc<Body>> {
         let cf = self.cframe();
         self.cframe.set(cf);
-        let link = self.link.borrow_mut().take()?;
-        Some(link.object)
+        let body = self.link.borrow_mut().take()?;
+        body.ended.set(Some(why));
+        Some(body)
     }
 
     /// Removes the part's body from its plane (queued), keeping the part.
-    pub fn detach(self: &Rc<Self>) {
-        let plane = self.link.borrow().as_ref().map(|l| l.plane.clone());
-        if let Some(object) = self.unlink() {
-            object.destroy();
-        }
-        if let Some(plane) = plane.and_then(|p| p.upgrade()) {
-            plane.forget(self);
+    pub fn detach(self: &Rc<Self>, why: Ended) {
+        if let Some(body) = self.unlink(why) {
+            body.object.destroy();
+            if let Some(plane) = body.plane.upgrade() {
+                plane.forget(self);
+            }
         }
     }
 
     /// Removes the body, disconnects every change signal and marks the part destroyed.
     pub fn destroy(self: &Rc<Self>) {
-        self.detach();
+        self.detach(Ended::Destroyed);
         self.destroyed.set(true);
         for (_, s) in self.signals.borrow().iter() {
             s.disconnect_all();

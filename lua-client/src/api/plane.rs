@@ -8,7 +8,7 @@ use client_sdk::{Client, Plane, PlaneInfo, PlaneOptions, PlaneProp};
 use mlua::{Lua, MetaMethod, Table, UserData, UserDataMethods, Value};
 
 use super::object::PhysicsObject;
-use super::part::{BasePart, Link, PartState};
+use super::part::{BasePart, Body, Ended, PartState};
 use crate::props::plane::{NOT_YET_METHODS, PLANE};
 use crate::props::{not_yet_methods, Target};
 use crate::values::{describe, expected, finite_number, sdk_error};
@@ -60,9 +60,22 @@ impl PlaneState {
             return Ok(());
         }
         for part in self.parts.take() {
-            part.unlink();
+            part.unlink(Ended::PlaneDestroyed);
         }
         self.plane.destroy()
+    }
+
+    /// The post-tick pass of a step: every part of the plane whose CFrame signal has
+    /// listeners announces its new pose (handlers run before `Step` returns).
+    fn after_tick(&self, lua: &Lua) -> mlua::Result<()> {
+        // A copy: handlers may add, unlink or destroy parts.
+        let parts: Vec<Rc<PartState>> = self.parts.borrow().clone();
+        for part in parts {
+            if part.cframe_listeners() > 0 {
+                part.fire_cframe_if_moved(lua)?;
+            }
+        }
+        Ok(())
     }
 }
 
@@ -70,15 +83,15 @@ impl Target for PlaneState {
     type Prop = PlaneProp;
 
     /// Queues an option change for the frame's batch.
-    fn write(&self, _: &str, prop: PlaneProp) -> mlua::Result<()> {
+    fn write(&self, name: &str, prop: PlaneProp) -> mlua::Result<()> {
         if !self.alive() {
             return Err(mlua::Error::runtime(format!(
-                "PhysicsPlane: cannot set {prop:?} on a destroyed plane"
+                "PhysicsPlane.{name}: the plane was destroyed"
             )));
         }
         self.plane
             .set(prop)
-            .map_err(|e| sdk_error("PhysicsPlane", e))
+            .map_err(|e| sdk_error(&format!("PhysicsPlane.{name}"), e))
     }
 }
 
@@ -120,7 +133,7 @@ impl UserData for PhysicsPlane {
                 &on,
             )
         });
-        methods.add_method("Step", |_, p, dt: Value| {
+        methods.add_method("Step", |lua, p, dt: Value| {
             let dt = match finite_number("PhysicsPlane:Step", &dt) {
                 Ok(dt) if dt > 0.0 && dt <= MAX_DT as f64 => dt,
                 _ => {
@@ -137,8 +150,8 @@ impl UserData for PhysicsPlane {
             }
             p.0.plane
                 .step(dt as f32)
-                .map(|_| ())
-                .map_err(|e| sdk_error("PhysicsPlane:Step", e))
+                .map_err(|e| sdk_error("PhysicsPlane:Step", e))?;
+            p.0.after_tick(lua)
         });
         methods.add_method("Destroy", |lua, p, ()| {
             context(lua)
@@ -157,7 +170,10 @@ impl UserData for PhysicsPlane {
             |lua, p, (key, value): (Value, Value)| PLANE.set(lua, &p.0, &key, &value),
         );
         methods.add_meta_method(MetaMethod::ToString, |_, p, ()| {
-            Ok(format!("PhysicsPlane {}", p.0.plane.id()))
+            Ok(match p.0.alive() {
+                true => format!("PhysicsPlane {}", p.0.plane.id()),
+                false => format!("PhysicsPlane {} (destroyed)", p.0.plane.id()),
+            })
         });
     }
 }
@@ -194,13 +210,11 @@ fn add(plane: &Rc<PlaneState>, part: Value) -> mlua::Result<PhysicsObject> {
         .plane
         .add(collider, state.cframe().pose(), &[])
         .map_err(|e| sdk_error(&what(), e))?;
-    state.link(Link {
-        object: object.clone(),
-        plane: Rc::downgrade(plane),
-    });
+    let body = Body::new(object, Rc::downgrade(plane));
+    state.link(body.clone());
     plane.parts.borrow_mut().push(state.clone());
     Ok(PhysicsObject {
-        object,
+        body,
         part: state,
         part_ud: ud.clone(),
     })

@@ -1,15 +1,22 @@
 //! `physics-lua SCRIPT.luau`: runs a Luau script against the physics daemon of a domain
 //! (starting one for the run when none answers), then keeps running frames while the script
 //! has `Heart` handlers, pending waits or change listeners.
+//!
+//! The script runs sandboxed (`Lua::sandbox`), under a watchdog that stops it when it runs
+//! too long without yielding (`--max-run-ms`), when `--seconds` is up, or on the first
+//! SIGINT/SIGTERM, and with a memory limit (`--max-memory-mb`).
 
 use std::io::Write;
 use std::path::PathBuf;
 use std::process::ExitCode;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU32, AtomicU8, Ordering};
+use std::sync::mpsc::{self, Receiver, RecvTimeoutError};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use clap::Parser;
+use client_sdk::{Client, ConnectOptions, Session};
+use lua_client::{Host, Stop};
 use mlua::{Lua, Value, Variadic};
 
 #[derive(Parser, Debug)]
@@ -20,12 +27,147 @@ struct Args {
     /// Domain of the daemon to use; one is started for the run when none answers.
     #[arg(long, env = "PHYSICS_DOMAIN", default_value = "physics")]
     domain: String,
-    /// Stop running frames after this many seconds (default: while there is work).
+    /// End the run after this many seconds, stopping the script if it is running then
+    /// (default: run while there is work).
     #[arg(long)]
     seconds: Option<f64>,
     /// Frames per second.
     #[arg(long, default_value_t = 60.0)]
     fps: f64,
+    /// Stop the script with an error when it runs this many milliseconds without yielding
+    /// back to the host (a `wait`, the end of a handler); 0 turns the limit off.
+    #[arg(long, default_value_t = 5000)]
+    max_run_ms: u64,
+    /// Memory the script's Lua state may use, in MiB; 0 turns the limit off.
+    #[arg(long, default_value_t = 1024)]
+    max_memory_mb: u64,
+    /// Longest wait for one reply of the daemon, in seconds.
+    #[arg(long, default_value_t = 30.0)]
+    request_timeout: f64,
+}
+
+/// How long the first signal lets a running script's run end before the runner stops the
+/// daemon it started and exits anyway (a call into a stalled daemon cannot be interrupted).
+const SIGNAL_GRACE: Duration = Duration::from_secs(2);
+/// Exit status after SIGINT or SIGTERM.
+const SIGNALLED: u8 = 130;
+
+/// Where the run is, for the signal handler.
+const CONNECTING: u8 = 0;
+const RUNNING: u8 = 1;
+const CLEANING_UP: u8 = 2;
+
+/// What the signal handler shares with the run.
+struct Shared {
+    /// Set by the first signal: the watchdog stops the script, the frame loop ends.
+    stop: Arc<AtomicBool>,
+    signals: AtomicU32,
+    phase: AtomicU8,
+    /// The daemon this run started (0: none), for a forced exit.
+    daemon_pid: AtomicU32,
+}
+
+impl Shared {
+    /// Stops the daemon this run started (unless the run is stopping it already) and exits.
+    fn exit_now(&self) -> ! {
+        let pid = self.daemon_pid.load(Ordering::SeqCst);
+        if pid != 0 && self.phase.load(Ordering::SeqCst) != CLEANING_UP {
+            // SAFETY: kill(2) on the daemon this process started; it shuts down cleanly.
+            unsafe { libc::kill(pid as libc::pid_t, libc::SIGINT) };
+        }
+        std::process::exit(SIGNALLED.into());
+    }
+
+    /// After the first signal: waits for the run to end; a run still going
+    /// [`SIGNAL_GRACE`] after the signal (or after connecting, whichever is later) is ended
+    /// by exiting. Connecting is waited for: it is bounded, and the daemon it may be starting
+    /// must be known to be stopped.
+    fn watch_the_run_end(&self) {
+        let mut since = Instant::now();
+        loop {
+            match self.phase.load(Ordering::SeqCst) {
+                CLEANING_UP => return,
+                CONNECTING => since = Instant::now(),
+                _ if since.elapsed() >= SIGNAL_GRACE => {
+                    eprintln!(
+                        "physics-lua: the run did not end within {SIGNAL_GRACE:?} of the signal; \
+                         exiting"
+                    );
+                    self.exit_now();
+                }
+                _ => {}
+            }
+            std::thread::sleep(Duration::from_millis(10));
+        }
+    }
+}
+
+/// The signal handler's side of the run.
+struct Signals {
+    shared: Arc<Shared>,
+    /// Wakes the frame loop out of its sleep when a signal arrives.
+    wake: Receiver<()>,
+}
+
+impl Signals {
+    /// Installs the SIGINT/SIGTERM handler. The first signal stops the run: the watchdog
+    /// interrupts a running script and the frame loop wakes up; a run that still has not
+    /// ended [`SIGNAL_GRACE`] later is ended by exiting (see [`Shared::watch_the_run_end`]).
+    /// A second signal exits at once. Either way the daemon this run started is stopped.
+    fn install() -> Signals {
+        let shared = Arc::new(Shared {
+            stop: Arc::new(AtomicBool::new(false)),
+            signals: AtomicU32::new(0),
+            phase: AtomicU8::new(CONNECTING),
+            daemon_pid: AtomicU32::new(0),
+        });
+        let (tx, wake) = mpsc::channel();
+        let on_signal = shared.clone();
+        let handler = move || {
+            on_signal.stop.store(true, Ordering::SeqCst);
+            let _ = tx.send(());
+            if on_signal.signals.fetch_add(1, Ordering::SeqCst) == 0 {
+                let watch = on_signal.clone();
+                std::thread::spawn(move || watch.watch_the_run_end());
+            } else {
+                on_signal.exit_now();
+            }
+        };
+        if let Err(e) = ctrlc::set_handler(handler) {
+            eprintln!("physics-lua: cannot install the SIGINT/SIGTERM handler: {e}");
+        }
+        Signals { shared, wake }
+    }
+
+    fn set_phase(&self, phase: u8) {
+        self.shared.phase.store(phase, Ordering::SeqCst);
+    }
+
+    fn stop_requested(&self) -> bool {
+        self.shared.stop.load(Ordering::SeqCst)
+    }
+
+    /// Sleeps until `until` or until a signal arrives.
+    fn sleep_until(&self, until: Instant) {
+        let now = Instant::now();
+        if until > now {
+            match self.wake.recv_timeout(until - now) {
+                Ok(()) | Err(RecvTimeoutError::Timeout) => {}
+                // No handler (it could not be installed): plain sleep.
+                Err(RecvTimeoutError::Disconnected) => std::thread::sleep(until - now),
+            }
+        }
+    }
+}
+
+/// How a run ended without an error.
+enum Ended {
+    /// No work left (or `--seconds` was up between frames).
+    Finished,
+    /// `--seconds` was up while the script was running; it was stopped.
+    StoppedAtDeadline(String),
+    /// A signal stopped the run.
+    Signalled,
 }
 
 /// `print` writes to stdout, one line per call, flushed so output interleaves sensibly.
@@ -47,7 +189,40 @@ fn install_print(lua: &Lua) -> mlua::Result<()> {
     lua.globals().set("print", print)
 }
 
-fn run(args: &Args, stop: &AtomicBool) -> Result<(), String> {
+/// Connects to the domain's daemon, starting one when none answers, with `timeout` as the
+/// longest wait for a reply.
+fn connect(domain: &str, timeout: Duration) -> Result<Session, client_sdk::Error> {
+    let mut options = ConnectOptions::new(domain);
+    options.request_timeout = timeout;
+    match Client::connect_with(options.clone()) {
+        Ok(client) => Ok(Session {
+            client,
+            daemon: None,
+        }),
+        Err(client_sdk::Error::NoDaemon { .. }) => {
+            let (daemon, started_with) = client_sdk::start_daemon(domain)?;
+            drop(started_with);
+            Ok(Session {
+                client: Client::connect_with(options)?,
+                daemon: Some(daemon),
+            })
+        }
+        Err(e) => Err(e),
+    }
+}
+
+/// Whether `e` is (or was caused by) the Lua state running out of memory.
+fn out_of_memory(e: &mlua::Error) -> bool {
+    match e {
+        mlua::Error::MemoryError(_) => true,
+        mlua::Error::CallbackError { cause, .. } | mlua::Error::WithContext { cause, .. } => {
+            out_of_memory(cause)
+        }
+        _ => false,
+    }
+}
+
+fn check_args(args: &Args) -> Result<(), String> {
     if !(args.fps.is_finite() && args.fps > 0.0) {
         return Err(format!("--fps must be a positive number, got {}", args.fps));
     }
@@ -56,72 +231,147 @@ fn run(args: &Args, stop: &AtomicBool) -> Result<(), String> {
             return Err(format!("--seconds must be a non-negative number, got {s}"));
         }
     }
+    if !(args.request_timeout.is_finite() && args.request_timeout > 0.0) {
+        return Err(format!(
+            "--request-timeout must be a positive number of seconds, got {}",
+            args.request_timeout
+        ));
+    }
+    if args.max_memory_mb > (usize::MAX >> 20) as u64 {
+        return Err(format!(
+            "--max-memory-mb {} is too large",
+            args.max_memory_mb
+        ));
+    }
+    Ok(())
+}
+
+fn run(args: &Args, signals: &Signals) -> Result<Ended, String> {
+    check_args(args)?;
     let source = std::fs::read_to_string(&args.script)
         .map_err(|e| format!("cannot read {}: {e}", args.script.display()))?;
     // A daemon started for this run logs warnings only, unless the user asked for more.
     if std::env::var_os("PHYSICS_LOG").is_none() {
         std::env::set_var("PHYSICS_LOG", "warn");
     }
-    let session = client_sdk::connect_or_start(&args.domain).map_err(|e| e.to_string())?;
+    let session = connect(&args.domain, Duration::from_secs_f64(args.request_timeout))
+        .map_err(|e| e.to_string())?;
+    if let Some(daemon) = &session.daemon {
+        signals
+            .shared
+            .daemon_pid
+            .store(daemon.pid(), Ordering::SeqCst);
+    }
+    signals.set_phase(RUNNING);
     let lua = Lua::new();
     let lua_err = |e: mlua::Error| e.to_string();
     install_print(&lua).map_err(lua_err)?;
     let host = lua_client::install(&lua, session.client.clone()).map_err(lua_err)?;
+    // Every global is in place: from here on scripts cannot change builtins or the API.
+    lua.sandbox(true).map_err(lua_err)?;
+    host.set_stop_flag(signals.shared.stop.clone());
+    let max_run = (args.max_run_ms > 0).then(|| Duration::from_millis(args.max_run_ms));
+    host.set_max_run_time(max_run);
+    let max_memory = (args.max_memory_mb > 0).then_some((args.max_memory_mb as usize) << 20);
+    host.set_memory_limit(max_memory).map_err(lua_err)?;
     let chunk = lua
         .load(source)
         .set_name(format!("@{}", args.script.display()))
         .into_function()
         .map_err(lua_err)?;
     let started = Instant::now();
-    host.spawn(chunk).map_err(lua_err)?;
-    host.flush().map_err(lua_err)?;
-
-    let frame = Duration::from_secs_f64(1.0 / args.fps);
     let deadline = args.seconds.map(|s| started + Duration::from_secs_f64(s));
+    host.set_deadline(deadline);
+    let ended = frames(&host, chunk, args.fps, deadline, signals)
+        .or_else(|e| failed(args, &host, signals, e));
+    drop(host);
+    drop(lua);
+    signals.set_phase(CLEANING_UP);
+    drop(session);
+    ended
+}
+
+/// Runs the script, then frames while there is work, until the deadline or a signal.
+fn frames(
+    host: &Host,
+    chunk: mlua::Function,
+    fps: f64,
+    deadline: Option<Instant>,
+    signals: &Signals,
+) -> mlua::Result<Ended> {
+    host.spawn(chunk)?;
+    host.flush()?;
+    let frame = Duration::from_secs_f64(1.0 / fps);
     let mut last = Instant::now();
-    while host.busy() && !stop.load(Ordering::Relaxed) {
+    while host.busy() {
+        if signals.stop_requested() {
+            return Ok(Ended::Signalled);
+        }
         let mut next = last + frame;
         // With only waits pending, sleep until the earliest is due rather than spinning frames.
-        if host.next_wake_in().is_some() && !host.busy_every_frame() {
-            let wake = Instant::now() + Duration::from_secs_f64(host.next_wake_in().unwrap_or(0.0));
-            next = next.max(wake);
+        if let (Some(wake_in), false) = (host.next_wake_in(), host.busy_every_frame()) {
+            next = next.max(Instant::now() + Duration::from_secs_f64(wake_in));
         }
-        if let Some(d) = deadline {
-            if next > d {
-                break;
-            }
+        if deadline.is_some_and(|d| next > d) {
+            break;
         }
-        let now = Instant::now();
-        if next > now {
-            std::thread::sleep(next - now);
+        signals.sleep_until(next);
+        if signals.stop_requested() {
+            return Ok(Ended::Signalled);
         }
         let now = Instant::now();
         let dt = (now - last).as_secs_f64();
         last = now;
-        host.frame(dt).map_err(lua_err)?;
+        host.frame(dt)?;
     }
-    drop(host);
-    drop(lua);
-    drop(session);
-    Ok(())
+    Ok(Ended::Finished)
+}
+
+/// A Lua error of the run: what the watchdog stopped, a memory limit hit, or the script's
+/// own error, said with the flag that set the limit.
+fn failed(args: &Args, host: &Host, signals: &Signals, e: mlua::Error) -> Result<Ended, String> {
+    if signals.stop_requested() {
+        // Whatever failed then (a script stopped mid-way, a call cut short) failed because of
+        // the signal.
+        return Ok(Ended::Signalled);
+    }
+    match host.stopped() {
+        Some(Stop::Requested) => Ok(Ended::Signalled),
+        Some(Stop::Deadline) => Ok(Ended::StoppedAtDeadline(e.to_string())),
+        Some(Stop::RunTime { .. }) => Err(format!(
+            "{e}\n(the limit is --max-run-ms {}; 0 turns it off)",
+            args.max_run_ms
+        )),
+        None if out_of_memory(&e) => Err(format!(
+            "script ran out of memory (limit --max-memory-mb {}; 0 turns it off)\n{e}",
+            args.max_memory_mb
+        )),
+        None => Err(e.to_string()),
+    }
 }
 
 fn main() -> ExitCode {
     let args = Args::parse();
-    let stop = Arc::new(AtomicBool::new(false));
-    let flag = stop.clone();
-    // First Ctrl-C ends the frame loop cleanly (daemon stopped, exit 0); a second one, for a
-    // script stuck in a loop of its own, exits at once.
-    let _ = ctrlc::set_handler(move || {
-        if flag.swap(true, Ordering::Relaxed) {
-            std::process::exit(130);
+    let signals = Signals::install();
+    let code = match run(&args, &signals) {
+        Ok(Ended::Finished) => ExitCode::SUCCESS,
+        Ok(Ended::StoppedAtDeadline(at)) => {
+            eprintln!(
+                "physics-lua: --seconds {} was up while the script was still running; stopped \
+                 it\n{at}",
+                args.seconds.unwrap_or_default()
+            );
+            ExitCode::SUCCESS
         }
-    });
-    match run(&args, &stop) {
-        Ok(()) => ExitCode::SUCCESS,
+        Ok(Ended::Signalled) => {
+            eprintln!("physics-lua: stopped by a signal");
+            ExitCode::from(SIGNALLED)
+        }
         Err(message) => {
             eprintln!("physics-lua: {message}");
             ExitCode::FAILURE
         }
-    }
+    };
+    signals.set_phase(CLEANING_UP);
+    code
 }

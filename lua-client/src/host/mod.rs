@@ -1,17 +1,24 @@
 //! The host side of the API: the frame loop ([`Host`]), the scheduler behind `wait` and
-//! coroutines, and signals. Nothing here knows an API type: what changes per frame (a
-//! simulated part's CFrame) is [`Watched`] through a trait object.
+//! coroutines, signals, the watchdog that stops runaway scripts, and errors as scripts see
+//! them. Nothing here knows an API type: what changes per frame (a simulated part's CFrame)
+//! is [`Watched`] through a trait object.
 
+pub mod errors;
 pub mod scheduler;
 pub mod signal;
+pub mod watchdog;
 
 use std::rc::Rc;
+use std::sync::atomic::AtomicBool;
+use std::sync::Arc;
+use std::time::{Duration, Instant};
 
 use client_sdk::Client;
 use mlua::{Function, Lua, MultiValue};
 
 use crate::values::sdk_error;
 use scheduler::Scheduler;
+pub use watchdog::Stop;
 
 /// Something with a per-frame change signal: probed each frame, fired when it changed.
 pub trait Watched {
@@ -76,5 +83,34 @@ impl Host {
     /// The client the API talks to the daemon through.
     pub fn client(&self) -> &Client {
         &self.client
+    }
+
+    /// Stops a script that runs longer than `max` without yielding back to the host (a
+    /// `wait`, the end of the main chunk or of a handler) with an error naming the limit.
+    /// Wall-clock time, API calls included. `None`: no limit.
+    pub fn set_max_run_time(&self, max: Option<Duration>) {
+        self.scheduler.watchdog.set_max_run(max);
+    }
+
+    /// Limits the memory of the Lua state to `bytes`: an allocation past it raises Lua's
+    /// "not enough memory" error. `None`: no limit.
+    pub fn set_memory_limit(&self, bytes: Option<usize>) -> mlua::Result<()> {
+        self.lua.set_memory_limit(bytes.unwrap_or(0)).map(|_| ())
+    }
+
+    /// Stops a script still running at `at` (`None`: no deadline). The host's own loop
+    /// should not start frames past it.
+    pub fn set_deadline(&self, at: Option<Instant>) {
+        self.scheduler.watchdog.set_deadline(at);
+    }
+
+    /// Stops a running script once `flag` is set, from any thread (a signal handler).
+    pub fn set_stop_flag(&self, flag: Arc<AtomicBool>) {
+        self.scheduler.watchdog.set_stop_flag(flag);
+    }
+
+    /// Why the watchdog stopped a script, if it did.
+    pub fn stopped(&self) -> Option<Stop> {
+        self.scheduler.watchdog.stopped()
     }
 }

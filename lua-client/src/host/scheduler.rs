@@ -10,6 +10,7 @@ use std::time::Instant;
 use mlua::{Function, LightUserData, Lua, MultiValue, Thread, ThreadStatus, Value};
 
 use super::signal::Signal;
+use super::watchdog::Watchdog;
 use super::Watched;
 use crate::values::{expected, number};
 
@@ -34,6 +35,8 @@ pub struct Scheduler {
     /// Values with per-frame change signals (simulated parts' CFrame); probed each frame
     /// for listeners.
     watched: RefCell<Vec<Weak<dyn Watched>>>,
+    /// Stops scripts that run too long (see `watchdog`).
+    pub watchdog: Rc<Watchdog>,
 }
 
 impl Scheduler {
@@ -44,6 +47,7 @@ impl Scheduler {
             waiting: RefCell::default(),
             heart: Signal::new("Heart"),
             watched: RefCell::default(),
+            watchdog: Rc::new(Watchdog::new()),
         }
     }
 
@@ -142,7 +146,10 @@ pub fn spawn(lua: &Lua, f: Function, args: MultiValue) -> mlua::Result<()> {
 }
 
 fn resume(sched: &Scheduler, thread: Thread, args: MultiValue) -> mlua::Result<()> {
-    let out: MultiValue = thread.resume(args)?;
+    let out: MultiValue = {
+        let _running = sched.watchdog.running();
+        thread.resume(args)?
+    };
     if thread.status() != ThreadStatus::Resumable {
         return Ok(());
     }
@@ -181,6 +188,6 @@ pub fn wait_function(lua: &Lua) -> mlua::Result<Function> {
         "local mark, check, yield = ...\n\
          return function(seconds) return yield(mark, check(seconds)) end",
     )
-    .set_name("=wait")
+    .set_name("=[wait]")
     .call((wait_mark(), check, yield_fn))
 }

@@ -41,9 +41,9 @@ pub enum Kind {
     },
     /// A whole number in `[min, max]`.
     Integer {
-        /// Smallest accepted value.
+        /// Smallest accepted value (`i64::MIN`: no bound).
         min: i64,
-        /// Largest accepted value.
+        /// Largest accepted value (`i64::MAX`: no bound).
         max: i64,
     },
     /// `true` or `false`.
@@ -71,6 +71,11 @@ impl Kind {
     };
     /// A number in [0, 1].
     pub const UNIT: Kind = Kind::Number { min: 0.0, max: 1.0 };
+    /// Any whole number (rows that clamp it themselves).
+    pub const ANY_INTEGER: Kind = Kind::Integer {
+        min: i64::MIN,
+        max: i64::MAX,
+    };
 
     /// What the error message says was expected.
     pub fn expected(&self) -> String {
@@ -81,7 +86,12 @@ impl Kind {
                 (false, true) => format!("a finite number <= {max}"),
                 (true, true) => format!("a number in [{min}, {max}]"),
             },
-            Kind::Integer { min, max } => format!("an integer in [{min}, {max}]"),
+            Kind::Integer { min, max } => match (min > i64::MIN, max < i64::MAX) {
+                (false, false) => "an integer".into(),
+                (true, false) => format!("an integer >= {min}"),
+                (false, true) => format!("an integer <= {max}"),
+                (true, true) => format!("an integer in [{min}, {max}]"),
+            },
             Kind::Boolean => "a boolean".into(),
             Kind::Vector => "a Vector with finite components".into(),
             Kind::PositiveVector => "a Vector with finite components > 0".into(),

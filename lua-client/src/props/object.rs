@@ -7,13 +7,13 @@ use client_sdk::validate::MAX_HIT_BOX_QUALITY;
 use client_sdk::{BodyState, ObjectInfo, ObjectProp, Pose};
 use mlua::{Error as LuaError, Value};
 
-use super::{Get, Kind, Props, Row, Set, Target};
+use super::{Get, Kind, Props, Row, Set};
 use crate::api::object::PhysicsObject;
 use crate::values::{new_vector, sdk_error, CFrame};
 
 /// The object's properties as the daemon holds them (one round trip).
 fn info(o: &PhysicsObject, what: &str) -> Result<ObjectInfo, LuaError> {
-    o.live(what)?
+    o.live_for(|| format!("PhysicsObject.{what}"))?
         .info()
         .map_err(|e| sdk_error(&format!("PhysicsObject.{what}"), e))
 }
@@ -21,7 +21,7 @@ fn info(o: &PhysicsObject, what: &str) -> Result<ObjectInfo, LuaError> {
 /// The object's published state: the newest tick with this process's unconfirmed writes on
 /// top (no request).
 fn state(o: &PhysicsObject, what: &str) -> Result<BodyState, LuaError> {
-    o.live(what)?
+    o.live_for(|| format!("PhysicsObject.{what}"))?
         .state()
         .map_err(|e| sdk_error(&format!("PhysicsObject.{what}"), e))
 }
@@ -109,10 +109,8 @@ pub static OBJECT: Props<PhysicsObject> = Props {
             kind: Kind::PositiveVector,
             get: Get::Fn(|_, o| Ok(new_vector(o.part.size()))),
             set: Set::Fn(|lua, o, a| {
-                let size = a.vector()?;
-                o.write("Size", ObjectProp::Size(size))?;
-                o.part.set_size(size);
-                o.part.changed(lua, "Size", new_vector(size))
+                o.live("PhysicsObject.Size")?;
+                o.part.resize(lua, "PhysicsObject.Size", a.vector()?)
             }),
         },
         info_row!(
@@ -165,10 +163,7 @@ pub static OBJECT: Props<PhysicsObject> = Props {
         // Documented as clamped to [1, 32]: any integer is accepted.
         info_row!(
             "HitBoxQuality",
-            Kind::Integer {
-                min: i64::MIN,
-                max: i64::MAX,
-            },
+            Kind::ANY_INTEGER,
             |i| Value::Number(i.hit_box_quality as f64),
             |a| ObjectProp::HitBoxQuality(a.integer()?.clamp(1, MAX_HIT_BOX_QUALITY as i64) as u32)
         ),

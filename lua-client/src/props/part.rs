@@ -1,8 +1,8 @@
 //! BasePart properties: the host's own state of the part (name, size, shape, and the pose
 //! while not simulated); the pose of a simulated part is its body's, read from the newest
-//! tick and written as a teleport.
+//! tick and written as a teleport, and its size is written to the body as well.
 
-use mlua::{Error as LuaError, Value};
+use mlua::Value;
 
 use super::{Get, Kind, Props, Row, Set};
 use crate::api::part::BasePart;
@@ -35,18 +35,8 @@ pub static PART: Props<BasePart> = Props {
             name: "Size",
             kind: Kind::PositiveVector,
             get: Get::Fn(|_, p| Ok(new_vector(p.0.size()))),
-            set: Set::Fn(|lua, p, a| {
-                let size = a.vector()?;
-                if p.0.object().is_some() {
-                    return Err(LuaError::runtime(format!(
-                        "BasePart.Size cannot change while the part is simulated (resizing a \
-                         physics object is not supported yet; assigned Vector({}, {}, {}))",
-                        size[0], size[1], size[2]
-                    )));
-                }
-                p.0.set_size(size);
-                p.0.changed(lua, "Size", new_vector(size))
-            }),
+            // Resizes the body too while the part is simulated (as PhysicsObject.Size does).
+            set: Set::Fn(|lua, p, a| p.0.resize(lua, "BasePart.Size", a.vector()?)),
         },
         Row {
             name: "Name",

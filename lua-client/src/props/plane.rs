@@ -122,10 +122,7 @@ pub static PLANE: Props<PlaneState> = Props {
         Row {
             // Documented as clamped to [1, 64]: any integer is accepted and clamped.
             name: "SolverIterations",
-            kind: Kind::Integer {
-                min: i64::MIN,
-                max: i64::MAX,
-            },
+            kind: Kind::ANY_INTEGER,
             get: Get::Fn(|_, p| {
                 Ok(Value::Number(
                     p.info("SolverIterations")?.solver_iterations as f64,
