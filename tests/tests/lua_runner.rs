@@ -267,24 +267,17 @@ fn the_first_signal_ends_a_run_blocked_on_a_stalled_daemon() {
 }
 
 #[test]
-fn a_stalled_daemon_is_a_timeout_error() {
+fn a_stalled_daemon_is_reported_within_seconds() {
     let daemon = TestDaemon::start("lua-stalled");
-    let mut runner = Runner::start(
-        &daemon.domain,
-        "tests/lua/step_forever.luau",
-        &["--request-timeout", "1"],
-    );
+    // The default request timeout (30 s) is far away: the daemon's silent heartbeat tells.
+    let mut runner = Runner::start(&daemon.domain, "tests/lua/step_forever.luau", &[]);
     runner.wait_for("ready", Duration::from_secs(30));
     stop_process(daemon.pid(), libc::SIGSTOP);
     runner.mark();
     let r = runner.wait(Duration::from_secs(20));
     stop_process(daemon.pid(), libc::SIGCONT);
     assert_eq!(r.status.code(), Some(1), "stderr:\n{}", r.stderr);
-    r.assert_stderr_has(&[
-        "PhysicsPlane:Step",
-        "timed out after 1s",
-        "step_forever.luau:9",
-    ]);
+    r.assert_stderr_has(&["PhysicsPlane:Step", "is stalled", "step_forever.luau:9"]);
     assert!(r.took < Duration::from_secs(8), "took {:?}", r.took);
 }
 
