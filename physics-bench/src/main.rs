@@ -23,6 +23,7 @@
 mod accuracy;
 mod daemon;
 mod error;
+mod fuzz;
 mod ipc;
 mod procfs;
 mod progress;
@@ -54,6 +55,9 @@ enum Bench {
     /// Stress scenes (tall stacks, mass ratios, fast bodies, overlap, far from the origin,
     /// tiny objects, extreme forces and tick rates), each with a pass criterion.
     Stability(stability::StabilityArgs),
+    /// Fuzzes the daemon's request decoder and command executor through a real daemon:
+    /// structured, raw and quota-exceeding frames; fails on any crash.
+    Fuzz(fuzz::FuzzArgs),
 }
 
 fn main() -> ExitCode {
@@ -72,6 +76,7 @@ fn main() -> ExitCode {
         Bench::Ipc(args) => ipc::run(args),
         Bench::Accuracy(args) => accuracy::run(args),
         Bench::Stability(args) => stability::run(args),
+        Bench::Fuzz(args) => fuzz::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
