@@ -25,6 +25,7 @@ mod daemon;
 mod error;
 mod fuzz;
 mod ipc;
+mod load;
 mod procfs;
 mod progress;
 mod report;
@@ -58,6 +59,8 @@ enum Bench {
     /// Fuzzes the daemon's request decoder and command executor through a real daemon:
     /// structured, raw and quota-exceeding frames; fails on any crash.
     Fuzz(fuzz::FuzzArgs),
+    /// 16 clients × 100,000 commands against one daemon: none lost, commands/s.
+    Load(load::LoadArgs),
 }
 
 fn main() -> ExitCode {
@@ -77,6 +80,7 @@ fn main() -> ExitCode {
         Bench::Accuracy(args) => accuracy::run(args),
         Bench::Stability(args) => stability::run(args),
         Bench::Fuzz(args) => fuzz::run(args),
+        Bench::Load(args) => load::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
