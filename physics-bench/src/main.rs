@@ -31,6 +31,7 @@ mod progress;
 mod report;
 mod scene;
 mod sim;
+mod soak;
 mod stability;
 mod stats;
 
@@ -61,6 +62,9 @@ enum Bench {
     Fuzz(fuzz::FuzzArgs),
     /// 16 clients × 100,000 commands against one daemon: none lost, commands/s.
     Load(load::LoadArgs),
+    /// 4 planes × 1,000 bodies at 60 Hz with a client writing every frame for N minutes:
+    /// daemon RSS and shared-memory growth against a bound.
+    Soak(soak::SoakArgs),
 }
 
 fn main() -> ExitCode {
@@ -81,6 +85,7 @@ fn main() -> ExitCode {
         Bench::Stability(args) => stability::run(args),
         Bench::Fuzz(args) => fuzz::run(args),
         Bench::Load(args) => load::run(args),
+        Bench::Soak(args) => soak::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
