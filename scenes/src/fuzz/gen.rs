@@ -22,15 +22,27 @@ const WILD: f64 = 0.35;
 
 /// Draws commands for one client from the seeded stream and the world it learned.
 pub struct Gen<'a> {
-    /// The random stream.
-    pub rng: &'a mut Rng,
-    /// What the replies told so far.
-    pub world: &'a World,
-    /// The client the commands are for.
-    pub client: usize,
+    rng: &'a mut Rng,
+    world: &'a World,
+    client: usize,
+    /// Planes and objects earlier commands of this batch destroy: valid commands leave
+    /// them alone (the world learns of it only from the reply).
+    dropped_planes: Vec<PlaneId>,
+    dropped_handles: Vec<Handle>,
 }
 
-impl Gen<'_> {
+impl<'a> Gen<'a> {
+    /// Commands for `client`, drawn from `rng`, aimed with what `world` knows.
+    pub fn new(rng: &'a mut Rng, world: &'a World, client: usize) -> Gen<'a> {
+        Gen {
+            rng,
+            world,
+            client,
+            dropped_planes: Vec::new(),
+            dropped_handles: Vec::new(),
+        }
+    }
+
     /// A batch of 1 to 1,000 commands (mostly short), led by a `Hello` when the client is
     /// not connected.
     pub fn batch(&mut self) -> Vec<Command> {
@@ -45,15 +57,49 @@ impl Gen<'_> {
             batch.push(hello());
         }
         for _ in 0..n {
-            batch.push(self.command());
+            let command = self.command();
+            match &command {
+                Command::Plane {
+                    plane,
+                    op: PlaneOp::Destroy,
+                } => self.dropped_planes.push(*plane),
+                Command::Plane {
+                    op:
+                        PlaneOp::Object {
+                            handle,
+                            op: ObjectOp::Destroy,
+                        },
+                    ..
+                } => self.dropped_handles.push(*handle),
+                _ => {}
+            }
+            batch.push(command);
         }
         batch
+    }
+
+    /// The client's planes not destroyed earlier in this batch.
+    fn own_planes(&self) -> Vec<PlaneId> {
+        let mut own = self.world.own_planes(self.client);
+        own.retain(|id| !self.dropped_planes.contains(id));
+        own
+    }
+
+    /// The plane's live objects not destroyed earlier in this batch.
+    fn live(&self, id: PlaneId) -> Vec<Handle> {
+        self.world.planes.get(&id).map_or_else(Vec::new, |p| {
+            p.live
+                .iter()
+                .filter(|h| !self.dropped_handles.contains(h))
+                .copied()
+                .collect()
+        })
     }
 
     /// One command.
     pub fn command(&mut self) -> Command {
         let wild = self.rng.chance(WILD);
-        let own = self.world.own_planes(self.client);
+        let own = self.own_planes();
         let u = self.rng.unit();
         if u < 0.0003 {
             return Command::Goodbye;
@@ -118,8 +164,7 @@ impl Gen<'_> {
     }
 
     fn plane_op(&mut self, wild: bool, id: PlaneId) -> PlaneOp {
-        let known = self.world.planes.get(&id);
-        let live = known.map_or(0, |p| p.live.len());
+        let live = self.live(id).len();
         let mut u = self.rng.unit();
         // Valid commands need something to act on, and keep planes small.
         if !wild && live == 0 && u >= 0.45 {
@@ -189,17 +234,17 @@ impl Gen<'_> {
     /// A live handle of the plane mostly; a stale one, a neighbour's generation or a bogus
     /// one otherwise.
     fn handle(&mut self, wild: bool, id: PlaneId) -> Handle {
-        let plane = self.world.planes.get(&id);
+        let live = self.live(id);
         let u = self.rng.unit();
-        if let Some(p) = plane {
-            if !p.live.is_empty() && (u < 0.75 || !wild && u < 0.97) {
-                return *self.rng.pick(&p.live);
+        if let Some(p) = self.world.planes.get(&id) {
+            if !live.is_empty() && (u < 0.75 || !wild && u < 0.97) {
+                return *self.rng.pick(&live);
             }
             if !p.stale.is_empty() && u < 0.85 {
                 return *self.rng.pick(&p.stale);
             }
-            if !p.live.is_empty() && u < 0.9 {
-                let h = *self.rng.pick(&p.live);
+            if !live.is_empty() && u < 0.9 {
+                let h = *self.rng.pick(&live);
                 return Handle {
                     slot: h.slot,
                     generation: h.generation.wrapping_add(1),

@@ -228,12 +228,7 @@ impl Engine<'_> {
     }
 
     fn generate(&mut self, c: usize) -> Vec<Command> {
-        Gen {
-            rng: &mut self.rng,
-            world: &self.world,
-            client: c,
-        }
-        .batch()
+        Gen::new(&mut self.rng, &self.world, c).batch()
     }
 
     fn send_commands(&mut self, c: usize, commands: Vec<Command>, source: Source) -> Vec<Reply> {
