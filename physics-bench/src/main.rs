@@ -23,12 +23,15 @@
 mod accuracy;
 mod daemon;
 mod error;
+mod fuzz;
 mod ipc;
+mod load;
 mod procfs;
 mod progress;
 mod report;
 mod scene;
 mod sim;
+mod soak;
 mod stability;
 mod stats;
 
@@ -54,6 +57,14 @@ enum Bench {
     /// Stress scenes (tall stacks, mass ratios, fast bodies, overlap, far from the origin,
     /// tiny objects, extreme forces and tick rates), each with a pass criterion.
     Stability(stability::StabilityArgs),
+    /// Fuzzes the daemon's request decoder and command executor through a real daemon:
+    /// structured, raw and quota-exceeding frames; fails on any crash.
+    Fuzz(fuzz::FuzzArgs),
+    /// 16 clients × 100,000 commands against one daemon: none lost, commands/s.
+    Load(load::LoadArgs),
+    /// 4 planes × 1,000 bodies at 60 Hz with a client writing every frame for N minutes:
+    /// daemon RSS and shared-memory growth against a bound.
+    Soak(soak::SoakArgs),
 }
 
 fn main() -> ExitCode {
@@ -72,6 +83,9 @@ fn main() -> ExitCode {
         Bench::Ipc(args) => ipc::run(args),
         Bench::Accuracy(args) => accuracy::run(args),
         Bench::Stability(args) => stability::run(args),
+        Bench::Fuzz(args) => fuzz::run(args),
+        Bench::Load(args) => load::run(args),
+        Bench::Soak(args) => soak::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -5,6 +5,38 @@ use std::path::{Path, PathBuf};
 
 use super::error::{BenchError, BenchResult};
 
+/// A goal of a report, what was measured, and whether it was met (`None`: not judged).
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct Goal {
+    pub goal: String,
+    pub value: String,
+    pub met: Option<bool>,
+}
+
+impl Goal {
+    pub fn new(goal: impl Into<String>, value: impl Into<String>, met: Option<bool>) -> Goal {
+        Goal {
+            goal: goal.into(),
+            value: value.into(),
+            met,
+        }
+    }
+}
+
+/// The markdown table of `goals`.
+pub fn goals_table(goals: &[Goal]) -> String {
+    let mut t = Table::new(&["goal", "measured", "verdict"]);
+    for g in goals {
+        t.row(&[g.goal.clone(), g.value.clone(), verdict(g.met).into()]);
+    }
+    t.finish()
+}
+
+/// Bytes as MiB with sensible digits.
+pub fn mib(bytes: f64) -> String {
+    num(Some(bytes / (1024.0 * 1024.0)))
+}
+
 /// Writes `dir/name.json` and `dir/name.md`, creating `dir`. Returns both paths.
 pub fn write(
     dir: &Path,

@@ -10,10 +10,13 @@
 //!
 //! - [`target`]: the trait and its implementations.
 //! - [`builders`]: the builders.
+//! - [`fuzz`]: the fuzzer of the daemon's request decoder and command executor (not a
+//!   scene, but shared the same way: `physics-bench fuzz` and the integration tests run it).
 
 #![warn(missing_docs)]
 
 pub mod builders;
+pub mod fuzz;
 pub mod target;
 
 pub use builders::*;

@@ -13,7 +13,7 @@ use std::time::{Duration, Instant};
 
 use super::error::{BenchError, BenchResult};
 use super::progress::Progress;
-use super::report;
+use super::report::{self, Goal};
 use super::scene::{Kind, Scene};
 use super::stats::Spread;
 
@@ -86,13 +86,6 @@ pub struct SizeReport {
     pub delivery: BTreeMap<Kind, Delivery>,
     /// Tick times behind the ratio.
     pub ticks: BTreeMap<Kind, Overhead>,
-}
-
-#[derive(Debug, Clone, serde::Serialize)]
-pub struct Goal {
-    pub goal: String,
-    pub value: String,
-    pub met: Option<bool>,
 }
 
 #[derive(Debug, Clone, serde::Serialize)]

@@ -1,0 +1,548 @@
+//! Structured input: batches of commands of every `Command`, `PlaneOp` and `ObjectOp`
+//! variant with every `PlaneProp` and `ObjectProp`. Each command is drawn either *valid*
+//! (realistic values on a plane and an object the client owns, so it gets past validation
+//! and runs the engine) or *wild* (fields replaced by NaN, infinities, zeros, subnormals,
+//! huge values, random bits; stale, random and out-of-range handles; unknown plane ids;
+//! degenerate meshes and bad triangle indices).
+
+use shm_layout::{
+    Command, Handle, ObjectOp, ObjectProp, Pin, PlaneId, PlaneKind, PlaneOp, PlaneProp, Pose,
+    Restraint, RotateTo, Shape, Vec3, CRATE_VERSION,
+};
+
+use super::rng::Rng;
+use super::world::World;
+
+/// Own planes a client keeps at most (valid creations beyond it destroy one instead).
+const MAX_OWN_PLANES: usize = 6;
+/// Objects valid adds put into one plane at most, so steps stay cheap.
+const MAX_VALID_OBJECTS: usize = 120;
+/// Share of commands drawn wild.
+const WILD: f64 = 0.35;
+
+/// Draws commands for one client from the seeded stream and the world it learned.
+pub struct Gen<'a> {
+    rng: &'a mut Rng,
+    world: &'a World,
+    client: usize,
+    /// Planes and objects earlier commands of this batch destroy: valid commands leave
+    /// them alone (the world learns of it only from the reply).
+    dropped_planes: Vec<PlaneId>,
+    dropped_handles: Vec<Handle>,
+}
+
+impl<'a> Gen<'a> {
+    /// Commands for `client`, drawn from `rng`, aimed with what `world` knows.
+    pub fn new(rng: &'a mut Rng, world: &'a World, client: usize) -> Gen<'a> {
+        Gen {
+            rng,
+            world,
+            client,
+            dropped_planes: Vec::new(),
+            dropped_handles: Vec::new(),
+        }
+    }
+
+    /// A batch of 1 to 1,000 commands (mostly short), led by a `Hello` when the client is
+    /// not connected.
+    pub fn batch(&mut self) -> Vec<Command> {
+        let n = match self.rng.unit() {
+            u if u < 0.5 => self.rng.range(1, 4),
+            u if u < 0.85 => self.rng.range(5, 32),
+            u if u < 0.98 => self.rng.range(33, 200),
+            _ => self.rng.range(201, 1_000),
+        };
+        let mut batch = Vec::with_capacity(n + 1);
+        if !self.world.connected[self.client] {
+            batch.push(hello());
+        }
+        for _ in 0..n {
+            let command = self.command();
+            match &command {
+                Command::Plane {
+                    plane,
+                    op: PlaneOp::Destroy,
+                } => self.dropped_planes.push(*plane),
+                Command::Plane {
+                    op:
+                        PlaneOp::Object {
+                            handle,
+                            op: ObjectOp::Destroy,
+                        },
+                    ..
+                } => self.dropped_handles.push(*handle),
+                _ => {}
+            }
+            batch.push(command);
+        }
+        batch
+    }
+
+    /// The client's planes not destroyed earlier in this batch.
+    fn own_planes(&self) -> Vec<PlaneId> {
+        let mut own = self.world.own_planes(self.client);
+        own.retain(|id| !self.dropped_planes.contains(id));
+        own
+    }
+
+    /// The plane's live objects not destroyed earlier in this batch.
+    fn live(&self, id: PlaneId) -> Vec<Handle> {
+        self.world.planes.get(&id).map_or_else(Vec::new, |p| {
+            p.live
+                .iter()
+                .filter(|h| !self.dropped_handles.contains(h))
+                .copied()
+                .collect()
+        })
+    }
+
+    /// One command.
+    pub fn command(&mut self) -> Command {
+        let wild = self.rng.chance(WILD);
+        let own = self.own_planes();
+        let u = self.rng.unit();
+        if u < 0.0003 {
+            return Command::Goodbye;
+        }
+        if u < 0.005 {
+            return if self.rng.chance(0.5) {
+                hello()
+            } else {
+                Command::Hello {
+                    crate_version: self.text(),
+                    pid: self.rng.u32(),
+                }
+            };
+        }
+        if u < 0.04 || (own.is_empty() && !wild && self.rng.chance(0.7)) {
+            if own.len() >= MAX_OWN_PLANES && !wild {
+                let id = *self.rng.pick(&own);
+                return Command::plane(id, PlaneOp::Destroy);
+            }
+            return self.create_plane(wild);
+        }
+        let plane = self.plane_id(wild, &own);
+        let op = self.plane_op(wild, plane);
+        Command::Plane { plane, op }
+    }
+
+    fn create_plane(&mut self, wild: bool) -> Command {
+        let mut props = Vec::new();
+        if !wild || self.rng.chance(0.5) {
+            // Mostly manual: automatic planes tick on their own and compete for the daemon.
+            props.push(PlaneProp::TickRate(if self.rng.chance(0.85) {
+                0.0
+            } else {
+                *self.rng.pick(&[30.0, 60.0, 120.0])
+            }));
+        }
+        for _ in 0..self.rng.below(5) {
+            props.push(self.plane_prop(wild, true));
+        }
+        Command::CreatePlane {
+            kind: PlaneKind::Rapier3d,
+            props,
+        }
+    }
+
+    /// An own plane mostly; sometimes another client's, a gone one or one never created.
+    fn plane_id(&mut self, wild: bool, own: &[PlaneId]) -> PlaneId {
+        let u = self.rng.unit();
+        if !own.is_empty() && (u < 0.8 || !wild && u < 0.95) {
+            return *self.rng.pick(own);
+        }
+        let foreign = self.world.foreign_planes(self.client);
+        if !foreign.is_empty() && u < 0.9 {
+            return *self.rng.pick(&foreign);
+        }
+        match self.rng.below(5) {
+            0 if !self.world.gone.is_empty() => *self.rng.pick(&self.world.gone),
+            1 => self.world.max_id + 1 + self.rng.below(3) as u32,
+            2 => self.rng.special_u32(),
+            _ => self.rng.u32(),
+        }
+    }
+
+    fn plane_op(&mut self, wild: bool, id: PlaneId) -> PlaneOp {
+        let live = self.live(id).len();
+        let mut u = self.rng.unit();
+        // Valid commands need something to act on, and keep planes small.
+        if !wild && live == 0 && u >= 0.45 {
+            u = 0.3;
+        }
+        if !wild && live >= MAX_VALID_OBJECTS && (0.25..0.45).contains(&u) {
+            u = 0.5;
+        }
+        match u {
+            u if u < 0.03 => PlaneOp::Info,
+            u if u < 0.10 => PlaneOp::Set(self.plane_prop(wild, false)),
+            u if u < 0.24 => PlaneOp::Step { dt: self.dt(wild) },
+            u if u < 0.25 => {
+                if wild || self.rng.chance(0.3) {
+                    PlaneOp::Destroy
+                } else {
+                    PlaneOp::Info
+                }
+            }
+            u if u < 0.45 => self.add_object(wild),
+            _ => {
+                let handle = self.handle(wild, id);
+                PlaneOp::Object {
+                    handle,
+                    op: self.object_op(wild),
+                }
+            }
+        }
+    }
+
+    /// A step length: the usual 1/60 s, anything from 1 µs to the 1 s limit, or (wild)
+    /// NaN, infinities, zero, negative, subnormal, just past the limit.
+    fn dt(&mut self, wild: bool) -> f32 {
+        if wild && self.rng.chance(0.6) {
+            return *self.rng.pick(&[
+                f32::NAN,
+                f32::INFINITY,
+                f32::NEG_INFINITY,
+                0.0,
+                -0.0,
+                -1.0 / 60.0,
+                1e-45,
+                1e-38,
+                1e-12,
+                1.000_000_1,
+                2.0,
+                1e38,
+                f32::MAX,
+            ]);
+        }
+        if self.rng.chance(0.5) {
+            1.0 / 60.0
+        } else {
+            self.rng.log_f32(1e-6, 1.0)
+        }
+    }
+
+    fn add_object(&mut self, wild: bool) -> PlaneOp {
+        let shape = self.shape(wild);
+        let pose = self.rng.pose(wild, 30.0);
+        let props = (0..self.rng.below(4))
+            .map(|_| self.object_prop(wild))
+            .collect();
+        PlaneOp::AddObject { shape, pose, props }
+    }
+
+    /// A live handle of the plane mostly; a stale one, a neighbour's generation or a bogus
+    /// one otherwise.
+    fn handle(&mut self, wild: bool, id: PlaneId) -> Handle {
+        let live = self.live(id);
+        let u = self.rng.unit();
+        if let Some(p) = self.world.planes.get(&id) {
+            if !live.is_empty() && (u < 0.75 || !wild && u < 0.97) {
+                return *self.rng.pick(&live);
+            }
+            if !p.stale.is_empty() && u < 0.85 {
+                return *self.rng.pick(&p.stale);
+            }
+            if !live.is_empty() && u < 0.9 {
+                let h = *self.rng.pick(&live);
+                return Handle {
+                    slot: h.slot,
+                    generation: h.generation.wrapping_add(1),
+                };
+            }
+        }
+        self.rng.bogus_handle()
+    }
+
+    fn object_op(&mut self, wild: bool) -> ObjectOp {
+        match self.rng.below(100) {
+            0..=54 => ObjectOp::Set(self.object_prop(wild)),
+            55..=66 => ObjectOp::ApplyImpulse(self.rng.vec3(wild, 20.0)),
+            67..=76 => ObjectOp::Info,
+            77..=81 => ObjectOp::RecalculateCenterOfMass,
+            82..=89 => ObjectOp::Wake,
+            _ => ObjectOp::Destroy,
+        }
+    }
+
+    /// A shape: cube, sphere or mesh.
+    fn shape(&mut self, wild: bool) -> Shape {
+        match self.rng.below(100) {
+            0..=44 => Shape::Cube {
+                size: self.size(wild),
+            },
+            45..=79 => {
+                let r = self.rng.f32_in(0.05, 2.0);
+                Shape::Sphere {
+                    radius: self.rng.maybe_wild(wild, r),
+                }
+            }
+            _ => self.mesh(wild),
+        }
+    }
+
+    fn size(&mut self, wild: bool) -> Vec3 {
+        [0; 3].map(|_| {
+            let s = self.rng.f32_in(0.1, 4.0);
+            self.rng.maybe_wild(wild, s)
+        })
+    }
+
+    /// A mesh part: a valid point cloud with valid triangles, or (wild) too few vertices,
+    /// coplanar, collinear or coincident points, non-finite, huge or tiny coordinates, bad
+    /// triangle indices, or many vertices.
+    fn mesh(&mut self, wild: bool) -> Shape {
+        let cloud = |rng: &mut Rng, n: usize, scale: f32| -> Vec<Vec3> {
+            (0..n)
+                .map(|_| [0; 3].map(|_| rng.f32_in(-scale, scale)))
+                .collect()
+        };
+        let n = self.rng.range(4, 32);
+        let mut vertices = cloud(self.rng, n, 1.0);
+        let mut triangles = self.triangles(vertices.len(), 0);
+        if wild {
+            match self.rng.below(11) {
+                0 => vertices.truncate(self.rng.below(4)),
+                1 => vertices.iter_mut().for_each(|v| v[2] = 0.0),
+                2 => vertices
+                    .iter_mut()
+                    .for_each(|v| *v = [v[0], 2.0 * v[0], -v[0]]),
+                3 => {
+                    let p = vertices[0];
+                    vertices.iter_mut().for_each(|v| *v = p);
+                }
+                4 => {
+                    let i = self.rng.below(vertices.len());
+                    vertices[i][self.rng.below(3)] = self.rng.special_f32();
+                }
+                5 => {
+                    let scale = *self.rng.pick(&[1e20, 1e30, 1e38]);
+                    vertices = cloud(self.rng, n, scale);
+                }
+                6 => {
+                    let scale = *self.rng.pick(&[1e-20, 1e-30, 1e-38]);
+                    vertices = cloud(self.rng, n, scale);
+                }
+                7 => {
+                    let bad = 1 + self.rng.below(3);
+                    triangles = self.triangles(vertices.len(), bad);
+                }
+                8 => {
+                    let n = self.rng.range(1_000, 4_000);
+                    vertices = cloud(self.rng, n, 3.0);
+                    triangles = self.triangles(n, 0);
+                }
+                9 => vertices.iter_mut().for_each(|v| v[2] *= 1e-7),
+                _ => {
+                    // More triangles than any real part, all in range.
+                    let m = self.rng.range(1_000, 20_000);
+                    triangles = (0..m)
+                        .map(|_| [0; 3].map(|_| self.rng.below(n) as u32))
+                        .collect();
+                }
+            }
+        }
+        Shape::Mesh {
+            vertices,
+            triangles,
+        }
+    }
+
+    /// Up to 16 triangles over `n` vertices, `bad` of them with an index out of range.
+    fn triangles(&mut self, n: usize, bad: usize) -> Vec<[u32; 3]> {
+        let mut t: Vec<[u32; 3]> = (0..self.rng.below(17))
+            .map(|_| [0; 3].map(|_| self.rng.below(n) as u32))
+            .collect();
+        for _ in 0..bad {
+            let k = *self.rng.pick(&[n as u32, n as u32 + 1, u32::MAX, 1 << 31]);
+            let tri = [self.rng.below(n.max(1)) as u32, k, 0];
+            let at = self.rng.below(t.len() + 1);
+            t.insert(at, tri);
+        }
+        t
+    }
+
+    /// Any plane option with a valid or wild value; creation-only ones too.
+    fn plane_prop(&mut self, wild: bool, creating: bool) -> PlaneProp {
+        let r = &mut *self.rng;
+        let any_u32 = |r: &mut Rng, lo: usize, hi: usize| {
+            if wild && r.chance(0.5) {
+                r.special_u32()
+            } else {
+                r.range(lo, hi) as u32
+            }
+        };
+        match r.below(14) {
+            0 => PlaneProp::Gravity(if r.chance(0.3) {
+                [0.0, -50.0, 0.0]
+            } else {
+                r.vec3(wild, 100.0)
+            }),
+            1 => PlaneProp::Threads(if creating && !wild {
+                r.range(1, 3) as u32
+            } else {
+                any_u32(r, 1, 3)
+            }),
+            2 => PlaneProp::TickRate(if wild {
+                *r.pick(&[
+                    f32::NAN,
+                    f32::INFINITY,
+                    -60.0,
+                    1e-45,
+                    1e-3,
+                    0.009_999,
+                    0.01,
+                    10_000.0,
+                    10_000.001,
+                    1e38,
+                ])
+            } else {
+                *r.pick(&[0.0, 0.0, 0.0, 30.0, 60.0, 240.0])
+            }),
+            3 => PlaneProp::Enabled(r.chance(0.85)),
+            4 => {
+                let k = r.f32_in(0.0, 5.0);
+                PlaneProp::LinearDamping(r.maybe_wild(wild, k))
+            }
+            5 => {
+                let k = r.f32_in(0.0, 5.0);
+                PlaneProp::AngularDamping(r.maybe_wild(wild, k))
+            }
+            6 => {
+                let k = r.f32_in(0.0, 2.0);
+                PlaneProp::Drag(r.maybe_wild(wild, k))
+            }
+            7 => {
+                let b = r.f32_in(-100.0, 100.0);
+                PlaneProp::Buoyancy(r.maybe_wild(wild, b))
+            }
+            8 => PlaneProp::ConstantForce(r.vec3(wild, 50.0)),
+            9 => {
+                let v = r.f32_in(0.0, 5.0);
+                PlaneProp::RestThreshold(r.maybe_wild(wild, v))
+            }
+            10 => PlaneProp::SolverIterations(any_u32(r, 1, 16)),
+            11 => PlaneProp::LoopSolver(r.chance(0.1)),
+            12 => PlaneProp::NeverSleep(r.chance(0.3)),
+            _ => PlaneProp::Shared(r.chance(0.5)),
+        }
+    }
+
+    /// Any object property with a valid or wild value.
+    fn object_prop(&mut self, wild: bool) -> ObjectProp {
+        let r = &mut *self.rng;
+        let f = |r: &mut Rng, lo: f32, hi: f32| {
+            let v = r.f32_in(lo, hi);
+            r.maybe_wild(wild, v)
+        };
+        match r.below(18) {
+            0 => ObjectProp::Pose(r.pose(wild, 30.0)),
+            1 => ObjectProp::Velocity(r.vec3(wild, 20.0)),
+            2 => ObjectProp::AngularVelocity(r.vec3(wild, 10.0)),
+            3 => ObjectProp::Anchored(r.chance(0.15)),
+            4 => ObjectProp::ReportContacts(r.chance(0.5)),
+            5 => {
+                let w = r.log_f32(1e-3, 1e3);
+                ObjectProp::Weight(r.maybe_wild(wild, w))
+            }
+            6 => {
+                let d = if r.chance(0.3) {
+                    0.0
+                } else {
+                    r.log_f32(0.01, 100.0)
+                };
+                ObjectProp::Density(r.maybe_wild(wild, d))
+            }
+            7 => ObjectProp::Bounciness(f(r, -0.5, 1.5)),
+            8 => ObjectProp::Friction(f(r, 0.0, 1.0)),
+            9 => ObjectProp::CanCollide(r.chance(0.8)),
+            10 => ObjectProp::HitBoxQuality(if wild && r.chance(0.5) {
+                r.special_u32()
+            } else {
+                *r.pick(&[1, 1, 2, 4, 8, 32])
+            }),
+            11 => ObjectProp::Size([0; 3].map(|_| f(r, 0.1, 4.0))),
+            12 => ObjectProp::CenterOfMass(if r.chance(0.3) {
+                [0.0; 3]
+            } else {
+                r.vec3(wild, 0.5)
+            }),
+            13 => ObjectProp::ImpulseDirection(r.vec3(wild, 20.0)),
+            14 => ObjectProp::ConstantForce(r.vec3(wild, 50.0)),
+            15 => {
+                let mut flag = || match r.below(3) {
+                    0 => None,
+                    1 => Some(false),
+                    _ => Some(true),
+                };
+                ObjectProp::FieldRestraint(Restraint {
+                    lock_x: flag(),
+                    lock_y: flag(),
+                    lock_z: flag(),
+                    lock_rot_x: flag(),
+                    lock_rot_y: flag(),
+                    lock_rot_z: flag(),
+                })
+            }
+            16 => ObjectProp::RotateTo(if r.chance(0.2) {
+                None
+            } else {
+                Some(RotateTo {
+                    target: r.quat(wild),
+                    strength: f(r, 0.0, 20.0),
+                })
+            }),
+            _ => ObjectProp::Pin(if r.chance(0.2) {
+                None
+            } else {
+                Some(Pin {
+                    force: f(r, 0.0, 1_000.0),
+                    relative: r.vec3(wild, 1.0),
+                    target: r.pose(wild, 20.0),
+                })
+            }),
+        }
+    }
+
+    /// A short string: empty, a near-miss version, or random (possibly invalid-looking)
+    /// characters.
+    fn text(&mut self) -> String {
+        match self.rng.below(4) {
+            0 => String::new(),
+            1 => format!("{CRATE_VERSION}-x"),
+            2 => "9.9.9".into(),
+            _ => (0..self.rng.below(40))
+                .map(|_| char::from_u32(self.rng.below(0x3000) as u32).unwrap_or('?'))
+                .collect(),
+        }
+    }
+}
+
+/// The handshake a client of this build sends.
+pub fn hello() -> Command {
+    Command::Hello {
+        crate_version: CRATE_VERSION.to_string(),
+        pid: std::process::id(),
+    }
+}
+
+/// `count` points on a unit sphere (golden-angle spiral): a mesh whose hull keeps them all.
+pub fn sphere_points(count: usize) -> Vec<Vec3> {
+    (0..count)
+        .map(|i| {
+            let t = i as f32 * 2.399_963;
+            let y = 1.0 - 2.0 * (i as f32 + 0.5) / count as f32;
+            let r = (1.0 - y * y).max(0.0).sqrt();
+            [r * t.cos(), y, r * t.sin()]
+        })
+        .collect()
+}
+
+/// A small valid box at `at`, for the quota rounds.
+pub fn small_cube(at: Vec3) -> PlaneOp {
+    PlaneOp::AddObject {
+        shape: Shape::Cube { size: [0.5; 3] },
+        pose: Pose::at(at),
+        props: vec![ObjectProp::Anchored(true)],
+    }
+}

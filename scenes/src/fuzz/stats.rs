@@ -1,0 +1,391 @@
+//! What a fuzz run counts: frames, commands, replies by kind, quota hits, per-op coverage and
+//! the failures (crashes, unanswered requests, replies of the wrong shape).
+
+use std::collections::BTreeMap;
+
+use shm_layout::{
+    Command, CommandResult, ErrorKind, ObjectOp, ObjectProp, PlaneOp, PlaneProp, Reply, Response,
+    Shape,
+};
+
+/// How many failures a run keeps in full (the counters count all of them).
+pub const MAX_FINDINGS: usize = 20;
+
+/// Counters of one fuzz run.
+#[derive(Debug, Clone, Default)]
+pub struct FuzzStats {
+    /// The seed the run was generated from.
+    pub seed: u64,
+    /// Wall time of the run.
+    pub seconds: f64,
+    /// Clients that sent frames.
+    pub clients: usize,
+    /// Batches (one or more frames each).
+    pub batches: u64,
+    /// Frames sent, all kinds together.
+    pub frames: u64,
+    /// Frames of well-formed requests built from generated commands.
+    pub structured_frames: u64,
+    /// Frames of random or mutated bytes.
+    pub raw_frames: u64,
+    /// Frames sent by quota rounds (requests built to exceed one quota).
+    pub quota_frames: u64,
+    /// Empty requests sent to check that the daemon still answers.
+    pub probe_frames: u64,
+    /// Commands in the frames the daemon could decode (each gets a result).
+    pub commands: u64,
+    /// Successful command results by reply variant.
+    pub ok: BTreeMap<String, u64>,
+    /// Failed command results by error kind.
+    pub errors: BTreeMap<String, u64>,
+    /// Whole requests refused, by error kind.
+    pub rejected: BTreeMap<String, u64>,
+    /// Replies in the version-neutral form (to frames of another layout version).
+    pub version_replies: u64,
+    /// Quota errors (command or request) by the daemon flag they name.
+    pub quota_hits: BTreeMap<String, u64>,
+    /// Quota rounds run and how many of them met the quota, by quota.
+    pub quota_rounds: BTreeMap<String, QuotaRound>,
+    /// Fuzzed commands (structured and raw frames) sent and how many succeeded, by op
+    /// (`Plane.Step`, `Object.Set.Velocity`).
+    pub ops: BTreeMap<String, OpCount>,
+    /// Planes that failed inside the daemon (a caught panic) and were removed, as reported
+    /// in replies.
+    pub plane_panics: u64,
+    /// The daemon exited, or a reply could not be decoded.
+    pub crashes: u64,
+    /// A request got no reply (timeout, stall, transport failure) while the daemon lived.
+    pub unanswered: u64,
+    /// A reply of the wrong shape: a result count that differs from the command count, or
+    /// results for a frame that cannot be decoded.
+    pub protocol_errors: u64,
+    /// The first failures in full (crashes, unanswered, protocol errors, plane panics).
+    pub findings: Vec<Finding>,
+}
+
+/// Commands of one op sent, and how many succeeded.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct OpCount {
+    /// Commands sent.
+    pub sent: u64,
+    /// Of those, succeeded.
+    pub ok: u64,
+}
+
+/// Rounds of one quota.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct QuotaRound {
+    /// Rounds run.
+    pub runs: u64,
+    /// Rounds in which the daemon refused with this quota's error.
+    pub hit: u64,
+}
+
+/// One failure, with the frame that caused it.
+#[derive(Debug, Clone)]
+pub struct Finding {
+    /// What went wrong: `crash`, `unanswered`, `protocol` or `plane panic`.
+    pub kind: &'static str,
+    /// The batch it happened in (0-based).
+    pub batch: u64,
+    /// The client that sent the frame.
+    pub client: usize,
+    /// A description (error message, reply summary).
+    pub detail: String,
+    /// The request frame, byte for byte (empty when it was larger than 1 MiB).
+    pub frame: Vec<u8>,
+}
+
+impl FuzzStats {
+    /// Whether the run met its goals: no crash, every request answered, every reply of the
+    /// right shape.
+    pub fn clean(&self) -> bool {
+        self.crashes == 0 && self.unanswered == 0 && self.protocol_errors == 0
+    }
+
+    /// Successful command results.
+    pub fn ok_total(&self) -> u64 {
+        self.ok.values().sum()
+    }
+
+    /// Failed command results.
+    pub fn error_total(&self) -> u64 {
+        self.errors.values().sum()
+    }
+
+    /// Of the fuzzed commands (structured and raw frames; not the quota rounds, whose
+    /// thousands of adds would swamp the figure), the fraction that succeeded: how often
+    /// the fuzzer gets past validation into the engine.
+    pub fn ok_fraction(&self) -> f64 {
+        let (sent, ok) = self
+            .ops
+            .values()
+            .fold((0, 0), |(s, o), c| (s + c.sent, o + c.ok));
+        if sent == 0 {
+            0.0
+        } else {
+            ok as f64 / sent as f64
+        }
+    }
+
+    /// The ops of [`all_op_names`] never sent.
+    pub fn ops_not_sent(&self) -> Vec<String> {
+        all_op_names()
+            .into_iter()
+            .filter(|op| self.ops.get(op).is_none_or(|c| c.sent == 0))
+            .collect()
+    }
+
+    pub(crate) fn finding(
+        &mut self,
+        kind: &'static str,
+        batch: u64,
+        client: usize,
+        detail: String,
+        frame: &[u8],
+    ) {
+        match kind {
+            "crash" => self.crashes += 1,
+            "unanswered" => self.unanswered += 1,
+            "protocol" => self.protocol_errors += 1,
+            _ => {}
+        }
+        if self.findings.len() < MAX_FINDINGS {
+            let frame = if frame.len() <= 1 << 20 {
+                frame.to_vec()
+            } else {
+                Vec::new()
+            };
+            self.findings.push(Finding {
+                kind,
+                batch,
+                client,
+                detail,
+                frame,
+            });
+        }
+    }
+
+    /// Counts a decoded response; `commands` are the request's commands when it could be
+    /// decoded here and the frame was fuzzed input (they are then counted per op).
+    pub(crate) fn count_response(&mut self, response: &Response, commands: Option<&[Command]>) {
+        match response {
+            Response::Rejected(e) => {
+                *self.rejected.entry(kind_name(e.kind)).or_default() += 1;
+                self.count_quota(e);
+            }
+            Response::Results(results) => {
+                self.commands += results.len() as u64;
+                for (i, r) in results.iter().enumerate() {
+                    let op = commands.and_then(|c| c.get(i)).map(op_name);
+                    self.count_result(r, op);
+                }
+            }
+        }
+    }
+
+    fn count_result(&mut self, result: &CommandResult, op: Option<String>) {
+        if let Some(op) = op {
+            let count = self.ops.entry(op).or_default();
+            count.sent += 1;
+            count.ok += result.is_ok() as u64;
+        }
+        match result {
+            Ok(reply) => *self.ok.entry(reply_name(reply).to_string()).or_default() += 1,
+            Err(e) => {
+                *self.errors.entry(kind_name(e.kind)).or_default() += 1;
+                self.count_quota(e);
+                if e.kind == ErrorKind::Internal && e.message.contains("failed and was removed") {
+                    self.plane_panics += 1;
+                }
+            }
+        }
+    }
+
+    fn count_quota(&mut self, e: &shm_layout::CommandError) {
+        if e.kind != ErrorKind::Quota {
+            return;
+        }
+        let flag = e
+            .message
+            .split_once("daemon flag ")
+            .and_then(|(_, rest)| rest.split([')', ' ', ',']).next())
+            .unwrap_or("(daemon-wide limit)");
+        *self.quota_hits.entry(flag.to_string()).or_default() += 1;
+    }
+}
+
+/// Every op name [`op_name`] gives: each `Command`, `PlaneOp`, `ObjectOp`, `PlaneProp`,
+/// `ObjectProp` and shape variant.
+pub fn all_op_names() -> Vec<String> {
+    let mut names: Vec<String> = [
+        "Hello",
+        "Goodbye",
+        "CreatePlane",
+        "Plane.Info",
+        "Plane.Step",
+        "Plane.Destroy",
+        "Plane.AddObject.Cube",
+        "Plane.AddObject.Sphere",
+        "Plane.AddObject.Mesh",
+        "Object.ApplyImpulse",
+        "Object.Info",
+        "Object.RecalculateCenterOfMass",
+        "Object.Wake",
+        "Object.Destroy",
+    ]
+    .map(String::from)
+    .to_vec();
+    let plane_props = [
+        PlaneProp::Gravity([0.0; 3]),
+        PlaneProp::Threads(1),
+        PlaneProp::TickRate(0.0),
+        PlaneProp::Enabled(true),
+        PlaneProp::LinearDamping(0.0),
+        PlaneProp::AngularDamping(0.0),
+        PlaneProp::Drag(0.0),
+        PlaneProp::Buoyancy(0.0),
+        PlaneProp::ConstantForce([0.0; 3]),
+        PlaneProp::RestThreshold(0.0),
+        PlaneProp::SolverIterations(1),
+        PlaneProp::LoopSolver(false),
+        PlaneProp::NeverSleep(false),
+        PlaneProp::Shared(false),
+    ];
+    names.extend(
+        plane_props
+            .iter()
+            .map(|p| format!("Plane.Set.{}", p.name())),
+    );
+    let object_props = [
+        ObjectProp::Pose(Default::default()),
+        ObjectProp::Velocity([0.0; 3]),
+        ObjectProp::AngularVelocity([0.0; 3]),
+        ObjectProp::Anchored(false),
+        ObjectProp::ReportContacts(false),
+        ObjectProp::Weight(1.0),
+        ObjectProp::Density(0.0),
+        ObjectProp::Bounciness(0.0),
+        ObjectProp::Friction(0.0),
+        ObjectProp::CanCollide(true),
+        ObjectProp::HitBoxQuality(1),
+        ObjectProp::Size([1.0; 3]),
+        ObjectProp::CenterOfMass([0.0; 3]),
+        ObjectProp::ImpulseDirection([0.0; 3]),
+        ObjectProp::ConstantForce([0.0; 3]),
+        ObjectProp::FieldRestraint(Default::default()),
+        ObjectProp::RotateTo(None),
+        ObjectProp::Pin(None),
+    ];
+    names.extend(
+        object_props
+            .iter()
+            .map(|p| format!("Object.Set.{}", object_prop_name(p))),
+    );
+    names
+}
+
+/// The name of an error kind (`InvalidValue`).
+pub fn kind_name(kind: ErrorKind) -> String {
+    format!("{kind:?}")
+}
+
+/// The name of a reply variant (`Stepped`).
+pub fn reply_name(reply: &Reply) -> &'static str {
+    match reply {
+        Reply::Done => "Done",
+        Reply::Welcome { .. } => "Welcome",
+        Reply::Plane(_) => "Plane",
+        Reply::Object { .. } => "Object",
+        Reply::Applied { .. } => "Applied",
+        Reply::Stepped { .. } => "Stepped",
+        Reply::ObjectInfo(_) => "ObjectInfo",
+        Reply::CenterOfMass(_) => "CenterOfMass",
+    }
+}
+
+/// The op a command performs, by variant path (`Plane.AddObject.Mesh`, `Object.Set.Size`).
+pub fn op_name(command: &Command) -> String {
+    match command {
+        Command::Hello { .. } => "Hello".into(),
+        Command::Goodbye => "Goodbye".into(),
+        Command::CreatePlane { .. } => "CreatePlane".into(),
+        Command::Plane { op, .. } => match op {
+            PlaneOp::Info => "Plane.Info".into(),
+            PlaneOp::Set(p) => format!("Plane.Set.{}", p.name()),
+            PlaneOp::Step { .. } => "Plane.Step".into(),
+            PlaneOp::Destroy => "Plane.Destroy".into(),
+            PlaneOp::AddObject { shape, .. } => format!(
+                "Plane.AddObject.{}",
+                match shape {
+                    Shape::Cube { .. } => "Cube",
+                    Shape::Sphere { .. } => "Sphere",
+                    Shape::Mesh { .. } => "Mesh",
+                }
+            ),
+            PlaneOp::Object { op, .. } => match op {
+                ObjectOp::Set(p) => format!("Object.Set.{}", object_prop_name(p)),
+                ObjectOp::ApplyImpulse(_) => "Object.ApplyImpulse".into(),
+                ObjectOp::Info => "Object.Info".into(),
+                ObjectOp::RecalculateCenterOfMass => "Object.RecalculateCenterOfMass".into(),
+                ObjectOp::Wake => "Object.Wake".into(),
+                ObjectOp::Destroy => "Object.Destroy".into(),
+            },
+        },
+    }
+}
+
+/// The name of an object property (`Velocity`).
+pub fn object_prop_name(prop: &ObjectProp) -> &'static str {
+    match prop {
+        ObjectProp::Pose(_) => "CFrame",
+        ObjectProp::Velocity(_) => "Velocity",
+        ObjectProp::AngularVelocity(_) => "AngularVelocity",
+        ObjectProp::Anchored(_) => "Anchored",
+        ObjectProp::ReportContacts(_) => "ReportContacts",
+        ObjectProp::Weight(_) => "Weight",
+        ObjectProp::Density(_) => "Density",
+        ObjectProp::Bounciness(_) => "Bounciness",
+        ObjectProp::Friction(_) => "Friction",
+        ObjectProp::CanCollide(_) => "CanCollide",
+        ObjectProp::HitBoxQuality(_) => "HitBoxQuality",
+        ObjectProp::Size(_) => "Size",
+        ObjectProp::CenterOfMass(_) => "CenterOfMass",
+        ObjectProp::ImpulseDirection(_) => "ImpulseDirection",
+        ObjectProp::ConstantForce(_) => "ConstantForce",
+        ObjectProp::FieldRestraint(_) => "FieldRestraint",
+        ObjectProp::RotateTo(_) => "RotateTo",
+        ObjectProp::Pin(_) => "Pin",
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use shm_layout::CommandError;
+
+    #[test]
+    fn quota_errors_are_counted_by_flag() {
+        let mut s = FuzzStats::default();
+        let e = CommandError::new(
+            ErrorKind::Quota,
+            "quota exceeded: objects per client is limited to 10 (daemon flag \
+             --max-objects-per-client), this would make 11",
+        );
+        s.count_response(&Response::Rejected(e.clone()), None);
+        s.count_response(&Response::Results(vec![Err(e), Ok(Reply::Done)]), None);
+        assert_eq!(s.quota_hits["--max-objects-per-client"], 2);
+        assert_eq!(s.rejected["Quota"], 1);
+        assert_eq!(s.errors["Quota"], 1);
+        assert_eq!(s.ok["Done"], 1);
+        assert_eq!(s.commands, 2);
+        assert_eq!(s.ok_fraction(), 0.0);
+        let cmds = [Command::Goodbye, Command::Goodbye];
+        s.count_response(
+            &Response::Results(vec![Ok(Reply::Done), Err(CommandError::invalid("x"))]),
+            Some(&cmds),
+        );
+        assert!((s.ok_fraction() - 0.5).abs() < 1e-9);
+        assert_eq!(s.ops_not_sent().len(), all_op_names().len() - 1);
+    }
+}
