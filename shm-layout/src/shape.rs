@@ -2,7 +2,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::validate::{finite3, positive, size, MAX_MESH_TRIANGLES, MAX_MESH_VERTICES};
+use crate::validate::{bounded3, extent, size, MAX_MESH_TRIANGLES, MAX_MESH_VERTICES, MAX_SIZE};
 use crate::{CommandError, Vec3};
 
 /// Collision shape of an object.
@@ -61,7 +61,7 @@ impl Shape {
     pub fn check(&self) -> Result<(), CommandError> {
         match self {
             Shape::Cube { size: s } => size("Size", *s).map(|_| ()),
-            Shape::Sphere { radius } => positive("radius", *radius).map(|_| ()),
+            Shape::Sphere { radius } => extent("radius", *radius).map(|_| ()),
             Shape::Mesh {
                 vertices,
                 triangles,
@@ -86,7 +86,7 @@ impl Shape {
                     ));
                 }
                 for (i, v) in vertices.iter().enumerate() {
-                    finite3(&format!("Mesh.vertices[{i}]"), *v)?;
+                    bounded3(&format!("Mesh.vertices[{i}]"), *v, MAX_SIZE)?;
                 }
                 let n = vertices.len() as u32;
                 if let Some((i, t)) = triangles

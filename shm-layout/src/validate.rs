@@ -60,10 +60,32 @@ pub fn in_range(field: &str, v: f32, lo: f32, hi: f32) -> Result<f32, CommandErr
     }
 }
 
-/// A finite position and a finite, non-degenerate quaternion (returned normalised).
+/// Largest coordinate of a position (units). Beyond it f32 positions are coarser than a
+/// unit and the collision library's numerics break down (a body at 1e20 made it panic).
+pub const MAX_COORDINATE: f32 = 1e7;
+/// Largest extent of a part and largest body-local offset (Size, radius, mesh vertices,
+/// CenterOfMass, a pin's point).
+pub const MAX_SIZE: f32 = 1e5;
+/// Smallest extent of a part (a size of 1e-30 has no usable mass or inertia).
+pub const MIN_SIZE: f32 = 1e-3;
+
+/// A vector whose components are finite and within `[-max, max]`.
+pub fn bounded3(field: &str, v: Vec3, max: f32) -> Result<Vec3, CommandError> {
+    if v.iter().all(|c| c.is_finite() && c.abs() <= max) {
+        Ok(v)
+    } else {
+        Err(CommandError::invalid_field(
+            field,
+            format!("{field} must have finite components within [-{max}, {max}], got {v:?}"),
+        ))
+    }
+}
+
+/// A finite position within [`MAX_COORDINATE`] and a finite, non-degenerate quaternion
+/// (returned normalised).
 pub fn pose(field: &str, p: Pose) -> Result<Pose, CommandError> {
     Ok(Pose {
-        position: finite3(&format!("{field}.position"), p.position)?,
+        position: bounded3(&format!("{field}.position"), p.position, MAX_COORDINATE)?,
         rotation: rotation(&format!("{field}.rotation"), p.rotation)?,
     })
 }
@@ -104,12 +126,26 @@ pub fn rotation(field: &str, q: [f32; 4]) -> Result<[f32; 4], CommandError> {
     Ok(q.map(|c| c / norm))
 }
 
-/// A size with positive finite components (errors name `field.X`, `.Y`, `.Z`).
+/// A size with components within [[`MIN_SIZE`], [`MAX_SIZE`]] (errors name `field.X`, `.Y`,
+/// `.Z`).
 pub fn size(field: &str, v: Vec3) -> Result<Vec3, CommandError> {
     for (axis, c) in ["X", "Y", "Z"].iter().zip(v) {
-        positive(&format!("{field}.{axis}"), c)?;
+        extent(&format!("{field}.{axis}"), c)?;
     }
     Ok(v)
+}
+
+/// One extent of a part: positive, within [[`MIN_SIZE`], [`MAX_SIZE`]].
+pub fn extent(field: &str, v: f32) -> Result<f32, CommandError> {
+    positive(field, v)?;
+    if (MIN_SIZE..=MAX_SIZE).contains(&v) {
+        Ok(v)
+    } else {
+        Err(CommandError::invalid_field(
+            field,
+            format!("{field} must be within [{MIN_SIZE}, {MAX_SIZE}], got {v}"),
+        ))
+    }
 }
 
 /// A finite number.
@@ -179,6 +215,26 @@ mod tests {
             e.message.contains("Size.Y") && e.message.contains("-2"),
             "{e}"
         );
+    }
+
+    #[test]
+    fn coordinates_and_sizes_are_bounded() {
+        let far = Pose::at([0.0, 0.0, 1e20]);
+        let e = pose("CFrame", far).unwrap_err();
+        assert_eq!(e.field.as_deref(), Some("CFrame.position"));
+        assert!(
+            e.message.contains("1e20") || e.message.contains("100000000000000000000"),
+            "{e}"
+        );
+        assert!(pose("CFrame", Pose::at([1e5, -1e5, 5e6])).is_ok());
+        let e = ObjectProp::Size([3.88, 3.67, 3.4e38])
+            .checked()
+            .unwrap_err();
+        assert_eq!(e.field.as_deref(), Some("Size.Z"));
+        assert!(ObjectProp::Size([1e-30, 1.0, 1.0]).checked().is_err());
+        assert!(ObjectProp::Size([0.05, 1e5, 1.0]).checked().is_ok());
+        assert!(ObjectProp::CenterOfMass([0.0, 1e9, 0.0]).checked().is_err());
+        assert!(Shape::Sphere { radius: 1e20 }.check().is_err());
     }
 
     #[test]

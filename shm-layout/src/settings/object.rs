@@ -3,8 +3,8 @@
 use serde::{Deserialize, Serialize};
 
 use crate::validate::{
-    clamped, finite3, in_range, non_negative, pose, positive, rotation, size, MAX_HIT_BOX_QUALITY,
-    MIN_MASS,
+    bounded3, clamped, finite3, in_range, non_negative, pose, positive, rotation, size,
+    MAX_HIT_BOX_QUALITY, MAX_SIZE, MIN_MASS,
 };
 use crate::{CommandError, Pose, Vec3};
 
@@ -232,7 +232,7 @@ impl ObjectProp {
             Friction(mu) => Friction(in_range("Friction", mu, 0.0, 1.0)?),
             HitBoxQuality(q) => HitBoxQuality(q.clamp(1, MAX_HIT_BOX_QUALITY)),
             Size(v) => Size(size("Size", v)?),
-            CenterOfMass(c) => CenterOfMass(finite3("CenterOfMass", c)?),
+            CenterOfMass(c) => CenterOfMass(bounded3("CenterOfMass", c, MAX_SIZE)?),
             ImpulseDirection(a) => ImpulseDirection(finite3("ImpulseDirection", a)?),
             ConstantForce(f) => ConstantForce(finite3("ConstantForce", f)?),
             RotateTo(Some(r)) => RotateTo(Some(self::RotateTo {
@@ -241,7 +241,7 @@ impl ObjectProp {
             })),
             Pin(Some(p)) => Pin(Some(self::Pin {
                 force: non_negative("SetPin.force", p.force)?,
-                relative: finite3("SetPin.relative", p.relative)?,
+                relative: bounded3("SetPin.relative", p.relative, MAX_SIZE)?,
                 target: pose("SetPin.target", p.target)?,
             })),
             other => other,
