@@ -495,11 +495,28 @@ impl Engine<'_> {
                 commands.push(Command::plane(id, PlaneOp::Destroy));
             }
         }
-        commands.push(Command::CreatePlane {
+        let create = Command::CreatePlane {
             kind: Default::default(),
             props: vec![PlaneProp::TickRate(0.0)],
-        });
-        match self.send_commands(c, commands, Source::Quota).last() {
+        };
+        commands.push(create.clone());
+        if let Some(Reply::Plane(info)) = self.send_commands(c, commands, Source::Quota).last() {
+            return Some(info.id);
+        }
+        // Quotas count per process and every fuzzing client shares this one: make room by
+        // letting every client destroy its planes, then try once more.
+        for k in 0..self.clients.len() {
+            let destroy: Vec<Command> = self
+                .world
+                .own_planes(k)
+                .into_iter()
+                .map(|id| Command::plane(id, PlaneOp::Destroy))
+                .collect();
+            if !destroy.is_empty() {
+                self.send_commands(k, destroy, Source::Quota);
+            }
+        }
+        match self.send_commands(c, vec![create], Source::Quota).last() {
             Some(Reply::Plane(info)) => Some(info.id),
             _ => None,
         }
