@@ -439,3 +439,54 @@ fn more_connections_of_one_process_share_its_quotas() {
     let e = command_error(b.add(cube(), Pose::IDENTITY, &[]).unwrap_err());
     assert_eq!(e.kind, ErrorKind::Quota, "{e}");
 }
+
+/// Node-record directories of daemons of `domain` (their `node.details` names the daemon).
+fn daemon_node_dirs(domain: &str) -> Vec<std::path::PathBuf> {
+    let prefix = shm_layout::names::prefix(domain);
+    integration_tests::domain_files(domain)
+        .into_iter()
+        .filter(|f| {
+            f.file_name()
+                .is_some_and(|n| n.to_string_lossy() == format!("{prefix}node.details"))
+                && std::fs::read(f).is_ok_and(|d| {
+                    String::from_utf8_lossy(&d).contains(shm_layout::names::DAEMON_NODE_NAME)
+                })
+        })
+        .filter_map(|f| f.parent().map(|p| p.to_path_buf()))
+        .collect()
+}
+
+#[test]
+fn a_new_daemon_removes_what_a_crashed_one_left() {
+    let mut crashed = TestDaemon::start("leftovers");
+    let domain = crashed.domain.clone();
+    let client = crashed.client();
+    for _ in 0..3 {
+        let plane = client.create_plane(&PlaneOptions::manual()).unwrap();
+        plane.add(cube(), Pose::IDENTITY, &[]).unwrap();
+        plane.step(1.0 / 60.0).unwrap();
+    }
+    // The daemon's nodes: the server's and its heartbeat's.
+    let dead = daemon_node_dirs(&domain);
+    assert!(!dead.is_empty());
+    crashed.kill9();
+    // A client still holds the domain open: the crash's leftovers stay until a daemon comes.
+    let left = integration_tests::domain_files(&domain).len();
+    assert!(dead.iter().all(|d| d.exists()));
+    let mut replacement = TestDaemon::start_in(&domain);
+    let after = integration_tests::domain_files(&domain).len();
+    assert!(
+        dead.iter().all(|d| !d.exists()),
+        "the dead daemon's node records survived the restart"
+    );
+    assert!(
+        after < left,
+        "{after} files after the restart, {left} before"
+    );
+    drop(client);
+    replacement.stop_with(libc::SIGTERM, Duration::from_secs(2));
+    assert_eq!(
+        integration_tests::domain_files(&domain),
+        Vec::<std::path::PathBuf>::new()
+    );
+}
