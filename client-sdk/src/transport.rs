@@ -34,7 +34,9 @@ pub(crate) type TickListener = Listener<ipc::Service>;
 pub(crate) struct Transport {
     config: Config,
     node: Node<ipc::Service>,
-    port: RequestPort<ipc::Service, [u8], u128, [u8], ()>,
+    control: ControlFactory,
+    /// Replaced when its memory is exhausted (see [`Transport::exchange`]).
+    port: RefCell<RequestPort<ipc::Service, [u8], u128, [u8], ()>>,
     daemon_wake: Notifier<ipc::Service>,
     replies: Listener<ipc::Service>,
     id: u128,
@@ -80,12 +82,7 @@ impl Transport {
             }
             std::thread::sleep(Duration::from_millis(2));
         }
-        let port = control
-            .client_builder()
-            .initial_max_slice_len(4096)
-            .allocation_strategy(AllocationStrategy::PowerOfTwo)
-            .create()
-            .map_err(|e| Error::ipc("cannot create request port", e))?;
+        let port = RefCell::new(request_port(&control)?);
         let daemon_wake = node
             .service_builder(&names::control_wake())
             .event()
@@ -105,6 +102,7 @@ impl Transport {
             .create()
             .map_err(|e| Error::ipc("cannot create reply listener", e))?;
         Ok(Transport {
+            control,
             config,
             node,
             port,
@@ -124,10 +122,23 @@ impl Transport {
         period: Duration,
         mut check: impl FnMut(bool) -> Result<(), Error>,
     ) -> Result<Vec<u8>, Error> {
-        let mut request = self
-            .port
-            .loan_slice_uninit(bytes.len())
-            .map_err(|e| Error::ipc("loan request", e))?;
+        let loaned = self.port.borrow().loan_slice_uninit(bytes.len());
+        let mut request = match loaned {
+            Ok(r) => r,
+            Err(e) => {
+                // A port whose shared memory is exhausted (requests of very different sizes
+                // can fragment it) is replaced by a fresh one, once.
+                tracing::debug!(
+                    "loan of {} request bytes failed ({e:?}): new request port",
+                    bytes.len()
+                );
+                *self.port.borrow_mut() = request_port(&self.control)?;
+                self.port
+                    .borrow()
+                    .loan_slice_uninit(bytes.len())
+                    .map_err(|e| Error::ipc("loan request", e))?
+            }
+        };
         // The daemon identifies us by the transport's node id; this copy in the user header
         // only keeps the control service's layout the same for every version (so a
         // version mismatch still reaches the handshake).
@@ -217,6 +228,27 @@ impl Transport {
             .create()
             .map_err(|e| Error::ipc("create event subscriber", e))
     }
+}
+
+/// The control service, as opened by a client.
+type ControlFactory = iceoryx2::service::port_factory::request_response::PortFactory<
+    ipc::Service,
+    [u8],
+    u128,
+    [u8],
+    (),
+>;
+
+/// A request port on the control service, growing its memory by powers of two.
+fn request_port(
+    control: &ControlFactory,
+) -> Result<RequestPort<ipc::Service, [u8], u128, [u8], ()>, Error> {
+    control
+        .client_builder()
+        .initial_max_slice_len(4096)
+        .allocation_strategy(AllocationStrategy::PowerOfTwo)
+        .create()
+        .map_err(|e| Error::ipc("cannot create request port", e))
 }
 
 /// Whether the daemon's node is alive: found by id once the handshake told us the id, by
