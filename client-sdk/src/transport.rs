@@ -36,7 +36,7 @@ pub(crate) struct Transport {
     node: Node<ipc::Service>,
     control: ControlFactory,
     /// Replaced when its memory is exhausted (see [`Transport::exchange`]).
-    port: RefCell<RequestPort<ipc::Service, [u8], u128, [u8], ()>>,
+    port: RefCell<ControlPort>,
     daemon_wake: Notifier<ipc::Service>,
     replies: Listener<ipc::Service>,
     id: u128,
@@ -230,6 +230,9 @@ impl Transport {
     }
 }
 
+/// A request port of the control service.
+type ControlPort = RequestPort<ipc::Service, [u8], u128, [u8], ()>;
+
 /// The control service, as opened by a client.
 type ControlFactory = iceoryx2::service::port_factory::request_response::PortFactory<
     ipc::Service,
@@ -240,9 +243,7 @@ type ControlFactory = iceoryx2::service::port_factory::request_response::PortFac
 >;
 
 /// A request port on the control service, growing its memory by powers of two.
-fn request_port(
-    control: &ControlFactory,
-) -> Result<RequestPort<ipc::Service, [u8], u128, [u8], ()>, Error> {
+fn request_port(control: &ControlFactory) -> Result<ControlPort, Error> {
     control
         .client_builder()
         .initial_max_slice_len(4096)
