@@ -140,8 +140,8 @@ pub fn render(r: &FuzzReport) -> String {
         let q = r.quota_rounds.get(flag);
         t.row(&[
             format!("`{flag}`"),
-            q.map_or(0, |q| q.rounds).to_string(),
-            q.map_or(0, |q| q.met).to_string(),
+            q.map_or(0, |q| q.runs).to_string(),
+            q.map_or(0, |q| q.hit).to_string(),
             r.quota_hits.get(flag).copied().unwrap_or(0).to_string(),
         ]);
     }

@@ -8,7 +8,7 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
-use physics_scenes::fuzz::{self, FuzzConfig, FuzzStats, OpCount, QuotaRound, QUOTA_FLAGS};
+use physics_scenes::fuzz::{self, FuzzConfig, FuzzStats, QUOTA_FLAGS};
 
 use super::daemon::DaemonProcess;
 use super::error::{BenchError, BenchResult};
@@ -43,54 +43,20 @@ pub struct FindingOut {
     pub frame_file: Option<String>,
 }
 
-#[derive(Debug, Clone, Copy, serde::Serialize)]
-pub struct OpOut {
-    pub sent: u64,
-    pub ok: u64,
-}
-
-#[derive(Debug, Clone, Copy, serde::Serialize)]
-pub struct QuotaOut {
-    pub rounds: u64,
-    pub met: u64,
-}
-
+/// The report of one run: the engine's counters (flattened into the JSON, read through
+/// `Deref`) and what the bench adds around them.
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct FuzzReport {
-    pub seed: u64,
-    pub seconds: f64,
-    pub clients: usize,
+    #[serde(flatten)]
+    pub stats: FuzzStats,
     pub daemon_flags: Vec<String>,
-    pub batches: u64,
-    pub frames: u64,
-    pub structured_frames: u64,
-    pub raw_frames: u64,
-    pub quota_frames: u64,
-    pub probe_frames: u64,
-    pub commands: u64,
     pub frames_per_s: f64,
     pub commands_per_s: f64,
-    /// Successful command results by reply variant.
-    pub ok: BTreeMap<String, u64>,
-    /// Failed command results by error kind.
-    pub errors: BTreeMap<String, u64>,
-    /// Whole requests refused, by error kind.
-    pub rejected: BTreeMap<String, u64>,
-    /// Version-neutral replies (frames claiming another layout version).
-    pub version_replies: u64,
     /// Share of fuzzed commands (not quota rounds) that succeeded.
     pub ok_fraction: f64,
-    pub quota_hits: BTreeMap<String, u64>,
-    pub quota_rounds: BTreeMap<String, QuotaOut>,
-    pub ops: BTreeMap<String, OpOut>,
     pub ops_not_sent: Vec<String>,
-    /// Planes that failed inside the daemon (a caught panic) as replies reported them.
-    pub plane_panics: u64,
     /// Panics in the daemon's log, by location and message (automatic ticks included).
     pub daemon_panics: BTreeMap<String, u64>,
-    pub crashes: u64,
-    pub unanswered: u64,
-    pub protocol_errors: u64,
     pub findings: Vec<FindingOut>,
     /// A normal client created a plane, dropped a ball and saw it fall after the run.
     pub served_after: Option<bool>,
@@ -98,6 +64,13 @@ pub struct FuzzReport {
     pub daemon_rss_end_bytes: Option<u64>,
     pub goals: Vec<Goal>,
     pub method: BTreeMap<&'static str, &'static str>,
+}
+
+impl std::ops::Deref for FuzzReport {
+    type Target = FuzzStats;
+    fn deref(&self) -> &FuzzStats {
+        &self.stats
+    }
 }
 
 pub fn run(args: &FuzzArgs) -> BenchResult<()> {
@@ -163,55 +136,19 @@ pub fn run(args: &FuzzArgs) -> BenchResult<()> {
         .collect();
     let seconds = stats.seconds.max(1e-9);
     let mut report = FuzzReport {
-        seed,
-        seconds: stats.seconds,
-        clients: stats.clients,
         daemon_flags: flags,
-        batches: stats.batches,
-        frames: stats.frames,
-        structured_frames: stats.structured_frames,
-        raw_frames: stats.raw_frames,
-        quota_frames: stats.quota_frames,
-        probe_frames: stats.probe_frames,
-        commands: stats.commands,
         frames_per_s: stats.frames as f64 / seconds,
         commands_per_s: stats.commands as f64 / seconds,
-        ok: stats.ok.clone(),
-        errors: stats.errors.clone(),
-        rejected: stats.rejected.clone(),
-        version_replies: stats.version_replies,
         ok_fraction: stats.ok_fraction(),
-        quota_hits: stats.quota_hits.clone(),
-        quota_rounds: stats
-            .quota_rounds
-            .iter()
-            .map(|(k, &QuotaRound { runs, hit })| {
-                (
-                    k.clone(),
-                    QuotaOut {
-                        rounds: runs,
-                        met: hit,
-                    },
-                )
-            })
-            .collect(),
-        ops: stats
-            .ops
-            .iter()
-            .map(|(k, &OpCount { sent, ok })| (k.clone(), OpOut { sent, ok }))
-            .collect(),
         ops_not_sent: stats.ops_not_sent(),
-        plane_panics: stats.plane_panics,
         daemon_panics,
-        crashes: stats.crashes,
-        unanswered: stats.unanswered,
-        protocol_errors: stats.protocol_errors,
         findings,
         served_after,
         daemon_rss_start_bytes: rss_start,
         daemon_rss_end_bytes: rss_end,
         goals: Vec::new(),
         method: markdown::method(),
+        stats: stats.clone(),
     };
     report.goals = goals(&report);
     let md = markdown::render(&report);
@@ -326,9 +263,9 @@ fn goals(r: &FuzzReport) -> Vec<Goal> {
         goals.push(Goal::new(
             format!("quota {flag} refused when exceeded"),
             q.map_or("no round ran".into(), |q| {
-                format!("{} of {} rounds", q.met, q.rounds)
+                format!("{} of {} rounds", q.hit, q.runs)
             }),
-            q.map(|q| q.rounds > 0 && q.met == q.rounds),
+            q.map(|q| q.runs > 0 && q.hit == q.runs),
         ));
     }
     let log_panics: u64 = r.daemon_panics.values().sum();

@@ -12,7 +12,7 @@ use shm_layout::{
 pub const MAX_FINDINGS: usize = 20;
 
 /// Counters of one fuzz run.
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Clone, Default, serde::Serialize)]
 pub struct FuzzStats {
     /// The seed the run was generated from.
     pub seed: u64,
@@ -60,11 +60,12 @@ pub struct FuzzStats {
     /// results for a frame that cannot be decoded.
     pub protocol_errors: u64,
     /// The first failures in full (crashes, unanswered, protocol errors, plane panics).
+    #[serde(skip)]
     pub findings: Vec<Finding>,
 }
 
 /// Commands of one op sent, and how many succeeded.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Serialize)]
 pub struct OpCount {
     /// Commands sent.
     pub sent: u64,
@@ -73,7 +74,7 @@ pub struct OpCount {
 }
 
 /// Rounds of one quota.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Serialize)]
 pub struct QuotaRound {
     /// Rounds run.
     pub runs: u64,
