@@ -11,16 +11,16 @@ pub struct Limits {
     /// Clients (connections) one process may hold at once.
     #[arg(long = "max-clients-per-process", default_value_t = Limits::DEFAULT.clients_per_process)]
     pub clients_per_process: usize,
-    /// Planes one client may own at once.
+    /// Planes one client process may own at once (all its connections together).
     #[arg(long = "max-planes-per-client", default_value_t = Limits::DEFAULT.planes_per_client)]
     pub planes_per_client: usize,
-    /// Objects in the planes one client owns, all planes together.
+    /// Objects in the planes one client process owns, all planes together.
     #[arg(long = "max-objects-per-client", default_value_t = Limits::DEFAULT.objects_per_client)]
     pub objects_per_client: u64,
     /// Vertices of one mesh part.
     #[arg(long = "max-mesh-vertices", default_value_t = Limits::DEFAULT.mesh_vertices_per_object)]
     pub mesh_vertices_per_object: u64,
-    /// Mesh vertices in the planes one client owns, all parts together.
+    /// Mesh vertices in the planes one client process owns, all parts together.
     #[arg(
         long = "max-mesh-vertices-per-client",
         default_value_t = Limits::DEFAULT.mesh_vertices_per_client
