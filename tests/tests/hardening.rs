@@ -70,7 +70,15 @@ fn tiny_tick_rates_are_refused_and_the_daemon_serves_on() {
 
 #[test]
 fn a_panic_inside_one_plane_fails_that_plane_only() {
-    let daemon = TestDaemon::start_with("panic", &[], &[("PHYSICS_FAULT_PANIC_DT", "0.0123")]);
+    // The injected panic prints its message, not a backtrace, to the daemon's stderr.
+    let daemon = TestDaemon::start_with(
+        "panic",
+        &[],
+        &[
+            ("PHYSICS_FAULT_PANIC_DT", "0.0123"),
+            ("RUST_BACKTRACE", "0"),
+        ],
+    );
     let a = daemon.client();
     let b = daemon.client();
     let doomed = a.create_plane(&PlaneOptions::manual()).unwrap();
