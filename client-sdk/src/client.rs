@@ -18,8 +18,13 @@ use crate::{Error, Plane};
 /// How often a waiting client checks that the daemon process is still alive.
 pub(crate) const LIVENESS_PERIOD: Duration = Duration::from_millis(100);
 /// A daemon whose heartbeat (a few beats a second, from a thread of its own) has been
-/// silent this long while a request waits is stalled (stopped or hung), not slow.
+/// silent this long while a request waits, and whose process is stopped (SIGSTOP), is
+/// stalled, not slow.
 pub const STALL_AFTER: Duration = Duration::from_secs(1);
+/// A silent heartbeat this long means a hung daemon even when its process is not stopped
+/// (longer than [`STALL_AFTER`], so a heavily loaded machine that starves the heartbeat
+/// thread for a moment does not fail requests).
+pub const HUNG_AFTER: Duration = Duration::from_secs(3);
 
 /// How to connect.
 #[derive(Debug, Clone)]
@@ -319,7 +324,9 @@ impl Inner {
                     }
                 }
                 let silent = now.duration_since(last_beat);
-                if silent > STALL_AFTER && self.daemon_node != 0 {
+                let stalled = silent > HUNG_AFTER
+                    || (silent > STALL_AFTER && process_stopped(self.daemon_pid));
+                if stalled && self.daemon_node != 0 {
                     return Err(Error::Stalled {
                         domain: self.options.domain.clone(),
                         pid: self.daemon_pid,
@@ -363,6 +370,15 @@ impl Drop for Inner {
             let _ = self.round_trip(vec![Command::Goodbye]);
         }
     }
+}
+
+/// Whether process `pid` is stopped (SIGSTOP, or stopped by a tracer).
+fn process_stopped(pid: u32) -> bool {
+    std::fs::read_to_string(format!("/proc/{pid}/stat")).is_ok_and(|stat| {
+        // The state follows the parenthesised command name.
+        stat.rsplit_once(") ")
+            .is_some_and(|(_, rest)| rest.starts_with('T') || rest.starts_with('t'))
+    })
 }
 
 fn unexpected(reply: Reply) -> Error {

@@ -20,7 +20,7 @@ mod plane;
 mod spawn;
 mod transport;
 
-pub use client::{Client, ConnectOptions, STALL_AFTER};
+pub use client::{Client, ConnectOptions, HUNG_AFTER, STALL_AFTER};
 pub use error::Error;
 pub use object::Object;
 pub use plane::{Plane, PlaneOptions, Snapshot};
