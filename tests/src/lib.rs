@@ -246,3 +246,36 @@ pub fn zero_gravity() -> client_sdk::PlaneOptions {
         ..no_damping()
     }
 }
+
+/// `physics-lua SCRIPT --domain DOMAIN EXTRA…` (SCRIPT relative to the repository root),
+/// with the runner built next to this test's executable by `cargo build --workspace --bins`,
+/// quiet logs, no stdin and piped output.
+pub fn physics_lua(domain: &str, script: &str, extra: &[&str]) -> Command {
+    let exe = std::env::current_exe().expect("test executable");
+    let runner = exe
+        .ancestors()
+        .skip(1)
+        .take(3)
+        .map(|dir| dir.join("physics-lua"))
+        .find(|p| p.is_file())
+        .unwrap_or_else(|| {
+            panic!(
+                "physics-lua not found near {} (run cargo build --workspace --bins first)",
+                exe.display()
+            )
+        });
+    let mut command = Command::new(runner);
+    command
+        .arg(
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+                .join("..")
+                .join(script),
+        )
+        .args(["--domain", domain])
+        .args(extra)
+        .env("PHYSICS_LOG", "warn")
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped());
+    command
+}

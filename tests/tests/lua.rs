@@ -2,30 +2,10 @@
 //! `physics-lua` runner against a real daemon and assert behaviour themselves; these tests
 //! check the runner's exit status and what the scripts printed.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output, Stdio};
+use std::process::Output;
 use std::time::{Duration, Instant};
 
-use integration_tests::{domain_files, unique_domain, TestDaemon};
-
-/// `physics-lua`, built next to this test's executable by `cargo build --workspace --bins`.
-fn runner() -> PathBuf {
-    let exe = std::env::current_exe().expect("test executable");
-    for dir in exe.ancestors().skip(1).take(3) {
-        let candidate = dir.join("physics-lua");
-        if candidate.is_file() {
-            return candidate;
-        }
-    }
-    panic!(
-        "physics-lua not found near {} (run cargo build --workspace --bins first)",
-        exe.display()
-    );
-}
-
-fn repo_path(rel: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join(rel)
-}
+use integration_tests::{domain_files, physics_lua, unique_domain, TestDaemon};
 
 struct Run {
     output: Output,
@@ -58,14 +38,7 @@ impl Run {
 /// Runs `physics-lua script --domain domain extra...`, killing it after `limit`.
 fn run_in(domain: &str, script: &str, extra: &[&str], limit: Duration) -> Run {
     let started = Instant::now();
-    let mut child = Command::new(runner())
-        .arg(repo_path(script))
-        .args(["--domain", domain])
-        .args(extra)
-        .env("PHYSICS_LOG", "warn")
-        .stdin(Stdio::null())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
+    let mut child = physics_lua(domain, script, extra)
         .spawn()
         .expect("spawn physics-lua");
     while child.try_wait().expect("wait physics-lua").is_none() {

@@ -3,29 +3,12 @@
 //! checks how, and how fast, the run ends.
 
 use std::io::{BufRead, BufReader, Read};
-use std::path::{Path, PathBuf};
-use std::process::{Child, Command, ExitStatus, Stdio};
+use std::process::{Child, ExitStatus};
 use std::sync::mpsc::{self, Receiver};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
-use integration_tests::{domain_files, eventually, unique_domain, TestDaemon};
-
-/// `physics-lua`, built next to this test's executable by `cargo build --workspace --bins`.
-fn runner_exe() -> PathBuf {
-    let exe = std::env::current_exe().expect("test executable");
-    exe.ancestors()
-        .skip(1)
-        .take(3)
-        .map(|dir| dir.join("physics-lua"))
-        .find(|p| p.is_file())
-        .unwrap_or_else(|| {
-            panic!(
-                "physics-lua not found near {} (run cargo build --workspace --bins first)",
-                exe.display()
-            )
-        })
-}
+use integration_tests::{domain_files, eventually, physics_lua, unique_domain, TestDaemon};
 
 /// A running `physics-lua`: its stdout lines as they come, stderr collected.
 struct Runner {
@@ -49,17 +32,7 @@ struct Ended {
 
 impl Runner {
     fn start(domain: &str, script: &str, extra: &[&str]) -> Runner {
-        let script = Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("..")
-            .join(script);
-        let mut child = Command::new(runner_exe())
-            .arg(script)
-            .args(["--domain", domain])
-            .args(extra)
-            .env("PHYSICS_LOG", "warn")
-            .stdin(Stdio::null())
-            .stdout(Stdio::piped())
-            .stderr(Stdio::piped())
+        let mut child = physics_lua(domain, script, extra)
             .spawn()
             .expect("spawn physics-lua");
         let (tx, lines) = mpsc::channel();
