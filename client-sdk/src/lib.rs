@@ -31,4 +31,6 @@ pub use shm_layout::{
     ObjectSettings, Pin, PlaneId, PlaneInfo, PlaneKind, PlaneOp, PlaneProp, PlaneSettings, Pose,
     Restraint, RotateTo, Shape, ShapeKind, TickHeader, Vec3,
 };
-pub use spawn::{connect_or_start, daemon_executable, start_daemon, DaemonChild, Session};
+pub use spawn::{
+    connect_or_start, daemon_executable, start_daemon, start_daemon_with, DaemonChild, Session,
+};

@@ -16,6 +16,11 @@ impl DaemonChild {
     pub fn pid(&self) -> u32 {
         self.child.id()
     }
+
+    /// Whether the daemon process still runs.
+    pub fn is_running(&mut self) -> bool {
+        matches!(self.child.try_wait(), Ok(None))
+    }
 }
 
 impl Drop for DaemonChild {
@@ -90,13 +95,24 @@ pub fn connect_or_start(domain: &str) -> Result<Session, Error> {
 /// and no client is left (`--starter-pid`), so a starter killed without cleanup leaves no
 /// daemon behind.
 pub fn start_daemon(domain: &str) -> Result<(DaemonChild, Client), Error> {
+    start_daemon_with(domain, &[], Stdio::inherit())
+}
+
+/// [`start_daemon`] with extra daemon flags (quotas) and where its stderr goes.
+pub fn start_daemon_with(
+    domain: &str,
+    args: &[String],
+    stderr: Stdio,
+) -> Result<(DaemonChild, Client), Error> {
     let exe = daemon_executable();
     let child = Command::new(&exe)
         .arg("--domain")
         .arg(domain)
         .arg("--starter-pid")
         .arg(std::process::id().to_string())
+        .args(args)
         .stdin(Stdio::null())
+        .stderr(stderr)
         .spawn()
         .map_err(|e| Error::NoDaemon {
             domain: domain.to_string(),

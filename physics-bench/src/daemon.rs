@@ -2,17 +2,16 @@
 //! when dropped.
 
 use std::path::Path;
-use std::process::{Child, Command, Stdio};
+use std::process::Stdio;
 use std::sync::atomic::{AtomicU32, Ordering};
-use std::time::{Duration, Instant};
 
-use client_sdk::{Client, Error};
+use client_sdk::{Client, DaemonChild};
 
 use super::error::{BenchError, BenchResult};
 
 pub struct DaemonProcess {
     pub domain: String,
-    child: Option<Child>,
+    child: Option<DaemonChild>,
 }
 
 /// A domain no other run uses (pid + counter), within the 32-character limit.
@@ -37,7 +36,6 @@ impl DaemonProcess {
         log: Option<&Path>,
     ) -> BenchResult<DaemonProcess> {
         let domain = unique_domain(tag);
-        let exe = client_sdk::daemon_executable();
         let stderr = match log {
             Some(path) => Stdio::from(
                 std::fs::OpenOptions::new()
@@ -48,45 +46,20 @@ impl DaemonProcess {
             ),
             None => Stdio::inherit(),
         };
-        let child = Command::new(&exe)
-            .args(["--domain", &domain])
-            .args(["--starter-pid", &std::process::id().to_string()])
-            .args(args)
-            .stdin(Stdio::null())
-            .stderr(stderr)
-            .spawn()
-            .map_err(BenchError::io(format!("start {}", exe.display())))?;
-        let mut daemon = DaemonProcess {
+        let (child, _) = client_sdk::start_daemon_with(&domain, args, stderr)?;
+        Ok(DaemonProcess {
             domain,
             child: Some(child),
-        };
-        let deadline = Instant::now() + Duration::from_secs(10);
-        loop {
-            match Client::connect(&daemon.domain) {
-                Ok(_) => return Ok(daemon),
-                Err(Error::NoDaemon { .. }) if Instant::now() < deadline => {
-                    if !daemon.is_running() {
-                        return Err(BenchError::Failed(format!(
-                            "the daemon of {} exited at start (flags {args:?})",
-                            daemon.domain
-                        )));
-                    }
-                    std::thread::sleep(Duration::from_millis(20));
-                }
-                Err(e) => return Err(e.into()),
-            }
-        }
+        })
     }
 
     pub fn pid(&self) -> u32 {
-        self.child.as_ref().map_or(0, |c| c.id())
+        self.child.as_ref().map_or(0, DaemonChild::pid)
     }
 
     /// Whether the daemon process still runs.
     pub fn is_running(&mut self) -> bool {
-        self.child
-            .as_mut()
-            .is_some_and(|c| matches!(c.try_wait(), Ok(None)))
+        self.child.as_mut().is_some_and(DaemonChild::is_running)
     }
 
     pub fn connect(&self) -> BenchResult<Client> {
@@ -98,16 +71,7 @@ impl Drop for DaemonProcess {
     /// Stops the daemon (SIGINT, SIGKILL after 3 s), then removes whatever is left in the
     /// domain.
     fn drop(&mut self) {
-        if let Some(mut child) = self.child.take() {
-            // SAFETY: kill(2) on our own child's pid.
-            unsafe { libc::kill(child.id() as i32, libc::SIGINT) };
-            let deadline = Instant::now() + Duration::from_secs(3);
-            while Instant::now() < deadline && matches!(child.try_wait(), Ok(None)) {
-                std::thread::sleep(Duration::from_millis(10));
-            }
-            let _ = child.kill();
-            let _ = child.wait();
-        }
+        drop(self.child.take());
         let _ = physics_daemon::cleanup_domain(&self.domain);
     }
 }
