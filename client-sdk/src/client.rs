@@ -248,7 +248,20 @@ impl Client {
     /// Test support: sends raw request bytes and returns the raw reply.
     #[doc(hidden)]
     pub fn raw_request(&self, bytes: &[u8]) -> Result<Vec<u8>, Error> {
-        self.inner.exchange(bytes)
+        self.inner.exchange(bytes, self.inner.transport.id())
+    }
+
+    /// Test support: [`Client::raw_request`] with `claimed` written where older clients put
+    /// their id (the request's user header), as a forging client would.
+    #[doc(hidden)]
+    pub fn raw_request_claiming(&self, bytes: &[u8], claimed: u128) -> Result<Vec<u8>, Error> {
+        self.inner.exchange(bytes, claimed)
+    }
+
+    /// Test support: this client's iceoryx2 node id.
+    #[doc(hidden)]
+    pub fn node_id(&self) -> u128 {
+        self.inner.transport.id()
     }
 
     /// Fails with [`Error::DaemonGone`] when the daemon process no longer exists.
@@ -278,7 +291,7 @@ impl Inner {
         } else {
             codec::encode_request_with_version(&request, self.options.layout_version)
         };
-        let reply = self.exchange(&bytes)?;
+        let reply = self.exchange(&bytes, self.transport.id())?;
         let frame = codec::Frame::parse(&reply).map_err(|e| Error::Protocol(e.to_string()))?;
         if frame.version != self.options.layout_version {
             // The daemon answered in the version-neutral form: its crate version as text.
@@ -304,14 +317,14 @@ impl Inner {
 
     /// Sends raw request bytes and waits for the raw reply, checking the daemon's liveness
     /// while waiting so a dead daemon is an error within a bounded time, not a hang.
-    fn exchange(&self, bytes: &[u8]) -> Result<Vec<u8>, Error> {
+    /// A beat buffered from before the request can delay a stall verdict by one check
+    /// (100 ms) at most, so the request's hot path does not drain the heartbeat first.
+    fn exchange(&self, bytes: &[u8], header: u128) -> Result<Vec<u8>, Error> {
         let started = Instant::now();
         let mut last_check = started;
         let mut last_beat = started;
-        // Beats that arrived before this request say nothing about now.
-        let _ = self.transport.heartbeat_arrived();
         self.transport
-            .exchange(bytes, LIVENESS_PERIOD, |connected| {
+            .exchange(bytes, header, LIVENESS_PERIOD, |connected| {
                 if !connected {
                     self.check_daemon()?;
                 }

@@ -119,6 +119,7 @@ impl Transport {
     pub(crate) fn exchange(
         &self,
         bytes: &[u8],
+        header: u128,
         period: Duration,
         mut check: impl FnMut(bool) -> Result<(), Error>,
     ) -> Result<Vec<u8>, Error> {
@@ -139,10 +140,10 @@ impl Transport {
                     .map_err(|e| Error::ipc("loan request", e))?
             }
         };
-        // The daemon identifies us by the transport's node id; this copy in the user header
-        // only keeps the control service's layout the same for every version (so a
-        // version mismatch still reaches the handshake).
-        *request.user_header_mut() = self.id;
+        // The daemon identifies us by the transport's node id; the user header (our id,
+        // normally) only keeps the control service's layout the same for every version (so
+        // a version mismatch still reaches the handshake).
+        *request.user_header_mut() = header;
         let pending = request
             .write_from_slice(bytes)
             .send()
@@ -160,6 +161,11 @@ impl Transport {
             check(pending.is_connected())?;
             let _ = self.replies.timed_wait(|_| {}, period);
         }
+    }
+
+    /// This client's iceoryx2 node id (what the daemon knows it by).
+    pub(crate) fn id(&self) -> u128 {
+        self.id
     }
 
     /// Whether a heartbeat of the daemon arrived since the last call; `None` when the

@@ -269,17 +269,29 @@ fn a_goodbye_releases_only_the_sender() {
     let victim = daemon.client();
     let plane = victim.create_plane(&PlaneOptions::manual()).unwrap();
     let attacker = daemon.client();
-    // The attacker's Goodbye (whatever it writes in the request's user header) is its own.
+    // The attacker claims the victim's id where clients used to send theirs (the request's
+    // user header); the daemon takes identity from the transport, so the Goodbye is the
+    // attacker's own.
     let bye = Request {
         commands: vec![Cmd::Goodbye],
     };
-    let r = results(attacker.raw_request(&encode_request(&bye)).unwrap());
+    let r = results(
+        attacker
+            .raw_request_claiming(&encode_request(&bye), victim.node_id())
+            .unwrap(),
+    );
     assert!(r[0].is_ok());
     assert!(
         plane.is_alive(),
-        "another client's Goodbye released the victim's plane"
+        "a forged Goodbye released the victim's plane"
     );
     plane.step(1.0 / 60.0).unwrap();
+    // The attacker itself was released: its next command must say Hello first.
+    let info = Request {
+        commands: vec![Cmd::plane(plane.id(), PlaneOp::Info)],
+    };
+    let r = results(attacker.raw_request(&encode_request(&info)).unwrap());
+    assert_eq!(r[0].as_ref().unwrap_err().kind, ErrorKind::NotConnected);
 }
 
 #[test]
