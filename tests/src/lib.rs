@@ -7,7 +7,6 @@ use std::sync::atomic::{AtomicU32, Ordering};
 use std::time::{Duration, Instant};
 
 use client_sdk::{Client, Error};
-use shm_layout::names;
 
 /// A daemon process owned by one test; killed when dropped.
 pub struct TestDaemon {
@@ -142,23 +141,7 @@ impl Drop for TestDaemon {
 
 /// Every file of `domain` under /dev/shm and the iceoryx2 root (sockets, node records).
 pub fn domain_files(domain: &str) -> Vec<PathBuf> {
-    let prefix = names::prefix(domain);
-    let mut found = Vec::new();
-    let mut dirs = vec![PathBuf::from("/dev/shm"), PathBuf::from(names::root_path())];
-    while let Some(dir) = dirs.pop() {
-        let Ok(entries) = std::fs::read_dir(&dir) else {
-            continue;
-        };
-        for entry in entries.flatten() {
-            let path = entry.path();
-            if path.is_dir() {
-                dirs.push(path);
-            } else if entry.file_name().to_string_lossy().starts_with(&prefix) {
-                found.push(path);
-            }
-        }
-    }
-    found
+    physics_daemon::server::files::domain_files(domain)
 }
 
 /// Polls `f` until it returns `Some` or `timeout` passes.

@@ -62,23 +62,20 @@ pub fn restrict(domain: &str) {
     }
 }
 
-/// Files of `domain` in /dev/shm and in the root directory (one level of subdirectories).
-fn domain_files(domain: &str) -> Vec<PathBuf> {
+/// Every file of `domain` under /dev/shm and the per-user root directory (sockets, node
+/// records, service descriptions), at any depth.
+pub fn domain_files(domain: &str) -> Vec<PathBuf> {
     let prefix = names::prefix(domain);
     let mut found = Vec::new();
-    let mut dirs = vec![
-        (PathBuf::from("/dev/shm"), 0),
-        (PathBuf::from(names::root_path()), 0),
-    ];
-    while let Some((dir, depth)) = dirs.pop() {
+    let mut dirs = vec![PathBuf::from("/dev/shm"), PathBuf::from(names::root_path())];
+    while let Some(dir) = dirs.pop() {
         let Ok(entries) = std::fs::read_dir(&dir) else {
             continue;
         };
         for entry in entries.flatten() {
             let path = entry.path();
-            let is_dir = entry.file_type().is_ok_and(|t| t.is_dir());
-            if is_dir && depth < 1 {
-                dirs.push((path, depth + 1));
+            if entry.file_type().is_ok_and(|t| t.is_dir()) {
+                dirs.push(path);
             } else if entry.file_name().to_string_lossy().starts_with(&prefix) {
                 found.push(path);
             }
