@@ -7,8 +7,8 @@ use std::time::{Duration, Instant};
 
 use shm_layout::codec;
 use shm_layout::{
-    Command, CommandError, CommandResult, ErrorKind, Handle, PlaneId, PlaneOp, Reply, Request,
-    Response, CRATE_VERSION, LAYOUT_VERSION,
+    CollisionGroups, Command, CommandError, CommandResult, ErrorKind, Handle, PlaneId, PlaneOp,
+    Reply, Request, Response, CRATE_VERSION, LAYOUT_VERSION,
 };
 
 use crate::plane::{PlaneOptions, PlaneShared};
@@ -65,6 +65,10 @@ struct State {
     /// Failures of queued commands sent along with another call, reported by `flush`.
     deferred: Vec<CommandError>,
     planes: HashMap<PlaneId, Rc<PlaneShared>>,
+    /// Planes this client created (they take its collision-group table).
+    owned: Vec<PlaneId>,
+    /// The collision-group table of this client (`collision_groups.rs`).
+    groups: CollisionGroups,
     gone: bool,
 }
 
@@ -139,13 +143,23 @@ impl Client {
 
     /// Creates a plane owned by this client (released when the client goes away).
     pub fn create_plane(&self, options: &PlaneOptions) -> Result<Plane, Error> {
-        match self.call(Command::CreatePlane {
+        let id = match self.call(Command::CreatePlane {
             kind: options.kind.unwrap_or_default(),
             props: options.props(),
         })? {
-            Reply::Plane(info) => self.attach_plane(info.id),
-            other => Err(unexpected(other)),
+            Reply::Plane(info) => info.id,
+            other => return Err(unexpected(other)),
+        };
+        let plane = self.attach_plane(id)?;
+        let table = {
+            let mut state = self.inner.state.borrow_mut();
+            state.owned.push(id);
+            state.groups.clone()
+        };
+        if table != CollisionGroups::default() {
+            self.queue(Command::plane(id, PlaneOp::CollisionGroups(table)), None);
         }
+        Ok(plane)
     }
 
     /// Opens an existing plane (created by any client) for reading and writing. Returns once
@@ -270,7 +284,38 @@ impl Client {
     }
 
     pub(crate) fn forget_plane(&self, id: PlaneId) {
-        self.inner.state.borrow_mut().planes.remove(&id);
+        let mut state = self.inner.state.borrow_mut();
+        state.owned.retain(|p| *p != id);
+        state.planes.remove(&id);
+    }
+
+    /// Reads the collision-group table.
+    pub(crate) fn groups<R>(&self, f: impl FnOnce(&CollisionGroups) -> R) -> R {
+        f(&self.inner.state.borrow().groups)
+    }
+
+    /// Changes the collision-group table through `f`; when it changed, every plane this
+    /// client created gets the new table with the next request.
+    pub(crate) fn change_groups<R>(
+        &self,
+        f: impl FnOnce(&mut CollisionGroups) -> Result<R, CommandError>,
+    ) -> Result<R, Error> {
+        let (result, table, owned) = {
+            let mut state = self.inner.state.borrow_mut();
+            let before = state.groups.clone();
+            let result = f(&mut state.groups).map_err(Error::invalid_value)?;
+            if state.groups == before {
+                return Ok(result);
+            }
+            (result, state.groups.clone(), state.owned.clone())
+        };
+        for id in owned {
+            self.queue(
+                Command::plane(id, PlaneOp::CollisionGroups(table.clone())),
+                None,
+            );
+        }
+        Ok(result)
     }
 
     /// The ports of this client (planes open their subscribers through it).

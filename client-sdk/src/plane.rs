@@ -5,13 +5,14 @@ use std::rc::Rc;
 use std::time::{Duration, Instant};
 
 use shm_layout::{
-    BodyState, Command, EventRecord, Handle, ObjectProp, PlaneId, PlaneInfo, PlaneKind, PlaneOp,
-    PlaneProp, Pose, Reply, Shape, TickHeader, Vec3,
+    BodyState, Command, Handle, ObjectProp, PlaneId, PlaneInfo, PlaneKind, PlaneOp, PlaneProp,
+    Pose, Reply, Shape, TickHeader, Vec3,
 };
 
 use crate::client::LIVENESS_PERIOD;
+use crate::events::EventReader;
 use crate::overlay::{Entry, Overlay};
-use crate::transport::{BodySample, BodySubscriber, EventSubscriber, TickListener, Transport};
+use crate::transport::{BodySample, BodySubscriber, TickListener, Transport};
 use crate::{Client, Error, Object};
 
 /// Options of a new plane; `None` keeps the daemon's default.
@@ -90,7 +91,7 @@ pub(crate) struct PlaneShared {
     overlay: RefCell<Overlay>,
     /// Created on the first wait: readers that never wait pay nothing for it.
     ticks: RefCell<Option<TickListener>>,
-    events: RefCell<Option<EventSubscriber>>,
+    pub(crate) events: RefCell<Option<EventReader>>,
     alive: Cell<bool>,
 }
 
@@ -363,22 +364,6 @@ impl Plane {
         let listener = self.client.transport().plane_ticks(self.id())?;
         *self.shared.ticks.borrow_mut() = Some(listener);
         Ok(())
-    }
-
-    /// Events (contact started / stopped) published since the last call. The first call
-    /// subscribes; events before it are not seen.
-    pub fn events(&self) -> Result<Vec<EventRecord>, Error> {
-        if self.shared.events.borrow().is_none() {
-            let sub = self.client.transport().plane_events(self.id())?;
-            *self.shared.events.borrow_mut() = Some(sub);
-        }
-        let mut out = Vec::new();
-        if let Some(sub) = self.shared.events.borrow().as_ref() {
-            while let Some(sample) = sub.receive().map_err(|e| Error::ipc("receive events", e))? {
-                out.extend_from_slice(sample.payload());
-            }
-        }
-        Ok(out)
     }
 
     /// Destroys the plane and everything in it. Objects keep reading their last pose.

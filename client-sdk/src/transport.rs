@@ -231,6 +231,7 @@ impl Transport {
             .open()
             .map_err(|e| Error::ipc("open event service", e))?
             .subscriber_builder()
+            .buffer_size(crate::events::EVENT_BUFFER_TICKS)
             .create()
             .map_err(|e| Error::ipc("create event subscriber", e))
     }

@@ -10,6 +10,7 @@ use serde::{Deserialize, Serialize};
 use crate::error::CommandError;
 use crate::object_op::ObjectOp;
 use crate::plane_op::{PlaneKind, PlaneOp};
+use crate::query::Hit;
 use crate::records::Handle;
 use crate::settings::{ObjectSettings, PlaneProp, PlaneSettings};
 use crate::shape::ShapeKind;
@@ -191,6 +192,10 @@ pub enum Reply {
     ObjectInfo(Box<ObjectInfo>),
     /// The centre of mass in effect, body-local.
     CenterOfMass(Vec3),
+    /// One optional hit per ray or sweep of a query, in order.
+    Hits(Vec<Option<Hit>>),
+    /// The objects an overlap query found.
+    Objects(Vec<Handle>),
 }
 
 /// The result of one command.

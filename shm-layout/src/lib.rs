@@ -5,6 +5,8 @@
 //!   [`Command`] → [`PlaneOp`] ([`plane_op`]) → [`ObjectOp`] ([`object_op`]).
 //! - [`settings`]: every plane option and object property with its default and its check,
 //!   defined once for the SDK and the daemon.
+//! - [`query`]: scene queries (rays, sweeps, overlaps); [`collision_groups`]: named groups
+//!   and which pairs collide.
 //! - [`shape`]: collision shapes; [`error`]: command errors that name their field.
 //! - [`codec`]: framing of those enums into bytes (version header + postcard body).
 //! - [`names`]: domain validation and the iceoryx2 service names of one deployment.
@@ -15,21 +17,25 @@
 #![warn(missing_docs)]
 
 pub mod codec;
+pub mod collision_groups;
 pub mod command;
 pub mod error;
 pub mod names;
 pub mod object_op;
 pub mod plane_op;
+pub mod query;
 pub mod records;
 pub mod settings;
 pub mod shape;
 pub mod validate;
 
 pub use codec::{DecodeError, Frame};
+pub use collision_groups::CollisionGroups;
 pub use command::*;
 pub use error::{CommandError, ErrorKind};
 pub use object_op::ObjectOp;
 pub use plane_op::{OpCost, PlaneKind, PlaneOp};
+pub use query::{FilterType, Hit, QueryFilter, QueryOp, Ray};
 pub use records::*;
 pub use settings::{
     ObjectProp, ObjectSettings, Pin, PlaneProp, PlaneSettings, Restraint, RotateTo,
@@ -38,7 +44,7 @@ pub use shape::{Shape, ShapeKind};
 
 /// Bumped whenever a record layout or the command encoding changes. Client and daemon must
 /// agree on it; the handshake reports both values when they differ.
-pub const LAYOUT_VERSION: u32 = 3;
+pub const LAYOUT_VERSION: u32 = 4;
 
 /// The crate version both sides were built from; also checked by the handshake.
 pub const CRATE_VERSION: &str = env!("CARGO_PKG_VERSION");

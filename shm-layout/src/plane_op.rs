@@ -4,7 +4,9 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::collision_groups::CollisionGroups;
 use crate::object_op::ObjectOp;
+use crate::query::QueryOp;
 use crate::records::Handle;
 use crate::settings::{ObjectProp, PlaneProp};
 use crate::shape::Shape;
@@ -48,6 +50,11 @@ pub enum PlaneOp {
         /// What to do to it.
         op: ObjectOp,
     },
+    /// A scene query on the latest tick (objects added or moved since are included).
+    Query(QueryOp),
+    /// Replaces the plane's collision-group table; objects in a group no longer registered
+    /// return to "Default".
+    CollisionGroups(CollisionGroups),
 }
 
 /// What an op may add to a plane, for the daemon's per-client quotas.
@@ -65,6 +72,7 @@ impl PlaneOp {
         matches!(
             self,
             PlaneOp::Info
+                | PlaneOp::Query(_)
                 | PlaneOp::Object {
                     op: ObjectOp::Info,
                     ..

@@ -109,7 +109,12 @@ pub const EVENT_CONTACT_STARTED: u32 = 1;
 /// Event kind: two objects stopped touching.
 pub const EVENT_CONTACT_STOPPED: u32 = 2;
 
-/// One per-tick event (published in the plane's event service).
+/// One per-tick event (published in the plane's event service, one sample per tick that
+/// has events). 64 bytes.
+///
+/// For contact events `a` and `b` are the two objects, `normal` points from `a` toward `b`,
+/// `position` is the world-space contact point and `impulse` the total normal impulse the
+/// solver applied in the tick the contact started (all zero for `EVENT_CONTACT_STOPPED`).
 #[derive(Debug, Clone, Copy, PartialEq, Default, ZeroCopySend)]
 #[type_name("physics::EventRecord")]
 #[repr(C)]
@@ -124,10 +129,17 @@ pub struct EventRecord {
     pub b_slot: u32,
     /// Generation of the second object.
     pub b_generation: u32,
-    /// Padding; always 0.
-    pub _reserved: u32,
+    /// Normal impulse magnitude (mass × velocity units).
+    pub impulse: f32,
+    /// World-space contact point.
+    pub position: [f32; 3],
+    /// Unit contact normal, from `a` toward `b`.
+    pub normal: [f32; 3],
     /// The tick in which the event happened.
     pub tick: u64,
+    /// The plane's running event number (0 for its first event): a reader that sees a gap
+    /// knows exactly how many events it lost.
+    pub seq: u64,
 }
 
 impl EventRecord {
@@ -165,7 +177,7 @@ mod tests {
     #[test]
     fn record_sizes_are_fixed() {
         assert_eq!(core::mem::size_of::<BodyState>(), 64);
-        assert_eq!(core::mem::size_of::<EventRecord>(), 32);
+        assert_eq!(core::mem::size_of::<EventRecord>(), 64);
         assert_eq!(core::mem::size_of::<TickHeader>(), 64);
     }
 

@@ -22,6 +22,8 @@ use changes::Changes;
 
 /// Subscribers (client ports) one plane accepts.
 pub const MAX_READERS: usize = 64;
+/// Ticks with events a reader's event queue holds (the SDK subscribes with the same size).
+pub const EVENT_BUFFER_TICKS: usize = 64;
 /// Nodes (processes) that may open one plane's services.
 pub const MAX_NODES: usize = 128;
 
@@ -64,8 +66,10 @@ impl PlaneOutput {
             .service_builder(&names::plane_events(plane))
             .publish_subscribe::<[EventRecord]>()
             .user_header::<TickHeader>()
+            // A reader's queue holds this many ticks' events; past it the oldest go, and the
+            // reader counts them from the gap in the records' running numbers.
             .enable_safe_overflow(true)
-            .subscriber_max_buffer_size(16)
+            .subscriber_max_buffer_size(EVENT_BUFFER_TICKS)
             .max_publishers(1)
             .max_subscribers(MAX_READERS)
             .max_nodes(MAX_NODES)

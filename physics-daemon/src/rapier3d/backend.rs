@@ -37,6 +37,10 @@ impl Backend for Plane {
                 ObjectOp::Wake => self.wake(handle).map(|_| applied(self)),
                 ObjectOp::Destroy => self.destroy_object(handle).map(|_| applied(self)),
             },
+            PlaneOp::Query(query) => self.query(query),
+            PlaneOp::CollisionGroups(table) => {
+                self.set_collision_groups(table).map(|_| Reply::Done)
+            }
             PlaneOp::Step { .. } | PlaneOp::Destroy => Err(CommandError::new(
                 ErrorKind::Internal,
                 format!("{op:?} is handled by the server, not the plane"),

@@ -54,29 +54,54 @@ impl Plane {
         (deepest, pairs)
     }
 
+    /// Turns the step's collision events into records: both objects, and for a start the
+    /// contact point, the normal (from `a` toward `b`) and the normal impulse of the step.
     pub(super) fn collect_events(&mut self) {
         self.events.clear();
         while let Ok(event) = self.collision_rx.try_recv() {
-            let kind = if event.started() {
-                EVENT_CONTACT_STARTED
-            } else {
-                EVENT_CONTACT_STOPPED
+            let (c1, c2) = (event.collider1(), event.collider2());
+            let (Some(a), Some(b)) = (self.handle_of_collider(c1), self.handle_of_collider(c2))
+            else {
+                continue; // a collider of neither a live nor a just-removed object
             };
-            let (Some(a), Some(b)) = (
-                self.handle_of_collider(event.collider1()),
-                self.handle_of_collider(event.collider2()),
-            ) else {
-                continue; // one side was removed in the same step
-            };
-            self.events.push(EventRecord {
-                kind,
+            let mut record = EventRecord {
+                kind: EVENT_CONTACT_STOPPED,
                 a_slot: a.slot,
                 a_generation: a.generation,
                 b_slot: b.slot,
                 b_generation: b.generation,
-                _reserved: 0,
                 tick: self.tick,
-            });
+                seq: self.event_seq,
+                ..EventRecord::default()
+            };
+            if event.started() {
+                record.kind = EVENT_CONTACT_STARTED;
+                if let Some((position, normal, impulse)) = self.contact_geometry(c1, c2) {
+                    record.position = position.into();
+                    record.normal = normal.into();
+                    record.impulse = impulse;
+                }
+            }
+            self.event_seq += 1;
+            self.events.push(record);
         }
+    }
+
+    /// The deepest contact point of the pair (world space), its normal from `c1` toward
+    /// `c2`, and the total normal impulse of the pair.
+    fn contact_geometry(
+        &self,
+        c1: ColliderHandle,
+        c2: ColliderHandle,
+    ) -> Option<(Vector, Vector, f32)> {
+        let pair = self.world.narrow_phase.contact_pair(c1, c2)?;
+        let (manifold, contact) = pair.find_deepest_contact()?;
+        let first = self.world.colliders.get(pair.collider1)?;
+        let position = first.position().transform_point(contact.local_p1);
+        let normal = match pair.collider1 == c1 {
+            true => manifold.data.normal,
+            false => -manifold.data.normal,
+        };
+        Some((position, normal, pair.total_impulse_magnitude()))
     }
 }

@@ -5,13 +5,16 @@
 //! - `backend`: the [`Backend`](crate::backend::Backend) implementation (op routing).
 //! - `objects`, `properties`, `part`: objects, their properties and their rapier mapping.
 //! - `forces`, `solver`, `contacts`: the per-tick force pass, solver tuning, contacts.
+//! - `queries`, `collision_groups`: scene queries and the plane's collision-group table.
 
 mod backend;
+mod collision_groups;
 mod contacts;
 mod forces;
 mod objects;
 mod part;
 mod properties;
+mod queries;
 mod solver;
 
 use std::sync::mpsc;
@@ -21,8 +24,8 @@ use std::time::Instant;
 use rapier3d::prelude::*;
 use shm_layout::validate::{self, MAX_DT, MAX_HIT_BOX_QUALITY};
 use shm_layout::{
-    BodyState, CommandError, EventRecord, PlaneId, PlaneInfo, PlaneKind, PlaneProp, PlaneSettings,
-    TickHeader, FLAG_ALIVE, FLAG_ANCHORED, FLAG_SLEEPING, LAYOUT_VERSION,
+    BodyState, CollisionGroups, CommandError, EventRecord, PlaneId, PlaneInfo, PlaneKind,
+    PlaneProp, PlaneSettings, TickHeader, FLAG_ALIVE, FLAG_ANCHORED, FLAG_SLEEPING, LAYOUT_VERSION,
 };
 
 use crate::backend::{Dirty, SlotTable};
@@ -69,6 +72,16 @@ pub struct Plane {
     force_tx: mpsc::Sender<ContactForceEvent>,
     tear_tx: mpsc::Sender<SoftBodyTearEvent>,
     events: Vec<EventRecord>,
+    /// Running number of the next event (EventRecord::seq).
+    event_seq: u64,
+    /// Colliders removed since the last step with the object they belonged to, so their
+    /// contact-stopped events still name it.
+    removed: Vec<(ColliderHandle, shm_layout::Handle)>,
+    /// The collision-group table objects' CollisionGroup indexes into.
+    groups: CollisionGroups,
+    /// An op added, moved, resized or removed something since collision detection last ran:
+    /// a query first refreshes the broad phase so it sees the change.
+    scene_changed: bool,
 }
 
 impl Plane {
@@ -103,6 +116,10 @@ impl Plane {
             force_tx,
             tear_tx,
             events: Vec::new(),
+            event_seq: 0,
+            removed: Vec::new(),
+            groups: CollisionGroups::default(),
+            scene_changed: false,
         };
         for prop in props {
             plane.apply_prop(*prop, true)?;
@@ -216,12 +233,14 @@ impl Plane {
         } else {
             self.world.step_with_events(&hooks, &());
         }
+        self.scene_changed = false;
         self.dirty.stepped(self.bodies.slot_count());
         self.tick += 1;
         self.sim_time += dt as f64;
         self.last_dt = dt;
         (self.max_penetration, self.contact_pairs) = self.contact_figures();
         self.collect_events();
+        self.removed.clear();
         self.last_step_us = started.elapsed().as_secs_f32() * 1e6;
         Ok(true)
     }

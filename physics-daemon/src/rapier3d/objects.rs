@@ -31,7 +31,7 @@ impl Plane {
             .collect::<Result<Vec<_>, _>>()?;
         let part = Part::new(shape);
         let mut collider = ColliderBuilder::new(part.collider_shape()?).build();
-        part.configure_collider(&mut collider)?;
+        part.configure_collider(&mut collider, &self.groups)?;
         let slot = self.bodies.next_slot().ok_or_else(|| {
             CommandError::new(
                 ErrorKind::Internal,
@@ -53,6 +53,7 @@ impl Plane {
         let handle = self.bodies.insert(Body { handle: h, part })?;
         debug_assert_eq!(handle.slot, slot);
         self.dirty.mark(handle.slot);
+        self.scene_changed = true;
         for prop in props {
             self.set_object(handle, prop)?;
         }
@@ -74,8 +75,14 @@ impl Plane {
     }
 
     pub(super) fn handle_of_collider(&self, collider: ColliderHandle) -> Option<Handle> {
-        let body = self.world.colliders.get(collider)?.parent()?;
-        let slot = self.world.bodies.get(body)?.user_data as usize;
+        let Some(c) = self.world.colliders.get(collider) else {
+            return self
+                .removed
+                .iter()
+                .find(|(c, _)| *c == collider)
+                .map(|(_, h)| *h);
+        };
+        let slot = self.world.bodies.get(c.parent()?)?.user_data as usize;
         self.bodies.handle_at(slot)
     }
 
@@ -108,8 +115,13 @@ impl Plane {
         if part.is_driven() {
             self.driven -= 1;
         }
+        // Its contact-stopped events come at the next step, after the slot is gone.
+        for c in self.world.bodies[h].colliders() {
+            self.removed.push((*c, handle));
+        }
         self.world.remove_body(h);
         self.dirty.mark(handle.slot);
+        self.scene_changed = true;
         Ok(())
     }
 

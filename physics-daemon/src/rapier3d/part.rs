@@ -2,7 +2,7 @@
 //! into rapier's collider shape, material, mass properties and locked axes.
 
 use rapier3d::prelude::*;
-use shm_layout::{CommandError, ObjectSettings, Shape, ShapeKind, Vec3};
+use shm_layout::{CollisionGroups, CommandError, ObjectSettings, Shape, ShapeKind, Vec3};
 
 /// Contact skin of one collider at HitBoxQuality 1 (a pair of them keeps 0.02 apart); it
 /// shrinks as 1 / quality.
@@ -151,8 +151,26 @@ impl Part {
         }
     }
 
-    /// Writes shape, material and mass properties into `collider`.
-    pub fn configure_collider(&self, collider: &mut Collider) -> Result<(), CommandError> {
+    /// Which colliders this part's collider meets: none without CanCollide, else those whose
+    /// collision group collides with its group in `groups`.
+    pub fn interaction_groups(&self, groups: &CollisionGroups) -> InteractionGroups {
+        if !self.can_collide {
+            return InteractionGroups::none();
+        }
+        let g = self.collision_group;
+        InteractionGroups::new(
+            Group::from_bits_retain(1 << g),
+            Group::from_bits_retain(groups.mask(g)),
+            InteractionTestMode::And,
+        )
+    }
+
+    /// Writes shape, material, collision groups and mass properties into `collider`.
+    pub fn configure_collider(
+        &self,
+        collider: &mut Collider,
+        groups: &CollisionGroups,
+    ) -> Result<(), CommandError> {
         collider.set_shape(self.collider_shape()?);
         // Rapier has no geometric-mean rule: storing sqrt(μ) and multiplying gives sqrt(a·b).
         collider.set_friction(self.friction.sqrt());
@@ -160,11 +178,7 @@ impl Part {
         collider.set_restitution(self.bounciness);
         collider.set_restitution_combine_rule(CoefficientCombineRule::Max);
         collider.set_contact_skin(BASE_CONTACT_SKIN / self.hit_box_quality as f32);
-        collider.set_collision_groups(if self.can_collide {
-            InteractionGroups::all()
-        } else {
-            InteractionGroups::none()
-        });
+        collider.set_collision_groups(self.interaction_groups(groups));
         // The rest-threshold hook only matters where something can bounce.
         collider.set_active_hooks(if self.bounciness > 0.0 {
             ActiveHooks::MODIFY_SOLVER_CONTACTS

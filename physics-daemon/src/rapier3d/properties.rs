@@ -11,6 +11,17 @@ impl Plane {
     /// Sets one property of an object (checked first; errors name the property and value).
     pub fn set_object(&mut self, handle: Handle, prop: ObjectProp) -> Result<(), CommandError> {
         let prop = prop.checked()?;
+        if let ObjectProp::CollisionGroup(g) = prop {
+            if !self.groups.is_registered(g) {
+                return Err(CommandError::invalid_field(
+                    "CollisionGroup",
+                    format!(
+                        "CollisionGroup {g} is not a registered group of plane {}",
+                        self.id
+                    ),
+                ));
+            }
+        }
         let h = self.body_of(handle)?;
         let part = &mut self.bodies.get_mut(handle)?.part;
         let was_driven = part.is_driven();
@@ -54,7 +65,8 @@ impl Plane {
             | ObjectProp::Density(_)
             | ObjectProp::Bounciness(_)
             | ObjectProp::Friction(_)
-            | ObjectProp::CanCollide(_) => collider_changed = true,
+            | ObjectProp::CanCollide(_)
+            | ObjectProp::CollisionGroup(_) => collider_changed = true,
             ObjectProp::HitBoxQuality(_) | ObjectProp::CenterOfMass(_) => {
                 collider_changed = true;
                 body_changed = true;
@@ -76,14 +88,15 @@ impl Plane {
             // shape changed: a fresh collider gets fresh contacts.
             for c in self.world.bodies[h].colliders().to_vec() {
                 self.world.remove_collider(c);
+                self.removed.push((c, handle));
             }
             let mut collider = ColliderBuilder::new(part.collider_shape()?).build();
-            part.configure_collider(&mut collider)?;
+            part.configure_collider(&mut collider, &self.groups)?;
             self.world.insert_collider(collider, Some(h));
             body_changed = true;
         } else if collider_changed {
             for c in self.world.bodies[h].colliders().to_vec() {
-                part.configure_collider(&mut self.world.colliders[c])?;
+                part.configure_collider(&mut self.world.colliders[c], &self.groups)?;
             }
             body_changed = true;
         }
@@ -104,6 +117,7 @@ impl Plane {
             (true, false) => self.reporting -= 1,
             _ => {}
         }
+        self.scene_changed = true;
         // Any change may need the body awake and seen by the next force pass.
         self.world.bodies[h].wake_up(true);
         self.dirty.mark(handle.slot);

@@ -2,6 +2,7 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::collision_groups::MAX_COLLISION_GROUPS;
 use crate::validate::{
     bounded3, clamped, finite3, in_range, non_negative, pose, positive, rotation, size,
     MAX_HIT_BOX_QUALITY, MAX_SIZE, MIN_MASS,
@@ -101,6 +102,8 @@ pub enum ObjectProp {
     RotateTo(Option<RotateTo>),
     /// `None` releases the pin.
     Pin(Option<Pin>),
+    /// The object's collision group: an index into the plane's collision-group table.
+    CollisionGroup(u8),
 }
 
 /// The stored (not per-tick) properties of an object. [`Default`] holds the documented
@@ -133,6 +136,8 @@ pub struct ObjectSettings {
     pub rotate_to: Option<RotateTo>,
     /// `SetPin`, default none.
     pub pin: Option<Pin>,
+    /// `CollisionGroup` index, default 0 ("Default").
+    pub collision_group: u8,
 }
 
 impl Default for ObjectSettings {
@@ -151,6 +156,7 @@ impl Default for ObjectSettings {
             locks: [false; 6],
             rotate_to: None,
             pin: None,
+            collision_group: 0,
         }
     }
 }
@@ -179,6 +185,7 @@ impl ObjectSettings {
             }
             ObjectProp::RotateTo(r) => self.rotate_to = r,
             ObjectProp::Pin(p) => self.pin = p,
+            ObjectProp::CollisionGroup(g) => self.collision_group = g,
             ObjectProp::Pose(_)
             | ObjectProp::Velocity(_)
             | ObjectProp::AngularVelocity(_)
@@ -231,6 +238,15 @@ impl ObjectProp {
             Bounciness(e) => Bounciness(clamped("Bounciness", e, 0.0, 1.0)?),
             Friction(mu) => Friction(in_range("Friction", mu, 0.0, 1.0)?),
             HitBoxQuality(q) => HitBoxQuality(q.clamp(1, MAX_HIT_BOX_QUALITY)),
+            CollisionGroup(g) if g as usize >= MAX_COLLISION_GROUPS => {
+                return Err(CommandError::invalid_field(
+                    "CollisionGroup",
+                    format!(
+                        "CollisionGroup must be a group index below {MAX_COLLISION_GROUPS}, \
+                         got {g}"
+                    ),
+                ))
+            }
             Size(v) => Size(size("Size", v)?),
             CenterOfMass(c) => CenterOfMass(bounded3("CenterOfMass", c, MAX_SIZE)?),
             ImpulseDirection(a) => ImpulseDirection(finite3("ImpulseDirection", a)?),

@@ -1,0 +1,137 @@
+//! Per-tick events of a plane (contact started / stopped), read from shared memory in tick
+//! order. The daemon numbers every event; a reader that fell more than
+//! [`EVENT_BUFFER_TICKS`] ticks with events behind loses the oldest and is told how many.
+
+use std::cell::Cell;
+
+use shm_layout::{EventRecord, Handle, Vec3, EVENT_CONTACT_STARTED, EVENT_CONTACT_STOPPED};
+
+use crate::transport::EventSubscriber;
+use crate::{Error, Plane};
+
+/// How many ticks' worth of event samples a reader's queue holds (one sample per tick that
+/// had events); past it the oldest are dropped and reported as lost.
+pub const EVENT_BUFFER_TICKS: usize = 64;
+
+/// What `Plane::events` returns: the events since the last call, in order, and how many
+/// events were lost before them because the reader fell behind.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Events {
+    /// The events, in tick order.
+    pub records: Vec<EventRecord>,
+    /// Events dropped before `records` because the queue overflowed (0 normally).
+    pub lost: u64,
+}
+
+/// A contact event as the API names it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Contact {
+    /// `a` and `b` started touching.
+    Started {
+        /// One object.
+        a: Handle,
+        /// The other.
+        b: Handle,
+        /// World-space contact point.
+        position: Vec3,
+        /// Unit normal from `a` toward `b`.
+        normal: Vec3,
+        /// Normal impulse of the tick the contact started.
+        impulse: f32,
+        /// The tick.
+        tick: u64,
+    },
+    /// `a` and `b` stopped touching (or one of them was removed).
+    Ended {
+        /// One object.
+        a: Handle,
+        /// The other.
+        b: Handle,
+        /// The tick.
+        tick: u64,
+    },
+}
+
+impl Contact {
+    /// The contact event a record carries, if it is one.
+    pub fn from_record(r: &EventRecord) -> Option<Contact> {
+        match r.kind {
+            EVENT_CONTACT_STARTED => Some(Contact::Started {
+                a: r.a(),
+                b: r.b(),
+                position: r.position,
+                normal: r.normal,
+                impulse: r.impulse,
+                tick: r.tick,
+            }),
+            EVENT_CONTACT_STOPPED => Some(Contact::Ended {
+                a: r.a(),
+                b: r.b(),
+                tick: r.tick,
+            }),
+            _ => None,
+        }
+    }
+}
+
+/// A subscription to a plane's events and the number of the next event it expects.
+pub(crate) struct EventReader {
+    subscriber: EventSubscriber,
+    next_seq: Cell<Option<u64>>,
+}
+
+impl EventReader {
+    pub(crate) fn new(subscriber: EventSubscriber) -> EventReader {
+        EventReader {
+            subscriber,
+            next_seq: Cell::new(None),
+        }
+    }
+
+    /// Drains the queue into `out`, counting the events missing between samples.
+    fn drain(&self, out: &mut Events) -> Result<(), Error> {
+        while let Some(sample) = self
+            .subscriber
+            .receive()
+            .map_err(|e| Error::ipc("receive events", e))?
+        {
+            let records = sample.payload();
+            let Some(first) = records.first() else {
+                continue;
+            };
+            if let Some(expected) = self.next_seq.get() {
+                out.lost += first.seq.saturating_sub(expected);
+            }
+            if let Some(last) = records.last() {
+                self.next_seq.set(Some(last.seq + 1));
+            }
+            out.records.extend_from_slice(records);
+        }
+        Ok(())
+    }
+}
+
+impl Plane {
+    /// Subscribes to the plane's events now (the first [`Plane::events`] call does it too):
+    /// events of later ticks are kept for the next `events` call.
+    pub fn subscribe_events(&self) -> Result<(), Error> {
+        let mut slot = self.shared.events.borrow_mut();
+        if slot.is_none() {
+            let sub = self.client().transport().plane_events(self.id())?;
+            *slot = Some(EventReader::new(sub));
+        }
+        Ok(())
+    }
+
+    /// Events (contact started / stopped) published since the last call, in tick order, with
+    /// the count of events lost if this reader fell more than [`EVENT_BUFFER_TICKS`] ticks
+    /// behind. The first call subscribes; events before it are not seen.
+    pub fn events(&self) -> Result<Events, Error> {
+        self.subscribe_events()?;
+        let mut out = Events::default();
+        if let Some(reader) = self.shared.events.borrow().as_ref() {
+            reader.drain(&mut out)?;
+        }
+        Ok(out)
+    }
+}

@@ -1,0 +1,271 @@
+//! Scene queries: rays, swept shapes and overlap tests against a plane's latest tick, with
+//! Roblox's `RaycastParams` / `OverlapParams` filter. One op answers many rays
+//! ([`QueryOp::Raycast`] takes a batch), so hitscan for a whole server is one round trip.
+
+use serde::{Deserialize, Serialize};
+
+use crate::records::Handle;
+use crate::validate::{bounded3, extent, pose, size, MAX_COORDINATE};
+use crate::{CommandError, Pose, Vec3};
+
+/// Most rays one [`QueryOp::Raycast`] may carry (bounds the work of one request).
+pub const MAX_RAYS: usize = 65_536;
+/// Most objects one filter may list.
+pub const MAX_FILTER: usize = 65_536;
+/// Longest ray or sweep (units): a direction longer than this is almost certainly a bug.
+pub const MAX_QUERY_DISTANCE: f32 = 2.0 * MAX_COORDINATE;
+
+/// Whether the filter's list is what to skip or all that may be hit (Roblox's
+/// `Enum.RaycastFilterType`).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum FilterType {
+    /// The listed objects are skipped (the default).
+    #[default]
+    Exclude,
+    /// Only the listed objects may be hit.
+    Include,
+}
+
+/// Which objects a query considers (Roblox's `RaycastParams` / `OverlapParams`).
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct QueryFilter {
+    /// What `list` means.
+    pub filter_type: FilterType,
+    /// The objects `filter_type` applies to (unknown or stale handles are ignored: a
+    /// filter built from last frame's list must not fail).
+    pub list: Vec<Handle>,
+    /// When set, only objects whose collision group collides with this group (an index into
+    /// the plane's collision-group table) are considered.
+    pub collision_group: Option<u8>,
+    /// When true, objects with CanCollide = false are skipped (Roblox's default is false:
+    /// queries see every part).
+    pub respect_can_collide: bool,
+}
+
+/// One ray: from `origin` along `direction`, whose length is the maximum distance.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Ray {
+    /// Where the ray starts.
+    pub origin: Vec3,
+    /// Direction and length (Roblox convention: the length is the reach).
+    pub direction: Vec3,
+}
+
+/// What a ray or a sweep hit first.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Hit {
+    /// The object hit.
+    pub object: Handle,
+    /// World-space point of the hit (for sweeps: the contact point on the object hit).
+    pub position: Vec3,
+    /// Unit surface normal of the object hit at `position`, pointing out of it.
+    pub normal: Vec3,
+    /// Distance travelled from the origin to the hit along the direction.
+    pub distance: f32,
+}
+
+/// A query on one plane. Read-only: any client may ask it of any plane.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub enum QueryOp {
+    /// Casts every ray; the reply holds one optional hit per ray, in order. A ray that
+    /// starts inside an object does not hit that object (Roblox convention).
+    Raycast {
+        /// The rays (at most [`MAX_RAYS`]).
+        rays: Vec<Ray>,
+        /// Which objects may be hit.
+        filter: QueryFilter,
+    },
+    /// Sweeps a sphere of `radius` from `origin` along `direction`.
+    Spherecast {
+        /// Centre at the start.
+        origin: Vec3,
+        /// The sphere's radius.
+        radius: f32,
+        /// Direction and length of the sweep.
+        direction: Vec3,
+        /// Which objects may be hit.
+        filter: QueryFilter,
+    },
+    /// Sweeps a box of full `size` from `pose` along `direction`.
+    Blockcast {
+        /// The box's pose at the start.
+        pose: Pose,
+        /// Full size of the box.
+        size: Vec3,
+        /// Direction and length of the sweep.
+        direction: Vec3,
+        /// Which objects may be hit.
+        filter: QueryFilter,
+    },
+    /// Sweeps the shape of `object` from its current pose along `direction` (the object
+    /// itself is never hit).
+    Shapecast {
+        /// The object whose shape is swept.
+        object: Handle,
+        /// Direction and length of the sweep.
+        direction: Vec3,
+        /// Which objects may be hit.
+        filter: QueryFilter,
+    },
+    /// Objects whose bounding box (world axis-aligned) touches the sphere.
+    BoundsInRadius {
+        /// The sphere's centre.
+        position: Vec3,
+        /// The sphere's radius.
+        radius: f32,
+        /// Which objects may be listed.
+        filter: QueryFilter,
+    },
+    /// Objects whose bounding box (world axis-aligned) touches the oriented box.
+    BoundsInBox {
+        /// The box's pose.
+        pose: Pose,
+        /// Full size of the box.
+        size: Vec3,
+        /// Which objects may be listed.
+        filter: QueryFilter,
+    },
+    /// Objects whose shape overlaps the shape of `object` (exact test; the object itself is
+    /// not listed).
+    InPart {
+        /// The object whose shape is tested.
+        object: Handle,
+        /// Which objects may be listed.
+        filter: QueryFilter,
+    },
+}
+
+/// A direction whose length is a reach: finite and at most [`MAX_QUERY_DISTANCE`].
+pub fn direction(field: &str, d: Vec3) -> Result<Vec3, CommandError> {
+    bounded3(field, d, MAX_QUERY_DISTANCE)
+}
+
+impl QueryOp {
+    /// The op with every value checked, or an error naming the field and the value.
+    pub fn checked(self) -> Result<QueryOp, CommandError> {
+        let point = |f: &str, p: Vec3| bounded3(f, p, MAX_COORDINATE);
+        Ok(match self {
+            QueryOp::Raycast { rays, filter } => {
+                if rays.len() > MAX_RAYS {
+                    return Err(CommandError::invalid_field(
+                        "rays",
+                        format!("rays must hold at most {MAX_RAYS} rays, got {}", rays.len()),
+                    ));
+                }
+                for (i, r) in rays.iter().enumerate() {
+                    point(&format!("rays[{i}].origin"), r.origin)?;
+                    direction(&format!("rays[{i}].direction"), r.direction)?;
+                }
+                QueryOp::Raycast {
+                    rays,
+                    filter: filter.checked()?,
+                }
+            }
+            QueryOp::Spherecast {
+                origin,
+                radius,
+                direction: d,
+                filter,
+            } => QueryOp::Spherecast {
+                origin: point("origin", origin)?,
+                radius: extent("radius", radius)?,
+                direction: direction("direction", d)?,
+                filter: filter.checked()?,
+            },
+            QueryOp::Blockcast {
+                pose: p,
+                size: s,
+                direction: d,
+                filter,
+            } => QueryOp::Blockcast {
+                pose: pose("cframe", p)?,
+                size: size("size", s)?,
+                direction: direction("direction", d)?,
+                filter: filter.checked()?,
+            },
+            QueryOp::Shapecast {
+                object,
+                direction: d,
+                filter,
+            } => QueryOp::Shapecast {
+                object,
+                direction: direction("direction", d)?,
+                filter: filter.checked()?,
+            },
+            QueryOp::BoundsInRadius {
+                position,
+                radius,
+                filter,
+            } => QueryOp::BoundsInRadius {
+                position: point("position", position)?,
+                radius: extent("radius", radius)?,
+                filter: filter.checked()?,
+            },
+            QueryOp::BoundsInBox {
+                pose: p,
+                size: s,
+                filter,
+            } => QueryOp::BoundsInBox {
+                pose: pose("cframe", p)?,
+                size: size("size", s)?,
+                filter: filter.checked()?,
+            },
+            QueryOp::InPart { object, filter } => QueryOp::InPart {
+                object,
+                filter: filter.checked()?,
+            },
+        })
+    }
+}
+
+impl QueryFilter {
+    /// The filter with a bounded list, or an error naming `Filter`.
+    pub fn checked(self) -> Result<QueryFilter, CommandError> {
+        if self.list.len() > MAX_FILTER {
+            return Err(CommandError::invalid_field(
+                "Filter",
+                format!(
+                    "Filter must list at most {MAX_FILTER} objects, got {}",
+                    self.list.len()
+                ),
+            ));
+        }
+        Ok(self)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn bad_rays_name_their_index_and_field() {
+        let op = QueryOp::Raycast {
+            rays: vec![
+                Ray {
+                    origin: [0.0; 3],
+                    direction: [0.0, -1.0, 0.0],
+                },
+                Ray {
+                    origin: [0.0; 3],
+                    direction: [f32::NAN, 0.0, 0.0],
+                },
+            ],
+            filter: QueryFilter::default(),
+        };
+        let e = op.checked().unwrap_err();
+        assert_eq!(e.field.as_deref(), Some("rays[1].direction"));
+        assert!(e.message.contains("NaN"), "{}", e.message);
+    }
+
+    #[test]
+    fn a_negative_radius_is_refused() {
+        let op = QueryOp::Spherecast {
+            origin: [0.0; 3],
+            radius: -1.0,
+            direction: [1.0, 0.0, 0.0],
+            filter: QueryFilter::default(),
+        };
+        assert_eq!(op.checked().unwrap_err().field.as_deref(), Some("radius"));
+    }
+}
