@@ -2,9 +2,12 @@
 //! `PhysicsObject` a plane's `:Add` returns ([`object`]), and `Renderable.BasePart`
 //! ([`part`]). Their properties are the rows in `props`; values come from `values`.
 
+pub mod collision_groups;
+pub mod contacts;
 pub mod object;
 pub mod part;
 pub mod plane;
+pub mod query;
 
 use std::rc::Rc;
 

@@ -255,5 +255,14 @@ impl UserData for PhysicsObject {
         );
         methods.add_meta_method(MetaMethod::ToString, |_, o, ()| Ok(o.describe()));
         methods.add_meta_method(DESCRIBE, |_, o, ()| Ok(o.describe()));
+        // Two handles on the same body (e.g. `plane:Add`'s and a raycast's) are equal.
+        methods.add_meta_method(MetaMethod::Eq, |_, o, other: Value| {
+            Ok(match other {
+                Value::UserData(ud) => ud
+                    .borrow::<PhysicsObject>()
+                    .is_ok_and(|p| Rc::ptr_eq(&p.body, &o.body)),
+                _ => false,
+            })
+        });
     }
 }

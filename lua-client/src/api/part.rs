@@ -111,6 +111,8 @@ pub struct PartState {
     signals: RefCell<Vec<(&'static str, Signal)>>,
     /// The last pose the per-tick change pass announced.
     last_fired: Cell<Option<CFrame>>,
+    /// Whether its body was asked to report contacts (while Touched / TouchEnded listen).
+    reporting: Cell<bool>,
 }
 
 impl PartState {
@@ -124,6 +126,7 @@ impl PartState {
             link: RefCell::new(None),
             signals: RefCell::default(),
             last_fired: Cell::new(None),
+            reporting: Cell::new(false),
         }
     }
 
@@ -159,15 +162,82 @@ impl PartState {
         self.destroyed.get()
     }
 
+    /// The part's current body, if it is in a plane.
+    pub fn body(&self) -> Option<Rc<Body>> {
+        self.link.borrow().clone()
+    }
+
     /// The simulated body, if the part is in a plane.
     pub fn object(&self) -> Option<Object> {
         self.link.borrow().as_ref().map(|l| l.object.clone())
     }
 
-    /// Makes `body` the part's body (the part is simulated from now on).
-    pub fn link(&self, body: Rc<Body>) {
+    /// Makes `body` the part's body (the part is simulated from now on). `reporting`: the
+    /// body was created reporting contacts.
+    pub fn link(&self, body: Rc<Body>, reporting: bool) {
         self.last_fired.set(None);
+        self.reporting.set(reporting);
         *self.link.borrow_mut() = Some(body);
+    }
+
+    /// Handlers connected to Touched and TouchEnded.
+    pub fn touch_listeners(&self) -> usize {
+        ["Touched", "TouchEnded"]
+            .iter()
+            .filter_map(|n| self.existing_signal(n))
+            .map(|s| s.listeners())
+            .sum()
+    }
+
+    /// `part.Touched` / `part.TouchEnded`: while either has handlers, the part's body asks
+    /// the daemon for contact events (a part nobody listens to costs nothing).
+    pub fn touch_signal(self: &Rc<Self>, name: &'static str) -> Signal {
+        let (signal, created) = self.signal(name);
+        if created {
+            let part = Rc::downgrade(self);
+            signal.on_listeners(move |_| {
+                if let Some(part) = part.upgrade() {
+                    part.sync_contact_reports();
+                }
+            });
+        }
+        signal
+    }
+
+    /// Asks the body to report contacts exactly while touch handlers exist.
+    fn sync_contact_reports(&self) {
+        let want = self.touch_listeners() > 0;
+        let link = self.link.borrow();
+        let Some(body) = link.as_ref() else {
+            return;
+        };
+        if want == self.reporting.get() {
+            return;
+        }
+        self.reporting.set(want);
+        // A queued write: a refusal comes back with the frame's flush like any other write.
+        let _ = body.object.set_report_contacts(want);
+        if want {
+            if let Some(plane) = body.plane.upgrade() {
+                plane.listen_for_contacts();
+            }
+        }
+    }
+
+    /// Fires Touched (`contact` given) or TouchEnded with the other part.
+    pub fn fire_touch(&self, lua: &Lua, other: Value, contact: Option<Value>) -> mlua::Result<()> {
+        let name = if contact.is_some() {
+            "Touched"
+        } else {
+            "TouchEnded"
+        };
+        match self.existing_signal(name) {
+            Some(s) if s.listeners() > 0 => s.fire(
+                lua,
+                MultiValue::from_iter(std::iter::once(other).chain(contact)),
+            ),
+            _ => Ok(()),
+        }
     }
 
     /// The pose: the newest tick's for a simulated part, else the stored one.
@@ -192,6 +262,7 @@ impl PartState {
         self.cframe.set(cf);
         let body = self.link.borrow_mut().take()?;
         body.ended.set(Some(why));
+        self.reporting.set(false);
         Some(body)
     }
 
@@ -200,7 +271,7 @@ impl PartState {
         if let Some(body) = self.unlink(why) {
             body.object.destroy();
             if let Some(plane) = body.plane.upgrade() {
-                plane.forget(self);
+                plane.forget(self, body.object.handle());
             }
         }
     }

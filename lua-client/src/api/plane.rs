@@ -4,11 +4,15 @@ use std::cell::{Cell, RefCell};
 use std::rc::Rc;
 
 use client_sdk::validate::MAX_DT;
-use client_sdk::{Client, Plane, PlaneInfo, PlaneOptions, PlaneProp};
+use std::collections::HashMap;
+
+use client_sdk::{Client, Handle, ObjectProp, Plane, PlaneInfo, PlaneOptions, PlaneProp};
 use mlua::{Lua, MetaMethod, Table, UserData, UserDataMethods, Value};
 
+use super::contacts::ContactPump;
 use super::object::PhysicsObject;
 use super::part::{BasePart, Body, Ended, PartState};
+use crate::host::scheduler::scheduler;
 use crate::props::plane::{NOT_YET_METHODS, PLANE};
 use crate::props::{not_yet_methods, Target};
 use crate::values::{describe, expected, finite_number, sdk_error};
@@ -20,6 +24,10 @@ pub struct PlaneState {
     pub plane: Plane,
     alive: Cell<bool>,
     parts: RefCell<Vec<Rc<PartState>>>,
+    /// The same parts by their body's handle (contacts and query hits name handles).
+    by_handle: RefCell<HashMap<Handle, Rc<PartState>>>,
+    /// Contact delivery of this plane (`contacts.rs`).
+    pub(crate) contacts: ContactPump,
 }
 
 impl PlaneState {
@@ -49,9 +57,20 @@ impl PlaneState {
         Ok(self.plane.info()?.object_count)
     }
 
-    /// Forgets `part` (its body left the plane).
-    pub fn forget(&self, part: &Rc<PartState>) {
+    /// Forgets `part`, whose body `handle` left the plane.
+    pub fn forget(&self, part: &Rc<PartState>, handle: Handle) {
         self.parts.borrow_mut().retain(|p| !Rc::ptr_eq(p, part));
+        self.by_handle.borrow_mut().remove(&handle);
+    }
+
+    /// Whether any part of the plane passes `f`.
+    pub fn any_part(&self, f: impl Fn(&PartState) -> bool) -> bool {
+        self.parts.borrow().iter().any(|p| f(p))
+    }
+
+    /// The part whose body is `handle`, if this host added it.
+    pub fn part_of(&self, handle: Handle) -> Option<Rc<PartState>> {
+        self.by_handle.borrow().get(&handle).cloned()
     }
 
     /// Removes every body (their parts stay at their last pose) and the plane itself.
@@ -62,12 +81,14 @@ impl PlaneState {
         for part in self.parts.take() {
             part.unlink(Ended::PlaneDestroyed);
         }
+        self.by_handle.borrow_mut().clear();
         self.plane.destroy()
     }
 
     /// The post-tick pass of a step: every part of the plane whose CFrame signal has
     /// listeners announces its new pose (handlers run before `Step` returns).
     fn after_tick(&self, lua: &Lua) -> mlua::Result<()> {
+        self.deliver_contacts(lua)?;
         // A copy: handlers may add, unlink or destroy parts.
         let parts: Vec<Rc<PartState>> = self.parts.borrow().clone();
         for part in parts {
@@ -112,7 +133,7 @@ impl Context {
     }
 }
 
-fn context(lua: &Lua) -> Rc<Context> {
+pub(crate) fn context(lua: &Lua) -> Rc<Context> {
     lua.app_data_ref::<Rc<Context>>()
         .expect("lua_client::install registers the context")
         .clone()
@@ -161,6 +182,7 @@ impl UserData for PhysicsPlane {
             p.0.destroy()
                 .map_err(|e| sdk_error("PhysicsPlane:Destroy", e))
         });
+        super::query::add_methods(methods);
         not_yet_methods(methods, "PhysicsPlane", NOT_YET_METHODS);
         methods.add_meta_method(MetaMethod::Index, |lua, p, key: Value| {
             PLANE.get(lua, &p.0, &key)
@@ -206,13 +228,24 @@ fn add(plane: &Rc<PlaneState>, part: Value) -> mlua::Result<PhysicsObject> {
         )));
     }
     let collider = state.shape.collider(state.size());
+    // A part whose Touched already has handlers reports contacts from its first tick.
+    let reporting = state.touch_listeners() > 0;
+    let props: &[ObjectProp] = match reporting {
+        true => &[ObjectProp::ReportContacts(true)],
+        false => &[],
+    };
     let object = plane
         .plane
-        .add(collider, state.cframe().pose(), &[])
+        .add(collider, state.cframe().pose(), props)
         .map_err(|e| sdk_error(&what(), e))?;
+    let handle = object.handle();
     let body = Body::new(object, Rc::downgrade(plane));
-    state.link(body.clone());
+    state.link(body.clone(), reporting);
+    if reporting {
+        plane.listen_for_contacts();
+    }
     plane.parts.borrow_mut().push(state.clone());
+    plane.by_handle.borrow_mut().insert(handle, state.clone());
     Ok(PhysicsObject {
         body,
         part: state,
@@ -244,7 +277,11 @@ fn new_plane(lua: &Lua, opts: Value) -> mlua::Result<PhysicsPlane> {
         plane,
         alive: Cell::new(true),
         parts: RefCell::default(),
+        by_handle: RefCell::default(),
+        contacts: ContactPump::default(),
     });
+    // Probed every frame; it costs one check while no part of it has touch handlers.
+    scheduler(lua).watch(state.clone());
     ctx.planes.borrow_mut().push(state.clone());
     Ok(PhysicsPlane(state))
 }
@@ -273,6 +310,7 @@ fn option(o: &mut PlaneOptions, prop: PlaneProp) {
 pub fn module(lua: &Lua) -> mlua::Result<Table> {
     let m = lua.create_table()?;
     m.set("New", lua.create_function(new_plane)?)?;
+    super::collision_groups::install(lua, &m)?;
     m.set(
         "NewGUI",
         lua.create_function(|_, _: Value| -> mlua::Result<()> {

@@ -23,6 +23,18 @@ pub struct SignalInner {
     name: String,
     slots: RefCell<Vec<Slot>>,
     next_id: Cell<u64>,
+    /// Told the number of handlers whenever it changes (a part's Touched asks the daemon
+    /// for contact events only while someone listens).
+    on_listeners: RefCell<Option<Box<dyn Fn(usize)>>>,
+}
+
+impl SignalInner {
+    fn listeners_changed(&self) {
+        let n = self.slots.borrow().len();
+        if let Some(f) = self.on_listeners.borrow().as_ref() {
+            f(n);
+        }
+    }
 }
 
 /// A signal; clones share the same connections.
@@ -43,15 +55,25 @@ impl Signal {
         self.0.slots.borrow().len()
     }
 
+    /// Calls `f` with the number of handlers each time it changes.
+    pub fn on_listeners(&self, f: impl Fn(usize) + 'static) {
+        *self.0.on_listeners.borrow_mut() = Some(Box::new(f));
+    }
+
     /// Drops every connection.
     pub fn disconnect_all(&self) {
+        let had = !self.0.slots.borrow().is_empty();
         self.0.slots.borrow_mut().clear();
+        if had {
+            self.0.listeners_changed();
+        }
     }
 
     fn connect(&self, handler: Function, once: bool) -> Connection {
         let id = self.0.next_id.get();
         self.0.next_id.set(id + 1);
         self.0.slots.borrow_mut().push(Slot { id, handler, once });
+        self.0.listeners_changed();
         Connection {
             signal: Rc::downgrade(&self.0),
             id,
@@ -61,12 +83,16 @@ impl Signal {
     /// Runs every handler connected now with `args`. Handlers connected while firing wait for
     /// the next fire; one-shot handlers are removed before they run.
     pub fn fire(&self, lua: &Lua, args: MultiValue) -> mlua::Result<()> {
-        let handlers: Vec<Function> = {
+        let (handlers, removed): (Vec<Function>, bool) = {
             let mut slots = self.0.slots.borrow_mut();
             let handlers = slots.iter().map(|s| s.handler.clone()).collect();
+            let before = slots.len();
             slots.retain(|s| !s.once);
-            handlers
+            (handlers, slots.len() != before)
         };
+        if removed {
+            self.0.listeners_changed();
+        }
         for handler in handlers {
             scheduler::spawn(lua, handler, args.clone())?;
         }
@@ -117,7 +143,11 @@ impl UserData for Connection {
     fn add_methods<M: UserDataMethods<Self>>(methods: &mut M) {
         methods.add_method("Disconnect", |_, c, ()| {
             if let Some(signal) = c.signal.upgrade() {
+                let before = signal.slots.borrow().len();
                 signal.slots.borrow_mut().retain(|slot| slot.id != c.id);
+                if signal.slots.borrow().len() != before {
+                    signal.listeners_changed();
+                }
             }
             Ok(())
         });

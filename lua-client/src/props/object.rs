@@ -113,6 +113,21 @@ pub static OBJECT: Props<PhysicsObject> = Props {
                 o.part.resize(lua, "PhysicsObject.Size", a.vector()?)
             }),
         },
+        // A registered collision group's name (PhysicsService:RegisterCollisionGroup).
+        Row {
+            name: "CollisionGroup",
+            kind: Kind::String,
+            get: Get::Fn(|lua, o| {
+                let id = info(o, "CollisionGroup")?.collision_group;
+                let name = o.body.object.plane().client().collision_group_name(id);
+                Ok(Value::String(lua.create_string(name)?))
+            }),
+            set: Set::Fn(|_, o, a| {
+                o.live("PhysicsObject.CollisionGroup")?
+                    .set_collision_group(&a.string()?)
+                    .map_err(|e| sdk_error("PhysicsObject.CollisionGroup", e))
+            }),
+        },
         info_row!(
             "ImpulseDirection",
             Kind::Vector,

@@ -49,6 +49,28 @@ pub static PART: Props<BasePart> = Props {
                 p.0.changed(lua, "Name", value)
             }),
         },
+        // Roblox's contact signals: Touched(otherPart, contact), TouchEnded(otherPart). The
+        // part's body reports contacts only while either has handlers.
+        Row {
+            name: "Touched",
+            kind: Kind::String,
+            get: Get::Fn(|lua, p| {
+                Ok(Value::UserData(
+                    lua.create_userdata(p.0.touch_signal("Touched"))?,
+                ))
+            }),
+            set: Set::ReadOnly,
+        },
+        Row {
+            name: "TouchEnded",
+            kind: Kind::String,
+            get: Get::Fn(|lua, p| {
+                Ok(Value::UserData(
+                    lua.create_userdata(p.0.touch_signal("TouchEnded"))?,
+                ))
+            }),
+            set: Set::ReadOnly,
+        },
         Row {
             name: "Shape",
             kind: Kind::String,

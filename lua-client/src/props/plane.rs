@@ -52,6 +52,17 @@ pub static PLANE: Props<PlaneState> = Props {
     owner: "PhysicsPlane",
     rows: &[
         vector_row!("Gravity", gravity, PlaneProp::Gravity),
+        // Fired with the number of contact events lost when the script fell behind.
+        Row {
+            name: "EventsLost",
+            kind: Kind::String,
+            get: Get::Fn(|lua, p| {
+                Ok(Value::UserData(
+                    lua.create_userdata(p.events_lost_signal())?,
+                ))
+            }),
+            set: Set::ReadOnly,
+        },
         bool_row!("Enabled", enabled, PlaneProp::Enabled),
         number_row!(
             "TickRate",

@@ -6,8 +6,9 @@
 //! degenerate meshes and bad triangle indices).
 
 use shm_layout::{
-    Command, Handle, ObjectOp, ObjectProp, Pin, PlaneId, PlaneKind, PlaneOp, PlaneProp, Pose,
-    Restraint, RotateTo, Shape, Vec3, CRATE_VERSION,
+    CollisionGroups, Command, FilterType, Handle, ObjectOp, ObjectProp, Pin, PlaneId, PlaneKind,
+    PlaneOp, PlaneProp, Pose, QueryFilter, QueryOp, Ray, Restraint, RotateTo, Shape, Vec3,
+    CRATE_VERSION,
 };
 
 use super::rng::Rng;
@@ -185,6 +186,8 @@ impl<'a> Gen<'a> {
                 }
             }
             u if u < 0.45 => self.add_object(wild),
+            u if u < 0.50 => PlaneOp::Query(self.query(wild, id)),
+            u if u < 0.51 => PlaneOp::CollisionGroups(self.collision_groups(wild)),
             _ => {
                 let handle = self.handle(wild, id);
                 PlaneOp::Object {
@@ -220,6 +223,98 @@ impl<'a> Gen<'a> {
         } else {
             self.rng.log_f32(1e-6, 1.0)
         }
+    }
+
+    /// Any scene query, with valid or wild rays, shapes, filters and groups.
+    fn query(&mut self, wild: bool, id: PlaneId) -> QueryOp {
+        let filter = QueryFilter {
+            filter_type: if self.rng.chance(0.5) {
+                FilterType::Exclude
+            } else {
+                FilterType::Include
+            },
+            list: (0..self.rng.below(4))
+                .map(|_| self.handle(wild, id))
+                .collect(),
+            collision_group: self
+                .rng
+                .chance(0.3)
+                .then(|| self.rng.below(if wild { 256 } else { 3 }) as u8),
+            respect_can_collide: self.rng.chance(0.5),
+        };
+        let r = &mut *self.rng;
+        let radius = {
+            let v = r.log_f32(0.01, 5.0);
+            r.maybe_wild(wild, v)
+        };
+        match r.below(7) {
+            0 => QueryOp::Raycast {
+                rays: (0..r.below(70))
+                    .map(|_| Ray {
+                        origin: r.vec3(wild, 30.0),
+                        direction: r.vec3(wild, 60.0),
+                    })
+                    .collect(),
+                filter,
+            },
+            1 => QueryOp::Spherecast {
+                origin: r.vec3(wild, 30.0),
+                radius,
+                direction: r.vec3(wild, 60.0),
+                filter,
+            },
+            2 => QueryOp::Blockcast {
+                pose: r.pose(wild, 30.0),
+                size: [radius, 1.0, 2.0],
+                direction: r.vec3(wild, 60.0),
+                filter,
+            },
+            3 => QueryOp::Shapecast {
+                object: self.handle(wild, id),
+                direction: self.rng.vec3(wild, 60.0),
+                filter,
+            },
+            4 => QueryOp::BoundsInRadius {
+                position: r.vec3(wild, 30.0),
+                radius,
+                filter,
+            },
+            5 => QueryOp::BoundsInBox {
+                pose: r.pose(wild, 30.0),
+                size: [radius, 2.0, 1.0],
+                filter,
+            },
+            _ => QueryOp::InPart {
+                object: self.handle(wild, id),
+                filter,
+            },
+        }
+    }
+
+    /// A collision-group table: a valid one, or (wild) a forged one.
+    fn collision_groups(&mut self, wild: bool) -> CollisionGroups {
+        let mut table = CollisionGroups::default();
+        for i in 0..self.rng.below(if wild { 40 } else { 4 }) {
+            let _ = table.register(&format!("G{i}"));
+        }
+        let registered: Vec<String> = table.registered().map(|(_, n, _)| n.to_string()).collect();
+        for _ in 0..self.rng.below(4) {
+            let a = self.rng.pick(&registered).clone();
+            let b = self.rng.pick(&registered).clone();
+            let _ = table.set_collidable(&a, &b, self.rng.chance(0.5));
+        }
+        if wild && self.rng.chance(0.5) {
+            // Forged bytes: decode a mangled encoding, or fall back to the valid table.
+            let mut bytes = postcard::to_allocvec(&table).unwrap_or_default();
+            if !bytes.is_empty() {
+                let i = self.rng.below(bytes.len());
+                bytes[i] = self.rng.byte();
+            }
+            if let Ok(forged) = postcard::from_bytes(&bytes) {
+                return forged;
+            }
+        }
+        table
     }
 
     fn add_object(&mut self, wild: bool) -> PlaneOp {
@@ -435,7 +530,8 @@ impl<'a> Gen<'a> {
             let v = r.f32_in(lo, hi);
             r.maybe_wild(wild, v)
         };
-        match r.below(18) {
+        match r.below(19) {
+            18 => ObjectProp::CollisionGroup(if wild { r.byte() } else { r.below(3) as u8 }),
             0 => ObjectProp::Pose(r.pose(wild, 30.0)),
             1 => ObjectProp::Velocity(r.vec3(wild, 20.0)),
             2 => ObjectProp::AngularVelocity(r.vec3(wild, 10.0)),

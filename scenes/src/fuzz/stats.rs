@@ -4,8 +4,8 @@
 use std::collections::BTreeMap;
 
 use shm_layout::{
-    Command, CommandResult, ErrorKind, ObjectOp, ObjectProp, PlaneOp, PlaneProp, Reply, Response,
-    Shape,
+    Command, CommandResult, ErrorKind, ObjectOp, ObjectProp, PlaneOp, PlaneProp, QueryOp, Reply,
+    Response, Shape,
 };
 
 /// How many failures a run keeps in full (the counters count all of them).
@@ -302,6 +302,8 @@ pub fn reply_name(reply: &Reply) -> &'static str {
         Reply::Stepped { .. } => "Stepped",
         Reply::ObjectInfo(_) => "ObjectInfo",
         Reply::CenterOfMass(_) => "CenterOfMass",
+        Reply::Hits(_) => "Hits",
+        Reply::Objects(_) => "Objects",
     }
 }
 
@@ -332,6 +334,8 @@ pub fn op_name(command: &Command) -> String {
                 ObjectOp::Wake => "Object.Wake".into(),
                 ObjectOp::Destroy => "Object.Destroy".into(),
             },
+            PlaneOp::Query(q) => format!("Plane.Query.{}", query_name(q)),
+            PlaneOp::CollisionGroups(_) => "Plane.CollisionGroups".into(),
         },
     }
 }
@@ -357,6 +361,20 @@ pub fn object_prop_name(prop: &ObjectProp) -> &'static str {
         ObjectProp::FieldRestraint(_) => "FieldRestraint",
         ObjectProp::RotateTo(_) => "RotateTo",
         ObjectProp::Pin(_) => "Pin",
+        ObjectProp::CollisionGroup(_) => "CollisionGroup",
+    }
+}
+
+/// The name of a query (`Raycast`).
+pub fn query_name(query: &QueryOp) -> &'static str {
+    match query {
+        QueryOp::Raycast { .. } => "Raycast",
+        QueryOp::Spherecast { .. } => "Spherecast",
+        QueryOp::Blockcast { .. } => "Blockcast",
+        QueryOp::Shapecast { .. } => "Shapecast",
+        QueryOp::BoundsInRadius { .. } => "BoundsInRadius",
+        QueryOp::BoundsInBox { .. } => "BoundsInBox",
+        QueryOp::InPart { .. } => "InPart",
     }
 }
 

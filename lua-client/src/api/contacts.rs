@@ -1,0 +1,166 @@
+//! Contact events for scripts: `part.Touched(otherPart, contact)` and
+//! `part.TouchEnded(otherPart)`, fired from the plane's per-tick event stream in tick order,
+//! once per contact start and end. A plane reads its events only while one of its parts has
+//! touch handlers; `plane.EventsLost(n)` (or, with no handler, a line on stderr) says when a
+//! script fell so far behind that the daemon's queue dropped events.
+
+use std::cell::{Cell, RefCell};
+
+use client_sdk::{Contact, Handle};
+use mlua::{Lua, MultiValue, Value};
+
+use super::part::BasePart;
+use super::plane::PlaneState;
+use crate::host::signal::Signal;
+use crate::host::Watched;
+use crate::values::{new_vector, sdk_error};
+
+/// Per plane: whether events are being read, and the `EventsLost` signal.
+pub struct ContactPump {
+    /// True while some part of the plane has touch handlers (events are drained each frame).
+    reading: Cell<bool>,
+    /// `plane.EventsLost`, created on first access.
+    lost: RefCell<Option<Signal>>,
+}
+
+impl Default for ContactPump {
+    fn default() -> Self {
+        ContactPump {
+            reading: Cell::new(false),
+            lost: RefCell::new(None),
+        }
+    }
+}
+
+impl PlaneState {
+    /// `plane.EventsLost`: fired with the number of events lost when the script fell behind.
+    pub fn events_lost_signal(&self) -> Signal {
+        self.contacts
+            .lost
+            .borrow_mut()
+            .get_or_insert_with(|| {
+                Signal::new(format!("PhysicsPlane {}.EventsLost", self.plane.id()))
+            })
+            .clone()
+    }
+
+    /// A part of the plane got touch handlers: subscribe to the plane's events now, so the
+    /// first contact after this point is delivered.
+    pub fn listen_for_contacts(&self) {
+        if !self.alive() {
+            return;
+        }
+        if let Err(e) = self.plane.subscribe_events() {
+            eprintln!(
+                "PhysicsPlane {}: cannot read contact events: {e}",
+                self.plane.id()
+            );
+        }
+    }
+
+    fn touch_handlers(&self) -> bool {
+        self.any_part(|p| p.touch_listeners() > 0)
+    }
+
+    /// Delivers the events published since the last call to the parts' touch handlers.
+    pub(crate) fn deliver_contacts(&self, lua: &Lua) -> mlua::Result<()> {
+        if !self.alive() || !self.touch_handlers() {
+            self.contacts.reading.set(false);
+            return Ok(());
+        }
+        let events = self
+            .plane
+            .events()
+            .map_err(|e| sdk_error("PhysicsPlane contact events", e))?;
+        // Events queued while nobody listened are not news: drop them, lost or not.
+        if !self.contacts.reading.replace(true) {
+            return Ok(());
+        }
+        if events.lost > 0 {
+            self.report_lost(lua, events.lost)?;
+        }
+        for record in &events.records {
+            match Contact::from_record(record) {
+                Some(Contact::Started {
+                    a,
+                    b,
+                    position,
+                    normal,
+                    impulse,
+                    ..
+                }) => {
+                    let flipped = normal.map(|c| -c);
+                    // Each side gets the other part, and the normal of the other's surface
+                    // pointing toward itself.
+                    self.touch(lua, a, b, Some((position, flipped, impulse)))?;
+                    self.touch(lua, b, a, Some((position, normal, impulse)))?;
+                }
+                Some(Contact::Ended { a, b, .. }) => {
+                    self.touch(lua, a, b, None)?;
+                    self.touch(lua, b, a, None)?;
+                }
+                None => {}
+            }
+        }
+        Ok(())
+    }
+
+    fn touch(
+        &self,
+        lua: &Lua,
+        this: Handle,
+        other: Handle,
+        contact: Option<([f32; 3], [f32; 3], f32)>,
+    ) -> mlua::Result<()> {
+        let Some(part) = self.part_of(this) else {
+            return Ok(());
+        };
+        if part.touch_listeners() == 0 {
+            return Ok(());
+        }
+        let other = match self.part_of(other) {
+            Some(p) => Value::UserData(lua.create_userdata(BasePart(p))?),
+            None => Value::Nil,
+        };
+        let contact = match contact {
+            Some((position, normal, impulse)) => {
+                let t = lua.create_table()?;
+                t.set("Position", new_vector(position))?;
+                t.set("Normal", new_vector(normal))?;
+                t.set("Impulse", impulse)?;
+                Some(Value::Table(t))
+            }
+            None => None,
+        };
+        part.fire_touch(lua, other, contact)
+    }
+
+    fn report_lost(&self, lua: &Lua, n: u64) -> mlua::Result<()> {
+        let signal = self.contacts.lost.borrow().clone();
+        match signal {
+            Some(s) if s.listeners() > 0 => {
+                s.fire(lua, MultiValue::from_iter([Value::Number(n as f64)]))
+            }
+            _ => {
+                eprintln!(
+                    "PhysicsPlane {}: events lost: {n} (the script fell more than {} ticks \
+                     with events behind)",
+                    self.plane.id(),
+                    client_sdk::EVENT_BUFFER_TICKS
+                );
+                Ok(())
+            }
+        }
+    }
+}
+
+/// Each frame, a plane with touch handlers delivers its new contact events.
+impl Watched for PlaneState {
+    fn listeners(&self) -> usize {
+        usize::from(self.touch_handlers())
+    }
+
+    fn fire_if_changed(&self, lua: &Lua) -> mlua::Result<()> {
+        self.deliver_contacts(lua)
+    }
+}
