@@ -74,17 +74,20 @@ impl Contact {
     }
 }
 
-/// A subscription to a plane's events and the number of the next event it expects.
+/// A subscription to a plane's events and the number (modulo 2³²) of the next event it
+/// expects.
 pub(crate) struct EventReader {
     subscriber: EventSubscriber,
-    next_seq: Cell<Option<u64>>,
+    next_seq: Cell<u32>,
 }
 
 impl EventReader {
-    pub(crate) fn new(subscriber: EventSubscriber) -> EventReader {
+    /// `start`: the plane's event count at its newest tick when the subscriber existed
+    /// (events from there on reach it).
+    pub(crate) fn new(subscriber: EventSubscriber, start: u32) -> EventReader {
         EventReader {
             subscriber,
-            next_seq: Cell::new(None),
+            next_seq: Cell::new(start),
         }
     }
 
@@ -99,11 +102,12 @@ impl EventReader {
             let Some(first) = records.first() else {
                 continue;
             };
-            if let Some(expected) = self.next_seq.get() {
-                out.lost += first.seq.saturating_sub(expected);
-            }
+            // Wrapping arithmetic on the low 32 bits: a sample older than expected (sent while
+            // the reader was being set up) counts as nothing lost.
+            let gap = (first.seq as u32).wrapping_sub(self.next_seq.get()) as i32;
+            out.lost += gap.max(0) as u64;
             if let Some(last) = records.last() {
-                self.next_seq.set(Some(last.seq + 1));
+                self.next_seq.set((last.seq as u32).wrapping_add(1));
             }
             out.records.extend_from_slice(records);
         }
@@ -115,11 +119,14 @@ impl Plane {
     /// Subscribes to the plane's events now (the first [`Plane::events`] call does it too):
     /// events of later ticks are kept for the next `events` call.
     pub fn subscribe_events(&self) -> Result<(), Error> {
-        let mut slot = self.shared.events.borrow_mut();
-        if slot.is_none() {
-            let sub = self.client().transport().plane_events(self.id())?;
-            *slot = Some(EventReader::new(sub));
+        if self.shared.events.borrow().is_some() {
+            return Ok(());
         }
+        // Subscribe first, then read where the stream stands: every event after that point
+        // reaches the subscriber, so a gap is a real loss.
+        let sub = self.client().transport().plane_events(self.id())?;
+        let start = self.snapshot().map_or(0, |s| s.header().event_count);
+        *self.shared.events.borrow_mut() = Some(EventReader::new(sub, start));
         Ok(())
     }
 

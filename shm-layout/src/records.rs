@@ -100,8 +100,10 @@ pub struct TickHeader {
     pub max_joint_error: f32,
     /// Number of contact pairs with at least one contact point.
     pub contact_pairs: u32,
-    /// Padding to 64 bytes; always 0.
-    pub _reserved: u32,
+    /// Events the plane has published up to and including this tick, modulo 2³² (the next
+    /// event's [`EventRecord::seq`], wrapped): a new event reader learns from the newest
+    /// tick where its stream starts, so it can count losses from its very first read.
+    pub event_count: u32,
 }
 
 /// Event kind: two objects started touching.

@@ -223,7 +223,8 @@ impl Plane {
         self.tune_solver();
         self.apply_forces(dt);
         let hooks = contacts::RestThreshold(self.settings.rest_threshold);
-        if self.reporting > 0 {
+        // Contacts of objects removed since the last step still end with an event.
+        if self.reporting > 0 || !self.removed.is_empty() {
             let collector = ChannelEventCollector::new(
                 self.collision_tx.clone(),
                 self.force_tx.clone(),
@@ -265,7 +266,7 @@ impl Plane {
             max_penetration: self.max_penetration,
             max_joint_error: 0.0,
             contact_pairs: self.contact_pairs,
-            _reserved: 0,
+            event_count: self.event_seq as u32,
         }
     }
 

@@ -161,7 +161,8 @@ impl Plane {
             return;
         }
         let hooks = RestThreshold(self.settings.rest_threshold);
-        if self.reporting > 0 {
+        // Contacts of objects removed since the last step still end with an event.
+        if self.reporting > 0 || !self.removed.is_empty() {
             let collector = ChannelEventCollector::new(
                 self.collision_tx.clone(),
                 self.force_tx.clone(),
