@@ -305,3 +305,11 @@ fn scripts_run_sandboxed_with_the_api_globals() {
     let daemon = TestDaemon::start("lua-sandbox");
     run_ok(&daemon, "tests/lua/sandbox.luau", "sandbox ok");
 }
+
+#[test]
+fn queries_touches_and_collision_groups_from_luau() {
+    let daemon = TestDaemon::start("lua-queries");
+    let r = run(&daemon, "tests/lua/queries.luau");
+    r.assert_ok();
+    assert!(r.stdout().contains("queries ok"), "{}", r.stdout());
+}
