@@ -6,6 +6,7 @@
 //! `physics-bench accuracy [--quick] [--out DIR]` writes DIR/accuracy.json, DIR/accuracy.md
 //! and DIR/accuracy-*.svg: error against cost of reference scenes, in process.
 //! `physics-bench stability [--out DIR]` writes DIR/stability.json and DIR/stability.md.
+//! `physics-bench queries [--quick] [--out DIR]` writes DIR/queries.json and DIR/queries.md.
 //!
 //! Its parts, shared by the subcommands:
 //!
@@ -28,6 +29,7 @@ mod ipc;
 mod load;
 mod procfs;
 mod progress;
+mod queries;
 mod report;
 mod scene;
 mod sim;
@@ -62,6 +64,9 @@ enum Bench {
     Fuzz(fuzz::FuzzArgs),
     /// 16 clients × 100,000 commands against one daemon: none lost, commands/s.
     Load(load::LoadArgs),
+    /// Rays per second of RaycastMany batches (1, 64, 4,096 rays) against a 10,000-body
+    /// plane, next to the same rays cast in process.
+    Queries(queries::QueriesArgs),
     /// 4 planes × 1,000 bodies at 60 Hz with a client writing every frame for N minutes:
     /// daemon RSS and shared-memory growth against a bound.
     Soak(soak::SoakArgs),
@@ -86,6 +91,7 @@ fn main() -> ExitCode {
         Bench::Fuzz(args) => fuzz::run(args),
         Bench::Load(args) => load::run(args),
         Bench::Soak(args) => soak::run(args),
+        Bench::Queries(args) => queries::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
