@@ -5,10 +5,12 @@
 //! - `backend`: the [`Backend`](crate::backend::Backend) implementation (op routing).
 //! - `objects`, `properties`, `part`: objects, their properties and their rapier mapping.
 //! - `forces`, `solver`, `contacts`: the per-tick force pass, solver tuning, contacts.
+//! - `limits`: MaxLinearSpeed and MaxAngularSpeed.
 
 mod backend;
 mod contacts;
 mod forces;
+mod limits;
 mod objects;
 mod part;
 mod properties;
@@ -205,6 +207,7 @@ impl Plane {
         self.world.integration_parameters.dt = dt;
         self.tune_solver();
         self.apply_forces(dt);
+        self.limit_speeds_before_step();
         let hooks = contacts::RestThreshold(self.settings.rest_threshold);
         if self.reporting > 0 {
             let collector = ChannelEventCollector::new(
@@ -216,6 +219,7 @@ impl Plane {
         } else {
             self.world.step_with_events(&hooks, &());
         }
+        self.limit_speeds_after_step();
         self.dirty.stepped(self.bodies.slot_count());
         self.tick += 1;
         self.sim_time += dt as f64;
