@@ -135,13 +135,18 @@ impl Part {
                 }
             }
             (_, ShapeKind::Cylinder) => SharedShape::cylinder(y / 2.0, x.min(z) / 2.0),
-            (_, ShapeKind::Wedge) => SharedShape::convex_hull(&wedge_points(self.size))
-                .ok_or_else(|| {
-                    CommandError::invalid_field(
-                        "Size",
-                        format!("a Wedge of Size {:?} spans no volume", self.size),
-                    )
-                })?,
+            // The convex hull of its 6 corners, whose faces are known: handing them over
+            // skips the hull search, which fails on accepted extremes such as
+            // 0.001 × 0.001 × 100,000 (f32 cannot tell those corners apart from coplanar).
+            (_, ShapeKind::Wedge) => {
+                SharedShape::convex_mesh(wedge_points(self.size).to_vec(), &WEDGE_FACES)
+                    .ok_or_else(|| {
+                        CommandError::invalid_field(
+                            "Size",
+                            format!("a Wedge of Size {:?} spans no volume", self.size),
+                        )
+                    })?
+            }
             (Some(mesh), ShapeKind::Mesh) => {
                 let points = mesh.scaled_hull_points(self.size);
                 let flat = || {
@@ -353,6 +358,19 @@ fn wedge_points(size: Vec3) -> [Vector; 6] {
     })
 }
 
+/// The faces of [`wedge_points`] as outward (counter-clockwise) triangles: the two ends
+/// (-X, +X), the bottom (-Y), the back (+Z) and the slope.
+const WEDGE_FACES: [[u32; 3]; 8] = [
+    [0, 1, 2],
+    [3, 5, 4],
+    [0, 3, 4],
+    [0, 4, 1],
+    [1, 4, 5],
+    [1, 5, 2],
+    [0, 2, 5],
+    [0, 5, 3],
+];
+
 /// Centroid of the wedge of `size` (that of its right-triangle cross-section):
 /// (0, -Y/6, +Z/6).
 fn wedge_centroid(size: Vec3) -> Vec3 {
@@ -456,6 +474,28 @@ mod tests {
         let at = rapier3d::math::Pose::IDENTITY;
         assert!(hull.contains_point(&at, top_back));
         assert!(!hull.contains_point(&at, top_front));
+    }
+
+    #[test]
+    fn extreme_accepted_sizes_build_every_new_shape() {
+        use shm_layout::validate::{MAX_SIZE, MIN_SIZE};
+        let extremes = [MIN_SIZE, 1.0, MAX_SIZE];
+        for x in extremes {
+            for y in extremes {
+                for z in extremes {
+                    let size = [x, y, z];
+                    for shape in [
+                        Shape::Capsule { size },
+                        Shape::Cylinder { size },
+                        Shape::Wedge { size },
+                    ] {
+                        let part = Part::new(&shape);
+                        let props = part.collider_shape().unwrap().mass_properties(1.0);
+                        assert!(props.mass() > 0.0 && props.mass().is_finite(), "{shape:?}");
+                    }
+                }
+            }
+        }
     }
 
     #[test]
