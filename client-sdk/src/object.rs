@@ -203,7 +203,8 @@ impl Object {
         }
     }
 
-    /// CenterOfMass := vertex centroid of the object's mesh (no-op for cubes and spheres).
+    /// CenterOfMass := vertex centroid of the object's mesh, or a wedge's centroid (no-op for
+    /// the other primitives).
     /// Returns the centre of mass in effect.
     pub fn recalculate_center_of_mass(&self) -> Result<Vec3, Error> {
         match self

@@ -48,6 +48,12 @@ pub struct PlaneOptions {
     pub never_sleep: Option<bool>,
     /// `Shared` (creation only): other clients may change the plane, not only read it.
     pub shared: Option<bool>,
+    /// `MaxLinearSpeed` (units/s): no body moves faster. Default 10,000
+    /// (`shm_layout::settings::plane::DEFAULT_MAX_LINEAR_SPEED`).
+    pub max_linear_speed: Option<f32>,
+    /// `MaxAngularSpeed` (rad/s): no body spins faster. Default 1,000
+    /// (`shm_layout::settings::plane::DEFAULT_MAX_ANGULAR_SPEED`).
+    pub max_angular_speed: Option<f32>,
 }
 
 impl PlaneOptions {
@@ -76,6 +82,8 @@ impl PlaneOptions {
             o.loop_solver.map(PlaneProp::LoopSolver),
             o.never_sleep.map(PlaneProp::NeverSleep),
             o.shared.map(PlaneProp::Shared),
+            o.max_linear_speed.map(PlaneProp::MaxLinearSpeed),
+            o.max_angular_speed.map(PlaneProp::MaxAngularSpeed),
         ]
         .into_iter()
         .flatten()

@@ -18,6 +18,28 @@ pub enum Shape {
         /// Radius.
         radius: f32,
     },
+    /// A capsule along the body's Y axis: radius `min(size.x, size.z) / 2`, total height
+    /// `size.y` (caps included), so its segment is `size.y - 2·radius` long; a capsule no
+    /// taller than its diameter is a ball.
+    Capsule {
+        /// Full size along x, y, z.
+        size: Vec3,
+    },
+    /// A cylinder along the body's Y axis: radius `min(size.x, size.z) / 2`, height `size.y`.
+    Cylinder {
+        /// Full size along x, y, z.
+        size: Vec3,
+    },
+    /// A ramp filling half of its size box (Roblox's WedgePart): the bottom face (-Y) is
+    /// full, the vertical face is at the back (+Z), and the slope falls from the top-back
+    /// edge to the bottom-front edge (-Z). Its cross-section in YZ has the corners
+    /// (-y/2, -z/2), (-y/2, +z/2), (+y/2, +z/2), extruded over x. The body's origin is the
+    /// centre of the size box, so its centre of mass is off the origin, at
+    /// (0, -size.y/6, +size.z/6).
+    Wedge {
+        /// Full size along x, y, z.
+        size: Vec3,
+    },
     /// A part that carries a mesh (body-local vertices, triangles as vertex indices). It
     /// collides as the convex hull of its vertices.
     Mesh {
@@ -37,6 +59,12 @@ pub enum ShapeKind {
     Sphere,
     /// A convex hull of mesh vertices.
     Mesh,
+    /// A capsule along Y.
+    Capsule,
+    /// A cylinder along Y.
+    Cylinder,
+    /// A ramp: half of its size box, sloping down toward -Z.
+    Wedge,
 }
 
 impl Shape {
@@ -46,6 +74,9 @@ impl Shape {
             Shape::Cube { .. } => ShapeKind::Cube,
             Shape::Sphere { .. } => ShapeKind::Sphere,
             Shape::Mesh { .. } => ShapeKind::Mesh,
+            Shape::Capsule { .. } => ShapeKind::Capsule,
+            Shape::Cylinder { .. } => ShapeKind::Cylinder,
+            Shape::Wedge { .. } => ShapeKind::Wedge,
         }
     }
 
@@ -60,7 +91,10 @@ impl Shape {
     /// Positive sizes, finite vertices, triangle indices in range, bounded mesh size.
     pub fn check(&self) -> Result<(), CommandError> {
         match self {
-            Shape::Cube { size: s } => size("Size", *s).map(|_| ()),
+            Shape::Cube { size: s }
+            | Shape::Capsule { size: s }
+            | Shape::Cylinder { size: s }
+            | Shape::Wedge { size: s } => size("Size", *s).map(|_| ()),
             Shape::Sphere { radius } => extent("radius", *radius).map(|_| ()),
             Shape::Mesh {
                 vertices,

@@ -91,7 +91,7 @@ fn documented_properties_read_back_and_only_the_gpu_backend_is_missing() {
     let daemon = TestDaemon::start("lua-props");
     let r = run(&daemon, "tests/lua/properties.luau");
     r.assert_ok();
-    // 18 properties read back what was written; DeferGpu alone says "not supported yet".
+    // 20 properties read back what was written; DeferGpu alone says "not supported yet".
     let fields: Vec<usize> = r
         .stdout()
         .trim()
@@ -99,7 +99,15 @@ fn documented_properties_read_back_and_only_the_gpu_backend_is_missing() {
         .skip(1)
         .map(|n| n.parse().expect("count"))
         .collect();
-    assert_eq!(fields, vec![18, 1], "{}", r.stdout());
+    assert_eq!(fields, vec![20, 1], "{}", r.stdout());
+}
+
+#[test]
+fn speed_limits_are_plane_options_from_lua() {
+    let daemon = TestDaemon::start("lua-speed");
+    let r = run(&daemon, "tests/lua/speed_limits.luau");
+    r.assert_ok();
+    assert!(r.stdout().contains("speed limits ok"), "{}", r.stdout());
 }
 
 #[test]

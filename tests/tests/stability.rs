@@ -9,6 +9,7 @@ use physics_scenes::{
     ball, column, floor, launched_box, overlapping_pile, pair_gap, pyramid, stack_and_ball,
     thin_wall,
 };
+use shm_layout::settings::plane::DEFAULT_MAX_LINEAR_SPEED;
 
 /// Steps `n` times, asserting after each step that every body is finite.
 fn run_finite(scene: &Scene, dt: f32, n: u32) {
@@ -170,9 +171,9 @@ fn a_box_at_400_does_not_tunnel_through_a_thin_wall() {
 }
 
 #[test]
-fn linear_speed_is_capped_at_400() {
-    // rapier's normalized_max_linear_velocity is 400 (length unit 1): a launch at 1,000
-    // units/s moves at most 400 after one tick (damping takes a little more off).
+fn linear_speed_is_capped_at_max_linear_speed() {
+    // MaxLinearSpeed (default 10,000, rapier's normalized_max_linear_velocity, applied after
+    // every substep): a launch at 20,000 units/s moves at most 10,000 after one tick.
     let scene = Scene::new(
         "cap",
         PlaneOptions {
@@ -180,10 +181,13 @@ fn linear_speed_is_capped_at_400() {
             ..Default::default()
         },
     );
-    let b = launched_box(&mut &scene.plane, 0.0, 1000.0, &[]).unwrap();
+    let b = launched_box(&mut &scene.plane, 0.0, 20_000.0, &[]).unwrap();
     run_finite(&scene, DT, 1);
     let v = b.velocity().unwrap()[0];
-    assert!(v > 390.0 && v <= 400.0 * (1.0 + 1e-5), "v = {v}");
+    assert!(
+        v > 9_900.0 && v <= DEFAULT_MAX_LINEAR_SPEED * (1.0 + 1e-5),
+        "v = {v}"
+    );
 }
 
 #[test]
@@ -310,14 +314,17 @@ fn extreme_buoyancy_and_constant_force_stay_exact_then_capped() {
     let exact = (1e4 - 50.0) * 2.0 * DT;
     let v = b.velocity().unwrap()[1];
     assert!((v - exact).abs() <= 1e-3 * exact, "v {v}, exact {exact}");
-    // ConstantForce 1e9 on a unit mass: finite, and held at the 400 speed cap.
+    // ConstantForce 1e9 on a unit mass: finite, and held at MaxLinearSpeed (10,000).
     let (scene, b) = ball_in(PlaneOptions {
         constant_force: Some([1e9, 0.0, 0.0]),
         ..Default::default()
     });
     run_finite(&scene, DT, 60);
     let speed = dist(b.velocity().unwrap(), [0.0; 3]);
-    assert!(speed <= 400.0 * (1.0 + 1e-5), "speed {speed}");
+    assert!(
+        speed <= DEFAULT_MAX_LINEAR_SPEED * (1.0 + 1e-5),
+        "speed {speed}"
+    );
 }
 
 #[test]

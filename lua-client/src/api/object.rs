@@ -227,7 +227,7 @@ pub fn methods(lua: &Lua) -> mlua::Result<Table> {
             o.live(what)?.wake().map_err(|e| sdk_error(what, e))
         })?,
     )?;
-    // Lua parts are Cube / Sphere (no mesh): this returns the CenterOfMass unchanged.
+    // Lua parts carry no mesh: a Wedge gets its centroid back, other shapes keep theirs.
     t.set(
         "RecalculateCenterOfMass",
         lua.create_function(|_, o: Value| {

@@ -15,35 +15,65 @@ use crate::props::part::PART;
 use crate::props::Target;
 use crate::values::{describe, expected, new_vector, sdk_error, CFrame, DESCRIBE};
 
-/// Shapes a BasePart can have (the collider the plane builds from it).
+/// Shapes a BasePart can have (the collider the plane builds from it). The part's origin is
+/// the centre of its Size box for every shape.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum PartShape {
     /// A box of the part's size.
     Cube,
     /// The largest sphere that fits in the part's size.
     Sphere,
+    /// A capsule along the part's Y axis: radius min(Size.X, Size.Z) / 2, total height
+    /// Size.Y (a ball when Size.Y is at most the diameter).
+    Capsule,
+    /// A cylinder along the part's Y axis: radius min(Size.X, Size.Z) / 2, height Size.Y.
+    Cylinder,
+    /// A ramp filling half of the Size box (Roblox's WedgePart): full bottom face, vertical
+    /// face at the back (+Z), slope falling from the top-back edge to the bottom-front edge
+    /// (-Z). Its centre of mass is at (0, -Size.Y/6, +Size.Z/6).
+    Wedge,
 }
 
 impl PartShape {
+    /// Every shape, in the order error messages list them.
+    pub const ALL: [PartShape; 5] = [
+        PartShape::Cube,
+        PartShape::Sphere,
+        PartShape::Capsule,
+        PartShape::Cylinder,
+        PartShape::Wedge,
+    ];
+
     /// The accepted names, as error messages list them.
-    pub const NAMES: &'static str = "\"Cube\" or \"Sphere\"";
+    pub const NAMES: &'static str = "\"Cube\", \"Sphere\", \"Capsule\", \"Cylinder\" or \"Wedge\"";
 
     /// The Lua name (also a new part's default name).
     pub fn name(self) -> &'static str {
         match self {
             PartShape::Cube => "Cube",
             PartShape::Sphere => "Sphere",
+            PartShape::Capsule => "Capsule",
+            PartShape::Cylinder => "Cylinder",
+            PartShape::Wedge => "Wedge",
         }
     }
 
-    /// The collider for a part of `size`: a box of that full size, or the largest sphere
-    /// that fits in it.
+    /// The shape called `name`, if any.
+    pub fn from_name(name: &[u8]) -> Option<PartShape> {
+        Self::ALL.into_iter().find(|s| s.name().as_bytes() == name)
+    }
+
+    /// The collider for a part of `size`: a box of that full size, the largest sphere that
+    /// fits in it, or the capsule, cylinder or wedge of that size.
     pub fn collider(self, size: [f32; 3]) -> Shape {
         match self {
             PartShape::Cube => Shape::Cube { size },
             PartShape::Sphere => Shape::Sphere {
                 radius: size.iter().copied().fold(f32::INFINITY, f32::min) * 0.5,
             },
+            PartShape::Capsule => Shape::Capsule { size },
+            PartShape::Cylinder => Shape::Cylinder { size },
+            PartShape::Wedge => Shape::Wedge { size },
         }
     }
 }
@@ -436,11 +466,11 @@ pub fn module(lua: &Lua) -> mlua::Result<Table> {
         "BasePart",
         lua.create_function(|_, shape: Value| {
             let shape = match &shape {
-                Value::Nil => PartShape::Cube,
-                Value::String(s) if &*s.as_bytes() == b"Cube" => PartShape::Cube,
-                Value::String(s) if &*s.as_bytes() == b"Sphere" => PartShape::Sphere,
-                other => return Err(expected("Renderable.BasePart", PartShape::NAMES, other)),
-            };
+                Value::Nil => Some(PartShape::Cube),
+                Value::String(s) => PartShape::from_name(&s.as_bytes()),
+                _ => None,
+            }
+            .ok_or_else(|| expected("Renderable.BasePart", PartShape::NAMES, &shape))?;
             Ok(BasePart(Rc::new(PartState::new(shape))))
         })?,
     )?;

@@ -303,6 +303,8 @@ fn option(o: &mut PlaneOptions, prop: PlaneProp) {
         PlaneProp::LoopSolver(v) => o.loop_solver = Some(v),
         PlaneProp::NeverSleep(v) => o.never_sleep = Some(v),
         PlaneProp::Shared(v) => o.shared = Some(v),
+        PlaneProp::MaxLinearSpeed(v) => o.max_linear_speed = Some(v),
+        PlaneProp::MaxAngularSpeed(v) => o.max_angular_speed = Some(v),
     }
 }
 

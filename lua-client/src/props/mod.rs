@@ -39,6 +39,8 @@ pub enum Kind {
         /// Largest accepted value (may be inf: no bound).
         max: f64,
     },
+    /// A finite number > 0 (limits that cannot be zero).
+    Positive,
     /// A whole number in `[min, max]`.
     Integer {
         /// Smallest accepted value (`i64::MIN`: no bound).
@@ -86,6 +88,7 @@ impl Kind {
                 (false, true) => format!("a finite number <= {max}"),
                 (true, true) => format!("a number in [{min}, {max}]"),
             },
+            Kind::Positive => "a finite number > 0".into(),
             Kind::Integer { min, max } => match (min > i64::MIN, max < i64::MAX) {
                 (false, false) => "an integer".into(),
                 (true, false) => format!("an integer >= {min}"),
@@ -112,6 +115,10 @@ impl Kind {
         match *self {
             Kind::Number { min, max } => match number(value) {
                 Some(n) if n.is_finite() && n >= min && n <= max => Ok(Arg::Number(n)),
+                _ => Err(bad()),
+            },
+            Kind::Positive => match number(value) {
+                Some(n) if n.is_finite() && n > 0.0 => Ok(Arg::Number(n)),
                 _ => Err(bad()),
             },
             Kind::Integer { min, max } => match number(value) {
@@ -150,7 +157,7 @@ impl Kind {
 /// A converted property value. Each variant is what one `Kind` produces.
 #[derive(Debug, Clone)]
 pub enum Arg {
-    /// From [`Kind::Number`].
+    /// From [`Kind::Number`] and [`Kind::Positive`].
     Number(f64),
     /// From [`Kind::Integer`].
     Integer(i64),

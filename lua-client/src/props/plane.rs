@@ -147,6 +147,18 @@ pub static PLANE: Props<PlaneState> = Props {
         },
         bool_row!("LoopSolver", loop_solver, PlaneProp::LoopSolver),
         bool_row!("NeverSleep", never_sleep, PlaneProp::NeverSleep),
+        number_row!(
+            "MaxLinearSpeed",
+            Kind::Positive,
+            max_linear_speed,
+            PlaneProp::MaxLinearSpeed
+        ),
+        number_row!(
+            "MaxAngularSpeed",
+            Kind::Positive,
+            max_angular_speed,
+            PlaneProp::MaxAngularSpeed
+        ),
         Row::not_yet("DeferGpu", Kind::Boolean),
     ],
 };

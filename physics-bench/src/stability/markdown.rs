@@ -132,6 +132,7 @@ Reading the figures:
 - Contacts are soft springs (rapier's natural frequency: 30 Hz between bodies, 60 Hz against
   anchored ones, raised up to 2.5× by HitBoxQuality). Under a heavy body the steady sink grows
   with the mass ratio; more iterations or a higher tick rate do not remove it.
-- Speeds are capped at 400 units/s per substep (rapier's `normalized_max_linear_velocity`,
-  length unit 1): launches above 400 behave as 400, so the speed sweep cannot fail above it.
+- Speeds are capped at the plane's MaxLinearSpeed (default 10,000 units/s, applied per
+  substep through rapier's `normalized_max_linear_velocity`), far above the speed sweep, so
+  every launch of the sweep really flies at its speed.
 ";

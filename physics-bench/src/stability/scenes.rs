@@ -7,6 +7,7 @@
 
 use client_sdk::{Handle, ObjectProp, Pin, PlaneProp, Pose};
 use physics_scenes::{ball, column, floor, launched_box, overlapping_pile, thin_wall};
+use shm_layout::settings::plane::DEFAULT_MAX_LINEAR_SPEED;
 
 use crate::error::BenchResult;
 use crate::sim::{distance, Config, Sim};
@@ -126,7 +127,7 @@ pub const SCENES: &[Scene] = &[
     },
     Scene {
         name: "speed-cap",
-        criterion: "rapier's normalized_max_linear_velocity: a body launched at 1,000 units/s moves at ≤ 400 after one step",
+        criterion: "MaxLinearSpeed (default 10,000, rapier's normalized_max_linear_velocity): a body launched at 20,000 units/s moves at ≤ 10,000 after one step",
         unit: "units/s",
         config: Config::DEFAULT,
         run: speed_cap,
@@ -178,7 +179,7 @@ pub const SCENES: &[Scene] = &[
     },
     Scene {
         name: "extreme-constant-force",
-        criterion: "ConstantForce 1e9 on a unit mass for 1 s: stays finite, speed held at rapier's 400 cap",
+        criterion: "ConstantForce 1e9 on a unit mass for 1 s: stays finite, speed held at MaxLinearSpeed (10,000)",
         unit: "units/s",
         config: Config::DEFAULT,
         run: extreme_constant_force,
@@ -293,11 +294,15 @@ pub fn fast_box(c: Config, speed: f64) -> BenchResult<Check> {
 
 fn speed_cap(c: Config) -> BenchResult<Check> {
     let mut sim = Sim::new(c, &[PlaneProp::Gravity([0.0; 3])])?;
-    let b = launched_box(&mut sim, 0.0, 1000.0, &[])?;
+    let b = launched_box(&mut sim, 0.0, 20_000.0, &[])?;
     sim.step()?;
     let v = sim.state(b).linear_velocity;
     let speed = distance(v, [0.0; 3]);
-    Ok(Check::at_most(&sim, speed, 400.0 * (1.0 + 1e-5)))
+    Ok(Check::at_most(
+        &sim,
+        speed,
+        DEFAULT_MAX_LINEAR_SPEED as f64 * (1.0 + 1e-5),
+    ))
 }
 
 fn overlap(c: Config) -> BenchResult<Check> {
@@ -409,7 +414,11 @@ fn extreme_constant_force(c: Config) -> BenchResult<Check> {
         sim.step()?;
         fastest = fastest.max(distance(sim.state(b).linear_velocity, [0.0; 3]));
     }
-    Ok(Check::at_most(&sim, fastest, 400.0 * (1.0 + 1e-5)))
+    Ok(Check::at_most(
+        &sim,
+        fastest,
+        DEFAULT_MAX_LINEAR_SPEED as f64 * (1.0 + 1e-5),
+    ))
 }
 
 fn extreme_pin(c: Config) -> BenchResult<Check> {

@@ -6,11 +6,13 @@
 //! - `objects`, `properties`, `part`: objects, their properties and their rapier mapping.
 //! - `forces`, `solver`, `contacts`: the per-tick force pass, solver tuning, contacts.
 //! - `queries`, `collision_groups`: scene queries and the plane's collision-group table.
+//! - `limits`: MaxLinearSpeed and MaxAngularSpeed.
 
 mod backend;
 mod collision_groups;
 mod contacts;
 mod forces;
+mod limits;
 mod objects;
 mod part;
 mod properties;
@@ -222,6 +224,7 @@ impl Plane {
         self.world.integration_parameters.dt = dt;
         self.tune_solver();
         self.apply_forces(dt);
+        self.limit_speeds_before_step();
         let hooks = contacts::RestThreshold(self.settings.rest_threshold);
         // Contacts of objects removed since the last step still end with an event.
         if self.reporting > 0 || !self.removed.is_empty() {
@@ -235,6 +238,7 @@ impl Plane {
             self.world.step_with_events(&hooks, &());
         }
         self.scene_changed = false;
+        self.limit_speeds_after_step();
         self.dirty.stepped(self.bodies.slot_count());
         self.tick += 1;
         self.sim_time += dt as f64;

@@ -148,11 +148,11 @@ impl Plane {
         })
     }
 
-    /// Sets CenterOfMass to the mesh's vertex centroid (mesh parts only) and returns the
-    /// centre of mass in effect.
+    /// Sets CenterOfMass to the mesh's vertex centroid or the wedge's centroid (other
+    /// shapes are unchanged) and returns the centre of mass in effect.
     pub fn recalculate_center_of_mass(&mut self, handle: Handle) -> Result<Vec3, CommandError> {
         self.body_of(handle)?;
-        match self.part(handle).mesh_centroid() {
+        match self.part(handle).centroid() {
             Some(c) => {
                 self.set_object(handle, ObjectProp::CenterOfMass(c))?;
                 Ok(c)

@@ -1,5 +1,11 @@
 //! What an object is beyond its rapier body: the properties of the API, and how they turn
 //! into rapier's collider shape, material, mass properties and locked axes.
+//!
+//! Shapes and their Size: Cube (a box of Size), Sphere (radius min(Size) / 2), Capsule and
+//! Cylinder along the body's Y axis (radius min(Size.X, Size.Z) / 2, total height Size.Y),
+//! Wedge (half of the Size box, sloping down toward -Z: see [`wedge_points`]) and Mesh (the
+//! convex hull of its vertices, scaled to Size). The body's origin is always the centre of
+//! the Size box.
 
 use rapier3d::prelude::*;
 use shm_layout::{CollisionGroups, CommandError, ObjectSettings, Shape, ShapeKind, Vec3};
@@ -51,7 +57,10 @@ impl std::ops::DerefMut for Part {
 impl Part {
     pub fn new(shape: &Shape) -> Part {
         let (size, mesh) = match shape {
-            Shape::Cube { size } => (*size, None),
+            Shape::Cube { size }
+            | Shape::Capsule { size }
+            | Shape::Cylinder { size }
+            | Shape::Wedge { size } => (*size, None),
             Shape::Sphere { radius } => ([2.0 * radius; 3], None),
             Shape::Mesh { vertices, .. } => {
                 let extent = extent_of(vertices);
@@ -65,12 +74,42 @@ impl Part {
                 )
             }
         };
-        Part {
+        let mut part = Part {
             shape: shape.kind(),
             size,
             mesh,
             settings: ObjectSettings::default(),
             forced_tick: 0,
+        };
+        // A wedge's mass sits off its origin: CenterOfMass reads where it is.
+        part.settings.center_of_mass = part.natural_center_of_mass();
+        part
+    }
+
+    /// Changes Size, checking that the shape can be built at it (the part is unchanged on
+    /// error). A CenterOfMass that was the shape's own centroid follows the new size; one
+    /// set by hand stays.
+    pub fn resize(&mut self, size: Vec3) -> Result<(), CommandError> {
+        let old = self.size;
+        let followed = self.center_of_mass == self.natural_center_of_mass();
+        self.size = size;
+        if let Err(e) = self.collider_shape() {
+            self.size = old;
+            return Err(e);
+        }
+        if followed {
+            self.settings.center_of_mass = self.natural_center_of_mass();
+        }
+        Ok(())
+    }
+
+    /// Where the shape's mass centre is when CenterOfMass is left alone: the wedge's
+    /// centroid (0, -Size.Y/6, +Size.Z/6), the origin for every other shape (a mesh part's
+    /// vertex centroid only through RecalculateCenterOfMass).
+    pub fn natural_center_of_mass(&self) -> Vec3 {
+        match self.shape {
+            ShapeKind::Wedge => wedge_centroid(self.size),
+            _ => [0.0; 3],
         }
     }
 
@@ -85,6 +124,29 @@ impl Part {
         Ok(match (&self.mesh, self.shape) {
             (_, ShapeKind::Cube) => SharedShape::cuboid(x / 2.0, y / 2.0, z / 2.0),
             (_, ShapeKind::Sphere) => SharedShape::ball(x.min(y).min(z) / 2.0),
+            (_, ShapeKind::Capsule) => {
+                let radius = x.min(z) / 2.0;
+                let half_segment = y / 2.0 - radius;
+                if half_segment > 0.0 {
+                    SharedShape::capsule_y(half_segment, radius)
+                } else {
+                    // No taller than its diameter: only the two caps remain, a ball.
+                    SharedShape::ball(radius)
+                }
+            }
+            (_, ShapeKind::Cylinder) => SharedShape::cylinder(y / 2.0, x.min(z) / 2.0),
+            // The convex hull of its 6 corners, whose faces are known: handing them over
+            // skips the hull search, which fails on accepted extremes such as
+            // 0.001 × 0.001 × 100,000 (f32 cannot tell those corners apart from coplanar).
+            (_, ShapeKind::Wedge) => {
+                SharedShape::convex_mesh(wedge_points(self.size).to_vec(), &WEDGE_FACES)
+                    .ok_or_else(|| {
+                        CommandError::invalid_field(
+                            "Size",
+                            format!("a Wedge of Size {:?} spans no volume", self.size),
+                        )
+                    })?
+            }
             (Some(mesh), ShapeKind::Mesh) => {
                 let points = mesh.scaled_hull_points(self.size);
                 let flat = || {
@@ -105,20 +167,27 @@ impl Part {
         })
     }
 
-    /// Vertex centroid of the mesh at the current Size (body-local), if the part has one.
-    pub fn mesh_centroid(&self) -> Option<Vec3> {
+    /// What RecalculateCenterOfMass writes (body-local, at the current Size): a mesh part's
+    /// vertex centroid, a wedge's centroid; `None` for the symmetric primitives, whose
+    /// centroid is the origin and who carry no vertices (the call leaves them unchanged).
+    pub fn centroid(&self) -> Option<Vec3> {
+        if self.shape == ShapeKind::Wedge {
+            return Some(wedge_centroid(self.size));
+        }
         let points = self.mesh.as_ref()?.scaled(self.size);
         let n = points.len() as f32;
         let sum = points.iter().fold(Vector::ZERO, |a, p| a + *p);
         Some((sum / n).into())
     }
 
-    /// Low-quality non-spheres without a centre of mass translate but do not spin from
-    /// contacts (the documented HitBoxQuality behaviour).
+    /// Low-quality non-spheres (capsules and cylinders included) without a CenterOfMass
+    /// offset translate but do not spin from contacts (the documented HitBoxQuality
+    /// behaviour). A wedge's own off-centre centroid is not an offset: only a CenterOfMass
+    /// moved away from it frees its rotation.
     pub fn rotation_locked_by_quality(&self) -> bool {
         self.hit_box_quality < 2
             && self.shape != ShapeKind::Sphere
-            && self.center_of_mass == [0.0; 3]
+            && self.center_of_mass == self.natural_center_of_mass()
     }
 
     pub fn locked_axes(&self) -> LockedAxes {
@@ -202,6 +271,9 @@ impl Part {
     /// Writes locks and CCD into `body` and refreshes its mass from `colliders`.
     pub fn configure_body(&self, body: &mut RigidBody, colliders: &ColliderSet) {
         body.set_locked_axes(self.locked_axes(), true);
+        // Rapier's own angular cap (a quarter turn per tick) is switched off: the plane's
+        // MaxAngularSpeed is the one limit (see `limits`).
+        body.set_allow_fast_rotation(true);
         body.enable_ccd(self.hit_box_quality > 1);
         body.recompute_mass_properties_from_colliders(colliders);
         // Zero the velocity along newly locked axes so a lock holds the current value.
@@ -286,6 +358,39 @@ fn hull_points(vertices: &[Vec3]) -> Vec<Vec3> {
     picked.into_iter().map(|i| vertices[i]).collect()
 }
 
+/// The 6 corners of a wedge filling half of its `size` box (origin at the box centre), as
+/// Roblox's WedgePart: the bottom face (y = -Y/2) is full, the vertical face is the back
+/// (z = +Z/2), and the slope runs from the top-back edge (y = +Y/2, z = +Z/2) down to the
+/// bottom-front edge (y = -Y/2, z = -Z/2). Cross-section in YZ: (-Y/2, -Z/2), (-Y/2, +Z/2),
+/// (+Y/2, +Z/2), extruded over X.
+fn wedge_points(size: Vec3) -> [Vector; 6] {
+    let [hx, hy, hz] = size.map(|c| c / 2.0);
+    let section = [(-hy, -hz), (-hy, hz), (hy, hz)];
+    std::array::from_fn(|i| {
+        let (y, z) = section[i % 3];
+        Vector::new(if i < 3 { -hx } else { hx }, y, z)
+    })
+}
+
+/// The faces of [`wedge_points`] as outward (counter-clockwise) triangles: the two ends
+/// (-X, +X), the bottom (-Y), the back (+Z) and the slope.
+const WEDGE_FACES: [[u32; 3]; 8] = [
+    [0, 1, 2],
+    [3, 5, 4],
+    [0, 3, 4],
+    [0, 4, 1],
+    [1, 4, 5],
+    [1, 5, 2],
+    [0, 2, 5],
+    [0, 5, 3],
+];
+
+/// Centroid of the wedge of `size` (that of its right-triangle cross-section):
+/// (0, -Y/6, +Z/6).
+fn wedge_centroid(size: Vec3) -> Vec3 {
+    [0.0, -size[1] / 6.0, size[2] / 6.0]
+}
+
 fn extent_of(vertices: &[Vec3]) -> Vec3 {
     let mut lo = Vector::splat(f32::INFINITY);
     let mut hi = Vector::splat(f32::NEG_INFINITY);
@@ -335,6 +440,87 @@ mod tests {
             (stretched / volume - 2.0).abs() < 1e-3,
             "{stretched} vs 2 × {volume}"
         );
+    }
+
+    #[test]
+    fn new_shapes_have_their_closed_form_volumes_and_centroids() {
+        use std::f32::consts::PI;
+        let volume = |shape: Shape| {
+            let part = Part::new(&shape);
+            let props = part.collider_shape().unwrap().mass_properties(1.0);
+            (props.mass(), props.local_com, part)
+        };
+        let close = |a: f32, b: f32| (a - b).abs() <= 1e-5 * b.abs().max(1.0);
+        // Capsule: r = min(X, Z)/2 = 0.5, segment h = Y - 2r = 2.
+        let (v, com, _) = volume(Shape::Capsule {
+            size: [1.0, 3.0, 1.5],
+        });
+        assert!(close(v, PI * 0.25 * (2.0 + 4.0 * 0.5 / 3.0)), "{v}");
+        assert!(com.length() < 1e-6);
+        // A capsule no taller than its diameter is the ball.
+        let (v, _, _) = volume(Shape::Capsule {
+            size: [2.0, 1.5, 2.0],
+        });
+        assert!(close(v, 4.0 / 3.0 * PI), "{v}");
+        // Cylinder: π r² h.
+        let (v, _, _) = volume(Shape::Cylinder {
+            size: [2.0, 3.0, 4.0],
+        });
+        assert!(close(v, PI * 3.0), "{v}");
+        // Wedge: half the box, centroid (0, -Y/6, Z/6), which CenterOfMass reads.
+        let (v, com, part) = volume(Shape::Wedge {
+            size: [2.0, 3.0, 4.0],
+        });
+        assert!(close(v, 12.0), "{v}");
+        assert!(
+            (com - Vector::new(0.0, -0.5, 4.0 / 6.0)).length() < 1e-5,
+            "{com:?}"
+        );
+        assert_eq!(part.center_of_mass, [0.0, -0.5, 4.0 / 6.0]);
+        assert!(
+            part.rotation_locked_by_quality(),
+            "its own centroid is no offset"
+        );
+        // The slope falls toward -Z: the top at the back, nothing at the front top.
+        let hull = part.collider_shape().unwrap();
+        let top_back = Vector::new(0.0, 1.49, 1.99);
+        let top_front = Vector::new(0.0, 1.49, -1.99);
+        let at = rapier3d::math::Pose::IDENTITY;
+        assert!(hull.contains_point(&at, top_back));
+        assert!(!hull.contains_point(&at, top_front));
+    }
+
+    #[test]
+    fn extreme_accepted_sizes_build_every_new_shape() {
+        use shm_layout::validate::{MAX_SIZE, MIN_SIZE};
+        let extremes = [MIN_SIZE, 1.0, MAX_SIZE];
+        for x in extremes {
+            for y in extremes {
+                for z in extremes {
+                    let size = [x, y, z];
+                    for shape in [
+                        Shape::Capsule { size },
+                        Shape::Cylinder { size },
+                        Shape::Wedge { size },
+                    ] {
+                        let part = Part::new(&shape);
+                        let props = part.collider_shape().unwrap().mass_properties(1.0);
+                        assert!(props.mass() > 0.0 && props.mass().is_finite(), "{shape:?}");
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn a_wedge_centre_of_mass_follows_size_unless_set_by_hand() {
+        let mut part = Part::new(&Shape::Wedge { size: [1.0; 3] });
+        part.resize([1.0, 6.0, 6.0]).unwrap();
+        assert_eq!(part.center_of_mass, [0.0, -1.0, 1.0]);
+        part.settings.center_of_mass = [0.0; 3];
+        part.resize([1.0, 3.0, 3.0]).unwrap();
+        assert_eq!(part.center_of_mass, [0.0; 3]);
+        assert!(!part.rotation_locked_by_quality(), "moved off its centroid");
     }
 
     #[test]

@@ -50,12 +50,7 @@ impl Plane {
                 body.set_angvel(Vector::ZERO, true);
             }
             ObjectProp::Size(size) => {
-                let old = part.size;
-                part.size = size;
-                if let Err(e) = part.collider_shape() {
-                    part.size = old;
-                    return Err(e);
-                }
+                part.resize(size)?;
                 shape_changed = true;
             }
             ObjectProp::ReportContacts(_) => {

@@ -360,13 +360,22 @@ impl<'a> Gen<'a> {
         }
     }
 
-    /// A shape: cube, sphere or mesh.
+    /// A shape: cube, sphere, capsule, cylinder, wedge or mesh.
     fn shape(&mut self, wild: bool) -> Shape {
         match self.rng.below(100) {
-            0..=44 => Shape::Cube {
+            0..=29 => Shape::Cube {
                 size: self.size(wild),
             },
-            45..=79 => {
+            30..=39 => Shape::Capsule {
+                size: self.size(wild),
+            },
+            40..=49 => Shape::Cylinder {
+                size: self.size(wild),
+            },
+            50..=59 => Shape::Wedge {
+                size: self.size(wild),
+            },
+            60..=79 => {
                 let r = self.rng.f32_in(0.05, 2.0);
                 Shape::Sphere {
                     radius: self.rng.maybe_wild(wild, r),
@@ -467,7 +476,7 @@ impl<'a> Gen<'a> {
                 r.range(lo, hi) as u32
             }
         };
-        match r.below(14) {
+        match r.below(16) {
             0 => PlaneProp::Gravity(if r.chance(0.3) {
                 [0.0, -50.0, 0.0]
             } else {
@@ -519,6 +528,14 @@ impl<'a> Gen<'a> {
             10 => PlaneProp::SolverIterations(any_u32(r, 1, 16)),
             11 => PlaneProp::LoopSolver(r.chance(0.1)),
             12 => PlaneProp::NeverSleep(r.chance(0.3)),
+            13 => {
+                let v = r.f32_in(1.0, 20_000.0);
+                PlaneProp::MaxLinearSpeed(r.maybe_wild(wild, v))
+            }
+            14 => {
+                let w = r.f32_in(0.5, 2_000.0);
+                PlaneProp::MaxAngularSpeed(r.maybe_wild(wild, w))
+            }
             _ => PlaneProp::Shared(r.chance(0.5)),
         }
     }

@@ -229,6 +229,9 @@ pub fn all_op_names() -> Vec<String> {
         "Plane.AddObject.Cube",
         "Plane.AddObject.Sphere",
         "Plane.AddObject.Mesh",
+        "Plane.AddObject.Capsule",
+        "Plane.AddObject.Cylinder",
+        "Plane.AddObject.Wedge",
         "Object.ApplyImpulse",
         "Object.Info",
         "Object.RecalculateCenterOfMass",
@@ -252,6 +255,8 @@ pub fn all_op_names() -> Vec<String> {
         PlaneProp::LoopSolver(false),
         PlaneProp::NeverSleep(false),
         PlaneProp::Shared(false),
+        PlaneProp::MaxLinearSpeed(1.0),
+        PlaneProp::MaxAngularSpeed(1.0),
     ];
     names.extend(
         plane_props
@@ -324,6 +329,9 @@ pub fn op_name(command: &Command) -> String {
                     Shape::Cube { .. } => "Cube",
                     Shape::Sphere { .. } => "Sphere",
                     Shape::Mesh { .. } => "Mesh",
+                    Shape::Capsule { .. } => "Capsule",
+                    Shape::Cylinder { .. } => "Cylinder",
+                    Shape::Wedge { .. } => "Wedge",
                 }
             ),
             PlaneOp::Object { op, .. } => match op {

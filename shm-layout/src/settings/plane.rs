@@ -2,8 +2,8 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::validate::{finite, finite3, in_range, non_negative, MAX_THREADS, MAX_TICK_RATE};
-use crate::validate::{MAX_SOLVER_ITERATIONS, MIN_TICK_RATE};
+use crate::validate::{finite, finite3, in_range, non_negative, positive};
+use crate::validate::{MAX_SOLVER_ITERATIONS, MAX_THREADS, MAX_TICK_RATE, MIN_TICK_RATE};
 use crate::{CommandError, Vec3};
 
 /// A plane option. Options marked "creation only" are rejected by a later `Set`.
@@ -38,7 +38,26 @@ pub enum PlaneProp {
     /// Other clients may change the plane (set options, add and change objects, step it);
     /// without it they may only read. Only the owner may destroy it. Creation only.
     Shared(bool),
+    /// Largest linear speed of a body (units/s), enforced by the solver after every substep.
+    /// Default [`DEFAULT_MAX_LINEAR_SPEED`]. Positive and finite.
+    MaxLinearSpeed(f32),
+    /// Largest angular speed of a body (rad/s), enforced before and after every step.
+    /// Default [`DEFAULT_MAX_ANGULAR_SPEED`]. Positive and finite.
+    MaxAngularSpeed(f32),
 }
+
+/// Default `MaxLinearSpeed`: 10,000 units/s. With units like Roblox studs (≈ 0.28 m) that is
+/// about 2.8 km/s, above any projectile a game fires (a rifle bullet is ≈ 3,200 units/s) and
+/// 200 s of free fall under the default gravity, while a runaway force still ends at a finite
+/// speed instead of overflowing. Rapier's own default (400) would clip bullets and fast
+/// vehicles.
+pub const DEFAULT_MAX_LINEAR_SPEED: f32 = 10_000.0;
+
+/// Default `MaxAngularSpeed`: 1,000 rad/s (about 9,500 rpm), above a car wheel of radius 0.5
+/// at 300 units/s (600 rad/s) and a spinning propeller, while a runaway torque still ends at
+/// a finite spin. Rapier's own cap (a quarter turn per tick, 47 rad/s at 60 Hz) would stop
+/// wheels of ordinary vehicles.
+pub const DEFAULT_MAX_ANGULAR_SPEED: f32 = 1_000.0;
 
 /// Every option of a plane, as set. [`Default`] holds the documented defaults.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -71,6 +90,10 @@ pub struct PlaneSettings {
     pub never_sleep: bool,
     /// `Shared`, default false (creation only).
     pub shared: bool,
+    /// `MaxLinearSpeed`, default [`DEFAULT_MAX_LINEAR_SPEED`] (10,000 units/s).
+    pub max_linear_speed: f32,
+    /// `MaxAngularSpeed`, default [`DEFAULT_MAX_ANGULAR_SPEED`] (1,000 rad/s).
+    pub max_angular_speed: f32,
 }
 
 impl Default for PlaneSettings {
@@ -90,6 +113,8 @@ impl Default for PlaneSettings {
             loop_solver: false,
             never_sleep: false,
             shared: false,
+            max_linear_speed: DEFAULT_MAX_LINEAR_SPEED,
+            max_angular_speed: DEFAULT_MAX_ANGULAR_SPEED,
         }
     }
 }
@@ -124,6 +149,8 @@ impl PlaneSettings {
             PlaneProp::LoopSolver(on) => self.loop_solver = on,
             PlaneProp::NeverSleep(on) => self.never_sleep = on,
             PlaneProp::Shared(on) => self.shared = on,
+            PlaneProp::MaxLinearSpeed(v) => self.max_linear_speed = v,
+            PlaneProp::MaxAngularSpeed(w) => self.max_angular_speed = w,
         }
         Ok(prop)
     }
@@ -147,6 +174,8 @@ impl PlaneProp {
             PlaneProp::LoopSolver(_) => "LoopSolver",
             PlaneProp::NeverSleep(_) => "NeverSleep",
             PlaneProp::Shared(_) => "Shared",
+            PlaneProp::MaxLinearSpeed(_) => "MaxLinearSpeed",
+            PlaneProp::MaxAngularSpeed(_) => "MaxAngularSpeed",
         }
     }
 
@@ -177,7 +206,9 @@ impl PlaneProp {
             | PlaneProp::AngularDamping(x)
             | PlaneProp::Drag(x)
             | PlaneProp::Buoyancy(x)
-            | PlaneProp::RestThreshold(x) => x.to_string(),
+            | PlaneProp::RestThreshold(x)
+            | PlaneProp::MaxLinearSpeed(x)
+            | PlaneProp::MaxAngularSpeed(x) => x.to_string(),
             PlaneProp::Enabled(b)
             | PlaneProp::LoopSolver(b)
             | PlaneProp::NeverSleep(b)
@@ -217,6 +248,8 @@ impl PlaneProp {
             ConstantForce(f) => ConstantForce(finite3("ConstantForce", f)?),
             RestThreshold(v) => RestThreshold(non_negative("RestThreshold", v)?),
             SolverIterations(n) => SolverIterations(n.clamp(1, MAX_SOLVER_ITERATIONS)),
+            MaxLinearSpeed(v) => MaxLinearSpeed(positive("MaxLinearSpeed", v)?),
+            MaxAngularSpeed(w) => MaxAngularSpeed(positive("MaxAngularSpeed", w)?),
             other => other,
         })
     }
