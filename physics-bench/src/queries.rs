@@ -80,7 +80,11 @@ fn rays(n: usize, extent: f32, seed: u64) -> Vec<Ray> {
 
 /// Runs `f` (which casts `batch` rays) until `budget` has passed; returns rays per second and
 /// the mean time per call.
-fn measure(batch: usize, budget: Duration, mut f: impl FnMut() -> BenchResult<()>) -> BenchResult<(f64, f64)> {
+fn measure(
+    batch: usize,
+    budget: Duration,
+    mut f: impl FnMut() -> BenchResult<()>,
+) -> BenchResult<(f64, f64)> {
     // Warm up: caches, allocations, the daemon's first refresh.
     for _ in 0..3 {
         f()?;
@@ -92,10 +96,7 @@ fn measure(batch: usize, budget: Duration, mut f: impl FnMut() -> BenchResult<()
         calls += 1;
     }
     let s = started.elapsed().as_secs_f64();
-    Ok((
-        (calls as f64 * batch as f64) / s,
-        s / calls as f64 * 1e6,
-    ))
+    Ok(((calls as f64 * batch as f64) / s, s / calls as f64 * 1e6))
 }
 
 pub fn run(args: &QueriesArgs) -> BenchResult<()> {
@@ -136,7 +137,10 @@ pub fn run(args: &QueriesArgs) -> BenchResult<()> {
                 .map_err(|e| BenchError::Failed(e.to_string()))
         })?;
         let (daemon_rate, round_trip) = measure(batch, budget, || {
-            plane.raycast_many(&rays, None).map(|_| ()).map_err(Into::into)
+            plane
+                .raycast_many(&rays, None)
+                .map(|_| ())
+                .map_err(Into::into)
         })?;
         let hits = remote_hits.iter().filter(|h| h.is_some()).count();
         rows.push(Row {
@@ -214,7 +218,11 @@ fn markdown(r: &QueriesReport) -> String {
                 format!(
                     "RaycastMany of {} rays within {GOAL_RATIO}× of in-process throughput{}",
                     row.batch,
-                    if judged { "" } else { " (reported, not judged)" }
+                    if judged {
+                        ""
+                    } else {
+                        " (reported, not judged)"
+                    }
                 ),
                 format!("{}×", num(Some(row.ratio))),
                 judged.then_some(row.ratio <= GOAL_RATIO),

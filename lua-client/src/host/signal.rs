@@ -17,6 +17,9 @@ struct Slot {
     once: bool,
 }
 
+/// What a signal tells when its number of handlers changes.
+type ListenerHook = Box<dyn Fn(usize)>;
+
 /// The connections of a signal, shared by its clones.
 #[derive(Default)]
 pub struct SignalInner {
@@ -25,7 +28,7 @@ pub struct SignalInner {
     next_id: Cell<u64>,
     /// Told the number of handlers whenever it changes (a part's Touched asks the daemon
     /// for contact events only while someone listens).
-    on_listeners: RefCell<Option<Box<dyn Fn(usize)>>>,
+    on_listeners: RefCell<Option<ListenerHook>>,
 }
 
 impl SignalInner {
