@@ -27,7 +27,6 @@ impl Plane {
         }
         // Pairs that collide now must meet at the next step, including resting ones.
         self.world.wake_up_all(true);
-        self.scene_changed = true;
         Ok(())
     }
 

@@ -81,9 +81,9 @@ pub struct Plane {
     removed: Vec<(ColliderHandle, shm_layout::Handle)>,
     /// The collision-group table objects' CollisionGroup indexes into.
     groups: CollisionGroups,
-    /// An op added, moved, resized or removed something since collision detection last ran:
-    /// a query first refreshes the broad phase so it sees the change.
-    scene_changed: bool,
+    /// Bodies an op added, moved or reshaped since the last step: a query first brings their
+    /// colliders' poses and broad-phase boxes up to date, so it sees the change.
+    query_stale: Vec<RigidBodyHandle>,
 }
 
 impl Plane {
@@ -121,7 +121,7 @@ impl Plane {
             event_seq: 0,
             removed: Vec::new(),
             groups: CollisionGroups::default(),
-            scene_changed: false,
+            query_stale: Vec::new(),
         };
         for prop in props {
             plane.apply_prop(*prop, true)?;
@@ -237,7 +237,7 @@ impl Plane {
         } else {
             self.world.step_with_events(&hooks, &());
         }
-        self.scene_changed = false;
+        self.query_stale.clear();
         self.limit_speeds_after_step();
         self.dirty.stepped(self.bodies.slot_count());
         self.tick += 1;

@@ -53,7 +53,7 @@ impl Plane {
         let handle = self.bodies.insert(Body { handle: h, part })?;
         debug_assert_eq!(handle.slot, slot);
         self.dirty.mark(handle.slot);
-        self.scene_changed = true;
+        self.query_stale.push(h);
         for prop in props {
             self.set_object(handle, prop)?;
         }
@@ -121,7 +121,6 @@ impl Plane {
         }
         self.world.remove_body(h);
         self.dirty.mark(handle.slot);
-        self.scene_changed = true;
         Ok(())
     }
 

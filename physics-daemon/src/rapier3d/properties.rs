@@ -112,7 +112,7 @@ impl Plane {
             (true, false) => self.reporting -= 1,
             _ => {}
         }
-        self.scene_changed = true;
+        self.query_stale.push(h);
         // Any change may need the body awake and seen by the next force pass.
         self.world.bodies[h].wake_up(true);
         self.dirty.mark(handle.slot);

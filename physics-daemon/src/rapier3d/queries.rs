@@ -1,7 +1,7 @@
 //! Scene queries on rapier's query pipeline: rays, swept spheres / boxes / object shapes,
 //! and overlap tests, with Roblox's filter (Include / Exclude list, collision group,
 //! RespectCanCollide). Queries see the latest tick plus whatever ops added, moved or
-//! removed since: such a change first refreshes collision detection (no time passes).
+//! removed since: such a change first refreshes the broad phase's tree (no time passes).
 
 use std::cell::RefCell;
 use std::collections::HashSet;
@@ -10,7 +10,6 @@ use rapier3d::parry::query::ShapeCastOptions;
 use rapier3d::prelude::*;
 use shm_layout::{CommandError, FilterType, Handle, Hit, QueryFilter, QueryOp, Reply, Vec3};
 
-use super::contacts::RestThreshold;
 use super::Plane;
 
 /// How many objects containing a ray's or sweep's start are skipped before giving up (a
@@ -154,25 +153,32 @@ impl Plane {
         })
     }
 
-    /// Runs collision detection (no time passes) when an op changed the scene since it last
-    /// ran, so the query pipeline's tree holds every object where it is now.
+    /// Brings the colliders of bodies ops added, moved or reshaped since the last step to
+    /// their bodies' poses and puts their boxes into the broad phase's tree, which queries
+    /// walk. No time passes and no contact is computed (the step does that as always).
     fn refresh_scene(&mut self) {
-        if !self.scene_changed {
+        if self.query_stale.is_empty() {
             return;
         }
-        let hooks = RestThreshold(self.settings.rest_threshold);
-        // Contacts of objects removed since the last step still end with an event.
-        if self.reporting > 0 || !self.removed.is_empty() {
-            let collector = ChannelEventCollector::new(
-                self.collision_tx.clone(),
-                self.force_tx.clone(),
-                self.tear_tx.clone(),
-            );
-            self.world.detect_collisions(&hooks, &collector);
-        } else {
-            self.world.detect_collisions(&hooks, &());
+        let stale = std::mem::take(&mut self.query_stale);
+        let world = &mut self.world;
+        for h in stale {
+            let Some(body) = world.bodies.get(h) else {
+                continue; // removed since: its collider is gone from the set queries read
+            };
+            let pose = *body.position();
+            for c in body.colliders() {
+                let Some(co) = world.colliders.get_mut(*c) else {
+                    continue;
+                };
+                let local = co.position_wrt_parent().copied().unwrap_or_default();
+                co.set_position(pose * local);
+                let aabb = co.compute_aabb();
+                world
+                    .broad_phase
+                    .set_aabb(&world.integration_parameters, *c, aabb);
+            }
         }
-        self.scene_changed = false;
     }
 
     fn resolve(
