@@ -14,6 +14,7 @@
 
 mod client;
 mod collision_groups;
+mod controller;
 mod error;
 mod events;
 mod object;
@@ -25,6 +26,7 @@ mod transport;
 
 pub use client::{Client, ConnectOptions, HUNG_AFTER, STALL_AFTER};
 pub use collision_groups::CollisionGroup;
+pub use controller::Controller;
 pub use error::Error;
 pub use events::{Contact, Events, EVENT_BUFFER_TICKS};
 pub use object::Object;
@@ -33,7 +35,7 @@ pub use query::QueryParams;
 /// The limits and checks the daemon applies, for callers that want to check early.
 pub use shm_layout::validate;
 pub use shm_layout::{
-    BodyState, CollisionGroups, CommandError, ErrorKind, EventRecord, FilterType, Handle, Hit,
+    BodyState, CollisionGroups, CommandError, ControllerInfo, ControllerProp, ControllerSettings, ErrorKind, EventRecord, FilterType, Handle, Hit,
     ObjectInfo, ObjectOp, ObjectProp, ObjectSettings, Pin, PlaneId, PlaneInfo, PlaneKind, PlaneOp,
     PlaneProp, PlaneSettings, Pose, Ray, Restraint, RotateTo, Shape, ShapeKind, TickHeader, Vec3,
 };

@@ -196,6 +196,10 @@ pub enum Reply {
     Hits(Vec<Option<Hit>>),
     /// The objects an overlap query found.
     Objects(Vec<Handle>),
+    /// A controller's description.
+    Controller(Box<crate::controller_op::ControllerInfo>),
+    /// A yes / no answer (whether a jump launched).
+    Flag(bool),
 }
 
 /// The result of one command.

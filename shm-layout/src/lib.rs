@@ -19,6 +19,7 @@
 pub mod codec;
 pub mod collision_groups;
 pub mod command;
+pub mod controller_op;
 pub mod error;
 pub mod names;
 pub mod object_op;
@@ -32,13 +33,15 @@ pub mod validate;
 pub use codec::{DecodeError, Frame};
 pub use collision_groups::CollisionGroups;
 pub use command::*;
+pub use controller_op::{ControllerInfo, ControllerOp};
 pub use error::{CommandError, ErrorKind};
 pub use object_op::ObjectOp;
 pub use plane_op::{OpCost, PlaneKind, PlaneOp};
 pub use query::{FilterType, Hit, QueryFilter, QueryOp, Ray};
 pub use records::*;
 pub use settings::{
-    ObjectProp, ObjectSettings, Pin, PlaneProp, PlaneSettings, Restraint, RotateTo,
+    ControllerProp, ControllerSettings, ObjectProp, ObjectSettings, Pin, PlaneProp, PlaneSettings,
+    Restraint, RotateTo,
 };
 pub use shape::{Shape, ShapeKind};
 

@@ -5,6 +5,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::collision_groups::CollisionGroups;
+use crate::controller_op::ControllerOp;
 use crate::object_op::ObjectOp;
 use crate::query::QueryOp;
 use crate::records::Handle;
@@ -55,6 +56,8 @@ pub enum PlaneOp {
     /// Replaces the plane's collision-group table; objects in a group no longer registered
     /// return to "Default".
     CollisionGroups(CollisionGroups),
+    /// An op on the plane's character controllers.
+    Controller(ControllerOp),
 }
 
 /// What an op may add to a plane, for the daemon's per-client quotas.
@@ -73,6 +76,7 @@ impl PlaneOp {
             self,
             PlaneOp::Info
                 | PlaneOp::Query(_)
+                | PlaneOp::Controller(ControllerOp::Info { .. })
                 | PlaneOp::Object {
                     op: ObjectOp::Info,
                     ..
@@ -86,6 +90,10 @@ impl PlaneOp {
             PlaneOp::AddObject { shape, .. } => OpCost {
                 objects: 1,
                 mesh_vertices: shape.mesh_vertices() as u64,
+            },
+            PlaneOp::Controller(ControllerOp::Create { .. }) => OpCost {
+                objects: 1,
+                mesh_vertices: 0,
             },
             _ => OpCost::default(),
         }

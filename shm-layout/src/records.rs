@@ -8,6 +8,10 @@ pub const FLAG_ALIVE: u32 = 1 << 0;
 pub const FLAG_SLEEPING: u32 = 1 << 1;
 /// Body flag: the body is anchored (fixed).
 pub const FLAG_ANCHORED: u32 = 1 << 2;
+/// Body flag: a character controller that stood on the ground after the tick.
+pub const FLAG_ON_GROUND: u32 = 1 << 3;
+/// Body flag: the body is a character controller's capsule.
+pub const FLAG_CONTROLLER: u32 = 1 << 4;
 
 /// A stable reference to one body: the slot indexes the published array, the generation
 /// tells a reused slot from the body that used to live there.
@@ -110,6 +114,17 @@ pub struct TickHeader {
 pub const EVENT_CONTACT_STARTED: u32 = 1;
 /// Event kind: two objects stopped touching.
 pub const EVENT_CONTACT_STOPPED: u32 = 2;
+/// Controller event: a jump launched (`a` = the controller).
+pub const EVENT_CONTROLLER_JUMPED: u32 = 16;
+/// Controller event: it landed (OnGround became true).
+pub const EVENT_CONTROLLER_LANDED: u32 = 17;
+/// Controller event: it moved this tick; `normal` carries its velocity (only while asked,
+/// `ReportMoved`).
+pub const EVENT_CONTROLLER_MOVED: u32 = 18;
+/// Controller event: waypoint `b_slot` (1-based) of its path was reached.
+pub const EVENT_WAYPOINT_REACHED: u32 = 19;
+/// Controller event: the last waypoint was reached.
+pub const EVENT_PATH_FINISHED: u32 = 20;
 
 /// One per-tick event (published in the plane's event service, one sample per tick that
 /// has events). 64 bytes.

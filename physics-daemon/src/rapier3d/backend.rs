@@ -38,6 +38,7 @@ impl Backend for Plane {
                 ObjectOp::Destroy => self.destroy_object(handle).map(|_| applied(self)),
             },
             PlaneOp::Query(query) => self.query(query),
+            PlaneOp::Controller(op) => self.controller_op(op),
             PlaneOp::CollisionGroups(table) => {
                 self.set_collision_groups(table).map(|_| Reply::Done)
             }

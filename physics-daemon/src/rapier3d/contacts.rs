@@ -6,17 +6,36 @@ use shm_layout::{EventRecord, EVENT_CONTACT_STARTED, EVENT_CONTACT_STOPPED};
 
 use super::Plane;
 
-/// RestThreshold: a contact whose normal approach speed is below the threshold does not
-/// bounce. Runs only for pairs where a collider has Bounciness > 0 (its active hook).
+/// The plane's contact hook, run only for pairs where a collider asks for it (Bounciness >
+/// 0, or a character controller's capsule):
+/// - RestThreshold: a contact whose normal approach speed is below the threshold does not
+///   bounce.
+/// - A controller (the only kinematic bodies) pressing sideways on a dynamic body: the
+///   solver does not push it (a kinematic body would push with infinite strength); the
+///   controller pushes it itself with a force capped at its PushStrength. Contacts along
+///   the vertical stay: a crate dropped on a character rests on its head.
 pub(super) struct RestThreshold(pub f32);
+
+/// Contacts more vertical than this (|normal.y|) between a controller and a dynamic body are
+/// left to the solver.
+const VERTICAL: f32 = 0.7;
 
 impl PhysicsHooks for RestThreshold {
     fn modify_solver_contacts(&self, context: &mut ContactModificationContext) {
         let bodies = context.bodies;
         let (b1, b2) = (context.rigid_body1, context.rigid_body2);
+        let kind = |h: Option<RigidBodyHandle>| h.and_then(|h| bodies.get(h)).map(|b| (b.is_kinematic(), b.is_dynamic()));
+        let controller_push = matches!(
+            (kind(b1), kind(b2)),
+            (Some((true, _)), Some((_, true))) | (Some((_, true)), Some((true, _)))
+        );
         let Some(manifold) = context.rigid_mut() else {
             return;
         };
+        if controller_push && manifold.normal.y.abs() < VERTICAL {
+            manifold.solver_contacts.clear();
+            return;
+        }
         if *manifold.restitution == 0.0 {
             return;
         }
@@ -58,6 +77,13 @@ impl Plane {
     /// contact point, the normal (from `a` toward `b`) and the normal impulse of the step.
     pub(super) fn collect_events(&mut self) {
         self.events.clear();
+        // Events the controllers produced before the step come first, in their order.
+        for mut record in std::mem::take(&mut self.pending_events) {
+            record.tick = self.tick;
+            record.seq = self.event_seq;
+            self.event_seq += 1;
+            self.events.push(record);
+        }
         while let Ok(event) = self.collision_rx.try_recv() {
             let (c1, c2) = (event.collider1(), event.collider2());
             let (Some(a), Some(b)) = (self.handle_of_collider(c1), self.handle_of_collider(c2))

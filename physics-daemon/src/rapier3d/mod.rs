@@ -6,11 +6,13 @@
 //! - `objects`, `properties`, `part`: objects, their properties and their rapier mapping.
 //! - `forces`, `solver`, `contacts`: the per-tick force pass, solver tuning, contacts.
 //! - `queries`, `collision_groups`: scene queries and the plane's collision-group table.
+//! - `controllers`: kinematic character controllers, ticked before each step.
 //! - `limits`: MaxLinearSpeed and MaxAngularSpeed.
 
 mod backend;
 mod collision_groups;
 mod contacts;
+mod controllers;
 mod forces;
 mod limits;
 mod objects;
@@ -40,6 +42,8 @@ pub use objects::MAX_SLOTS;
 struct Body {
     handle: RigidBodyHandle,
     part: Part,
+    /// `FLAG_*` bits the plane adds to the published state (controllers).
+    flags: u32,
 }
 
 /// One rapier3d plane.
@@ -79,6 +83,10 @@ pub struct Plane {
     /// Colliders removed since the last step with the object they belonged to, so their
     /// contact-stopped events still name it.
     removed: Vec<(ColliderHandle, shm_layout::Handle)>,
+    /// Character controllers by slot; ticked before each step (none: nothing to do).
+    controllers: controllers::Controllers,
+    /// Events produced before the step (controllers), published with the step's events.
+    pending_events: Vec<EventRecord>,
     /// The collision-group table objects' CollisionGroup indexes into.
     groups: CollisionGroups,
     /// Bodies an op added, moved or reshaped since the last step: a query first brings their
@@ -121,6 +129,8 @@ impl Plane {
             event_seq: 0,
             removed: Vec::new(),
             groups: CollisionGroups::default(),
+            controllers: Default::default(),
+            pending_events: Vec::new(),
             query_stale: Vec::new(),
         };
         for prop in props {
@@ -223,6 +233,7 @@ impl Plane {
         let started = Instant::now();
         self.world.integration_parameters.dt = dt;
         self.tune_solver();
+        self.tick_controllers(dt);
         self.apply_forces(dt);
         self.limit_speeds_before_step();
         let hooks = contacts::RestThreshold(self.settings.rest_threshold);
@@ -296,10 +307,10 @@ impl Plane {
     /// The published state of slot `i` (dead slots carry only their generation).
     pub fn body_state(&self, i: usize) -> BodyState {
         let generation = self.bodies.generation(i);
-        let Some(body) = self
+        let Some((body, extra)) = self
             .bodies
             .at(i)
-            .and_then(|b| self.world.bodies.get(b.handle))
+            .and_then(|b| Some((self.world.bodies.get(b.handle)?, b.flags)))
         else {
             return BodyState {
                 generation,
@@ -307,7 +318,7 @@ impl Plane {
             };
         };
         let pose = body.position();
-        let mut flags = FLAG_ALIVE;
+        let mut flags = FLAG_ALIVE | extra;
         if body.is_sleeping() {
             flags |= FLAG_SLEEPING;
         }

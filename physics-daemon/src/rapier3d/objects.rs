@@ -50,7 +50,11 @@ impl Plane {
         part.configure_body(&mut self.world.bodies[h], &self.world.colliders);
         self.quality_counts[part.hit_box_quality as usize] += 1;
         self.mesh_vertices += shape.mesh_vertices() as u64;
-        let handle = self.bodies.insert(Body { handle: h, part })?;
+        let handle = self.bodies.insert(Body {
+            handle: h,
+            part,
+            flags: 0,
+        })?;
         debug_assert_eq!(handle.slot, slot);
         self.dirty.mark(handle.slot);
         self.query_stale.push(h);
@@ -106,7 +110,9 @@ impl Plane {
 
     /// Removes the object; its handle becomes stale.
     pub fn destroy_object(&mut self, handle: Handle) -> Result<(), CommandError> {
-        let Body { handle: h, part } = self.bodies.remove(handle).map_err(|e| self.in_plane(e))?;
+        let Body { handle: h, part, .. } =
+            self.bodies.remove(handle).map_err(|e| self.in_plane(e))?;
+        self.controllers.remove(&handle.slot);
         if part.report_contacts {
             self.reporting -= 1;
         }

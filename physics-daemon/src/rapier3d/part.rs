@@ -39,6 +39,8 @@ pub(super) struct Part {
     pub settings: ObjectSettings,
     /// The tick whose force pass already handled this object (avoids doing it twice).
     pub forced_tick: u64,
+    /// A character controller's capsule (its collider runs the contact hook).
+    pub is_controller: bool,
 }
 
 impl std::ops::Deref for Part {
@@ -80,6 +82,7 @@ impl Part {
             mesh,
             settings: ObjectSettings::default(),
             forced_tick: 0,
+            is_controller: false,
         };
         // A wedge's mass sits off its origin: CenterOfMass reads where it is.
         part.settings.center_of_mass = part.natural_center_of_mass();
@@ -248,8 +251,9 @@ impl Part {
         collider.set_restitution_combine_rule(CoefficientCombineRule::Max);
         collider.set_contact_skin(BASE_CONTACT_SKIN / self.hit_box_quality as f32);
         collider.set_collision_groups(self.interaction_groups(groups));
-        // The rest-threshold hook only matters where something can bounce.
-        collider.set_active_hooks(if self.bounciness > 0.0 {
+        // The rest-threshold hook only matters where something can bounce; a controller's
+        // capsule needs it for its capped pushes.
+        collider.set_active_hooks(if self.bounciness > 0.0 || self.is_controller {
             ActiveHooks::MODIFY_SOLVER_CONTACTS
         } else {
             ActiveHooks::empty()

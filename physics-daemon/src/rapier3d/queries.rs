@@ -156,7 +156,7 @@ impl Plane {
     /// Brings the colliders of bodies ops added, moved or reshaped since the last step to
     /// their bodies' poses and puts their boxes into the broad phase's tree, which queries
     /// walk. No time passes and no contact is computed (the step does that as always).
-    fn refresh_scene(&mut self) {
+    pub(super) fn refresh_scene(&mut self) {
         if self.query_stale.is_empty() {
             return;
         }

@@ -4,7 +4,7 @@
 use std::collections::BTreeMap;
 
 use shm_layout::{
-    Command, CommandResult, ErrorKind, ObjectOp, ObjectProp, PlaneOp, PlaneProp, QueryOp, Reply,
+    Command, CommandResult, ControllerOp, ErrorKind, ObjectOp, ObjectProp, PlaneOp, PlaneProp, QueryOp, Reply,
     Response, Shape,
 };
 
@@ -309,6 +309,8 @@ pub fn reply_name(reply: &Reply) -> &'static str {
         Reply::CenterOfMass(_) => "CenterOfMass",
         Reply::Hits(_) => "Hits",
         Reply::Objects(_) => "Objects",
+        Reply::Controller(_) => "Controller",
+        Reply::Flag(_) => "Flag",
     }
 }
 
@@ -344,6 +346,7 @@ pub fn op_name(command: &Command) -> String {
             },
             PlaneOp::Query(q) => format!("Plane.Query.{}", query_name(q)),
             PlaneOp::CollisionGroups(_) => "Plane.CollisionGroups".into(),
+            PlaneOp::Controller(c) => format!("Plane.Controller.{}", controller_op_name(c)),
         },
     }
 }
@@ -370,6 +373,21 @@ pub fn object_prop_name(prop: &ObjectProp) -> &'static str {
         ObjectProp::RotateTo(_) => "RotateTo",
         ObjectProp::Pin(_) => "Pin",
         ObjectProp::CollisionGroup(_) => "CollisionGroup",
+    }
+}
+
+/// The name of a controller op (`Create`).
+pub fn controller_op_name(op: &ControllerOp) -> &'static str {
+    match op {
+        ControllerOp::Create { .. } => "Create",
+        ControllerOp::Set { .. } => "Set",
+        ControllerOp::Info { .. } => "Info",
+        ControllerOp::SetPath { .. } => "SetPath",
+        ControllerOp::AppendWaypoint { .. } => "AppendWaypoint",
+        ControllerOp::StopWalking { .. } => "StopWalking",
+        ControllerOp::Jump { .. } => "Jump",
+        ControllerOp::Teleport { .. } => "Teleport",
+        ControllerOp::Destroy { .. } => "Destroy",
     }
 }
 

@@ -6,8 +6,10 @@
 //! Adding a property: one variant plus its check and default in [`plane`] or [`object`],
 //! one mapping onto the engine in the daemon's backend, one row in lua-client's `props/`.
 
+pub mod controller;
 pub mod object;
 pub mod plane;
 
+pub use controller::{ControllerProp, ControllerSettings};
 pub use object::{ObjectProp, ObjectSettings, Pin, Restraint, RotateTo};
 pub use plane::{PlaneProp, PlaneSettings};
