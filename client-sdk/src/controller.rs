@@ -102,9 +102,13 @@ impl Controller {
 
     /// Every setting and the controller's own state (one round trip).
     pub fn info(&self) -> Result<ControllerInfo, Error> {
-        match self.object.plane().client().call(self.command(ControllerOp::Info {
-            handle: self.handle(),
-        }))? {
+        match self
+            .object
+            .plane()
+            .client()
+            .call(self.command(ControllerOp::Info {
+                handle: self.handle(),
+            }))? {
             Reply::Controller(info) => Ok(*info),
             other => Err(Error::Protocol(format!("unexpected reply {other:?}"))),
         }
@@ -155,9 +159,13 @@ impl Controller {
 
     /// Jumps when on the ground (one round trip); returns whether it launched.
     pub fn jump(&self) -> Result<bool, Error> {
-        match self.object.plane().client().call(self.command(ControllerOp::Jump {
-            handle: self.handle(),
-        }))? {
+        match self
+            .object
+            .plane()
+            .client()
+            .call(self.command(ControllerOp::Jump {
+                handle: self.handle(),
+            }))? {
             Reply::Flag(launched) => Ok(launched),
             other => Err(Error::Protocol(format!("unexpected reply {other:?}"))),
         }

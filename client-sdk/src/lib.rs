@@ -35,9 +35,12 @@ pub use query::QueryParams;
 /// The limits and checks the daemon applies, for callers that want to check early.
 pub use shm_layout::validate;
 pub use shm_layout::{
-    BodyState, CollisionGroups, CommandError, ControllerInfo, ControllerProp, ControllerSettings, ErrorKind, EventRecord, FilterType, Handle, Hit,
-    ObjectInfo, ObjectOp, ObjectProp, ObjectSettings, Pin, PlaneId, PlaneInfo, PlaneKind, PlaneOp,
-    PlaneProp, PlaneSettings, Pose, Ray, Restraint, RotateTo, Shape, ShapeKind, TickHeader, Vec3,
+    BodyState, CollisionGroups, CommandError, ControllerInfo, ControllerProp, ControllerSettings,
+    ErrorKind, EventRecord, FilterType, Handle, Hit, ObjectInfo, ObjectOp, ObjectProp,
+    ObjectSettings, Pin, PlaneId, PlaneInfo, PlaneKind, PlaneOp, PlaneProp, PlaneSettings, Pose,
+    Ray, Restraint, RotateTo, Shape, ShapeKind, TickHeader, Vec3, EVENT_CONTROLLER_JUMPED,
+    EVENT_CONTROLLER_LANDED, EVENT_CONTROLLER_MOVED, EVENT_PATH_FINISHED, EVENT_WAYPOINT_REACHED,
+    FLAG_ON_GROUND,
 };
 pub use spawn::{
     connect_or_start, daemon_executable, start_daemon, start_daemon_with, DaemonChild, Session,

@@ -7,8 +7,7 @@ use client_sdk::{
 };
 use integration_tests::{quat, Scene};
 use shm_layout::{
-    EVENT_CONTROLLER_JUMPED, EVENT_CONTROLLER_LANDED, EVENT_PATH_FINISHED,
-    EVENT_WAYPOINT_REACHED,
+    EVENT_CONTROLLER_JUMPED, EVENT_CONTROLLER_LANDED, EVENT_PATH_FINISHED, EVENT_WAYPOINT_REACHED,
 };
 
 const DT: f32 = 1.0 / 60.0;
@@ -147,7 +146,11 @@ fn slopes_steeper_than_max_slope_are_not_climbed_and_gentle_ones_are() {
     }
     s.run(DT, 120);
     assert!(y(&gentle) > HALF + 3.0, "climbs 30°: y {}", y(&gentle));
-    assert!(y(&steep) < HALF + 1.5, "does not climb 60°: y {}", y(&steep));
+    assert!(
+        y(&steep) < HALF + 1.5,
+        "does not climb 60°: y {}",
+        y(&steep)
+    );
 }
 
 #[test]
@@ -168,9 +171,7 @@ fn steps_below_step_height_are_walked_up_and_walls_stop_and_slide() {
     climber.set_move_vector(0.0, 1.0).unwrap();
     let blocked = character(&s, [24.0, HALF + SKIN, 0.0], &[]);
     // Diagonally into the wall (+X and +Z at yaw 0): slides along +Z.
-    blocked
-        .set(ControllerProp::LookWhereMoving(false))
-        .unwrap();
+    blocked.set(ControllerProp::LookWhereMoving(false)).unwrap();
     blocked.set_move_vector(0.7, 0.7).unwrap();
     let mut grounded_ticks = 0;
     for _ in 0..90 {
@@ -182,9 +183,16 @@ fn steps_below_step_height_are_walked_up_and_walls_stop_and_slide() {
         "walked up the stairs: y {}",
         y(&climber)
     );
-    assert!(grounded_ticks > 80, "no hopping: grounded {grounded_ticks} of 90");
+    assert!(
+        grounded_ticks > 80,
+        "no hopping: grounded {grounded_ticks} of 90"
+    );
     let p = blocked.object().position().unwrap();
-    assert!(p[0] <= 30.0 - 0.5 - 1.0 + 0.02, "the wall stops it: x {}", p[0]);
+    assert!(
+        p[0] <= 30.0 - 0.5 - 1.0 + 0.02,
+        "the wall stops it: x {}",
+        p[0]
+    );
     assert!(p[2] > 8.0, "slides along the wall: z {}", p[2]);
     assert!(y(&blocked) < HALF + 0.1, "a 2-high wall is not a step");
 }
@@ -233,7 +241,10 @@ fn platforms_carry_riders_up_down_and_sideways_and_jumps_inherit_their_velocity(
         let bottom = y(&c) - HALF;
         worst = worst.max((bottom - top).abs());
     }
-    assert!(worst < 0.05, "rides at the platform's top: worst gap {worst}");
+    assert!(
+        worst < 0.05,
+        "rides at the platform's top: worst gap {worst}"
+    );
     // Sideways at 5 units/s: carried along.
     let x0 = c.object().position().unwrap()[0];
     let mut x = 0.0;
@@ -275,13 +286,19 @@ fn light_crates_are_pushed_heavy_ones_block_and_controllers_collide() {
     s.run(DT, 120);
     let light_z = light.position().unwrap()[2];
     let heavy_z = heavy.position().unwrap()[2];
-    assert!(light_z > 10.0, "the light crate (mass 0.8) is pushed: z {light_z}");
+    assert!(
+        light_z > 10.0,
+        "the light crate (mass 0.8) is pushed: z {light_z}"
+    );
     assert!(
         (heavy_z - 6.0).abs() < 0.05,
         "the heavy crate (mass 800; friction 20,000 > push 500) blocks: z {heavy_z}"
     );
     let bz = b.object().position().unwrap()[2];
-    assert!(bz < 6.0 - 1.0 - 1.0 + 0.05, "blocked by the heavy crate: z {bz}");
+    assert!(
+        bz < 6.0 - 1.0 - 1.0 + 0.05,
+        "blocked by the heavy crate: z {bz}"
+    );
 
     // Two controllers walking into each other stop apart.
     let c1 = character(&s, [40.0, HALF + SKIN, 0.0], &[]);
@@ -361,4 +378,3 @@ fn paths_are_walked_in_order_with_one_event_per_waypoint_and_one_finish() {
     );
     let _ = Contact::from_record;
 }
-

@@ -321,3 +321,11 @@ fn queries_touches_and_collision_groups_from_luau() {
     r.assert_ok();
     assert!(r.stdout().contains("queries ok"), "{}", r.stdout());
 }
+
+#[test]
+fn controllers_from_luau() {
+    let daemon = TestDaemon::start("lua-kcc");
+    let r = run(&daemon, "tests/lua/controllers.luau");
+    r.assert_ok();
+    assert!(r.stdout().contains("controllers ok"), "{}", r.stdout());
+}

@@ -44,22 +44,23 @@ impl PlaneState {
             .clone()
     }
 
-    /// A part of the plane got touch handlers: subscribe to the plane's events now, so the
-    /// first contact after this point is delivered.
+    /// Something of the plane got handlers: subscribe to the plane's events now, so the
+    /// first event after this point is delivered, and drop what queued while nobody
+    /// listened.
     pub fn listen_for_contacts(&self) {
-        if !self.alive() {
+        if !self.alive() || self.contacts.reading.get() {
             return;
         }
-        if let Err(e) = self.plane.subscribe_events() {
-            eprintln!(
-                "PhysicsPlane {}: cannot read contact events: {e}",
-                self.plane.id()
-            );
+        match self.plane.events() {
+            Ok(_) => self.contacts.reading.set(true),
+            Err(e) => eprintln!("PhysicsPlane {}: cannot read events: {e}", self.plane.id()),
         }
     }
 
+    /// Whether anyone listens to the plane's events: a part's touch handlers or a
+    /// controller's signals.
     fn touch_handlers(&self) -> bool {
-        self.any_part(|p| p.touch_listeners() > 0)
+        self.any_part(|p| p.touch_listeners() > 0) || self.controller_listeners()
     }
 
     /// Delivers the events published since the last call to the parts' touch handlers.
@@ -99,7 +100,7 @@ impl PlaneState {
                     self.touch(lua, a, b, None)?;
                     self.touch(lua, b, a, None)?;
                 }
-                None => {}
+                None => self.controller_event(lua, record)?,
             }
         }
         Ok(())
@@ -133,6 +134,28 @@ impl PlaneState {
             None => None,
         };
         part.fire_touch(lua, other, contact)
+    }
+
+    /// Fires the controller signal a record carries (Jumped, Landed, Moved(vx, vy, vz),
+    /// WaypointReached(index), PathFinished).
+    fn controller_event(&self, lua: &Lua, r: &client_sdk::EventRecord) -> mlua::Result<()> {
+        let Some(c) = self.controller_of(r.a()) else {
+            return Ok(());
+        };
+        let num = |x: f32| Value::Number(x as f64);
+        let (name, args): (&str, Vec<Value>) = match r.kind {
+            client_sdk::EVENT_CONTROLLER_JUMPED => ("Jumped", vec![]),
+            client_sdk::EVENT_CONTROLLER_LANDED => ("Landed", vec![]),
+            client_sdk::EVENT_CONTROLLER_MOVED => {
+                ("Moved", r.normal.iter().map(|v| num(*v)).collect())
+            }
+            client_sdk::EVENT_WAYPOINT_REACHED => {
+                ("WaypointReached", vec![Value::Number(r.b_slot as f64)])
+            }
+            client_sdk::EVENT_PATH_FINISHED => ("PathFinished", vec![]),
+            _ => return Ok(()),
+        };
+        c.fire(lua, name, MultiValue::from_iter(args))
     }
 
     fn report_lost(&self, lua: &Lua, n: u64) -> mlua::Result<()> {

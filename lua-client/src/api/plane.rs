@@ -10,11 +10,12 @@ use client_sdk::{Client, Handle, ObjectProp, Plane, PlaneInfo, PlaneOptions, Pla
 use mlua::{Lua, MetaMethod, Table, UserData, UserDataMethods, Value};
 
 use super::contacts::ContactPump;
+use super::controller::{new_controller, ControllerState};
 use super::object::PhysicsObject;
 use super::part::{BasePart, Body, Ended, PartState};
 use crate::host::scheduler::scheduler;
-use crate::props::plane::{NOT_YET_METHODS, PLANE};
-use crate::props::{not_yet_methods, Target};
+use crate::props::plane::PLANE;
+use crate::props::Target;
 use crate::values::{describe, expected, finite_number, sdk_error};
 
 /// A plane as the host holds it. Its options live in the daemon alone: the property rows
@@ -28,6 +29,8 @@ pub struct PlaneState {
     by_handle: RefCell<HashMap<Handle, Rc<PartState>>>,
     /// Contact delivery of this plane (`contacts.rs`).
     pub(crate) contacts: ContactPump,
+    /// Its character controllers by body handle (`controller.rs`).
+    controllers: RefCell<HashMap<Handle, Rc<ControllerState>>>,
 }
 
 impl PlaneState {
@@ -63,6 +66,39 @@ impl PlaneState {
         self.by_handle.borrow_mut().remove(&handle);
     }
 
+    /// Makes `body` the simulated body of `part` in this plane.
+    pub fn adopt(&self, part: &Rc<PartState>, body: Rc<Body>, reporting: bool) {
+        let handle = body.object.handle();
+        part.link(body, reporting);
+        self.parts.borrow_mut().push(part.clone());
+        self.by_handle.borrow_mut().insert(handle, part.clone());
+    }
+
+    /// Keeps a controller so its events reach it.
+    pub fn keep_controller(&self, c: Rc<ControllerState>) {
+        self.controllers
+            .borrow_mut()
+            .insert(c.controller.handle(), c);
+    }
+
+    /// Forgets the controller of body `handle` (destroyed).
+    pub fn forget_controller(&self, handle: Handle) {
+        self.controllers.borrow_mut().remove(&handle);
+    }
+
+    /// The controller of body `handle`, if this host made it.
+    pub fn controller_of(&self, handle: Handle) -> Option<Rc<ControllerState>> {
+        self.controllers.borrow().get(&handle).cloned()
+    }
+
+    /// Whether any controller of the plane has signal handlers.
+    pub fn controller_listeners(&self) -> bool {
+        self.controllers
+            .borrow()
+            .values()
+            .any(|c| c.listeners() > 0)
+    }
+
     /// Whether any part of the plane passes `f`.
     pub fn any_part(&self, f: impl Fn(&PartState) -> bool) -> bool {
         self.parts.borrow().iter().any(|p| f(p))
@@ -82,6 +118,7 @@ impl PlaneState {
             part.unlink(Ended::PlaneDestroyed);
         }
         self.by_handle.borrow_mut().clear();
+        self.controllers.borrow_mut().clear();
         self.plane.destroy()
     }
 
@@ -183,7 +220,13 @@ impl UserData for PhysicsPlane {
                 .map_err(|e| sdk_error("PhysicsPlane:Destroy", e))
         });
         super::query::add_methods(methods);
-        not_yet_methods(methods, "PhysicsPlane", NOT_YET_METHODS);
+        methods.add_method("NewController", |_, p, (part, opts): (Value, Value)| {
+            new_controller(&p.0, part, opts, false)
+        });
+        methods.add_method(
+            "NewControlledController",
+            |_, p, (part, opts): (Value, Value)| new_controller(&p.0, part, opts, true),
+        );
         methods.add_meta_method(MetaMethod::Index, |lua, p, key: Value| {
             PLANE.get(lua, &p.0, &key)
         });
@@ -238,14 +281,11 @@ fn add(plane: &Rc<PlaneState>, part: Value) -> mlua::Result<PhysicsObject> {
         .plane
         .add(collider, state.cframe().pose(), props)
         .map_err(|e| sdk_error(&what(), e))?;
-    let handle = object.handle();
     let body = Body::new(object, Rc::downgrade(plane));
-    state.link(body.clone(), reporting);
+    plane.adopt(&state, body.clone(), reporting);
     if reporting {
         plane.listen_for_contacts();
     }
-    plane.parts.borrow_mut().push(state.clone());
-    plane.by_handle.borrow_mut().insert(handle, state.clone());
     Ok(PhysicsObject {
         body,
         part: state,
@@ -279,6 +319,7 @@ fn new_plane(lua: &Lua, opts: Value) -> mlua::Result<PhysicsPlane> {
         parts: RefCell::default(),
         by_handle: RefCell::default(),
         contacts: ContactPump::default(),
+        controllers: RefCell::default(),
     });
     // Probed every frame; it costs one check while no part of it has touch handlers.
     scheduler(lua).watch(state.clone());

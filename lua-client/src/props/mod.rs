@@ -11,6 +11,7 @@
 //! - A documented property the SDK cannot do yet is a row marked `NotYet`, so wiring it later
 //!   is editing one row, and using it meanwhile is a clear error instead of a silent no-op.
 
+pub mod controller;
 pub mod object;
 pub mod part;
 pub mod plane;
@@ -387,20 +388,5 @@ impl<T: Target> Props<T> {
             row.kind
                 .convert(&format!("{what} option {}", row.name), value)?,
         )
-    }
-}
-
-/// Registers documented methods the SDK cannot do yet: calling one is a clear error.
-pub fn not_yet_methods<T, M: mlua::UserDataMethods<T>>(
-    methods: &mut M,
-    owner: &'static str,
-    names: &[&'static str],
-) {
-    for &name in names {
-        methods.add_function(name, move |_, _: mlua::MultiValue| -> mlua::Result<()> {
-            Err(LuaError::runtime(format!(
-                "{owner}:{name} is not supported yet"
-            )))
-        });
     }
 }

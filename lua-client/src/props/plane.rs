@@ -162,6 +162,3 @@ pub static PLANE: Props<PlaneState> = Props {
         Row::not_yet("DeferGpu", Kind::Boolean),
     ],
 };
-
-/// Documented methods the SDK cannot do yet.
-pub const NOT_YET_METHODS: &[&str] = &["NewController", "NewControlledController"];

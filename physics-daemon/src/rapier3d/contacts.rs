@@ -24,7 +24,10 @@ impl PhysicsHooks for RestThreshold {
     fn modify_solver_contacts(&self, context: &mut ContactModificationContext) {
         let bodies = context.bodies;
         let (b1, b2) = (context.rigid_body1, context.rigid_body2);
-        let kind = |h: Option<RigidBodyHandle>| h.and_then(|h| bodies.get(h)).map(|b| (b.is_kinematic(), b.is_dynamic()));
+        let kind = |h: Option<RigidBodyHandle>| {
+            h.and_then(|h| bodies.get(h))
+                .map(|b| (b.is_kinematic(), b.is_dynamic()))
+        };
         let controller_push = matches!(
             (kind(b1), kind(b2)),
             (Some((true, _)), Some((_, true))) | (Some((_, true)), Some((true, _)))

@@ -19,7 +19,9 @@
 
 use std::collections::BTreeMap;
 
-use rapier3d::control::{CharacterAutostep, CharacterCollision, CharacterLength, KinematicCharacterController};
+use rapier3d::control::{
+    CharacterAutostep, CharacterCollision, CharacterLength, KinematicCharacterController,
+};
 use rapier3d::parry::query::ShapeCastOptions;
 use rapier3d::prelude::*;
 use shm_layout::controller_op::ControllerInfo;
@@ -98,13 +100,20 @@ impl Controller {
     }
 
     fn shape(&self) -> SharedShape {
-        SharedShape::capsule_y(self.settings.capsule_half_height, self.settings.capsule_radius)
+        SharedShape::capsule_y(
+            self.settings.capsule_half_height,
+            self.settings.capsule_radius,
+        )
     }
 
     /// Full size of the capsule's box, for the object's Size.
     fn size(&self) -> Vec3 {
         let r = self.settings.capsule_radius;
-        [2.0 * r, 2.0 * (self.settings.capsule_half_height + r), 2.0 * r]
+        [
+            2.0 * r,
+            2.0 * (self.settings.capsule_half_height + r),
+            2.0 * r,
+        ]
     }
 
     /// The wish direction (unit or zero) and its intensity in [0, 1], for a controller at
@@ -283,7 +292,12 @@ impl Plane {
     }
 
     /// Moves a controller's body to `position` facing `yaw` at once (a teleport).
-    fn place_controller(&mut self, handle: Handle, position: Vector, yaw: f32) -> Result<(), CommandError> {
+    fn place_controller(
+        &mut self,
+        handle: Handle,
+        position: Vector,
+        yaw: f32,
+    ) -> Result<(), CommandError> {
         let h = self.body_of(handle)?;
         let pose = rapier3d::math::Pose::from_parts(position, yaw_rotation(yaw));
         let body = &mut self.world.bodies[h];
@@ -342,7 +356,10 @@ impl Plane {
     fn controller_info(&self, handle: Handle) -> Result<ControllerInfo, CommandError> {
         self.body_of(handle)?;
         let c = self.controllers.get(&handle.slot).ok_or_else(|| {
-            CommandError::invalid_field("controller", format!("object {handle:?} is not a controller"))
+            CommandError::invalid_field(
+                "controller",
+                format!("object {handle:?} is not a controller"),
+            )
         })?;
         Ok(ControllerInfo {
             handle,
@@ -385,7 +402,11 @@ impl Plane {
             return;
         };
         let s = c.settings;
-        let g = if s.use_plane_gravity { plane_gravity } else { s.gravity };
+        let g = if s.use_plane_gravity {
+            plane_gravity
+        } else {
+            s.gravity
+        };
         let shape = c.shape();
         let half_height = s.capsule_half_height + s.capsule_radius;
         let start = self.world.bodies[h].translation();
@@ -455,7 +476,8 @@ impl Plane {
             }),
             max_slope_climb_angle: s.max_slope.to_radians(),
             min_slope_slide_angle: s.max_slope.to_radians(),
-            snap_to_ground: (c.on_ground && !jumped).then_some(CharacterLength::Absolute(s.step_height.max(SKIN * 4.0))),
+            snap_to_ground: (c.on_ground && !jumped)
+                .then_some(CharacterLength::Absolute(s.step_height.max(SKIN * 4.0))),
             ..KinematicCharacterController::default()
         };
         let pose = rapier3d::math::Pose::from_parts(position, yaw_rotation(c.yaw));
@@ -466,14 +488,20 @@ impl Plane {
             };
             let filter = rapier3d::prelude::QueryFilter::default().predicate(&exclude);
             let pipeline = self.world.query_pipeline_with_filter(filter);
-            kcc.move_shape(dt, &pipeline, &*shape, &pose, desired, |col| collisions.push(col))
+            kcc.move_shape(dt, &pipeline, &*shape, &pose, desired, |col| {
+                collisions.push(col)
+            })
         };
         let mut next = position + moved.translation;
 
         // 6. Ground probe: what is under the capsule now. Rapier's controller also says
         // whether it is grounded (it sees stair edges as ground, whose normals lean).
         let was_on_ground = c.on_ground;
-        let probe = if was_on_ground && !jumped { s.step_height.max(SKIN * 4.0) } else { SKIN * 4.0 };
+        let probe = if was_on_ground && !jumped {
+            s.step_height.max(SKIN * 4.0)
+        } else {
+            SKIN * 4.0
+        };
         let rising = v.y > 0.0 && !was_on_ground;
         let ground = if rising {
             None
@@ -517,7 +545,10 @@ impl Plane {
         // 7. Push dynamic bodies; clip the velocity against what stopped it (slide along
         // walls, stop at ceilings); a body pushed with less than the cap gave way.
         let gave_way = self.push_bodies(&collisions, &c, dt);
-        for col in collisions.iter().filter(|col| !gave_way.contains(&col.handle)) {
+        for col in collisions
+            .iter()
+            .filter(|col| !gave_way.contains(&col.handle))
+        {
             let n = col.hit.normal1;
             let into = v.dot(n);
             if into < 0.0 {
@@ -570,7 +601,11 @@ impl Plane {
         }
         if let Ok(b) = self.bodies.get_mut(handle) {
             b.flags = shm_layout::FLAG_CONTROLLER
-                | if c.on_ground { shm_layout::FLAG_ON_GROUND } else { 0 };
+                | if c.on_ground {
+                    shm_layout::FLAG_ON_GROUND
+                } else {
+                    0
+                };
         }
         for (kind, index, velocity) in events {
             self.pending_events.push(EventRecord {
@@ -597,7 +632,9 @@ impl Plane {
         let Some(body) = self.world.bodies.get(ground.body) else {
             return none;
         };
-        if body.is_dynamic() || (body.is_kinematic() && body.body_type() == RigidBodyType::KinematicVelocityBased) {
+        if body.is_dynamic()
+            || (body.is_kinematic() && body.body_type() == RigidBodyType::KinematicVelocityBased)
+        {
             let v = body.velocity_at_point(foot);
             return (v * dt, v, body.angvel().y * dt);
         }
@@ -610,7 +647,13 @@ impl Plane {
     }
 
     /// Pushes the capsule at `position` out of everything it overlaps, deepest first.
-    fn depenetrate(&self, own: RigidBodyHandle, shape: &SharedShape, position: Vector, groups: InteractionGroups) -> Vector {
+    fn depenetrate(
+        &self,
+        own: RigidBodyHandle,
+        shape: &SharedShape,
+        position: Vector,
+        groups: InteractionGroups,
+    ) -> Vector {
         let mut offset = Vector::ZERO;
         for _ in 0..DEPENETRATION_PASSES {
             let pose = rapier3d::math::Pose::from_translation(position + offset);
@@ -618,9 +661,9 @@ impl Plane {
             let pred = |_: ColliderHandle, co: &Collider| {
                 co.parent() != Some(own) && co.collision_groups().test(groups) && !co.is_sensor()
             };
-            let pipeline = self
-                .world
-                .query_pipeline_with_filter(rapier3d::prelude::QueryFilter::default().predicate(&pred));
+            let pipeline = self.world.query_pipeline_with_filter(
+                rapier3d::prelude::QueryFilter::default().predicate(&pred),
+            );
             for (_, co) in pipeline.intersect_shape(pose, &**shape) {
                 if let Ok(Some(contact)) =
                     rapier3d::parry::query::contact(&pose, &**shape, co.position(), co.shape(), 0.0)
@@ -682,7 +725,12 @@ impl Plane {
         let cap = c.settings.push_strength * dt;
         let mut gave_way = Vec::new();
         for col in collisions {
-            let Some(body) = self.world.colliders.get(col.handle).and_then(|co| co.parent()) else {
+            let Some(body) = self
+                .world
+                .colliders
+                .get(col.handle)
+                .and_then(|co| co.parent())
+            else {
                 continue;
             };
             let Some(rb) = self.world.bodies.get_mut(body) else {

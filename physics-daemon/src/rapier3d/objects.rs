@@ -110,8 +110,9 @@ impl Plane {
 
     /// Removes the object; its handle becomes stale.
     pub fn destroy_object(&mut self, handle: Handle) -> Result<(), CommandError> {
-        let Body { handle: h, part, .. } =
-            self.bodies.remove(handle).map_err(|e| self.in_plane(e))?;
+        let Body {
+            handle: h, part, ..
+        } = self.bodies.remove(handle).map_err(|e| self.in_plane(e))?;
         self.controllers.remove(&handle.slot);
         if part.report_contacts {
             self.reporting -= 1;

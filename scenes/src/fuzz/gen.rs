@@ -6,9 +6,9 @@
 //! degenerate meshes and bad triangle indices).
 
 use shm_layout::{
-    CollisionGroups, Command, ControllerOp, ControllerProp, FilterType, Handle, ObjectOp, ObjectProp, Pin, PlaneId, PlaneKind,
-    PlaneOp, PlaneProp, Pose, QueryFilter, QueryOp, Ray, Restraint, RotateTo, Shape, Vec3,
-    CRATE_VERSION,
+    CollisionGroups, Command, ControllerOp, ControllerProp, FilterType, Handle, ObjectOp,
+    ObjectProp, Pin, PlaneId, PlaneKind, PlaneOp, PlaneProp, Pose, QueryFilter, QueryOp, Ray,
+    Restraint, RotateTo, Shape, Vec3, CRATE_VERSION,
 };
 
 use super::rng::Rng;

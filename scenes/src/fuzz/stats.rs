@@ -4,8 +4,8 @@
 use std::collections::BTreeMap;
 
 use shm_layout::{
-    Command, CommandResult, ControllerOp, ErrorKind, ObjectOp, ObjectProp, PlaneOp, PlaneProp, QueryOp, Reply,
-    Response, Shape,
+    Command, CommandResult, ControllerOp, ErrorKind, ObjectOp, ObjectProp, PlaneOp, PlaneProp,
+    QueryOp, Reply, Response, Shape,
 };
 
 /// How many failures a run keeps in full (the counters count all of them).

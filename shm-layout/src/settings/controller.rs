@@ -206,9 +206,12 @@ impl ControllerProp {
             Gravity(g) => Gravity(in_range("Gravity", g, -1e5, 1e5)?),
             TurnSpeed(v) => TurnSpeed(in_range("TurnSpeed", v, 0.0, 1e4)?),
             MaxSlope(v) => MaxSlope(in_range("MaxSlope", v, 0.0, MAX_SLOPE_LIMIT)?),
-            GroundY(Some(y)) => {
-                GroundY(Some(in_range("GroundY", y, -MAX_COORDINATE, MAX_COORDINATE)?))
-            }
+            GroundY(Some(y)) => GroundY(Some(in_range(
+                "GroundY",
+                y,
+                -MAX_COORDINATE,
+                MAX_COORDINATE,
+            )?)),
             CapsuleRadius(r) => CapsuleRadius(crate::validate::extent("CapsuleRadius", r)?),
             CapsuleHalfHeight(h) => {
                 CapsuleHalfHeight(in_range("CapsuleHalfHeight", h, 0.0, MAX_SIZE)?)
@@ -255,7 +258,9 @@ mod tests {
         assert_eq!(e.field.as_deref(), Some("WalkSpeed"));
         let e = ControllerProp::MaxSlope(95.0).checked().unwrap_err();
         assert_eq!(e.field.as_deref(), Some("MaxSlope"));
-        let e = ControllerProp::MoveVector([0.0, 2.0]).checked().unwrap_err();
+        let e = ControllerProp::MoveVector([0.0, 2.0])
+            .checked()
+            .unwrap_err();
         assert_eq!(e.field.as_deref(), Some("MoveVector.Z"));
     }
 }
