@@ -174,18 +174,24 @@ fn steps_below_step_height_are_walked_up_and_walls_stop_and_slide() {
     blocked.set(ControllerProp::LookWhereMoving(false)).unwrap();
     blocked.set_move_vector(0.7, 0.7).unwrap();
     let mut grounded_ticks = 0;
+    let mut top: f32 = 0.0;
+    let mut stair_ticks = 0;
     for _ in 0..90 {
         s.plane.step(DT).unwrap();
-        grounded_ticks += usize::from(climber.on_ground().unwrap());
+        // On the staircase (it ends at z = 16, where a 3-high drop begins).
+        if climber.object().position().unwrap()[2] < 15.0 {
+            stair_ticks += 1;
+            grounded_ticks += usize::from(climber.on_ground().unwrap());
+        }
+        top = top.max(y(&climber));
     }
     assert!(
-        y(&climber) > HALF + 2.9,
-        "walked up the stairs: y {}",
-        y(&climber)
+        (top - (HALF + SKIN + 3.0)).abs() < 0.02,
+        "walked up to the top step (3 high): y {top}"
     );
     assert!(
-        grounded_ticks > 80,
-        "no hopping: grounded {grounded_ticks} of 90"
+        grounded_ticks + 2 >= stair_ticks && stair_ticks > 30,
+        "no hopping: grounded {grounded_ticks} of {stair_ticks} ticks on the stairs"
     );
     let p = blocked.object().position().unwrap();
     assert!(
@@ -377,4 +383,25 @@ fn paths_are_walked_in_order_with_one_event_per_waypoint_and_one_finish() {
         info.rotation[1]
     );
     let _ = Contact::from_record;
+}
+
+#[test]
+fn steps_up_to_step_height_are_climbed_and_taller_ones_are_not() {
+    // The default StepHeight of a radius-1 capsule is 0.6 × 1 + 0.5 = 1.1.
+    for (h, climbs) in [(0.3f32, true), (0.7, true), (1.0, true), (1.3, false)] {
+        let s = scene("kcc-stepheight");
+        anchored(&s, [10.0, h, 10.0], Pose::at([0.0, h / 2.0, 10.0]));
+        let c = character(&s, [0.0, HALF + SKIN, 0.0], &[]);
+        c.set_move_vector(0.0, 1.0).unwrap();
+        s.run(DT, 60);
+        let p = c.object().position().unwrap();
+        if climbs {
+            assert!(
+                (p[1] - (h + HALF + SKIN)).abs() < 0.02 && p[2] > 8.0,
+                "a {h} step is walked up: {p:?}"
+            );
+        } else {
+            assert!(p[1] < HALF + 0.1 && p[2] < 4.1, "a {h} step blocks: {p:?}");
+        }
+    }
 }

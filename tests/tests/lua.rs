@@ -221,6 +221,7 @@ fn reference_examples_run() {
         ("examples/falling_ball.luau", "ball at"),
         ("examples/cframe_changes.luau", "ball at"),
         ("examples/mixed_mode.luau", "unlinked at"),
+        ("examples/controllers.luau", "enemy 4 at"),
     ] {
         let r = run(&daemon, script);
         r.assert_ok();

@@ -19,9 +19,7 @@
 
 use std::collections::BTreeMap;
 
-use rapier3d::control::{
-    CharacterAutostep, CharacterCollision, CharacterLength, KinematicCharacterController,
-};
+use rapier3d::control::{CharacterCollision, CharacterLength, KinematicCharacterController};
 use rapier3d::parry::query::ShapeCastOptions;
 use rapier3d::prelude::*;
 use shm_layout::controller_op::ControllerInfo;
@@ -469,11 +467,9 @@ impl Plane {
             up: Vector::Y,
             offset: CharacterLength::Absolute(SKIN),
             slide: true,
-            autostep: (s.step_height > 0.0).then_some(CharacterAutostep {
-                max_height: CharacterLength::Absolute(s.step_height),
-                min_width: CharacterLength::Absolute(s.capsule_radius * 0.5),
-                include_dynamic_bodies: false,
-            }),
+            // Steps are ours (`step_up`): rapier's autostep nudges only as far as the tick's
+            // motion, so a round capsule's bottom stays on the edge and taller steps fail.
+            autostep: None,
             max_slope_climb_angle: s.max_slope.to_radians(),
             min_slope_slide_angle: s.max_slope.to_radians(),
             snap_to_ground: (c.on_ground && !jumped)
@@ -493,6 +489,22 @@ impl Plane {
             })
         };
         let mut next = position + moved.translation;
+        // Blocked while walking on the ground: try the step (lift, move, drop).
+        let wanted_h = horizontal(desired - carry);
+        let got_h = horizontal(moved.translation - carry);
+        if c.on_ground
+            && !jumped
+            && s.step_height > 0.0
+            && got_h.length() + 1e-4 < wanted_h.length() * 0.5
+        {
+            if let Some(stepped) =
+                self.step_up(h, &shape, next, c.yaw, wanted_h - got_h, &s, groups)
+            {
+                next = stepped;
+                // The step's face did not stop it: keep the speed.
+                collisions.clear();
+            }
+        }
 
         // 6. Ground probe: what is under the capsule now. Rapier's controller also says
         // whether it is grounded (it sees stair edges as ground, whose normals lean).
@@ -536,7 +548,7 @@ impl Plane {
             }
         }
         if c.on_ground {
-            v.y = v.y.max(0.0).min(0.0);
+            v.y = 0.0;
             if !was_on_ground {
                 events.push((EVENT_CONTROLLER_LANDED, 0, Vector::ZERO));
             }
@@ -646,6 +658,87 @@ impl Plane {
         (carried, carried / dt, yaw)
     }
 
+    /// Quake's stair step for a capsule blocked at `position` with `remaining` horizontal
+    /// motion: lift by StepHeight (as far as the ceiling allows), move forward by the
+    /// remaining motion (at least far enough for the capsule's bottom to clear the edge),
+    /// drop back down. Accepted when it lands on walkable ground higher than it started and
+    /// no higher than StepHeight.
+    #[allow(clippy::too_many_arguments)]
+    fn step_up(
+        &self,
+        own: RigidBodyHandle,
+        shape: &SharedShape,
+        position: Vector,
+        yaw: f32,
+        remaining: Vector,
+        s: &ControllerSettings,
+        groups: InteractionGroups,
+    ) -> Option<Vector> {
+        let dir = remaining.normalize_or_zero();
+        if dir == Vector::ZERO {
+            return None;
+        }
+        let pred = |_: ColliderHandle, co: &Collider| {
+            co.parent() != Some(own) && co.collision_groups().test(groups) && !co.is_sensor()
+        };
+        let pipeline = self
+            .world
+            .query_pipeline_with_filter(rapier3d::prelude::QueryFilter::default().predicate(&pred));
+        let rotation = yaw_rotation(yaw);
+        let cast = |from: Vector, along: Vector, reach: f32| {
+            let options = ShapeCastOptions {
+                max_time_of_impact: reach,
+                target_distance: SKIN,
+                stop_at_penetration: false,
+                compute_impact_geometry_on_penetration: true,
+            };
+            pipeline
+                .cast_shape(
+                    &rapier3d::math::Pose::from_parts(from, rotation),
+                    along,
+                    &**shape,
+                    options,
+                )
+                .map(|(_, hit)| hit)
+        };
+        // Lift.
+        let lift =
+            cast(position, Vector::Y, s.step_height).map_or(s.step_height, |h| h.time_of_impact);
+        if lift < SKIN * 2.0 {
+            return None;
+        }
+        let lifted = position + Vector::Y * lift;
+        // Forward: the remaining motion, at least enough to get the capsule's bottom over
+        // the tread.
+        let reach = remaining.length().max(s.capsule_radius);
+        let forward = cast(lifted, dir, reach).map_or(reach, |h| h.time_of_impact);
+        if forward < SKIN * 2.0 {
+            return None;
+        }
+        let ahead = lifted + dir * forward;
+        // Drop.
+        let hit = cast(ahead, -Vector::Y, lift + SKIN * 2.0)?;
+        // The contact normal as the capsule feels it (a box reports a face normal at its
+        // edges; the capsule's own normal there leans, and says it would stand on an edge).
+        let felt = -(rotation * hit.normal2);
+        if hit.time_of_impact <= 0.0 || felt.y < s.max_slope.to_radians().cos() - 1e-4 {
+            return None; // started inside something, or landed on a slope too steep
+        }
+        let landed = ahead - Vector::Y * hit.time_of_impact;
+        // How high the step is: where the capsule stands on it, above its bottom now.
+        let bottom = position.y - (s.capsule_half_height + s.capsule_radius);
+        let rise = hit.witness1.y - bottom;
+        if landed.y - position.y <= SKIN || rise > s.step_height + SKIN {
+            return None;
+        }
+        // Nothing may overlap the capsule where it lands.
+        let pose = rapier3d::math::Pose::from_parts(landed, rotation);
+        if pipeline.intersect_shape(pose, &**shape).next().is_some() {
+            return None;
+        }
+        Some(landed)
+    }
+
     /// Pushes the capsule at `position` out of everything it overlaps, deepest first.
     fn depenetrate(
         &self,
@@ -709,7 +802,10 @@ impl Plane {
             compute_impact_geometry_on_penetration: true,
         };
         let (col, hit) = pipeline.cast_shape(&pose, -Vector::Y, &**shape, options)?;
-        let walkable = hit.normal1.y >= max_slope.to_radians().cos() - 1e-4;
+        // The normal as the capsule feels it: on a box's edge it leans (a box reports its
+        // face normal there).
+        let felt = -(pose.rotation * hit.normal2);
+        let walkable = felt.y >= max_slope.to_radians().cos() - 1e-4;
         let body = self.world.colliders.get(col)?.parent()?;
         Some((body, hit.time_of_impact, walkable))
     }
