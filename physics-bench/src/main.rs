@@ -7,6 +7,7 @@
 //! and DIR/accuracy-*.svg: error against cost of reference scenes, in process.
 //! `physics-bench stability [--out DIR]` writes DIR/stability.json and DIR/stability.md.
 //! `physics-bench queries [--quick] [--out DIR]` writes DIR/queries.json and DIR/queries.md.
+//! `physics-bench controllers [--quick] [--out DIR]` writes DIR/controllers.json and .md.
 //!
 //! Its parts, shared by the subcommands:
 //!
@@ -22,6 +23,7 @@
 //! - [`stability`]: the `stability` subcommand (stiff and extreme scenes, pass/fail).
 
 mod accuracy;
+mod controllers;
 mod daemon;
 mod error;
 mod fuzz;
@@ -67,6 +69,9 @@ enum Bench {
     /// Rays per second of RaycastMany batches (1, 64, 4,096 rays) against a 10,000-body
     /// plane, next to the same rays cast in process.
     Queries(queries::QueriesArgs),
+    /// Character controllers' cost per tick: 1, 100 and 1,000 controllers walking waypoints
+    /// among obstacles, in process on one core.
+    Controllers(controllers::ControllersArgs),
     /// 4 planes × 1,000 bodies at 60 Hz with a client writing every frame for N minutes:
     /// daemon RSS and shared-memory growth against a bound.
     Soak(soak::SoakArgs),
@@ -92,6 +97,7 @@ fn main() -> ExitCode {
         Bench::Load(args) => load::run(args),
         Bench::Soak(args) => soak::run(args),
         Bench::Queries(args) => queries::run(args),
+        Bench::Controllers(args) => controllers::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
