@@ -151,6 +151,22 @@ fn slopes_steeper_than_max_slope_are_not_climbed_and_gentle_ones_are() {
         "does not climb 60°: y {}",
         y(&steep)
     );
+    // Put on the steep ramp, it slides down (not held there).
+    let a = 60f32.to_radians();
+    let z = 25.0;
+    let surface = (z - 20.0) * a.tan() + 0.5 / a.cos();
+    steep
+        .set(ControllerProp::Position([20.0, surface + HALF + 1.5, z]))
+        .unwrap();
+    steep.set_move_vector(0.0, 0.0).unwrap();
+    s.run(DT, 3);
+    let start = y(&steep);
+    s.run(DT, 30);
+    assert!(
+        y(&steep) < start - 1.0,
+        "slides down 60°: {start} -> {}",
+        y(&steep)
+    );
 }
 
 #[test]
@@ -251,6 +267,14 @@ fn platforms_carry_riders_up_down_and_sideways_and_jumps_inherit_their_velocity(
         worst < 0.05,
         "rides at the platform's top: worst gap {worst}"
     );
+    // Standing still on the box: no jitter over 10 s.
+    let (mut lo, mut hi) = (f32::MAX, f32::MIN);
+    for _ in 0..600 {
+        s.plane.step(DT).unwrap();
+        lo = lo.min(y(&c));
+        hi = hi.max(y(&c));
+    }
+    assert!(hi - lo < 1e-3, "jitter on a box {}", hi - lo);
     // Sideways at 5 units/s: carried along.
     let x0 = c.object().position().unwrap()[0];
     let mut x = 0.0;
@@ -268,6 +292,34 @@ fn platforms_carry_riders_up_down_and_sideways_and_jumps_inherit_their_velocity(
     s.plane.step(DT).unwrap();
     let vx = c.info().unwrap().velocity[0];
     assert!((vx - 5.0).abs() < 0.3, "inherits 5 units/s: {vx}");
+}
+
+#[test]
+fn a_rotating_platform_turns_its_rider() {
+    let s = scene("kcc-turntable");
+    let table = anchored(&s, [20.0, 1.0, 20.0], Pose::at([0.0, 0.5, 0.0]));
+    let c = character(&s, [6.0, 1.0 + HALF + SKIN, 0.0], &[]);
+    s.run(DT, 10);
+    assert!(c.on_ground().unwrap());
+    // 1 rad/s about Y by pose writes: after 1 s the rider is 1 rad around, radius kept.
+    for i in 1..=60 {
+        let angle = i as f32 * DT;
+        table
+            .set_pose(Pose {
+                position: [0.0, 0.5, 0.0],
+                rotation: quat([0.0, 1.0, 0.0], angle),
+            })
+            .unwrap();
+        s.plane.step(DT).unwrap();
+    }
+    let p = c.object().position().unwrap();
+    let r = (p[0] * p[0] + p[2] * p[2]).sqrt();
+    // A positive turn about Y takes +X toward -Z.
+    let angle = (-p[2]).atan2(p[0]);
+    assert!((r - 6.0).abs() < 0.05, "radius {r}");
+    assert!((angle - 1.0).abs() < 0.03, "turned {angle} rad");
+    let yaw = c.info().unwrap().rotation[1];
+    assert!((yaw - 1.0).abs() < 0.03, "facing turned with it: {yaw}");
 }
 
 #[test]

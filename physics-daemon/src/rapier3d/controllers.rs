@@ -522,9 +522,11 @@ impl Plane {
         };
         c.on_ground = false;
         c.ground = None;
-        if let Some((body, distance, walkable)) = ground {
+        if let Some((body, distance, walkable, face_walkable)) = ground {
             let close = distance <= SKIN * 3.0;
-            if (walkable && (close || (was_on_ground && !jumped))) || (moved.grounded && close) {
+            // Standing on a step's edge counts (the face under it is walkable ground); a
+            // steep slope does not, whatever touches it.
+            if (walkable && (close || (was_on_ground && !jumped))) || (face_walkable && close) {
                 // Settle onto it (snap down slopes and steps while grounded).
                 if walkable && distance > SKIN {
                     next.y -= distance - SKIN;
@@ -537,9 +539,6 @@ impl Plane {
                     pose: *b.position(),
                 });
             }
-        }
-        if moved.grounded && !rising {
-            c.on_ground = true;
         }
         if let Some(floor) = s.ground_y {
             if next.y - half_height <= floor + SKIN && v.y <= 0.0 {
@@ -776,7 +775,8 @@ impl Plane {
     }
 
     /// The ground within `reach` under the capsule at `position`: (its body, the gap to it,
-    /// whether its normal is walkable under `max_slope`).
+    /// whether the contact normal as the capsule feels it is walkable under `max_slope`,
+    /// whether the surface's own normal is).
     #[allow(clippy::too_many_arguments)]
     fn probe_ground(
         &self,
@@ -787,7 +787,7 @@ impl Plane {
         reach: f32,
         max_slope: f32,
         groups: InteractionGroups,
-    ) -> Option<(RigidBodyHandle, f32, bool)> {
+    ) -> Option<(RigidBodyHandle, f32, bool, bool)> {
         let pred = |_: ColliderHandle, co: &Collider| {
             co.parent() != Some(own) && co.collision_groups().test(groups) && !co.is_sensor()
         };
@@ -805,9 +805,14 @@ impl Plane {
         // The normal as the capsule feels it: on a box's edge it leans (a box reports its
         // face normal there).
         let felt = -(pose.rotation * hit.normal2);
-        let walkable = felt.y >= max_slope.to_radians().cos() - 1e-4;
+        let limit = max_slope.to_radians().cos() - 1e-4;
         let body = self.world.colliders.get(col)?.parent()?;
-        Some((body, hit.time_of_impact, walkable))
+        Some((
+            body,
+            hit.time_of_impact,
+            felt.y >= limit,
+            hit.normal1.y >= limit,
+        ))
     }
 
     /// Dynamic bodies the move ran into get an impulse along the push, capped at
