@@ -135,7 +135,7 @@ pub fn run(args: &ControllersArgs) -> BenchResult<()> {
             ]
         };
         let refill = |plane: &mut LocalPlane, t: usize| {
-            if t % 240 == 0 {
+            if t.is_multiple_of(240) {
                 for (handle, at) in &handles {
                     let _ = plane.controller_op(ControllerOp::SetPath {
                         handle: *handle,
