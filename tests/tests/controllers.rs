@@ -118,6 +118,21 @@ fn jump_apex_is_jump_power_squared_over_2g_and_events_fire_once() {
     assert_eq!(kinds(&events, EVENT_CONTROLLER_LANDED), 1);
     assert!((y(&c) - rest).abs() < 1e-3, "back on the floor");
     assert!(c.on_ground().unwrap());
+    // Air control: the same intent gains speed at AirControl (0.3) of the ground rate.
+    assert!(c.jump().unwrap());
+    s.plane.step(DT).unwrap();
+    c.set_move_vector(0.0, 1.0).unwrap();
+    s.run(DT, 6);
+    let air = speed_h(&c);
+    // Ground: accelerate adds Acceleration × WalkSpeed × dt = 10 × 16 / 60 per tick.
+    let per_tick = 10.0 * 16.0 * DT;
+    assert!(
+        (air - 6.0 * 0.3 * per_tick).abs() < 0.05,
+        "6 ticks of air control: {air} vs {}",
+        6.0 * 0.3 * per_tick
+    );
+    c.set_move_vector(0.0, 0.0).unwrap();
+    s.run(DT, 120);
     // In the air, Jump does nothing.
     assert!(c.jump().unwrap());
     s.plane.step(DT).unwrap();
