@@ -332,6 +332,13 @@ pub fn new_controller(
         .plane
         .new_controller(state.cframe().pose(), state.size(), controlled, &props)
         .map_err(|e| sdk_error(what, e))?;
+    let group = state.collision_group();
+    if group != "Default" {
+        controller
+            .object()
+            .set_collision_group(&group)
+            .map_err(|e| sdk_error(what, e))?;
+    }
     let body = Body::new(controller.object().clone(), Rc::downgrade(plane));
     plane.adopt(&state, body.clone(), false);
     let c = Rc::new(ControllerState {

@@ -134,6 +134,8 @@ pub struct PartState {
     pub shape: PartShape,
     name: RefCell<String>,
     size: Cell<[f32; 3]>,
+    /// Roblox's BasePart.CollisionGroup: given to its body when it is added.
+    collision_group: RefCell<String>,
     /// The pose while not simulated; the frozen last pose after the body went away.
     cframe: Cell<CFrame>,
     destroyed: Cell<bool>,
@@ -150,6 +152,7 @@ impl PartState {
         PartState {
             shape,
             name: RefCell::new(shape.name().to_string()),
+            collision_group: RefCell::new("Default".to_string()),
             size: Cell::new([1.0; 3]),
             cframe: Cell::new(CFrame::IDENTITY),
             destroyed: Cell::new(false),
@@ -168,6 +171,30 @@ impl PartState {
     /// Renames the part.
     pub fn set_name(&self, name: String) {
         *self.name.borrow_mut() = name;
+    }
+
+    /// The part's collision group name.
+    pub fn collision_group(&self) -> String {
+        self.collision_group.borrow().clone()
+    }
+
+    /// Sets the collision group (checked against the connection's table; its body follows
+    /// while simulated).
+    pub fn set_collision_group(
+        &self,
+        client: &client_sdk::Client,
+        name: String,
+    ) -> mlua::Result<()> {
+        client
+            .collision_group_id(&name)
+            .map_err(|e| sdk_error("BasePart.CollisionGroup", e))?;
+        if let Some(object) = self.object() {
+            object
+                .set_collision_group(&name)
+                .map_err(|e| sdk_error("BasePart.CollisionGroup", e))?;
+        }
+        *self.collision_group.borrow_mut() = name;
+        Ok(())
     }
 
     /// The part's size.

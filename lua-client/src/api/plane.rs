@@ -273,13 +273,22 @@ fn add(plane: &Rc<PlaneState>, part: Value) -> mlua::Result<PhysicsObject> {
     let collider = state.shape.collider(state.size());
     // A part whose Touched already has handlers reports contacts from its first tick.
     let reporting = state.touch_listeners() > 0;
-    let props: &[ObjectProp] = match reporting {
-        true => &[ObjectProp::ReportContacts(true)],
-        false => &[],
-    };
+    let mut props = Vec::new();
+    if reporting {
+        props.push(ObjectProp::ReportContacts(true));
+    }
+    let group = state.collision_group();
+    if group != "Default" {
+        let id = plane
+            .plane
+            .client()
+            .collision_group_id(&group)
+            .map_err(|e| sdk_error(&what(), e))?;
+        props.push(ObjectProp::CollisionGroup(id));
+    }
     let object = plane
         .plane
-        .add(collider, state.cframe().pose(), props)
+        .add(collider, state.cframe().pose(), &props)
         .map_err(|e| sdk_error(&what(), e))?;
     let body = Body::new(object, Rc::downgrade(plane));
     plane.adopt(&state, body.clone(), reporting);

@@ -122,10 +122,10 @@ pub static OBJECT: Props<PhysicsObject> = Props {
                 let name = o.body.object.plane().client().collision_group_name(id);
                 Ok(Value::String(lua.create_string(name)?))
             }),
-            set: Set::Fn(|_, o, a| {
-                o.live("PhysicsObject.CollisionGroup")?
-                    .set_collision_group(&a.string()?)
-                    .map_err(|e| sdk_error("PhysicsObject.CollisionGroup", e))
+            set: Set::Fn(|lua, o, a| {
+                o.live("PhysicsObject.CollisionGroup")?;
+                let client = crate::api::plane::context(lua).client.clone();
+                o.part.set_collision_group(&client, a.string()?)
             }),
         },
         info_row!(

@@ -71,6 +71,16 @@ pub static PART: Props<BasePart> = Props {
             }),
             set: Set::ReadOnly,
         },
+        // Roblox's BasePart.CollisionGroup (PhysicsObject.CollisionGroup reads the body's).
+        Row {
+            name: "CollisionGroup",
+            kind: Kind::String,
+            get: Get::Fn(|lua, p| Ok(Value::String(lua.create_string(p.0.collision_group())?))),
+            set: Set::Fn(|lua, p, a| {
+                let client = crate::api::plane::context(lua).client.clone();
+                p.0.set_collision_group(&client, a.string()?)
+            }),
+        },
         Row {
             name: "Shape",
             kind: Kind::String,
