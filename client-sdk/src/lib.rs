@@ -16,6 +16,7 @@ mod client;
 mod collision_groups;
 mod error;
 mod events;
+mod gui;
 mod object;
 mod overlay;
 mod plane;
@@ -27,15 +28,18 @@ pub use client::{Client, ConnectOptions, HUNG_AFTER, STALL_AFTER};
 pub use collision_groups::CollisionGroup;
 pub use error::Error;
 pub use events::{Contact, Events, EVENT_BUFFER_TICKS};
+pub use gui::{GuiController, GuiEvent, GuiObject, GuiPlane, GuiPlaneOptions};
 pub use object::Object;
 pub use plane::{Plane, PlaneOptions, Snapshot};
 pub use query::QueryParams;
+pub use shm_layout::gui_op::{GuiControllerInfo, GuiObjectInfo, GuiPlaneInfo};
 /// The limits and checks the daemon applies, for callers that want to check early.
 pub use shm_layout::validate;
 pub use shm_layout::{
-    BodyState, CollisionGroups, CommandError, ErrorKind, EventRecord, FilterType, Handle, Hit,
-    ObjectInfo, ObjectOp, ObjectProp, ObjectSettings, Pin, PlaneId, PlaneInfo, PlaneKind, PlaneOp,
-    PlaneProp, PlaneSettings, Pose, Ray, Restraint, RotateTo, Shape, ShapeKind, TickHeader, Vec3,
+    BodyState, CollisionGroups, CommandError, ErrorKind, EventRecord, FilterType,
+    GuiControllerProp, GuiHit, GuiObjectProp, GuiPlaneProp, GuiShape, Handle, Hit, ObjectInfo,
+    ObjectOp, ObjectProp, ObjectSettings, Pin, PlaneId, PlaneInfo, PlaneKind, PlaneOp, PlaneProp,
+    PlaneSettings, Pose, Ray, Restraint, RotateTo, Shape, ShapeKind, TickHeader, Vec2, Vec3,
 };
 pub use spawn::{
     connect_or_start, daemon_executable, start_daemon, start_daemon_with, DaemonChild, Session,

@@ -196,6 +196,8 @@ pub enum Reply {
     Hits(Vec<Option<Hit>>),
     /// The objects an overlap query found.
     Objects(Vec<Handle>),
+    /// The answer of a GUI-plane op that carries data.
+    Gui(crate::gui_op::GuiReply),
 }
 
 /// The result of one command.

@@ -5,6 +5,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::collision_groups::CollisionGroups;
+use crate::gui_op::GuiOp;
 use crate::object_op::ObjectOp;
 use crate::query::QueryOp;
 use crate::records::Handle;
@@ -18,6 +19,8 @@ pub enum PlaneKind {
     /// A 3D plane simulated by rapier3d on the CPU.
     #[default]
     Rapier3d,
+    /// A 2D pixel-space plane for GUI primitives, simulated by rapier2d (`PhysicsService.NewGUI`).
+    Gui2d,
 }
 
 /// An op on one plane.
@@ -55,6 +58,8 @@ pub enum PlaneOp {
     /// Replaces the plane's collision-group table; objects in a group no longer registered
     /// return to "Default".
     CollisionGroups(CollisionGroups),
+    /// An op of the 2D GUI plane (objects, controllers, rays); other kinds refuse it.
+    Gui(GuiOp),
 }
 
 /// What an op may add to a plane, for the daemon's per-client quotas.
@@ -77,7 +82,7 @@ impl PlaneOp {
                     op: ObjectOp::Info,
                     ..
                 }
-        )
+        ) || matches!(self, PlaneOp::Gui(op) if op.is_read_only())
     }
 
     /// What the op may add to the plane.
@@ -86,6 +91,10 @@ impl PlaneOp {
             PlaneOp::AddObject { shape, .. } => OpCost {
                 objects: 1,
                 mesh_vertices: shape.mesh_vertices() as u64,
+            },
+            PlaneOp::Gui(GuiOp::Add { .. }) => OpCost {
+                objects: 1,
+                mesh_vertices: 0,
             },
             _ => OpCost::default(),
         }

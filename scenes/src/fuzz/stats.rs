@@ -4,8 +4,8 @@
 use std::collections::BTreeMap;
 
 use shm_layout::{
-    Command, CommandResult, ErrorKind, ObjectOp, ObjectProp, PlaneOp, PlaneProp, QueryOp, Reply,
-    Response, Shape,
+    Command, CommandResult, ErrorKind, GuiControllerOp, GuiObjectOp, GuiOp, ObjectOp, ObjectProp,
+    PlaneOp, PlaneProp, QueryOp, Reply, Response, Shape,
 };
 
 /// How many failures a run keeps in full (the counters count all of them).
@@ -309,6 +309,7 @@ pub fn reply_name(reply: &Reply) -> &'static str {
         Reply::CenterOfMass(_) => "CenterOfMass",
         Reply::Hits(_) => "Hits",
         Reply::Objects(_) => "Objects",
+        Reply::Gui(_) => "Gui",
     }
 }
 
@@ -344,6 +345,7 @@ pub fn op_name(command: &Command) -> String {
             },
             PlaneOp::Query(q) => format!("Plane.Query.{}", query_name(q)),
             PlaneOp::CollisionGroups(_) => "Plane.CollisionGroups".into(),
+            PlaneOp::Gui(op) => gui_op_name(op),
         },
     }
 }
@@ -370,6 +372,35 @@ pub fn object_prop_name(prop: &ObjectProp) -> &'static str {
         ObjectProp::RotateTo(_) => "RotateTo",
         ObjectProp::Pin(_) => "Pin",
         ObjectProp::CollisionGroup(_) => "CollisionGroup",
+    }
+}
+
+/// The name of a GUI-plane op (`Gui.Object.Set.Position`, `Gui.Controller.Move`).
+pub fn gui_op_name(op: &GuiOp) -> String {
+    match op {
+        GuiOp::Info => "Gui.Info".into(),
+        GuiOp::Add { shape, .. } => format!("Gui.Add.{}", shape.name()),
+        GuiOp::Object { op, .. } => match op {
+            GuiObjectOp::Set(p) => format!("Gui.Object.Set.{}", p.name()),
+            GuiObjectOp::ApplyImpulse(_) => "Gui.Object.ApplyImpulse".into(),
+            GuiObjectOp::Wake => "Gui.Object.Wake".into(),
+            GuiObjectOp::Info => "Gui.Object.Info".into(),
+            GuiObjectOp::Destroy => "Gui.Object.Destroy".into(),
+        },
+        GuiOp::Controller { op, .. } => format!(
+            "Gui.Controller.{}",
+            match op {
+                GuiControllerOp::Create { .. } => "Create",
+                GuiControllerOp::Set(_) => "Set",
+                GuiControllerOp::Move(_) => "Move",
+                GuiControllerOp::Jump => "Jump",
+                GuiControllerOp::SetWaypoints(_) => "SetWaypoints",
+                GuiControllerOp::ClearWaypoints => "ClearWaypoints",
+                GuiControllerOp::Info => "Info",
+                GuiControllerOp::Destroy => "Destroy",
+            }
+        ),
+        GuiOp::Raycast { .. } => "Gui.Raycast".into(),
     }
 }
 
