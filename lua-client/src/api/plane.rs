@@ -315,13 +315,6 @@ pub fn module(lua: &Lua) -> mlua::Result<Table> {
     let m = lua.create_table()?;
     m.set("New", lua.create_function(new_plane)?)?;
     super::collision_groups::install(lua, &m)?;
-    m.set(
-        "NewGUI",
-        lua.create_function(|_, _: Value| -> mlua::Result<()> {
-            Err(mlua::Error::runtime(
-                "PhysicsService.NewGUI is not supported yet",
-            ))
-        })?,
-    )?;
+    m.set("NewGUI", lua.create_function(super::gui_plane::new_gui)?)?;
     Ok(m)
 }

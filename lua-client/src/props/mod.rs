@@ -11,6 +11,7 @@
 //! - A documented property the SDK cannot do yet is a row marked `NotYet`, so wiring it later
 //!   is editing one row, and using it meanwhile is a clear error instead of a silent no-op.
 
+pub mod gui;
 pub mod object;
 pub mod part;
 pub mod plane;
