@@ -593,3 +593,23 @@ fn bad_input_is_refused_with_the_field_named() {
     // The daemon still serves.
     plane.step(DT).unwrap();
 }
+
+#[test]
+fn triangles_and_circles_rest_on_their_real_shapes() {
+    let daemon = TestDaemon::start("gui-shapes");
+    let client = daemon.client();
+    let plane = gui_plane(&client, undamped());
+    floor(&plane, 500.0, 0);
+    let tri = plane
+        .add(GuiShape::Triangle, [40.0, 30.0], [0.0, 400.0], &[])
+        .unwrap();
+    // A circle of Size (40, 20) is a disc of diameter 20.
+    let disc = plane
+        .add(GuiShape::Circle, [40.0, 20.0], [100.0, 400.0], &[])
+        .unwrap();
+    run(&plane, 90);
+    let [_, y] = tri.position().unwrap();
+    assert!((y - 485.0).abs() < 0.5, "triangle box centre {y}");
+    assert!(tri.rotation().unwrap().abs() < 0.5);
+    assert!((disc.position().unwrap()[1] - 490.0).abs() < 0.5);
+}

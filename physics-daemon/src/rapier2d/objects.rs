@@ -21,10 +21,11 @@ pub fn collider_shape(shape: GuiShape, size: Vec2) -> SharedShape {
     match shape {
         GuiShape::Square | GuiShape::Image | GuiShape::Text => SharedShape::cuboid(hx, hy),
         GuiShape::Circle => SharedShape::ball(hx.min(hy)),
+        // Counter-clockwise, as parry's triangle normals expect.
         GuiShape::Triangle => SharedShape::triangle(
             Vector::new(0.0, -hy),
-            Vector::new(-hx, hy),
             Vector::new(hx, hy),
+            Vector::new(-hx, hy),
         ),
     }
 }
