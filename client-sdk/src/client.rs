@@ -151,15 +151,20 @@ impl Client {
             other => return Err(unexpected(other)),
         };
         let plane = self.attach_plane(id)?;
+        self.note_owned(id);
         let table = {
-            let mut state = self.inner.state.borrow_mut();
-            state.owned.push(id);
+            let state = self.inner.state.borrow_mut();
             state.groups.clone()
         };
         if table != CollisionGroups::default() {
             self.queue(Command::plane(id, PlaneOp::CollisionGroups(table)), None);
         }
         Ok(plane)
+    }
+
+    /// Records that this client created plane `id`.
+    pub(crate) fn note_owned(&self, id: PlaneId) {
+        self.inner.state.borrow_mut().owned.push(id);
     }
 
     /// Opens an existing plane (created by any client) for reading and writing. Returns once

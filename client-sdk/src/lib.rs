@@ -17,6 +17,7 @@ mod collision_groups;
 mod controller;
 mod error;
 mod events;
+mod gui;
 mod object;
 mod overlay;
 mod plane;
@@ -29,18 +30,20 @@ pub use collision_groups::CollisionGroup;
 pub use controller::Controller;
 pub use error::Error;
 pub use events::{Contact, Events, EVENT_BUFFER_TICKS};
+pub use gui::{GuiController, GuiEvent, GuiObject, GuiPlane, GuiPlaneOptions};
 pub use object::Object;
 pub use plane::{Plane, PlaneOptions, Snapshot};
 pub use query::QueryParams;
+pub use shm_layout::gui_op::{GuiControllerInfo, GuiObjectInfo, GuiPlaneInfo};
 /// The limits and checks the daemon applies, for callers that want to check early.
 pub use shm_layout::validate;
 pub use shm_layout::{
     BodyState, CollisionGroups, CommandError, ControllerInfo, ControllerProp, ControllerSettings,
-    ErrorKind, EventRecord, FilterType, Handle, Hit, ObjectInfo, ObjectOp, ObjectProp,
-    ObjectSettings, Pin, PlaneId, PlaneInfo, PlaneKind, PlaneOp, PlaneProp, PlaneSettings, Pose,
-    Ray, Restraint, RotateTo, Shape, ShapeKind, TickHeader, Vec3, EVENT_CONTROLLER_JUMPED,
-    EVENT_CONTROLLER_LANDED, EVENT_CONTROLLER_MOVED, EVENT_PATH_FINISHED, EVENT_WAYPOINT_REACHED,
-    FLAG_ON_GROUND,
+    ErrorKind, EventRecord, FilterType, GuiControllerProp, GuiHit, GuiObjectProp, GuiPlaneProp,
+    GuiShape, Handle, Hit, ObjectInfo, ObjectOp, ObjectProp, ObjectSettings, Pin, PlaneId,
+    PlaneInfo, PlaneKind, PlaneOp, PlaneProp, PlaneSettings, Pose, Ray, Restraint, RotateTo, Shape,
+    ShapeKind, TickHeader, Vec2, Vec3, EVENT_CONTROLLER_JUMPED, EVENT_CONTROLLER_LANDED,
+    EVENT_CONTROLLER_MOVED, EVENT_PATH_FINISHED, EVENT_WAYPOINT_REACHED, FLAG_ON_GROUND,
 };
 pub use spawn::{
     connect_or_start, daemon_executable, start_daemon, start_daemon_with, DaemonChild, Session,

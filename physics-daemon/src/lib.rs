@@ -4,12 +4,15 @@
 //! - [`server`]: the iceoryx2 node, the WaitSet loop, clients, and routing by plane id.
 //! - [`backend`]: the seam every plane kind implements, and the reusable [`backend::SlotTable`].
 //! - [`rapier3d`]: the 3D plane kind (a rapier world with stable handles and the options).
+//! - `rapier2d`: the 2D GUI plane kind (`PhysicsService.NewGUI`), behind the `gui` feature.
 //! - [`publish`]: writing a plane's tick into loaned shared-memory samples.
 
 #![warn(missing_docs)]
 
 pub mod backend;
 pub mod publish;
+#[cfg(feature = "gui")]
+pub mod rapier2d;
 pub mod rapier3d;
 pub mod server;
 

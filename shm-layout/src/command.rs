@@ -200,6 +200,8 @@ pub enum Reply {
     Controller(Box<crate::controller_op::ControllerInfo>),
     /// A yes / no answer (whether a jump launched).
     Flag(bool),
+    /// The answer of a GUI-plane op that carries data.
+    Gui(crate::gui_op::GuiReply),
 }
 
 /// The result of one command.

@@ -21,6 +21,7 @@ pub mod collision_groups;
 pub mod command;
 pub mod controller_op;
 pub mod error;
+pub mod gui_op;
 pub mod names;
 pub mod object_op;
 pub mod plane_op;
@@ -35,19 +36,20 @@ pub use collision_groups::CollisionGroups;
 pub use command::*;
 pub use controller_op::{ControllerInfo, ControllerOp};
 pub use error::{CommandError, ErrorKind};
+pub use gui_op::{GuiControllerOp, GuiControllerProp, GuiHit, GuiObjectOp, GuiOp, GuiReply};
 pub use object_op::ObjectOp;
 pub use plane_op::{OpCost, PlaneKind, PlaneOp};
 pub use query::{FilterType, Hit, QueryFilter, QueryOp, Ray};
 pub use records::*;
 pub use settings::{
-    ControllerProp, ControllerSettings, ObjectProp, ObjectSettings, Pin, PlaneProp, PlaneSettings,
-    Restraint, RotateTo,
+    ControllerProp, ControllerSettings, GuiObjectProp, GuiPlaneProp, GuiShape, ObjectProp,
+    ObjectSettings, Pin, PlaneProp, PlaneSettings, Restraint, RotateTo, Vec2,
 };
 pub use shape::{Shape, ShapeKind};
 
 /// Bumped whenever a record layout or the command encoding changes. Client and daemon must
 /// agree on it; the handshake reports both values when they differ.
-pub const LAYOUT_VERSION: u32 = 4;
+pub const LAYOUT_VERSION: u32 = 5;
 
 /// The crate version both sides were built from; also checked by the handshake.
 pub const CRATE_VERSION: &str = env!("CARGO_PKG_VERSION");

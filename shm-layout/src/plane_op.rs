@@ -6,6 +6,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::collision_groups::CollisionGroups;
 use crate::controller_op::ControllerOp;
+use crate::gui_op::GuiOp;
 use crate::object_op::ObjectOp;
 use crate::query::QueryOp;
 use crate::records::Handle;
@@ -19,6 +20,8 @@ pub enum PlaneKind {
     /// A 3D plane simulated by rapier3d on the CPU.
     #[default]
     Rapier3d,
+    /// A 2D pixel-space plane for GUI primitives, simulated by rapier2d (`PhysicsService.NewGUI`).
+    Gui2d,
 }
 
 /// An op on one plane.
@@ -58,6 +61,8 @@ pub enum PlaneOp {
     CollisionGroups(CollisionGroups),
     /// An op on the plane's character controllers.
     Controller(ControllerOp),
+    /// An op of the 2D GUI plane (objects, controllers, rays); other kinds refuse it.
+    Gui(GuiOp),
 }
 
 /// What an op may add to a plane, for the daemon's per-client quotas.
@@ -81,7 +86,7 @@ impl PlaneOp {
                     op: ObjectOp::Info,
                     ..
                 }
-        )
+        ) || matches!(self, PlaneOp::Gui(op) if op.is_read_only())
     }
 
     /// What the op may add to the plane.
@@ -91,10 +96,12 @@ impl PlaneOp {
                 objects: 1,
                 mesh_vertices: shape.mesh_vertices() as u64,
             },
-            PlaneOp::Controller(ControllerOp::Create { .. }) => OpCost {
-                objects: 1,
-                mesh_vertices: 0,
-            },
+            PlaneOp::Controller(ControllerOp::Create { .. }) | PlaneOp::Gui(GuiOp::Add { .. }) => {
+                OpCost {
+                    objects: 1,
+                    mesh_vertices: 0,
+                }
+            }
             _ => OpCost::default(),
         }
     }

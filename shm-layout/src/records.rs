@@ -126,6 +126,16 @@ pub const EVENT_WAYPOINT_REACHED: u32 = 19;
 /// Controller event: the last waypoint was reached.
 pub const EVENT_PATH_FINISHED: u32 = 20;
 
+/// Event kind: a GUI controller reached a waypoint. `a` is the controller's body,
+/// `b_slot` the 1-based index of the waypoint, `position` the waypoint `[x, y, 0]`.
+pub const EVENT_GUI_WAYPOINT_REACHED: u32 = 0x20;
+/// Event kind: a GUI controller reached the last waypoint of its path (`a`: its body).
+pub const EVENT_GUI_PATH_FINISHED: u32 = 0x21;
+/// Event kind: a GUI controller moved in a tick; `position` is `[dx, dy, 0]` (px).
+pub const EVENT_GUI_MOVED: u32 = 0x22;
+/// Event kind: a GUI controller's OnGround flipped; `b_slot` is 1 (now on the ground) or 0.
+pub const EVENT_GUI_GROUND_CHANGED: u32 = 0x23;
+
 /// One per-tick event (published in the plane's event service, one sample per tick that
 /// has events). 64 bytes.
 ///

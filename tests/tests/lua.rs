@@ -330,3 +330,32 @@ fn controllers_from_luau() {
     r.assert_ok();
     assert!(r.stdout().contains("controllers ok"), "{}", r.stdout());
 }
+
+#[test]
+fn gui_snippet_layers_runs_unmodified() {
+    let daemon = TestDaemon::start("lua-gui-layers");
+    let r = run(&daemon, "tests/lua/gui_layers.luau");
+    r.assert_ok();
+    assert!(r.stdout().contains("gui layers ok"), "{}", r.stdout());
+}
+
+#[test]
+fn gui_snippet_cursor_drag_runs_with_a_stubbed_mouse() {
+    let daemon = TestDaemon::start("lua-gui-drag");
+    let r = run_in(
+        &daemon.domain,
+        "tests/lua/gui_drag.luau",
+        &["--seconds", "3"],
+        Duration::from_secs(60),
+    );
+    r.assert_ok();
+    assert!(r.stdout().contains("gui drag ok"), "{}", r.stdout());
+}
+
+#[test]
+fn gui_snippet_npc_waypoints_loops_in_order() {
+    let daemon = TestDaemon::start("lua-gui-npc");
+    let r = run(&daemon, "tests/lua/gui_npc.luau");
+    r.assert_ok();
+    assert!(r.stdout().contains("gui npc ok"), "{}", r.stdout());
+}

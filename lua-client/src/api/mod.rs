@@ -5,6 +5,10 @@
 pub mod collision_groups;
 pub mod contacts;
 pub mod controller;
+pub mod gui_basic;
+pub mod gui_controller;
+pub mod gui_object;
+pub mod gui_plane;
 pub mod object;
 pub mod part;
 pub mod plane;
@@ -18,7 +22,7 @@ use mlua::{Function, Lua, Table, Value};
 use crate::props::{Props, Target};
 
 /// The modules `import` knows, in the order error messages list them.
-pub const MODULES: [&str; 3] = ["PhysicsService", "Renderable", "Primitives"];
+pub const MODULES: [&str; 4] = ["PhysicsService", "Renderable", "Primitives", "GUI"];
 
 /// Methods of the types whose `__index` is ours alone (see [`index`]).
 pub struct MethodTables {
@@ -47,6 +51,7 @@ pub fn modules(lua: &Lua, client: Client) -> mlua::Result<Table> {
     modules.set("PhysicsService", plane::module(lua)?)?;
     modules.set("Renderable", part::module(lua)?)?;
     modules.set("Primitives", crate::values::module(lua)?)?;
+    modules.set("GUI", gui_basic::module(lua)?)?;
     Ok(modules)
 }
 

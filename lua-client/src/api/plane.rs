@@ -355,6 +355,8 @@ fn option(o: &mut PlaneOptions, prop: PlaneProp) {
         PlaneProp::Shared(v) => o.shared = Some(v),
         PlaneProp::MaxLinearSpeed(v) => o.max_linear_speed = Some(v),
         PlaneProp::MaxAngularSpeed(v) => o.max_angular_speed = Some(v),
+        // No row of PhysicsPlane makes a GUI option (NewGUI has its own rows).
+        PlaneProp::Gui(_) => {}
     }
 }
 
@@ -363,13 +365,6 @@ pub fn module(lua: &Lua) -> mlua::Result<Table> {
     let m = lua.create_table()?;
     m.set("New", lua.create_function(new_plane)?)?;
     super::collision_groups::install(lua, &m)?;
-    m.set(
-        "NewGUI",
-        lua.create_function(|_, _: Value| -> mlua::Result<()> {
-            Err(mlua::Error::runtime(
-                "PhysicsService.NewGUI is not supported yet",
-            ))
-        })?,
-    )?;
+    m.set("NewGUI", lua.create_function(super::gui_plane::new_gui)?)?;
     Ok(m)
 }

@@ -12,6 +12,7 @@
 //!   is editing one row, and using it meanwhile is a clear error instead of a silent no-op.
 
 pub mod controller;
+pub mod gui;
 pub mod object;
 pub mod part;
 pub mod plane;

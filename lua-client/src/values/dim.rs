@@ -1,5 +1,5 @@
-//! `Dim`: a 2D pixel-space value for GUI primitives (shipped so scripts that build Dims load;
-//! the GUI physics plane itself is not part of this host yet).
+//! `Dim`: a 2D pixel-space value for GUI primitives and the GUI plane (positions, sizes,
+//! velocities in pixels).
 
 use std::fmt;
 

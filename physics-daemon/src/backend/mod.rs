@@ -112,5 +112,13 @@ pub fn create(
 ) -> Result<Box<dyn Backend>, CommandError> {
     Ok(match kind {
         PlaneKind::Rapier3d => Box::new(crate::rapier3d::Plane::new(id, props)?),
+        #[cfg(feature = "gui")]
+        PlaneKind::Gui2d => Box::new(crate::rapier2d::Plane::new(id, props)?),
+        #[cfg(not(feature = "gui"))]
+        PlaneKind::Gui2d => {
+            return Err(CommandError::invalid(
+                "this daemon was built without GUI planes (cargo feature \"gui\")",
+            ))
+        }
     })
 }

@@ -42,6 +42,10 @@ impl Backend for Plane {
             PlaneOp::CollisionGroups(table) => {
                 self.set_collision_groups(table).map(|_| Reply::Done)
             }
+            PlaneOp::Gui(_) => Err(CommandError::new(
+                ErrorKind::InvalidValue,
+                "GUI ops (PlaneOp::Gui) need a GUI plane; this is a 3D plane",
+            )),
             PlaneOp::Step { .. } | PlaneOp::Destroy => Err(CommandError::new(
                 ErrorKind::Internal,
                 format!("{op:?} is handled by the server, not the plane"),

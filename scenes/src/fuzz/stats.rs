@@ -4,8 +4,8 @@
 use std::collections::BTreeMap;
 
 use shm_layout::{
-    Command, CommandResult, ControllerOp, ErrorKind, ObjectOp, ObjectProp, PlaneOp, PlaneProp,
-    QueryOp, Reply, Response, Shape,
+    Command, CommandResult, ControllerOp, ErrorKind, GuiControllerOp, GuiObjectOp, GuiOp, ObjectOp,
+    ObjectProp, PlaneOp, PlaneProp, QueryOp, Reply, Response, Shape,
 };
 
 /// How many failures a run keeps in full (the counters count all of them).
@@ -311,6 +311,7 @@ pub fn reply_name(reply: &Reply) -> &'static str {
         Reply::Objects(_) => "Objects",
         Reply::Controller(_) => "Controller",
         Reply::Flag(_) => "Flag",
+        Reply::Gui(_) => "Gui",
     }
 }
 
@@ -347,6 +348,7 @@ pub fn op_name(command: &Command) -> String {
             PlaneOp::Query(q) => format!("Plane.Query.{}", query_name(q)),
             PlaneOp::CollisionGroups(_) => "Plane.CollisionGroups".into(),
             PlaneOp::Controller(c) => format!("Plane.Controller.{}", controller_op_name(c)),
+            PlaneOp::Gui(op) => gui_op_name(op),
         },
     }
 }
@@ -388,6 +390,35 @@ pub fn controller_op_name(op: &ControllerOp) -> &'static str {
         ControllerOp::Jump { .. } => "Jump",
         ControllerOp::Teleport { .. } => "Teleport",
         ControllerOp::Destroy { .. } => "Destroy",
+    }
+}
+
+/// The name of a GUI-plane op (`Gui.Object.Set.Position`, `Gui.Controller.Move`).
+pub fn gui_op_name(op: &GuiOp) -> String {
+    match op {
+        GuiOp::Info => "Gui.Info".into(),
+        GuiOp::Add { shape, .. } => format!("Gui.Add.{}", shape.name()),
+        GuiOp::Object { op, .. } => match op {
+            GuiObjectOp::Set(p) => format!("Gui.Object.Set.{}", p.name()),
+            GuiObjectOp::ApplyImpulse(_) => "Gui.Object.ApplyImpulse".into(),
+            GuiObjectOp::Wake => "Gui.Object.Wake".into(),
+            GuiObjectOp::Info => "Gui.Object.Info".into(),
+            GuiObjectOp::Destroy => "Gui.Object.Destroy".into(),
+        },
+        GuiOp::Controller { op, .. } => format!(
+            "Gui.Controller.{}",
+            match op {
+                GuiControllerOp::Create { .. } => "Create",
+                GuiControllerOp::Set(_) => "Set",
+                GuiControllerOp::Move(_) => "Move",
+                GuiControllerOp::Jump => "Jump",
+                GuiControllerOp::SetWaypoints(_) => "SetWaypoints",
+                GuiControllerOp::ClearWaypoints => "ClearWaypoints",
+                GuiControllerOp::Info => "Info",
+                GuiControllerOp::Destroy => "Destroy",
+            }
+        ),
+        GuiOp::Raycast { .. } => "Gui.Raycast".into(),
     }
 }
 

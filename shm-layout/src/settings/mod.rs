@@ -7,9 +7,13 @@
 //! one mapping onto the engine in the daemon's backend, one row in lua-client's `props/`.
 
 pub mod controller;
+pub mod gui_object;
+pub mod gui_plane;
 pub mod object;
 pub mod plane;
 
 pub use controller::{ControllerProp, ControllerSettings};
+pub use gui_object::{GuiObjectProp, GuiObjectSettings, GuiShape};
+pub use gui_plane::{GuiPlaneProp, GuiPlaneSettings, Vec2};
 pub use object::{ObjectProp, ObjectSettings, Pin, Restraint, RotateTo};
 pub use plane::{PlaneProp, PlaneSettings};

@@ -44,6 +44,8 @@ pub enum PlaneProp {
     /// Largest angular speed of a body (rad/s), enforced before and after every step.
     /// Default [`DEFAULT_MAX_ANGULAR_SPEED`]. Positive and finite.
     MaxAngularSpeed(f32),
+    /// An option of a GUI plane (`PhysicsService.NewGUI`); 3D planes refuse it.
+    Gui(super::gui_plane::GuiPlaneProp),
 }
 
 /// Default `MaxLinearSpeed`: 10,000 units/s. With units like Roblox studs (≈ 0.28 m) that is
@@ -151,6 +153,15 @@ impl PlaneSettings {
             PlaneProp::Shared(on) => self.shared = on,
             PlaneProp::MaxLinearSpeed(v) => self.max_linear_speed = v,
             PlaneProp::MaxAngularSpeed(w) => self.max_angular_speed = w,
+            PlaneProp::Gui(g) => {
+                return Err(CommandError::invalid_field(
+                    g.name(),
+                    format!(
+                        "{} {g:?} is an option of GUI planes, not of 3D planes",
+                        g.name()
+                    ),
+                ))
+            }
         }
         Ok(prop)
     }
@@ -176,6 +187,7 @@ impl PlaneProp {
             PlaneProp::Shared(_) => "Shared",
             PlaneProp::MaxLinearSpeed(_) => "MaxLinearSpeed",
             PlaneProp::MaxAngularSpeed(_) => "MaxAngularSpeed",
+            PlaneProp::Gui(g) => g.name(),
         }
     }
 
@@ -213,6 +225,7 @@ impl PlaneProp {
             | PlaneProp::LoopSolver(b)
             | PlaneProp::NeverSleep(b)
             | PlaneProp::Shared(b) => b.to_string(),
+            PlaneProp::Gui(g) => format!("{g:?}"),
         }
     }
 
@@ -250,6 +263,7 @@ impl PlaneProp {
             SolverIterations(n) => SolverIterations(n.clamp(1, MAX_SOLVER_ITERATIONS)),
             MaxLinearSpeed(v) => MaxLinearSpeed(positive("MaxLinearSpeed", v)?),
             MaxAngularSpeed(w) => MaxAngularSpeed(positive("MaxAngularSpeed", w)?),
+            Gui(g) => Gui(g.checked()?),
             other => other,
         })
     }

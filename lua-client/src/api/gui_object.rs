@@ -1,0 +1,86 @@
+//! `PhysicsGuiObject`: the body `GuiPhysicsPlane:Add(primitive)` returns. Its properties are
+//! the rows in `props/gui.rs`; its methods are `ApplyImpulse`, `ApplyForce`, `Wake` and
+//! `Destroy` (the primitive stays at its last simulated position).
+
+use std::rc::{Rc, Weak};
+
+use client_sdk::{GuiObject, GuiObjectProp};
+use mlua::{MetaMethod, UserData, UserDataMethods, Value};
+
+use super::gui_basic::{dim_arg, GuiPrimitive, PrimState};
+use super::gui_plane::GuiPlaneState;
+use crate::values::sdk_error;
+
+/// The Lua handle of a GUI body.
+#[derive(Clone)]
+pub struct PhysicsGuiObject {
+    /// The SDK's object.
+    pub object: GuiObject,
+    /// The primitive it simulates.
+    pub prim: Rc<PrimState>,
+    /// Its plane.
+    pub plane: Weak<GuiPlaneState>,
+}
+
+impl PhysicsGuiObject {
+    /// Whether the body still exists (its plane alive, not destroyed).
+    pub fn alive(&self) -> bool {
+        self.plane.upgrade().is_some_and(|p| p.alive()) && self.object.is_alive().unwrap_or(false)
+    }
+
+    /// Errors naming `what` once the body ended.
+    pub fn check_alive(&self, what: &str) -> mlua::Result<()> {
+        match self.alive() {
+            true => Ok(()),
+            false => Err(mlua::Error::runtime(format!(
+                "{what}: the PhysicsGuiObject was destroyed (or its plane was)"
+            ))),
+        }
+    }
+}
+
+impl UserData for PhysicsGuiObject {
+    fn add_methods<M: UserDataMethods<Self>>(methods: &mut M) {
+        methods.add_method("ApplyImpulse", |_, o, j: Value| {
+            const WHAT: &str = "PhysicsGuiObject:ApplyImpulse";
+            o.check_alive(WHAT)?;
+            let j = dim_arg(WHAT, &j)?;
+            o.object.apply_impulse(j).map_err(|e| sdk_error(WHAT, e))
+        });
+        methods.add_method("ApplyForce", |_, o, f: Value| {
+            const WHAT: &str = "PhysicsGuiObject:ApplyForce";
+            o.check_alive(WHAT)?;
+            let f = dim_arg(WHAT, &f)?;
+            o.object
+                .set(GuiObjectProp::ConstantForce(f))
+                .map_err(|e| sdk_error(WHAT, e))
+        });
+        methods.add_method("Wake", |_, o, ()| {
+            const WHAT: &str = "PhysicsGuiObject:Wake";
+            o.check_alive(WHAT)?;
+            o.object.wake().map_err(|e| sdk_error(WHAT, e))
+        });
+        methods.add_method("Destroy", |_, o, ()| {
+            if !o.alive() {
+                return Ok(());
+            }
+            o.object.destroy();
+            o.prim.unlink();
+            if let Some(p) = o.plane.upgrade() {
+                p.forget(&o.prim, o.object.handle());
+            }
+            Ok(())
+        });
+        methods.add_method("Primitive", |_, o, ()| Ok(GuiPrimitive(o.prim.clone())));
+        methods.add_meta_method(MetaMethod::Index, |lua, o, key: Value| {
+            crate::props::gui::object_get(lua, o, &key)
+        });
+        methods.add_meta_method(
+            MetaMethod::NewIndex,
+            |_, o, (key, value): (Value, Value)| crate::props::gui::object_set(o, &key, &value),
+        );
+        methods.add_meta_method(MetaMethod::ToString, |_, o, ()| {
+            Ok(format!("PhysicsGuiObject {:?}", o.object.handle()))
+        });
+    }
+}

@@ -1,0 +1,156 @@
+//! The GUI plane behind the backend seam: routes each op to the plane's methods.
+
+use std::mem::MaybeUninit;
+
+use shm_layout::{
+    BodyState, CommandError, CommandResult, ErrorKind, EventRecord, GuiObjectOp, GuiOp, GuiReply,
+    ObjectOp, PlaneKind, PlaneOp, Reply, TickHeader,
+};
+
+use super::Plane;
+use crate::backend::{Backend, SlotFilter, Usage};
+
+impl Plane {
+    fn gui(&mut self, op: GuiOp) -> CommandResult {
+        let applied = |plane: &Plane| Reply::Applied { tick: plane.tick };
+        match op {
+            GuiOp::Info => Ok(Reply::Gui(GuiReply::Plane(self.gui_info()))),
+            GuiOp::Add {
+                shape,
+                size,
+                position,
+                props,
+            } => {
+                let handle = self.add_object(shape, size, position, &props)?;
+                Ok(Reply::Object {
+                    handle,
+                    tick: self.tick,
+                })
+            }
+            GuiOp::Object { handle, op } => match op {
+                GuiObjectOp::Set(prop) => self.set_object(handle, prop).map(|_| applied(self)),
+                GuiObjectOp::ApplyImpulse(j) => {
+                    self.apply_impulse(handle, j).map(|_| applied(self))
+                }
+                GuiObjectOp::Wake => self.wake(handle).map(|_| applied(self)),
+                GuiObjectOp::Info => Ok(Reply::Gui(GuiReply::Object(Box::new(
+                    self.object_info(handle)?,
+                )))),
+                GuiObjectOp::Destroy => self.destroy_object(handle).map(|_| applied(self)),
+            },
+            GuiOp::Controller { handle, op } => self.controller_op(handle, op),
+            GuiOp::Raycast {
+                from,
+                dir,
+                max_distance,
+            } => Ok(Reply::Gui(GuiReply::Hit(self.raycast(
+                from,
+                dir,
+                max_distance,
+            )?))),
+        }
+    }
+}
+
+fn not_for_gui(what: &str) -> CommandError {
+    CommandError::new(
+        ErrorKind::InvalidValue,
+        format!("{what} is an op of 3D planes; GUI planes take PlaneOp::Gui"),
+    )
+}
+
+impl Backend for Plane {
+    fn kind(&self) -> PlaneKind {
+        PlaneKind::Gui2d
+    }
+
+    fn apply(&mut self, op: PlaneOp) -> CommandResult {
+        match op {
+            PlaneOp::Info => Ok(Reply::Plane(self.info())),
+            PlaneOp::Set(prop) => self.set(prop).map(|_| Reply::Done),
+            PlaneOp::Gui(op) => self.gui(op),
+            PlaneOp::Object { handle, op } => match op {
+                ObjectOp::Wake => self.gui(GuiOp::Object {
+                    handle,
+                    op: GuiObjectOp::Wake,
+                }),
+                ObjectOp::Destroy => self.gui(GuiOp::Object {
+                    handle,
+                    op: GuiObjectOp::Destroy,
+                }),
+                ObjectOp::ApplyImpulse(j) => self.gui(GuiOp::Object {
+                    handle,
+                    op: GuiObjectOp::ApplyImpulse([j[0], j[1]]),
+                }),
+                other => Err(not_for_gui(&format!("ObjectOp::{other:?}"))),
+            },
+            PlaneOp::AddObject { .. } => Err(not_for_gui("AddObject")),
+            PlaneOp::Query(_) => Err(not_for_gui("Query")),
+            PlaneOp::Controller(_) => Err(not_for_gui("Controller")),
+            // Collision groups do not apply (ZIndex is the layer); a client sends its table to
+            // every plane it owns, so a GUI plane takes it and ignores it.
+            PlaneOp::CollisionGroups(_) => Ok(Reply::Done),
+            PlaneOp::Step { .. } | PlaneOp::Destroy => Err(CommandError::new(
+                ErrorKind::Internal,
+                format!("{op:?} is handled by the server, not the plane"),
+            )),
+        }
+    }
+
+    fn step(&mut self, dt: f32) -> Result<bool, CommandError> {
+        Plane::step(self, dt)
+    }
+
+    fn tick_rate(&self) -> f32 {
+        Plane::tick_rate(self)
+    }
+
+    fn enabled(&self) -> bool {
+        Plane::enabled(self)
+    }
+
+    fn tick(&self) -> u64 {
+        self.tick
+    }
+
+    fn header(&self) -> TickHeader {
+        Plane::header(self)
+    }
+
+    fn slot_count(&self) -> usize {
+        Plane::slot_count(self)
+    }
+
+    fn awake_count(&self) -> usize {
+        Plane::awake_count(self)
+    }
+
+    fn for_each_awake(&self, f: &mut dyn FnMut(usize)) {
+        for slot in self.awake_slots() {
+            f(slot);
+        }
+    }
+
+    fn drain_dirty(&mut self, into: &mut Vec<u32>) -> bool {
+        self.dirty.drain(into)
+    }
+
+    fn write_states(&self, out: &mut [MaybeUninit<BodyState>], filter: SlotFilter<'_>) {
+        for (i, dst) in out.iter_mut().enumerate() {
+            if filter.wants(i) {
+                dst.write(self.body_state(i));
+            }
+        }
+    }
+
+    fn events(&self) -> &[EventRecord] {
+        Plane::events(self)
+    }
+
+    fn usage(&self) -> Usage {
+        Usage {
+            objects: self.bodies.live() as u64,
+            mesh_vertices: 0,
+        }
+    }
+}

@@ -1,0 +1,366 @@
+//! The 2D GUI plane (`PhysicsService.NewGUI`): a rapier2d world in pixel space (+Y down)
+//! behind the same backend seam as the 3D plane, published through the same shared-memory
+//! records. Only a GUI plane pays for any of it; a build without the `gui` feature leaves the
+//! module out.
+//!
+//! - `backend`: the [`Backend`](crate::backend::Backend) implementation (op routing).
+//! - `objects`: bodies for GUI primitives, their properties and shapes.
+//! - `forces`: the per-tick pass (damping, drag, forces, one-shot impulses).
+//! - `hooks`: ZIndex as the collision layer, and the bounds walls' per-body materials.
+//! - `controllers`: `GUIController` (move, jump, waypoints, foot probe, signal events).
+//! - `queries`: `Raycast` and the scene refresh queries need.
+//!
+//! How 2D maps onto [`BodyState`]: `position = [x, y, 0]` px, `rotation` the quaternion about
+//! +Z, `linear_velocity = [vx, vy, 0]` px/s, `angular_velocity = [0, 0, ω]` rad/s.
+
+mod backend;
+mod controllers;
+mod forces;
+mod hooks;
+mod objects;
+mod queries;
+
+use std::time::Instant;
+
+use rapier2d::prelude::*;
+use shm_layout::gui_op::GuiPlaneInfo;
+use shm_layout::settings::gui_plane::GUI_TIME_UNTIL_SLEEP;
+use shm_layout::settings::{GuiObjectSettings, GuiPlaneProp, GuiPlaneSettings, GuiShape};
+use shm_layout::validate::{self, MAX_DT};
+use shm_layout::{
+    BodyState, CommandError, EventRecord, PlaneId, PlaneInfo, PlaneKind, PlaneProp, PlaneSettings,
+    TickHeader, FLAG_ALIVE, FLAG_ANCHORED, FLAG_SLEEPING, LAYOUT_VERSION,
+};
+
+use crate::backend::{Dirty, SlotTable};
+use controllers::Controller;
+
+/// Slots per GUI plane.
+pub const MAX_SLOTS: usize = 1 << 20;
+
+/// Pixels per "metre" for rapier's tolerances (`length_unit`): GUI bodies are tens to
+/// hundreds of pixels across.
+pub const LENGTH_UNIT: f32 = 100.0;
+
+/// One object: its rapier body and collider and what the API says about it.
+#[derive(Debug)]
+struct Body {
+    handle: RigidBodyHandle,
+    collider: ColliderHandle,
+    shape: GuiShape,
+    settings: GuiObjectSettings,
+    controller: Option<Box<Controller>>,
+}
+
+/// One GUI plane.
+pub struct Plane {
+    /// The plane's id (stamped into its tick headers).
+    pub id: PlaneId,
+    settings: GuiPlaneSettings,
+    world: PhysicsWorld,
+    bodies: SlotTable<Body>,
+    /// Slots of bodies with a controller, in creation order.
+    controlled: Vec<u32>,
+    /// Bodies with a force or a pending impulse of their own.
+    driven: u32,
+    dirty: Dirty,
+    /// An op moved, added or reshaped a body since the last step (queries refresh first).
+    query_stale: Vec<RigidBodyHandle>,
+    tick: u64,
+    sim_time: f64,
+    last_step_us: f32,
+    last_dt: f32,
+    max_penetration: f32,
+    contact_pairs: u32,
+    events: Vec<EventRecord>,
+    event_seq: u64,
+}
+
+impl Plane {
+    /// A GUI plane with default options, then `props` applied in order. It accepts the GUI
+    /// options (`PlaneProp::Gui`) and the options of every plane (`TickRate`, `Enabled`,
+    /// `Shared`).
+    pub fn new(id: PlaneId, props: &[PlaneProp]) -> Result<Plane, CommandError> {
+        let settings = GuiPlaneSettings::default();
+        let mut world = PhysicsWorld::new();
+        world.gravity = Vector::from(settings.gravity);
+        world.integration_parameters.length_unit = LENGTH_UNIT;
+        let mut plane = Plane {
+            id,
+            settings,
+            world,
+            bodies: SlotTable::new("object", MAX_SLOTS),
+            controlled: Vec::new(),
+            driven: 0,
+            dirty: Dirty::default(),
+            query_stale: Vec::new(),
+            tick: 0,
+            sim_time: 0.0,
+            last_step_us: 0.0,
+            last_dt: 0.0,
+            max_penetration: 0.0,
+            contact_pairs: 0,
+            events: Vec::new(),
+            event_seq: 0,
+        };
+        for prop in props {
+            plane.apply_prop(*prop, true)?;
+        }
+        if let Some((min, max)) = plane.settings.bounds {
+            plane.build_walls(min, max);
+        }
+        Ok(plane)
+    }
+
+    /// Applies one option after creation.
+    pub fn set(&mut self, prop: PlaneProp) -> Result<(), CommandError> {
+        self.apply_prop(prop, false)
+    }
+
+    fn apply_prop(&mut self, prop: PlaneProp, creating: bool) -> Result<(), CommandError> {
+        match prop.checked()? {
+            PlaneProp::TickRate(hz) => self.settings.tick_rate = hz,
+            PlaneProp::Enabled(on) => self.settings.enabled = on,
+            PlaneProp::Shared(on) if creating => self.settings.shared = on,
+            PlaneProp::Shared(on) => {
+                return Err(CommandError::invalid_field(
+                    "Shared",
+                    format!("Shared is read-only after creation (tried to set {on})"),
+                ))
+            }
+            PlaneProp::Gui(g) => {
+                let g = self.settings.apply(g, creating)?;
+                match g {
+                    GuiPlaneProp::Gravity(v) => self.world.gravity = Vector::from(v),
+                    GuiPlaneProp::RestThreshold(_) | GuiPlaneProp::NeverSleep(_) => {
+                        self.refresh_activation()
+                    }
+                    _ => {}
+                }
+                if g.changes_forces() {
+                    self.world.wake_up_all(true);
+                }
+            }
+            other => {
+                return Err(CommandError::invalid_field(
+                    other.name(),
+                    format!(
+                        "{} is an option of 3D planes; a GUI plane takes Gravity, \
+                         LinearDamping, AngularDamping, Drag, ConstantForce, RestThreshold, \
+                         SolverIterations, NeverSleep, BoundsMin/BoundsMax, TickRate, Enabled \
+                         and Shared",
+                        other.name()
+                    ),
+                ))
+            }
+        }
+        self.dirty.mark_all();
+        Ok(())
+    }
+
+    /// The sleep rule of the reference: a body whose speed stays below RestThreshold for
+    /// 0.5 s sleeps; RestThreshold 0 or NeverSleep keeps bodies awake. Rapier measures the
+    /// pose drift per step against `2 · threshold · dt`, hence the halving.
+    fn activation(&self) -> RigidBodyActivation {
+        if self.settings.never_sleep || self.settings.rest_threshold <= 0.0 {
+            return RigidBodyActivation::cannot_sleep();
+        }
+        let mut a = RigidBodyActivation::active();
+        a.normalized_linear_threshold = self.settings.rest_threshold / (2.0 * LENGTH_UNIT);
+        a.time_until_sleep = GUI_TIME_UNTIL_SLEEP;
+        a
+    }
+
+    fn refresh_activation(&mut self) {
+        let template = self.activation();
+        for (_, body) in self.world.bodies.iter_mut() {
+            let a = body.activation_mut();
+            a.normalized_linear_threshold = template.normalized_linear_threshold;
+            a.angular_threshold = template.angular_threshold;
+            a.time_until_sleep = template.time_until_sleep;
+            body.wake_up(true);
+        }
+    }
+
+    /// Automatic ticks per second (0 = manual).
+    pub fn tick_rate(&self) -> f32 {
+        self.settings.tick_rate
+    }
+
+    /// Whether the plane advances.
+    pub fn enabled(&self) -> bool {
+        self.settings.enabled
+    }
+
+    /// Every GUI option and count.
+    pub fn gui_info(&self) -> GuiPlaneInfo {
+        GuiPlaneInfo {
+            id: self.id,
+            settings: self.settings,
+            tick: self.tick,
+            object_count: self.bodies.live(),
+            controller_count: self.controlled.len() as u32,
+        }
+    }
+
+    /// The plane as every kind describes itself (`PlaneOp::Info`): the options planes share
+    /// are filled in (Gravity as (x, y, 0)); the others are the 3D defaults. `GuiOp::Info`
+    /// has every GUI option.
+    pub fn info(&self) -> PlaneInfo {
+        let s = &self.settings;
+        PlaneInfo {
+            id: self.id,
+            kind: PlaneKind::Gui2d,
+            settings: PlaneSettings {
+                gravity: [s.gravity[0], s.gravity[1], 0.0],
+                tick_rate: s.tick_rate,
+                enabled: s.enabled,
+                shared: s.shared,
+                linear_damping: s.linear_damping,
+                angular_damping: s.angular_damping,
+                drag: s.drag,
+                constant_force: [s.constant_force[0], s.constant_force[1], 0.0],
+                rest_threshold: s.rest_threshold,
+                solver_iterations: s.solver_iterations,
+                never_sleep: s.never_sleep,
+                ..PlaneSettings::default()
+            },
+            tick: self.tick,
+            object_count: self.bodies.live(),
+            effective_solver_iterations: s.solver_iterations,
+            max_hit_box_quality: 1,
+        }
+    }
+
+    /// Advances by `dt`. Returns false (and does nothing) when the plane is disabled.
+    pub fn step(&mut self, dt: f32) -> Result<bool, CommandError> {
+        let dt = validate::positive("dt", dt)?;
+        if dt > MAX_DT {
+            return Err(CommandError::invalid(format!(
+                "dt must be at most {MAX_DT} s, got {dt}"
+            )));
+        }
+        if !self.settings.enabled {
+            return Ok(false);
+        }
+        let started = Instant::now();
+        self.events.clear();
+        self.world.integration_parameters.dt = dt;
+        self.world.integration_parameters.num_solver_iterations =
+            self.settings.solver_iterations as usize;
+        self.drive_controllers(dt);
+        self.apply_forces(dt);
+        self.world.step_with_events(&hooks::Hooks, &());
+        self.query_stale.clear();
+        self.dirty.stepped(self.bodies.slot_count());
+        self.tick += 1;
+        self.sim_time += dt as f64;
+        self.last_dt = dt;
+        self.after_step_controllers();
+        (self.max_penetration, self.contact_pairs) = self.contact_figures();
+        self.last_step_us = started.elapsed().as_secs_f32() * 1e6;
+        Ok(true)
+    }
+
+    fn contact_figures(&self) -> (f32, u32) {
+        let mut deepest = 0.0f32;
+        let mut pairs = 0;
+        for (_, contact) in self
+            .world
+            .narrow_phase
+            .contact_pairs()
+            .filter_map(|p| p.find_deepest_contact())
+        {
+            deepest = deepest.max(-contact.dist);
+            pairs += 1;
+        }
+        (deepest, pairs)
+    }
+
+    /// Controller signals of the last step, in order.
+    pub fn events(&self) -> &[EventRecord] {
+        &self.events
+    }
+
+    /// The header of the newest tick.
+    pub fn header(&self) -> TickHeader {
+        TickHeader {
+            layout_version: LAYOUT_VERSION,
+            plane_id: self.id,
+            tick: self.tick,
+            sim_time: self.sim_time,
+            tick_end_ns: 0,
+            step_time_us: self.last_step_us,
+            dt: self.last_dt,
+            slot_count: self.bodies.slot_count() as u32,
+            body_count: self.bodies.live(),
+            max_penetration: self.max_penetration,
+            max_joint_error: 0.0,
+            contact_pairs: self.contact_pairs,
+            event_count: self.event_seq as u32,
+        }
+    }
+
+    /// Length of the published body array.
+    pub fn slot_count(&self) -> usize {
+        self.bodies.slot_count()
+    }
+
+    /// Slots of the bodies rapier simulates now.
+    pub fn awake_slots(&self) -> impl Iterator<Item = usize> + '_ {
+        self.world
+            .active_bodies()
+            .map(|(_, body)| body.user_data as usize)
+            .filter(|slot| *slot != WALLS_SLOT)
+    }
+
+    /// Number of awake bodies.
+    pub fn awake_count(&self) -> usize {
+        self.world.islands.num_active_bodies()
+    }
+
+    /// The published state of slot `i` (dead slots carry only their generation).
+    pub fn body_state(&self, i: usize) -> BodyState {
+        let generation = self.bodies.generation(i);
+        let Some(body) = self
+            .bodies
+            .at(i)
+            .and_then(|b| self.world.bodies.get(b.handle))
+        else {
+            return BodyState {
+                generation,
+                ..BodyState::default()
+            };
+        };
+        let mut flags = FLAG_ALIVE;
+        if body.is_sleeping() {
+            flags |= FLAG_SLEEPING;
+        }
+        if body.is_fixed() {
+            flags |= FLAG_ANCHORED;
+        }
+        let p = body.translation();
+        let half = body.rotation().angle() * 0.5;
+        let v = body.linvel();
+        BodyState {
+            position: [p.x, p.y, 0.0],
+            flags,
+            rotation: [0.0, 0.0, half.sin(), half.cos()],
+            linear_velocity: [v.x, v.y, 0.0],
+            generation,
+            angular_velocity: [0.0, 0.0, body.angvel()],
+            _reserved: 0,
+        }
+    }
+
+    /// Appends one event (running number assigned here).
+    fn push_event(&mut self, mut record: EventRecord) {
+        record.tick = self.tick;
+        record.seq = self.event_seq;
+        self.event_seq += 1;
+        self.events.push(record);
+    }
+}
+
+/// `user_data` of the bounds walls' body (never a slot).
+const WALLS_SLOT: usize = u32::MAX as usize;
