@@ -4,8 +4,8 @@
 use std::collections::BTreeMap;
 
 use shm_layout::{
-    Command, CommandResult, ControllerOp, ErrorKind, GuiControllerOp, GuiObjectOp, GuiOp, ObjectOp,
-    ObjectProp, PlaneOp, PlaneProp, QueryOp, Reply, Response, Shape,
+    Command, CommandResult, ControllerOp, ErrorKind, GuiControllerOp, GuiObjectOp, GuiOp, GuiShape,
+    ObjectOp, ObjectProp, PlaneOp, PlaneProp, QueryOp, Reply, Response, Shape,
 };
 
 /// How many failures a run keeps in full (the counters count all of them).
@@ -288,6 +288,52 @@ pub fn all_op_names() -> Vec<String> {
             .iter()
             .map(|p| format!("Object.Set.{}", object_prop_name(p))),
     );
+    names.push("Object.Set.CollisionGroup".into());
+    names.push("Plane.CollisionGroups".into());
+    for q in [
+        "Raycast",
+        "Spherecast",
+        "Blockcast",
+        "Shapecast",
+        "BoundsInRadius",
+        "BoundsInBox",
+        "InPart",
+    ] {
+        names.push(format!("Plane.Query.{q}"));
+    }
+    for c in [
+        "Create",
+        "Set",
+        "Info",
+        "SetPath",
+        "AppendWaypoint",
+        "StopWalking",
+        "Jump",
+        "Teleport",
+        "Destroy",
+    ] {
+        names.push(format!("Plane.Controller.{c}"));
+    }
+    names.push("Gui.Info".into());
+    names.push("Gui.Raycast".into());
+    for shape in GuiShape::ALL {
+        names.push(format!("Gui.Add.{}", shape.name()));
+    }
+    for o in ["ApplyImpulse", "Wake", "Info", "Destroy"] {
+        names.push(format!("Gui.Object.{o}"));
+    }
+    for c in [
+        "Create",
+        "Set",
+        "Move",
+        "Jump",
+        "SetWaypoints",
+        "ClearWaypoints",
+        "Info",
+        "Destroy",
+    ] {
+        names.push(format!("Gui.Controller.{c}"));
+    }
     names
 }
 
