@@ -6,6 +6,7 @@ mod chart;
 pub mod markdown;
 mod pareto;
 mod scenes;
+mod scenes_2d;
 pub mod sweep;
 
 use std::path::PathBuf;
@@ -47,16 +48,30 @@ pub struct Point {
 pub fn run(args: &AccuracyArgs) -> BenchResult<()> {
     let configs = sweep::configs(!args.quick);
     let repeats = if args.quick { 5 } else { 9 };
-    let progress = Progress::new((scenes::SCENES.len() * configs.len()) as u64);
+    // 2D scenes have no HitBoxQuality or LoopSolver: only the configurations without them.
+    let configs_2d: Vec<Config> = configs
+        .iter()
+        .copied()
+        .filter(|c| c.hit_box_quality == 1 && !c.loop_solver)
+        .collect();
+    let runs = scenes::SCENES.len() * configs.len() + scenes_2d::SCENES_2D.len() * configs_2d.len();
+    let progress = Progress::new(runs as u64);
     progress.note(format!(
-        "accuracy: {} scenes × {} configurations × {repeats} repeats, in process",
+        "accuracy: {} 3D scenes × {} configurations and {} 2D scenes × {}, × {repeats} repeats, \
+         in process",
         scenes::SCENES.len(),
-        configs.len()
+        configs.len(),
+        scenes_2d::SCENES_2D.len(),
+        configs_2d.len()
     ));
     let mut points = Vec::new();
-    for scene in scenes::SCENES {
+    let all = scenes::SCENES
+        .iter()
+        .map(|s| (s, &configs))
+        .chain(scenes_2d::SCENES_2D.iter().map(|s| (s, &configs_2d)));
+    for (scene, configs) in all {
         let mut these = Vec::new();
-        for config in &configs {
+        for config in configs {
             progress.phase(format!("{} at {}", scene.name, config.label()));
             let mut errors = Vec::new();
             let mut costs = Vec::new();
@@ -105,5 +120,8 @@ pub fn run(args: &AccuracyArgs) -> BenchResult<()> {
 
 /// The reference scenes, for the report's headings.
 pub fn scene_info(name: &str) -> Option<&'static scenes::Scene> {
-    scenes::SCENES.iter().find(|s| s.name == name)
+    scenes::SCENES
+        .iter()
+        .chain(scenes_2d::SCENES_2D)
+        .find(|s| s.name == name)
 }
