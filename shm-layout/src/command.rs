@@ -8,6 +8,8 @@
 use serde::{Deserialize, Serialize};
 
 use crate::error::CommandError;
+use crate::joint_op::JointInfo;
+use crate::map_op::MapInfo;
 use crate::object_op::ObjectOp;
 use crate::plane_op::{PlaneKind, PlaneOp};
 use crate::query::Hit;
@@ -196,6 +198,17 @@ pub enum Reply {
     Hits(Vec<Option<Hit>>),
     /// The objects an overlap query found.
     Objects(Vec<Handle>),
+    /// A new joint, and the tick after which it acts.
+    Joint {
+        /// The joint's handle.
+        handle: Handle,
+        /// Steps after this tick include it.
+        tick: u64,
+    },
+    /// A joint's description.
+    JointInfo(Box<JointInfo>),
+    /// A built map.
+    Map(Box<MapInfo>),
 }
 
 /// The result of one command.

@@ -20,6 +20,8 @@ pub mod codec;
 pub mod collision_groups;
 pub mod command;
 pub mod error;
+pub mod joint_op;
+pub mod map_op;
 pub mod names;
 pub mod object_op;
 pub mod plane_op;
@@ -33,6 +35,8 @@ pub use codec::{DecodeError, Frame};
 pub use collision_groups::CollisionGroups;
 pub use command::*;
 pub use error::{CommandError, ErrorKind};
+pub use joint_op::{AxisMode, JointInfo, JointKind, JointOp, JointProp, JointSettings};
+pub use map_op::{MapInfo, MapOp, MapReport};
 pub use object_op::ObjectOp;
 pub use plane_op::{OpCost, PlaneKind, PlaneOp};
 pub use query::{FilterType, Hit, QueryFilter, QueryOp, Ray};
@@ -44,7 +48,7 @@ pub use shape::{Shape, ShapeKind};
 
 /// Bumped whenever a record layout or the command encoding changes. Client and daemon must
 /// agree on it; the handshake reports both values when they differ.
-pub const LAYOUT_VERSION: u32 = 4;
+pub const LAYOUT_VERSION: u32 = 5;
 
 /// The crate version both sides were built from; also checked by the handshake.
 pub const CRATE_VERSION: &str = env!("CARGO_PKG_VERSION");

@@ -5,6 +5,8 @@
 use serde::{Deserialize, Serialize};
 
 use crate::collision_groups::CollisionGroups;
+use crate::joint_op::JointOp;
+use crate::map_op::MapOp;
 use crate::object_op::ObjectOp;
 use crate::query::QueryOp;
 use crate::records::Handle;
@@ -55,6 +57,10 @@ pub enum PlaneOp {
     /// Replaces the plane's collision-group table; objects in a group no longer registered
     /// return to "Default".
     CollisionGroups(CollisionGroups),
+    /// An op on the plane's joints.
+    Joint(JointOp),
+    /// An op on the plane's triangle-mesh map upload.
+    Map(MapOp),
 }
 
 /// What an op may add to a plane, for the daemon's per-client quotas.
@@ -73,6 +79,7 @@ impl PlaneOp {
             self,
             PlaneOp::Info
                 | PlaneOp::Query(_)
+                | PlaneOp::Joint(JointOp::Info { .. })
                 | PlaneOp::Object {
                     op: ObjectOp::Info,
                     ..
@@ -86,6 +93,15 @@ impl PlaneOp {
             PlaneOp::AddObject { shape, .. } => OpCost {
                 objects: 1,
                 mesh_vertices: shape.mesh_vertices() as u64,
+            },
+            // A joint counts as an object; map pieces count vertices + triangles.
+            PlaneOp::Joint(JointOp::Create { .. }) => OpCost {
+                objects: 1,
+                mesh_vertices: 0,
+            },
+            PlaneOp::Map(op) => OpCost {
+                objects: 0,
+                mesh_vertices: op.cost(),
             },
             _ => OpCost::default(),
         }

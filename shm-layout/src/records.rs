@@ -110,6 +110,10 @@ pub struct TickHeader {
 pub const EVENT_CONTACT_STARTED: u32 = 1;
 /// Event kind: two objects stopped touching.
 pub const EVENT_CONTACT_STOPPED: u32 = 2;
+/// Event kind: a joint broke (its force exceeded BreakForce). `a` is the joint's handle,
+/// `b` its object A, `position` the world anchor on A and `impulse` the force that broke
+/// it.
+pub const EVENT_JOINT_BROKE: u32 = 3;
 
 /// One per-tick event (published in the plane's event service, one sample per tick that
 /// has events). 64 bytes.

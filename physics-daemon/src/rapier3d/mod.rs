@@ -7,12 +7,15 @@
 //! - `forces`, `solver`, `contacts`: the per-tick force pass, solver tuning, contacts.
 //! - `queries`, `collision_groups`: scene queries and the plane's collision-group table.
 //! - `limits`: MaxLinearSpeed and MaxAngularSpeed.
+//! - `joints`: joints, their error figures and breaking; `maps`: triangle-mesh maps.
 
 mod backend;
 mod collision_groups;
 mod contacts;
 mod forces;
+mod joints;
 mod limits;
+mod maps;
 mod objects;
 mod part;
 mod properties;
@@ -84,6 +87,10 @@ pub struct Plane {
     /// Bodies an op added, moved or reshaped since the last step: a query first brings their
     /// colliders' poses and broad-phase boxes up to date, so it sees the change.
     query_stale: Vec<RigidBodyHandle>,
+    /// Joints (see `joints`).
+    joints: joints::Joints,
+    /// Map pieces uploaded since the last build (see `maps`).
+    map_pending: maps::PendingMap,
 }
 
 impl Plane {
@@ -122,6 +129,8 @@ impl Plane {
             removed: Vec::new(),
             groups: CollisionGroups::default(),
             query_stale: Vec::new(),
+            joints: joints::Joints::default(),
+            map_pending: maps::PendingMap::default(),
         };
         for prop in props {
             plane.apply_prop(*prop, true)?;
@@ -245,6 +254,7 @@ impl Plane {
         self.last_dt = dt;
         (self.max_penetration, self.contact_pairs) = self.contact_figures();
         self.collect_events();
+        self.joints_after_step(dt);
         self.removed.clear();
         self.last_step_us = started.elapsed().as_secs_f32() * 1e6;
         Ok(true)
@@ -268,7 +278,7 @@ impl Plane {
             slot_count: self.bodies.slot_count() as u32,
             body_count: self.bodies.live(),
             max_penetration: self.max_penetration,
-            max_joint_error: 0.0,
+            max_joint_error: self.joints.max_error,
             contact_pairs: self.contact_pairs,
             event_count: self.event_seq as u32,
         }
