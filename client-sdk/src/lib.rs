@@ -16,6 +16,8 @@ mod client;
 mod collision_groups;
 mod error;
 mod events;
+mod joint;
+pub mod map;
 mod object;
 mod overlay;
 mod plane;
@@ -27,15 +29,18 @@ pub use client::{Client, ConnectOptions, HUNG_AFTER, STALL_AFTER};
 pub use collision_groups::CollisionGroup;
 pub use error::Error;
 pub use events::{Contact, Events, EVENT_BUFFER_TICKS};
+pub use joint::{Joint, JointBroke};
+pub use map::{Map, MapMesh, MapOptions};
 pub use object::Object;
 pub use plane::{Plane, PlaneOptions, Snapshot};
 pub use query::QueryParams;
 /// The limits and checks the daemon applies, for callers that want to check early.
 pub use shm_layout::validate;
 pub use shm_layout::{
-    BodyState, CollisionGroups, CommandError, ErrorKind, EventRecord, FilterType, Handle, Hit,
-    ObjectInfo, ObjectOp, ObjectProp, ObjectSettings, Pin, PlaneId, PlaneInfo, PlaneKind, PlaneOp,
-    PlaneProp, PlaneSettings, Pose, Ray, Restraint, RotateTo, Shape, ShapeKind, TickHeader, Vec3,
+    AxisMode, BodyState, CollisionGroups, CommandError, ErrorKind, EventRecord, FilterType, Handle,
+    Hit, JointInfo, JointKind, JointProp, JointSettings, MapReport, ObjectInfo, ObjectOp,
+    ObjectProp, ObjectSettings, Pin, PlaneId, PlaneInfo, PlaneKind, PlaneOp, PlaneProp,
+    PlaneSettings, Pose, Ray, Restraint, RotateTo, Shape, ShapeKind, TickHeader, Vec3,
 };
 pub use spawn::{
     connect_or_start, daemon_executable, start_daemon, start_daemon_with, DaemonChild, Session,

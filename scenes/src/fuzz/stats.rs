@@ -4,8 +4,8 @@
 use std::collections::BTreeMap;
 
 use shm_layout::{
-    Command, CommandResult, ErrorKind, ObjectOp, ObjectProp, PlaneOp, PlaneProp, QueryOp, Reply,
-    Response, Shape,
+    Command, CommandResult, ErrorKind, JointOp, MapOp, ObjectOp, ObjectProp, PlaneOp, PlaneProp,
+    QueryOp, Reply, Response, Shape,
 };
 
 /// How many failures a run keeps in full (the counters count all of them).
@@ -309,6 +309,9 @@ pub fn reply_name(reply: &Reply) -> &'static str {
         Reply::CenterOfMass(_) => "CenterOfMass",
         Reply::Hits(_) => "Hits",
         Reply::Objects(_) => "Objects",
+        Reply::Joint { .. } => "Joint",
+        Reply::JointInfo(_) => "JointInfo",
+        Reply::Map(_) => "Map",
     }
 }
 
@@ -344,6 +347,17 @@ pub fn op_name(command: &Command) -> String {
             },
             PlaneOp::Query(q) => format!("Plane.Query.{}", query_name(q)),
             PlaneOp::CollisionGroups(_) => "Plane.CollisionGroups".into(),
+            PlaneOp::Joint(j) => match j {
+                JointOp::Create { kind, .. } => format!("Plane.Joint.Create.{}", kind.name()),
+                JointOp::Set { prop, .. } => format!("Plane.Joint.Set.{}", prop.name()),
+                JointOp::Info { .. } => "Plane.Joint.Info".into(),
+                JointOp::Destroy { .. } => "Plane.Joint.Destroy".into(),
+            },
+            PlaneOp::Map(m) => match m {
+                MapOp::Upload { .. } => "Plane.Map.Upload".into(),
+                MapOp::Build { .. } => "Plane.Map.Build".into(),
+                MapOp::Discard => "Plane.Map.Discard".into(),
+            },
         },
     }
 }
