@@ -362,7 +362,10 @@ impl Plane {
             Command::plane(self.id(), PlaneOp::Map(MapOp::Discard)),
             None,
         );
+        let (mut nv, mut nt) = (0u64, 0u64);
         for piece in pieces(meshes) {
+            nv += piece.vertices.len() as u64;
+            nt += piece.triangles.len() as u64;
             let op = MapOp::Upload {
                 vertices: piece.vertices,
                 triangles: piece.triangles,
@@ -371,9 +374,16 @@ impl Plane {
             .map_err(Error::invalid_value)?;
             client.queue(Command::plane(self.id(), PlaneOp::Map(op)), None);
         }
+        // Pieces refused (a quota, say) are reported here, before anything is built.
+        if let Err(e) = client.flush() {
+            let _ = client.call(Command::plane(self.id(), PlaneOp::Map(MapOp::Discard)));
+            return Err(e);
+        }
         let build = MapOp::Build {
             pose: options.pose,
             scale: options.scale,
+            vertices: nv,
+            triangles: nt,
         }
         .checked()
         .map_err(Error::invalid_value)?;

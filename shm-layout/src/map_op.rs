@@ -70,6 +70,12 @@ pub enum MapOp {
         pose: Pose,
         /// Per-axis scale applied to vertices before `pose`.
         scale: Vec3,
+        /// Vertices the client uploaded for this map: a build whose pending upload holds
+        /// another count (a piece was refused, say by a quota) fails instead of building
+        /// part of the map.
+        vertices: u64,
+        /// Triangles the client uploaded for this map.
+        triangles: u64,
     },
     /// Drops the pending upload.
     Discard,
@@ -111,7 +117,7 @@ impl MapOp {
                     ));
                 }
             }
-            MapOp::Build { pose: p, scale } => {
+            MapOp::Build { pose: p, scale, .. } => {
                 pose("Map.Position", *p)?;
                 let s = bounded3("Map.Scale", *scale, MAX_SIZE)?;
                 if s.iter().any(|c| c.abs() < 1e-6) {

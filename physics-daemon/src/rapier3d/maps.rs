@@ -154,8 +154,27 @@ impl Plane {
                 self.map_pending = PendingMap::default();
                 Ok(Reply::Done)
             }
-            MapOp::Build { pose, scale } => {
+            MapOp::Build {
+                pose,
+                scale,
+                vertices,
+                triangles,
+            } => {
                 let pending = std::mem::take(&mut self.map_pending);
+                let got = (
+                    pending.vertices.len() as u64,
+                    pending.triangles.len() as u64,
+                );
+                if got != (vertices, triangles) {
+                    return Err(CommandError::invalid_field(
+                        "Map",
+                        format!(
+                            "the map upload is incomplete: {} of {vertices} vertices and {} of \
+                             {triangles} triangles arrived (a piece was refused); nothing was built",
+                            got.0, got.1
+                        ),
+                    ));
+                }
                 let (handle, report) = self.build_map(&pending, pose, scale)?;
                 Ok(Reply::Map(Box::new(MapInfo { handle, report })))
             }

@@ -449,6 +449,8 @@ impl<'a> Gen<'a> {
                 } else {
                     [self.rng.f32_in(0.5, 2.0); 3]
                 },
+                vertices: if wild { self.rng.u64() % 100 } else { 0 },
+                triangles: if wild { self.rng.u64() % 100 } else { 0 },
             },
             _ => MapOp::Discard,
         }
