@@ -321,3 +321,11 @@ fn queries_touches_and_collision_groups_from_luau() {
     r.assert_ok();
     assert!(r.stdout().contains("queries ok"), "{}", r.stdout());
 }
+
+#[test]
+fn joints_from_lua_match_the_pendulum_period_and_check_options() {
+    let daemon = TestDaemon::start("lua-joints");
+    let r = run(&daemon, "tests/lua/joints.luau");
+    r.assert_ok();
+    assert!(r.stdout().contains("joints ok"), "{}", r.stdout());
+}

@@ -4,6 +4,7 @@
 
 pub mod collision_groups;
 pub mod contacts;
+pub mod joint;
 pub mod object;
 pub mod part;
 pub mod plane;

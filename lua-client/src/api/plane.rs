@@ -183,6 +183,7 @@ impl UserData for PhysicsPlane {
                 .map_err(|e| sdk_error("PhysicsPlane:Destroy", e))
         });
         super::query::add_methods(methods);
+        super::joint::add_methods(methods);
         not_yet_methods(methods, "PhysicsPlane", NOT_YET_METHODS);
         methods.add_meta_method(MetaMethod::Index, |lua, p, key: Value| {
             PLANE.get(lua, &p.0, &key)
