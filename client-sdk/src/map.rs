@@ -150,7 +150,7 @@ pub fn parse_meshes(bytes: &[u8], name: &str) -> Result<Vec<MapMesh>, Error> {
                     Some(i) => i.into_u32().collect(),
                     None => (0..n).collect(),
                 };
-                if flat.len() % 3 != 0 {
+                if !flat.len().is_multiple_of(3) {
                     return Err(file_error(
                         name,
                         format!("{what} has {} indices, not a multiple of 3", flat.len()),
@@ -217,7 +217,7 @@ pub fn write_glb(meshes: &[MapMesh]) -> Vec<u8> {
         let mut view = |bytes: &[u8], target| {
             let offset = bin.len();
             bin.extend_from_slice(bytes);
-            while bin.len() % 4 != 0 {
+            while !bin.len().is_multiple_of(4) {
                 bin.push(0);
             }
             root.push(json::buffer::View {
@@ -302,7 +302,7 @@ pub fn write_glb(meshes: &[MapMesh]) -> Vec<u8> {
     root.scene = Some(scene);
     let json_bytes = json::serialize::to_vec(&root).expect("glTF JSON serialises");
     let mut json_padded = json_bytes;
-    while json_padded.len() % 4 != 0 {
+    while !json_padded.len().is_multiple_of(4) {
         json_padded.push(b' ');
     }
     let glb = gltf::binary::Glb {

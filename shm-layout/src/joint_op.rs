@@ -401,8 +401,10 @@ impl JointSettings {
                 format!("a Spring needs Stiffness > 0, got {}", self.stiffness),
             ));
         }
-        if self.motor_speed.is_some() || self.motor_target.is_some() {
-            if !matches!(kind, JointKind::Hinge | JointKind::Prismatic) {
+        if (self.motor_speed.is_some() || self.motor_target.is_some())
+            && !matches!(kind, JointKind::Hinge | JointKind::Prismatic)
+        {
+            {
                 let field = if self.motor_speed.is_some() {
                     "MotorSpeed"
                 } else {
