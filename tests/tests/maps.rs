@@ -116,7 +116,10 @@ fn a_tiled_map_has_no_ghost_bumps_and_rays_hit_it_exactly() {
 
     // The map is static: reshaping it is refused with the property named.
     m.object.set_size([1.0; 3]).unwrap();
-    let e = s.client.flush().expect_err("Size accepted on a map")
+    let e = s
+        .client
+        .flush()
+        .expect_err("Size accepted on a map")
         .to_string();
     assert!(e.contains("Size") && e.contains("map"), "{e}");
 }

@@ -43,6 +43,10 @@ pub(super) struct Joint {
     force: f32,
     position: f32,
     broken: bool,
+    /// Whether A and B were dynamic at the last step, and whether the options changed
+    /// since: either rebuilds the rapier joint before the next step.
+    seen: Option<(bool, bool)>,
+    dirty: bool,
 }
 
 /// The plane's joints.
@@ -280,6 +284,8 @@ impl Plane {
             force: 0.0,
             position: 0.0,
             broken: false,
+            seen: None,
+            dirty: false,
         };
         match self.joints.table.insert(joint) {
             Ok(h) => {
@@ -298,13 +304,9 @@ impl Plane {
         let mut settings = joint.settings;
         settings.store(prop);
         settings.check(joint.kind)?;
-        let (kind, rel, rapier) = (joint.kind, joint.rel, joint.rapier);
-        self.joints.table.get_mut(handle)?.settings = settings;
-        if let Some(r) = rapier {
-            if let Some(j) = self.world.impulse_joints.get_mut(r, true) {
-                j.data = build(kind, &settings, rel);
-            }
-        }
+        let j = self.joints.table.get_mut(handle)?;
+        j.settings = settings;
+        j.dirty = true;
         Ok(())
     }
 
@@ -348,6 +350,44 @@ impl Plane {
             if let Ok(j) = self.joints.table.remove(h) {
                 self.remove_rapier_joint(&j);
             }
+        }
+    }
+
+    /// Before a step: a joint whose options changed, or whose bodies became or stopped
+    /// being dynamic (anchored), is rebuilt by removing and inserting it, which is what
+    /// makes rapier refresh its cached joint selection (changing a joint in place, or
+    /// anchoring its body, can leave the solver a joint between two fixed bodies, which
+    /// panics). A joint between two non-dynamic bodies is parked (no rapier joint) until
+    /// either is dynamic again.
+    pub(super) fn joints_before_step(&mut self) {
+        if self.joints.table.live() == 0 {
+            return;
+        }
+        for i in 0..self.joints.table.slot_count() {
+            let Some(j) = self.joints.table.at(i) else {
+                continue;
+            };
+            if j.broken {
+                continue;
+            }
+            let dynamic = |h| self.world.bodies.get(h).is_some_and(|b| b.is_dynamic());
+            let now = (dynamic(j.body_a), dynamic(j.body_b));
+            if j.seen == Some(now) && !j.dirty {
+                continue;
+            }
+            let (kind, rel, settings, a, b, old) =
+                (j.kind, j.rel, j.settings, j.body_a, j.body_b, j.rapier);
+            if let Some(r) = old {
+                self.world.impulse_joints.remove(r, true);
+            }
+            let new = (now.0 || now.1).then(|| {
+                self.world
+                    .insert_impulse_joint(a, b, build(kind, &settings, rel))
+            });
+            let j = self.joints.table.at_mut(i).expect("live slot");
+            j.rapier = new;
+            j.seen = Some(now);
+            j.dirty = false;
         }
     }
 

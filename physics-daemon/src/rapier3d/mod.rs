@@ -234,6 +234,7 @@ impl Plane {
         self.tune_solver();
         self.apply_forces(dt);
         self.limit_speeds_before_step();
+        self.joints_before_step();
         let hooks = contacts::RestThreshold(self.settings.rest_threshold);
         // Contacts of objects removed since the last step still end with an event.
         if self.reporting > 0 || !self.removed.is_empty() {
