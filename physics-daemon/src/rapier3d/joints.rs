@@ -43,10 +43,42 @@ pub(super) struct Joint {
     force: f32,
     position: f32,
     broken: bool,
-    /// Whether A and B were dynamic at the last step, and whether the options changed
-    /// since: either rebuilds the rapier joint before the next step.
-    seen: Option<(bool, bool)>,
+    /// What A and B were at the last step, and whether the options changed since: either
+    /// rebuilds the rapier joint before the next step.
+    seen: Option<(EndState, EndState)>,
     dirty: bool,
+}
+
+/// What one end of a joint is to the solver.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum EndState {
+    /// Dynamic and simulated.
+    Dynamic,
+    /// Fixed (anchored, the world, a map part).
+    Fixed,
+    /// Out of the simulation: gone, disabled by rapier's quarantine of non-finite state, or
+    /// about to be (a non-finite pose or velocity, which rapier disables at the start of the
+    /// step).
+    Disabled,
+}
+
+impl EndState {
+    fn of(body: Option<&RigidBody>) -> EndState {
+        let Some(b) = body else {
+            return EndState::Disabled;
+        };
+        let finite = b.position().translation.is_finite()
+            && b.position().rotation.is_finite()
+            && b.linvel().is_finite()
+            && b.angvel().is_finite();
+        if !b.is_enabled() || !finite {
+            EndState::Disabled
+        } else if b.is_dynamic() {
+            EndState::Dynamic
+        } else {
+            EndState::Fixed
+        }
+    }
 }
 
 /// The plane's joints.
@@ -353,12 +385,19 @@ impl Plane {
         }
     }
 
-    /// Before a step: a joint whose options changed, or whose bodies became or stopped
-    /// being dynamic (anchored), is rebuilt by removing and inserting it, which is what
-    /// makes rapier refresh its cached joint selection (changing a joint in place, or
-    /// anchoring its body, can leave the solver a joint between two fixed bodies, which
-    /// panics). A joint between two non-dynamic bodies is parked (no rapier joint) until
-    /// either is dynamic again.
+    /// Before a step: a joint whose options changed, or whose bodies changed what they are
+    /// to the solver (anchored, released, disabled), is rebuilt by removing and inserting it,
+    /// which is what makes rapier refresh its cached joint selection. A joint is parked (no
+    /// rapier joint) while it has no dynamic end or while either end is disabled, and comes
+    /// back when both ends allow it again.
+    ///
+    /// Why disabled ends matter: rapier disables a body whose pose or velocity went non-finite
+    /// (its quarantine) and takes it out of the active set, but its joint selection still
+    /// picks a joint whose dynamic ends are "not sleeping", and stamps such a body with the
+    /// world-attached solver id. A joint between two quarantined bodies, or between a
+    /// quarantined body and a fixed one, then reaches the solver with both ends
+    /// world-attached, and its constraint colouring panics (`unreachable!()` in
+    /// `interaction_groups.rs`).
     pub(super) fn joints_before_step(&mut self) {
         if self.joints.table.live() == 0 {
             return;
@@ -370,8 +409,10 @@ impl Plane {
             if j.broken {
                 continue;
             }
-            let dynamic = |h| self.world.bodies.get(h).is_some_and(|b| b.is_dynamic());
-            let now = (dynamic(j.body_a), dynamic(j.body_b));
+            let now = (
+                EndState::of(self.world.bodies.get(j.body_a)),
+                EndState::of(self.world.bodies.get(j.body_b)),
+            );
             if j.seen == Some(now) && !j.dirty {
                 continue;
             }
@@ -380,7 +421,10 @@ impl Plane {
             if let Some(r) = old {
                 self.world.impulse_joints.remove(r, true);
             }
-            let new = (now.0 || now.1).then(|| {
+            let active = now.0 != EndState::Disabled
+                && now.1 != EndState::Disabled
+                && (now.0 == EndState::Dynamic || now.1 == EndState::Dynamic);
+            let new = active.then(|| {
                 self.world
                     .insert_impulse_joint(a, b, build(kind, &settings, rel))
             });
@@ -610,5 +654,233 @@ mod tests {
         // m·g = 2 × 50 = 100.
         assert!((info.force - 100.0).abs() < 5.0, "force {}", info.force);
         assert!(info.error < 0.01, "error {}", info.error);
+    }
+
+    /// Bodies whose state went non-finite are disabled by rapier (its quarantine), yet its
+    /// joint selection still hands their joints to the solver with both ends world-attached,
+    /// which panics there. The sequence the fuzzer found: joined bodies, a step of the
+    /// smallest positive dt (1e-45 s: the solver's 1/dt overflows, every dynamic body is
+    /// quarantined), then a normal step. The joints are parked, no step panics, and a joint
+    /// made afterwards works.
+    #[test]
+    fn joints_of_quarantined_bodies_are_parked_instead_of_panicking_the_solver() {
+        use shm_layout::JointKind;
+        let mut p = Plane::new(
+            1,
+            &[
+                shm_layout::PlaneProp::TickRate(0.0),
+                shm_layout::PlaneProp::AngularDamping(3.4382944),
+                shm_layout::PlaneProp::SolverIterations(13),
+                shm_layout::PlaneProp::RestThreshold(0.8737293),
+            ],
+        )
+        .unwrap();
+        let a = p
+            .add_object(
+                &Shape::Cube {
+                    size: [1.0, 1.0, 1.0],
+                },
+                Pose::at([0.0, 0.0, 0.0]),
+                &[],
+            )
+            .unwrap();
+        let b = ball(&mut p, [0.4, 0.0, 0.0], 1.0);
+        let c = ball(&mut p, [5.0, 0.0, 0.0], 1.0);
+        let parked = |p: &Plane| {
+            (0..p.joints.table.slot_count())
+                .filter_map(|i| p.joints.table.at(i))
+                .filter(|j| j.rapier.is_none())
+                .count()
+        };
+        for h in [a, b, c] {
+            p.apply(PlaneOp::Object {
+                handle: h,
+                op: shm_layout::ObjectOp::Set(ObjectProp::ConstantForce([0.0, 1.0, 0.0])),
+            })
+            .unwrap();
+        }
+        let step = |p: &mut Plane, i: usize, dt: f32| {
+            let stepped = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| p.step(dt)));
+            assert!(stepped.is_ok(), "step {i} (dt {dt}) panicked");
+        };
+        step(&mut p, 0, 1.0e-45);
+        // Free balls, more than the quarantined ones, so that rapier's joint selection scans
+        // every joint rather than only those next to awake bodies.
+        for k in 0..6 {
+            ball(&mut p, [20.0 + k as f32, 0.0, 0.0], 1.0);
+        }
+        // Joints made on the quarantined balls (as the fuzzer did) are parked at once.
+        for (kind, x, y) in [
+            (JointKind::Hinge, a, Some(b)),
+            (JointKind::Ball, c, None),
+            (JointKind::Fixed, b, Some(c)),
+        ] {
+            joint(
+                &mut p,
+                JointOp::Create {
+                    kind,
+                    a: x,
+                    b: y,
+                    props: vec![],
+                },
+            );
+        }
+        for i in 1..4 {
+            step(&mut p, i, 1.0 / 60.0);
+        }
+        let quarantined = p
+            .world
+            .bodies
+            .iter()
+            .filter(|(_, b)| !b.is_enabled())
+            .count();
+        assert_eq!(quarantined, 3, "the tiny step quarantined the three balls");
+        assert_eq!(parked(&p), 3, "their joints are parked");
+
+        // A pendulum made now swings on its 2-unit rod.
+        let pendulum = ball(&mut p, [10.0, -2.0, 0.0], 1.0);
+        let rod = joint(
+            &mut p,
+            JointOp::Create {
+                kind: JointKind::Ball,
+                a: pendulum,
+                b: None,
+                props: vec![JointProp::AnchorA([0.0, 2.0, 0.0])],
+            },
+        );
+        p.apply(PlaneOp::Object {
+            handle: pendulum,
+            op: shm_layout::ObjectOp::Set(ObjectProp::Velocity([5.0, 0.0, 0.0])),
+        })
+        .unwrap();
+        for _ in 0..30 {
+            p.step(1.0 / 60.0).unwrap();
+        }
+        let Reply::JointInfo(info) = p
+            .apply(PlaneOp::Joint(JointOp::Info { joint: rod }))
+            .unwrap()
+        else {
+            panic!()
+        };
+        // Off the rod by under 1 % of its length.
+        assert!(info.error < 0.02, "pendulum joint error {}", info.error);
+        let body = p.joints.table.get(rod).unwrap().body_a;
+        let x = p.world.bodies[body].translation().x;
+        assert!((x - 10.0).abs() > 0.1, "the pendulum swung: x = {x}");
+    }
+
+    /// Random sequences of joint, anchoring, waking, teleporting, forcing, destroying and
+    /// stepping ops on a few objects: no step may panic (rapier's solver must never receive a joint
+    /// whose two bodies are both world-attached).
+    #[test]
+    fn random_joint_sequences_never_panic_the_solver() {
+        use shm_layout::{JointKind, ObjectOp};
+        let mut seed: u64 = 0x9e37_79b9_7f4a_7c15;
+        let mut rnd = move |n: u64| {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            seed % n
+        };
+        let kinds = [
+            JointKind::Ball,
+            JointKind::Hinge,
+            JointKind::ConeTwist,
+            JointKind::SixDof,
+            JointKind::Fixed,
+            JointKind::Prismatic,
+            JointKind::Rope,
+            JointKind::Spring,
+        ];
+        for round in 0..300 {
+            let mut p = plane();
+            let mut objs = Vec::new();
+            let mut joints = Vec::new();
+            let mut log = Vec::new();
+            for _ in 0..60 {
+                let op = match rnd(10) {
+                    0 => {
+                        let props = if rnd(3) == 0 {
+                            vec![ObjectProp::Anchored(true)]
+                        } else {
+                            vec![]
+                        };
+                        PlaneOp::AddObject {
+                            shape: Shape::Sphere { radius: 0.25 },
+                            pose: Pose::at([rnd(4) as f32, rnd(3) as f32 * 0.4, 0.0]),
+                            props,
+                        }
+                    }
+                    1 | 2 if !objs.is_empty() => {
+                        let a = objs[rnd(objs.len() as u64) as usize];
+                        let b = (rnd(3) != 0).then(|| objs[rnd(objs.len() as u64) as usize]);
+                        let mut props = vec![];
+                        if rnd(3) == 0 {
+                            props.push(JointProp::BreakForce(rnd(100) as f32));
+                        }
+                        PlaneOp::Joint(JointOp::Create {
+                            kind: kinds[rnd(8) as usize],
+                            a,
+                            b,
+                            props,
+                        })
+                    }
+                    3 if !objs.is_empty() => PlaneOp::Object {
+                        handle: objs[rnd(objs.len() as u64) as usize],
+                        op: ObjectOp::Set(ObjectProp::Anchored(rnd(2) == 0)),
+                    },
+                    4 if !objs.is_empty() => PlaneOp::Object {
+                        handle: objs[rnd(objs.len() as u64) as usize],
+                        op: if rnd(2) == 0 {
+                            ObjectOp::Wake
+                        } else {
+                            ObjectOp::Set(ObjectProp::Pose(Pose::at([0.0, 5.0, 0.0])))
+                        },
+                    },
+                    5 if !objs.is_empty() && rnd(3) == 0 => PlaneOp::Object {
+                        handle: objs[rnd(objs.len() as u64) as usize],
+                        op: ObjectOp::Destroy,
+                    },
+                    6 if !joints.is_empty() => {
+                        let joint = joints[rnd(joints.len() as u64) as usize];
+                        if rnd(3) == 0 {
+                            PlaneOp::Joint(JointOp::Destroy { joint })
+                        } else {
+                            PlaneOp::Joint(JointOp::Set {
+                                joint,
+                                prop: JointProp::CollideConnected(rnd(2) == 0),
+                            })
+                        }
+                    }
+                    7 if !objs.is_empty() => PlaneOp::Object {
+                        handle: objs[rnd(objs.len() as u64) as usize],
+                        op: ObjectOp::Set(ObjectProp::ConstantForce([0.0, 1.0, 0.0])),
+                    },
+                    // 1e-45 s overflows the force drive of forced bodies: rapier quarantines
+                    // (disables) them.
+                    _ => PlaneOp::Step {
+                        dt: [1.0 / 60.0, 1e-5, 0.1, 1e-45][rnd(4) as usize],
+                    },
+                };
+                log.push(format!("{op:?}"));
+                let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+                    if let PlaneOp::Step { dt } = op {
+                        // Long idle stretches let bodies fall asleep.
+                        for _ in 0..[1, 1, 90][rnd(3) as usize] {
+                            p.step(dt).map(|_| Reply::Applied { tick: 0 })?;
+                        }
+                        Ok(Reply::Applied { tick: 0 })
+                    } else {
+                        p.apply(op)
+                    }
+                }));
+                match outcome {
+                    Ok(Ok(Reply::Object { handle, .. })) => objs.push(handle),
+                    Ok(Ok(Reply::Joint { handle, .. })) => joints.push(handle),
+                    Ok(_) => {}
+                    Err(_) => panic!("round {round} panicked after:\n{}", log.join("\n")),
+                }
+            }
+        }
     }
 }
