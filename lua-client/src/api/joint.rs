@@ -3,12 +3,14 @@
 //! ask the daemon (one round trip).
 
 use std::path::Path;
+use std::rc::Rc;
 
 use client_sdk::{AxisMode, Joint, JointInfo, JointKind, JointProp, MapOptions, Object};
 use mlua::{Lua, MetaMethod, Table, UserData, UserDataMethods, Value};
 
+use super::contacts::{forget_joint, joint_broke_signal};
 use super::object::PhysicsObject;
-use super::plane::PhysicsPlane;
+use super::plane::{PhysicsPlane, PlaneState};
 use crate::values::{describe, expected, finite_number, finite_vector, new_vector, sdk_error};
 
 /// The option names `NewJoint` and the Joint's properties accept.
@@ -155,15 +157,26 @@ fn info_value(lua: &Lua, info: &JointInfo, key: &str) -> mlua::Result<Value> {
     })
 }
 
-/// The Lua handle of a joint.
-pub struct LuaJoint(Joint);
+/// The Lua handle of a joint, with its plane (for its Broke signal).
+pub struct LuaJoint(pub Joint, pub Rc<PlaneState>);
+
+impl LuaJoint {
+    fn name(&self) -> String {
+        format!("Joint {} ({:?})", self.0.kind().name(), self.0.handle())
+    }
+}
 
 impl UserData for LuaJoint {
     fn add_methods<M: UserDataMethods<Self>>(methods: &mut M) {
         methods.add_method("Destroy", |_, j, ()| {
+            forget_joint(&j.1, j.0.handle());
             j.0.destroy().map_err(|e| sdk_error("Joint:Destroy", e))
         });
         methods.add_meta_method(MetaMethod::Index, |lua, j, key: String| {
+            if key == "Broke" {
+                let signal = joint_broke_signal(&j.1, j.0.handle(), &j.name());
+                return Ok(Value::UserData(lua.create_userdata(signal)?));
+            }
             let info =
                 j.0.info()
                     .map_err(|e| sdk_error(&format!("Joint.{key}"), e))?;
@@ -177,9 +190,7 @@ impl UserData for LuaJoint {
                     .map_err(|e| sdk_error(&format!("Joint.{key}"), e))
             },
         );
-        methods.add_meta_method(MetaMethod::ToString, |_, j, ()| {
-            Ok(format!("Joint {} ({:?})", j.0.kind().name(), j.0.handle()))
-        });
+        methods.add_meta_method(MetaMethod::ToString, |_, j, ()| Ok(j.name()));
     }
 }
 
@@ -229,7 +240,7 @@ fn new_joint(
         .0
         .plane
         .joint(kind, &a, b.as_ref(), &props)
-        .map(LuaJoint)
+        .map(|j| LuaJoint(j, plane.0.clone()))
         .map_err(|e| sdk_error(what, e))
 }
 
