@@ -329,3 +329,10 @@ fn joints_from_lua_match_the_pendulum_period_and_check_options() {
     r.assert_ok();
     assert!(r.stdout().contains("joints ok"), "{}", r.stdout());
 }
+
+#[test]
+fn mesh_parts_and_props_from_lua_rest_where_their_meshes_say() {
+    let daemon = TestDaemon::start("lua-meshes");
+    let out = run_ok(&daemon, "tests/lua/meshes.luau", "meshes ok");
+    println!("{out}");
+}

@@ -221,3 +221,27 @@ fn a_prop_loads_as_one_convex_object() {
     // A 2-unit cube rests with its centre 1 above the floor (+ contact skins).
     assert!((y - 1.0).abs() < 0.05, "prop rests at {y}");
 }
+
+/// The .glb files the examples and Luau tests load are the ones `integration_tests::assets`
+/// generates (byte for byte), so they are reproducible and never downloaded.
+#[test]
+fn shipped_example_glbs_are_the_generated_ones() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    for (path, meshes) in integration_tests::assets::all() {
+        let bytes = map::write_glb(&meshes);
+        let file = root.join(path);
+        if std::env::var("PHYSICS_WRITE_ASSETS").is_ok_and(|v| v == "1") {
+            std::fs::write(&file, &bytes).unwrap();
+        }
+        let shipped = std::fs::read(&file)
+            .unwrap_or_else(|e| panic!("{path}: {e} (PHYSICS_WRITE_ASSETS=1 writes it)"));
+        assert!(
+            shipped == bytes,
+            "{path} differs from the generated file (PHYSICS_WRITE_ASSETS=1 rewrites it)"
+        );
+        // Small enough to ship, and what it says it is.
+        assert!(bytes.len() < 16 * 1024, "{path}: {} bytes", bytes.len());
+        let read = map::read_meshes(&file).unwrap();
+        assert_eq!(read.len(), meshes.len(), "{path}: mesh count");
+    }
+}

@@ -10,7 +10,9 @@ use mlua::{Lua, MetaMethod, Table, UserData, UserDataMethods, Value};
 
 use super::contacts::{forget_joint, joint_broke_signal};
 use super::object::PhysicsObject;
-use super::plane::{PhysicsPlane, PlaneState};
+use super::part::{BasePart, PartState};
+use super::plane::{add, PhysicsPlane, PlaneState};
+use crate::values::CFrame;
 use crate::values::{describe, expected, finite_number, finite_vector, new_vector, sdk_error};
 
 /// The option names `NewJoint` and the Joint's properties accept.
@@ -294,12 +296,129 @@ fn load_map(lua: &Lua, plane: &PhysicsPlane, (path, opts): (String, Value)) -> m
     Ok(t)
 }
 
-/// Registers `NewJoint` and `LoadMap` on PhysicsPlane.
+/// `plane:LoadProp(path, cframe, opts?)`: the .glb as one dynamic mesh part (the convex
+/// hull of all its vertices) placed by `cframe`, or with `Decompose = true` one mesh part
+/// per mesh of the file welded to the first by Fixed joints. `Scale` (number or vector)
+/// scales the file's coordinates. Returns the first PhysicsObject and an array of all.
+fn load_prop(
+    lua: &Lua,
+    plane: &PhysicsPlane,
+    (path, cframe, opts): (String, Value, Value),
+) -> mlua::Result<(PhysicsObject, Table)> {
+    let what = "PhysicsPlane:LoadProp";
+    let cf = match &cframe {
+        Value::UserData(ud) => ud.borrow::<CFrame>().map(|c| *c).ok(),
+        _ => None,
+    }
+    .ok_or_else(|| expected(&format!("{what} cframe"), "a CFrame", &cframe))?;
+    let (mut scale, mut decompose) = ([1.0f32; 3], false);
+    for (k, v) in options(what, &opts)? {
+        match k.as_str() {
+            "Scale" => {
+                let w = format!("{what} Scale");
+                scale = match &v {
+                    Value::Number(_) | Value::Integer(_) => [finite_number(&w, &v)? as f32; 3],
+                    _ => finite_vector(&w, &v)?,
+                };
+                if scale.iter().any(|c| *c <= 0.0) {
+                    return Err(expected(&w, "positive scale factors", &v));
+                }
+            }
+            "Decompose" => {
+                decompose = match v {
+                    Value::Boolean(b) => b,
+                    other => {
+                        return Err(expected(&format!("{what} Decompose"), "a boolean", &other))
+                    }
+                }
+            }
+            other => {
+                return Err(mlua::Error::runtime(format!(
+                    "{what}: unknown option \"{other}\" (expected Scale, Decompose)"
+                )))
+            }
+        }
+    }
+    let meshes = client_sdk::map::read_meshes(Path::new(&path)).map_err(|e| sdk_error(what, e))?;
+    let scaled = |m: &client_sdk::MapMesh| -> Vec<[f32; 3]> {
+        m.vertices
+            .iter()
+            .map(|v| std::array::from_fn(|k| v[k] * scale[k]))
+            .collect()
+    };
+    // (vertices, triangles) of each part.
+    type Group = (Vec<[f32; 3]>, Vec<[u32; 3]>);
+    let groups: Vec<Group> = if decompose {
+        meshes
+            .iter()
+            .map(|m| (scaled(m), m.triangles.clone()))
+            .collect()
+    } else {
+        let mut all = (Vec::new(), Vec::new());
+        for m in &meshes {
+            let base = all.0.len() as u32;
+            all.1
+                .extend(m.triangles.iter().map(|t| t.map(|i| i + base)));
+            all.0.extend(scaled(m));
+        }
+        vec![all]
+    };
+    if groups.is_empty() || groups.iter().all(|g| g.0.is_empty()) {
+        return Err(mlua::Error::runtime(format!("{what}: {path} has no mesh")));
+    }
+    let mut objects: Vec<PhysicsObject> = Vec::new();
+    for (i, (vertices, triangles)) in groups.into_iter().enumerate() {
+        if vertices.len() < 4 {
+            return Err(mlua::Error::runtime(format!(
+                "{what}: {path}: mesh {i} has {} vertices (a solid needs at least 4)",
+                vertices.len()
+            )));
+        }
+        let part = Rc::new(PartState::mesh(vertices, triangles, cf));
+        let ud = lua.create_userdata(BasePart(part))?;
+        let obj = add(&plane.0, Value::UserData(ud))?;
+        if let Some(first) = objects.first() {
+            // Same rotation for every part: A's local anchor is the centres' difference.
+            let a = first.part.cframe().position;
+            let b = obj.part.cframe().position;
+            let d = crate::values::rotation::rotate(
+                crate::values::rotation::conjugate(cf.rotation),
+                std::array::from_fn(|k| b[k] - a[k]),
+            );
+            plane
+                .0
+                .plane
+                .joint(
+                    JointKind::Fixed,
+                    &first.body.object,
+                    Some(&obj.body.object),
+                    &[JointProp::AnchorA(d), JointProp::AnchorB([0.0; 3])],
+                )
+                .map_err(|e| sdk_error(what, e))?;
+        }
+        objects.push(obj);
+    }
+    let all = lua.create_table()?;
+    for o in &objects {
+        all.push(PhysicsObject {
+            body: o.body.clone(),
+            part: o.part.clone(),
+            part_ud: o.part_ud.clone(),
+        })?;
+    }
+    let first = objects.swap_remove(0);
+    Ok((first, all))
+}
+
+/// Registers `NewJoint`, `LoadMap` and `LoadProp` on PhysicsPlane.
 pub fn add_methods<M: UserDataMethods<PhysicsPlane>>(methods: &mut M) {
     methods.add_method("NewJoint", |_, p, args: (Value, Value, Value, Value)| {
         new_joint(p, args)
     });
     methods.add_method("LoadMap", |lua, p, args: (String, Value)| {
         load_map(lua, p, args)
+    });
+    methods.add_method("LoadProp", |lua, p, args: (String, Value, Value)| {
+        load_prop(lua, p, args)
     });
 }

@@ -201,7 +201,7 @@ impl UserData for PhysicsPlane {
     }
 }
 
-fn add(plane: &Rc<PlaneState>, part: Value) -> mlua::Result<PhysicsObject> {
+pub(crate) fn add(plane: &Rc<PlaneState>, part: Value) -> mlua::Result<PhysicsObject> {
     let Value::UserData(ud) = &part else {
         return Err(expected("PhysicsPlane:Add", "a BasePart", &part));
     };
@@ -228,7 +228,7 @@ fn add(plane: &Rc<PlaneState>, part: Value) -> mlua::Result<PhysicsObject> {
             what()
         )));
     }
-    let collider = state.shape.collider(state.size());
+    let collider = state.collider();
     // A part whose Touched already has handlers reports contacts from its first tick.
     let reporting = state.touch_listeners() > 0;
     let props: &[ObjectProp] = match reporting {
