@@ -22,6 +22,7 @@ mod object;
 mod overlay;
 mod plane;
 mod query;
+pub mod ragdoll;
 mod spawn;
 mod transport;
 
@@ -34,6 +35,7 @@ pub use map::{Map, MapMesh, MapOptions};
 pub use object::Object;
 pub use plane::{Plane, PlaneOptions, Snapshot};
 pub use query::QueryParams;
+pub use ragdoll::{Bone, Ragdoll, RagdollDesc};
 /// The limits and checks the daemon applies, for callers that want to check early.
 pub use shm_layout::validate;
 pub use shm_layout::{
