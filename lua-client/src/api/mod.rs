@@ -9,6 +9,7 @@ pub mod object;
 pub mod part;
 pub mod plane;
 pub mod query;
+pub mod ragdoll;
 
 use std::rc::Rc;
 

@@ -236,7 +236,8 @@ pub struct PartState {
 }
 
 impl PartState {
-    fn new(shape: PartShape) -> PartState {
+    /// A part of `shape` at the origin with Size (1, 1, 1).
+    pub fn new(shape: PartShape) -> PartState {
         PartState {
             shape,
             name: RefCell::new(shape.name().to_string()),

@@ -184,6 +184,7 @@ impl UserData for PhysicsPlane {
         });
         super::query::add_methods(methods);
         super::joint::add_methods(methods);
+        super::ragdoll::add_methods(methods);
         not_yet_methods(methods, "PhysicsPlane", NOT_YET_METHODS);
         methods.add_meta_method(MetaMethod::Index, |lua, p, key: Value| {
             PLANE.get(lua, &p.0, &key)
@@ -313,6 +314,10 @@ fn option(o: &mut PlaneOptions, prop: PlaneProp) {
 pub fn module(lua: &Lua) -> mlua::Result<Table> {
     let m = lua.create_table()?;
     m.set("New", lua.create_function(new_plane)?)?;
+    m.set(
+        "HumanoidRagdoll",
+        lua.create_function(super::ragdoll::humanoid)?,
+    )?;
     super::collision_groups::install(lua, &m)?;
     m.set(
         "NewGUI",
