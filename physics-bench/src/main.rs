@@ -27,6 +27,7 @@ mod error;
 mod fuzz;
 mod ipc;
 mod load;
+mod maps;
 mod procfs;
 mod progress;
 mod queries;
@@ -67,6 +68,9 @@ enum Bench {
     /// Rays per second of RaycastMany batches (1, 64, 4,096 rays) against a 10,000-body
     /// plane, next to the same rays cast in process.
     Queries(queries::QueriesArgs),
+    /// A generated ~1M-triangle map: load time, daemon memory, and the step cost of 1,000
+    /// boxes resting on it.
+    Maps(maps::MapsArgs),
     /// 4 planes × 1,000 bodies at 60 Hz with a client writing every frame for N minutes:
     /// daemon RSS and shared-memory growth against a bound.
     Soak(soak::SoakArgs),
@@ -92,6 +96,7 @@ fn main() -> ExitCode {
         Bench::Load(args) => load::run(args),
         Bench::Soak(args) => soak::run(args),
         Bench::Queries(args) => queries::run(args),
+        Bench::Maps(args) => maps::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
