@@ -345,6 +345,10 @@ pub fn pieces(meshes: &[MapMesh]) -> Vec<MapMesh> {
     out
 }
 
+/// Most bytes of map pieces sent in one request (the daemon refuses requests over 16 MiB
+/// by default).
+pub const MAP_REQUEST_BYTES: usize = 8 << 20;
+
 impl Plane {
     /// Loads a .glb / .gltf as a static triangle-mesh map.
     pub fn load_map(&self, path: &Path, options: &MapOptions) -> Result<Map, Error> {
@@ -352,8 +356,9 @@ impl Plane {
         self.load_map_meshes(&meshes, options)
     }
 
-    /// Uploads `meshes` (map space) as one static triangle-mesh map: the pieces and the
-    /// build go in one request, so the daemon builds all of it or nothing.
+    /// Uploads `meshes` (map space) as one static triangle-mesh map: the pieces go in
+    /// requests of at most [`MAP_REQUEST_BYTES`], then the build, which checks the upload is
+    /// complete, so the daemon builds all of it or nothing.
     pub fn load_map_meshes(&self, meshes: &[MapMesh], options: &MapOptions) -> Result<Map, Error> {
         let client = self.client();
         client.flush()?;
@@ -363,7 +368,20 @@ impl Plane {
             None,
         );
         let (mut nv, mut nt) = (0u64, 0u64);
+        // Requests stay under the daemon's 16 MiB limit: pieces are flushed in requests of
+        // at most MAP_REQUEST_BYTES (worst-case encoded size: 12 bytes a vertex, 15 a
+        // triangle).
+        let mut pending = 0usize;
         for piece in pieces(meshes) {
+            let bytes = piece.vertices.len() * 12 + piece.triangles.len() * 15 + 64;
+            if pending > 0 && pending + bytes > MAP_REQUEST_BYTES {
+                if let Err(e) = client.flush() {
+                    let _ = client.call(Command::plane(self.id(), PlaneOp::Map(MapOp::Discard)));
+                    return Err(e);
+                }
+                pending = 0;
+            }
+            pending += bytes;
             nv += piece.vertices.len() as u64;
             nt += piece.triangles.len() as u64;
             let op = MapOp::Upload {
