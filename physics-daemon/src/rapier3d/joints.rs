@@ -658,10 +658,12 @@ mod tests {
 
     /// Bodies whose state went non-finite are disabled by rapier (its quarantine), yet its
     /// joint selection still hands their joints to the solver with both ends world-attached,
-    /// which panics there. The sequence the fuzzer found: joined bodies, a step of the
-    /// smallest positive dt (1e-45 s: the solver's 1/dt overflows, every dynamic body is
-    /// quarantined), then a normal step. The joints are parked, no step panics, and a joint
-    /// made afterwards works.
+    /// which panics there. The sequence the fuzzer found: forced bodies stepped with the
+    /// smallest positive dt (1e-45 s, which overflowed the force drive until it fell back to
+    /// setting velocities: see `tiny_steps_leave_forced_bodies_enabled`), then joints made on
+    /// them and a normal step. Quarantine is reproduced here as rapier leaves it (bodies
+    /// disabled); the joints are parked, no step panics, a joint made afterwards works, and
+    /// re-enabled bodies get their joints back.
     #[test]
     fn joints_of_quarantined_bodies_are_parked_instead_of_panicking_the_solver() {
         use shm_layout::JointKind;
@@ -692,18 +694,19 @@ mod tests {
                 .filter(|j| j.rapier.is_none())
                 .count()
         };
-        for h in [a, b, c] {
-            p.apply(PlaneOp::Object {
-                handle: h,
-                op: shm_layout::ObjectOp::Set(ObjectProp::ConstantForce([0.0, 1.0, 0.0])),
-            })
-            .unwrap();
-        }
         let step = |p: &mut Plane, i: usize, dt: f32| {
             let stepped = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| p.step(dt)));
             assert!(stepped.is_ok(), "step {i} (dt {dt}) panicked");
         };
-        step(&mut p, 0, 1.0e-45);
+        step(&mut p, 0, 1.0 / 60.0);
+        let bodies: Vec<_> = [a, b, c]
+            .iter()
+            .map(|h| p.bodies.get(*h).unwrap().handle)
+            .collect();
+        for h in &bodies {
+            p.world.bodies[*h].set_enabled(false);
+        }
+        step(&mut p, 0, 1.0 / 60.0);
         // Free balls, more than the quarantined ones, so that rapier's joint selection scans
         // every joint rather than only those next to awake bodies.
         for k in 0..6 {
@@ -734,7 +737,7 @@ mod tests {
             .iter()
             .filter(|(_, b)| !b.is_enabled())
             .count();
-        assert_eq!(quarantined, 3, "the tiny step quarantined the three balls");
+        assert_eq!(quarantined, 3, "the three balls are quarantined");
         assert_eq!(parked(&p), 3, "their joints are parked");
 
         // A pendulum made now swings on its 2-unit rod.
@@ -767,6 +770,36 @@ mod tests {
         let body = p.joints.table.get(rod).unwrap().body_a;
         let x = p.world.bodies[body].translation().x;
         assert!((x - 10.0).abs() > 0.1, "the pendulum swung: x = {x}");
+
+        // Re-enabled (set_enabled(true) is how rapier lifts a quarantine), the balls get
+        // their joints back.
+        for h in &bodies {
+            p.world.bodies[*h].set_enabled(true);
+        }
+        step(&mut p, 4, 1.0 / 60.0);
+        assert_eq!(parked(&p), 0, "joints restored");
+    }
+
+    /// A forced body stepped with the smallest positive dt (its force drive's mass / dt
+    /// overflows) keeps a finite state and stays in the simulation instead of being
+    /// quarantined by rapier.
+    #[test]
+    fn tiny_steps_leave_forced_bodies_enabled() {
+        let mut p = plane();
+        let a = ball(&mut p, [0.0, 0.0, 0.0], 1.0);
+        p.apply(PlaneOp::Object {
+            handle: a,
+            op: shm_layout::ObjectOp::Set(ObjectProp::ConstantForce([0.0, 1.0, 0.0])),
+        })
+        .unwrap();
+        p.step(1.0e-45).unwrap();
+        p.step(1.0 / 60.0).unwrap();
+        let body = &p.world.bodies[p.bodies.get(a).unwrap().handle];
+        assert!(body.is_enabled(), "quarantined by a tiny step");
+        assert!(body.translation().is_finite() && body.linvel().is_finite());
+        // Gravity (-50) and the force (+1 on weight 1) over the 1/60 s step.
+        let vy = body.linvel().y;
+        assert!((vy - (-49.0 / 60.0)).abs() < 0.02, "vy {vy}");
     }
 
     /// Random sequences of joint, anchoring, waking, teleporting, forcing, destroying and
@@ -798,7 +831,7 @@ mod tests {
             let mut joints = Vec::new();
             let mut log = Vec::new();
             for _ in 0..60 {
-                let op = match rnd(10) {
+                let op = match rnd(11) {
                     0 => {
                         let props = if rnd(3) == 0 {
                             vec![ObjectProp::Anchored(true)]
@@ -851,6 +884,15 @@ mod tests {
                                 prop: JointProp::CollideConnected(rnd(2) == 0),
                             })
                         }
+                    }
+                    8 if !objs.is_empty() && rnd(4) == 0 => {
+                        // What rapier's quarantine does to a body gone non-finite.
+                        let h = objs[rnd(objs.len() as u64) as usize];
+                        if let Ok(b) = p.bodies.get(h) {
+                            let on = rnd(3) == 0;
+                            p.world.bodies[b.handle].set_enabled(on);
+                        }
+                        PlaneOp::Info
                     }
                     7 if !objs.is_empty() => PlaneOp::Object {
                         handle: objs[rnd(objs.len() as u64) as usize],
