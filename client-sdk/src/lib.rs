@@ -18,10 +18,13 @@ mod controller;
 mod error;
 mod events;
 mod gui;
+mod joint;
+pub mod map;
 mod object;
 mod overlay;
 mod plane;
 mod query;
+pub mod ragdoll;
 mod spawn;
 mod transport;
 
@@ -31,16 +34,20 @@ pub use controller::Controller;
 pub use error::Error;
 pub use events::{Contact, Events, EVENT_BUFFER_TICKS};
 pub use gui::{GuiController, GuiEvent, GuiObject, GuiPlane, GuiPlaneOptions};
+pub use joint::{Joint, JointBroke};
+pub use map::{Map, MapMesh, MapOptions};
 pub use object::Object;
 pub use plane::{Plane, PlaneOptions, Snapshot};
 pub use query::QueryParams;
+pub use ragdoll::{Bone, Ragdoll, RagdollDesc};
 pub use shm_layout::gui_op::{GuiControllerInfo, GuiObjectInfo, GuiPlaneInfo};
 /// The limits and checks the daemon applies, for callers that want to check early.
 pub use shm_layout::validate;
 pub use shm_layout::{
-    BodyState, CollisionGroups, CommandError, ControllerInfo, ControllerProp, ControllerSettings,
-    ErrorKind, EventRecord, FilterType, GuiControllerProp, GuiHit, GuiObjectProp, GuiPlaneProp,
-    GuiShape, Handle, Hit, ObjectInfo, ObjectOp, ObjectProp, ObjectSettings, Pin, PlaneId,
+    AxisMode, BodyState, CollisionGroups, CommandError, ControllerInfo, ControllerProp,
+    ControllerSettings, ErrorKind, EventRecord, FilterType, GuiControllerProp, GuiHit,
+    GuiObjectProp, GuiPlaneProp, GuiShape, Handle, Hit, JointInfo, JointKind, JointProp,
+    JointSettings, MapReport, ObjectInfo, ObjectOp, ObjectProp, ObjectSettings, Pin, PlaneId,
     PlaneInfo, PlaneKind, PlaneOp, PlaneProp, PlaneSettings, Pose, Ray, Restraint, RotateTo, Shape,
     ShapeKind, TickHeader, Vec2, Vec3, EVENT_CONTROLLER_JUMPED, EVENT_CONTROLLER_LANDED,
     EVENT_CONTROLLER_MOVED, EVENT_PATH_FINISHED, EVENT_WAYPOINT_REACHED, FLAG_ON_GROUND,

@@ -29,6 +29,7 @@ mod error;
 mod fuzz;
 mod ipc;
 mod load;
+mod maps;
 mod procfs;
 mod progress;
 mod queries;
@@ -72,6 +73,9 @@ enum Bench {
     /// Character controllers' cost per tick: 1, 100 and 1,000 controllers walking waypoints
     /// among obstacles, in process on one core.
     Controllers(controllers::ControllersArgs),
+    /// A generated ~1M-triangle map: load time, daemon memory, and the step cost of 1,000
+    /// boxes resting on it.
+    Maps(maps::MapsArgs),
     /// 4 planes × 1,000 bodies at 60 Hz with a client writing every frame for N minutes:
     /// daemon RSS and shared-memory growth against a bound.
     Soak(soak::SoakArgs),
@@ -98,6 +102,7 @@ fn main() -> ExitCode {
         Bench::Soak(args) => soak::run(args),
         Bench::Queries(args) => queries::run(args),
         Bench::Controllers(args) => controllers::run(args),
+        Bench::Maps(args) => maps::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -8,6 +8,8 @@
 use serde::{Deserialize, Serialize};
 
 use crate::error::CommandError;
+use crate::joint_op::JointInfo;
+use crate::map_op::MapInfo;
 use crate::object_op::ObjectOp;
 use crate::plane_op::{PlaneKind, PlaneOp};
 use crate::query::Hit;
@@ -202,6 +204,17 @@ pub enum Reply {
     Flag(bool),
     /// The answer of a GUI-plane op that carries data.
     Gui(crate::gui_op::GuiReply),
+    /// A new joint, and the tick after which it acts.
+    Joint {
+        /// The joint's handle.
+        handle: Handle,
+        /// Steps after this tick include it.
+        tick: u64,
+    },
+    /// A joint's description.
+    JointInfo(Box<JointInfo>),
+    /// A built map.
+    Map(Box<MapInfo>),
 }
 
 /// The result of one command.

@@ -7,6 +7,8 @@ use serde::{Deserialize, Serialize};
 use crate::collision_groups::CollisionGroups;
 use crate::controller_op::ControllerOp;
 use crate::gui_op::GuiOp;
+use crate::joint_op::JointOp;
+use crate::map_op::MapOp;
 use crate::object_op::ObjectOp;
 use crate::query::QueryOp;
 use crate::records::Handle;
@@ -63,6 +65,10 @@ pub enum PlaneOp {
     Controller(ControllerOp),
     /// An op of the 2D GUI plane (objects, controllers, rays); other kinds refuse it.
     Gui(GuiOp),
+    /// An op on the plane's joints.
+    Joint(JointOp),
+    /// An op on the plane's triangle-mesh map upload.
+    Map(MapOp),
 }
 
 /// What an op may add to a plane, for the daemon's per-client quotas.
@@ -82,6 +88,7 @@ impl PlaneOp {
             PlaneOp::Info
                 | PlaneOp::Query(_)
                 | PlaneOp::Controller(ControllerOp::Info { .. })
+                | PlaneOp::Joint(JointOp::Info { .. })
                 | PlaneOp::Object {
                     op: ObjectOp::Info,
                     ..
@@ -102,6 +109,15 @@ impl PlaneOp {
                     mesh_vertices: 0,
                 }
             }
+            // A joint counts as an object; map pieces count vertices + triangles.
+            PlaneOp::Joint(JointOp::Create { .. }) => OpCost {
+                objects: 1,
+                mesh_vertices: 0,
+            },
+            PlaneOp::Map(op) => OpCost {
+                objects: 0,
+                mesh_vertices: op.cost(),
+            },
             _ => OpCost::default(),
         }
     }

@@ -135,6 +135,10 @@ pub const EVENT_GUI_PATH_FINISHED: u32 = 0x21;
 pub const EVENT_GUI_MOVED: u32 = 0x22;
 /// Event kind: a GUI controller's OnGround flipped; `b_slot` is 1 (now on the ground) or 0.
 pub const EVENT_GUI_GROUND_CHANGED: u32 = 0x23;
+/// Event kind: a joint broke (its force exceeded BreakForce). `a` is the joint's handle,
+/// `b` its object A, `position` the world anchor on A and `impulse` the force that broke
+/// it.
+pub const EVENT_JOINT_BROKE: u32 = 3;
 
 /// One per-tick event (published in the plane's event service, one sample per tick that
 /// has events). 64 bytes.

@@ -65,6 +65,8 @@ pub enum ShapeKind {
     Cylinder,
     /// A ramp: half of its size box, sloping down toward -Z.
     Wedge,
+    /// A static triangle-mesh map (`MapOp::Build`).
+    TriMesh,
 }
 
 impl Shape {

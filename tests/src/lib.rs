@@ -248,7 +248,9 @@ pub fn physics_lua(domain: &str, script: &str, extra: &[&str]) -> Command {
             )
         });
     let mut command = Command::new(runner);
+    // Scripts name files (maps, props) from the repository root, as the examples do.
     command
+        .current_dir(std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(".."))
         .arg(
             std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
                 .join("..")
@@ -261,4 +263,93 @@ pub fn physics_lua(domain: &str, script: &str, extra: &[&str]) -> Command {
         .stdout(Stdio::piped())
         .stderr(Stdio::piped());
     command
+}
+
+/// The .glb files the examples and Luau tests load (`examples/assets/`), generated here with
+/// the SDK's glTF writer; `tests/tests/maps.rs` checks the shipped files are exactly these
+/// (`PHYSICS_WRITE_ASSETS=1` rewrites them).
+pub mod assets {
+    use client_sdk::map::MapMesh;
+
+    /// `examples/assets/terrain.glb`: a 24 × 24 unit heightfield of 12 × 12 quads (two
+    /// triangles each, shared vertices), height `0.5·sin(x/3)·cos(z/4)`, wound
+    /// counter-clockwise seen from above.
+    pub fn terrain() -> Vec<MapMesh> {
+        let n = 12;
+        let step = 2.0f32;
+        let half = n as f32 * step / 2.0;
+        let mut m = MapMesh::default();
+        for i in 0..=n {
+            for j in 0..=n {
+                let (x, z) = (i as f32 * step - half, j as f32 * step - half);
+                m.vertices.push([x, terrain_height(x, z), z]);
+            }
+        }
+        let at = |i: u32, j: u32| i * (n + 1) + j;
+        for i in 0..n {
+            for j in 0..n {
+                let (a, b, c, d) = (at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1));
+                m.triangles.push([a, c, b]);
+                m.triangles.push([a, d, c]);
+            }
+        }
+        vec![m]
+    }
+
+    /// The terrain's height at (x, z) on its vertices (linear in between).
+    pub fn terrain_height(x: f32, z: f32) -> f32 {
+        0.5 * (x / 3.0).sin() * (z / 4.0).cos()
+    }
+
+    /// An axis-aligned box mesh of `size` centred on `centre` (8 vertices, 12 triangles,
+    /// outward counter-clockwise).
+    pub fn box_mesh(centre: [f32; 3], size: [f32; 3]) -> MapMesh {
+        let h = size.map(|s| s / 2.0);
+        let vertices = (0..8)
+            .map(|k| {
+                let s = |bit: u32| if k & (1 << bit) != 0 { 1.0 } else { -1.0 };
+                [
+                    centre[0] + s(0) * h[0],
+                    centre[1] + s(1) * h[1],
+                    centre[2] + s(2) * h[2],
+                ]
+            })
+            .collect();
+        // Corner index = x + 2y + 4z (bits).
+        let triangles = vec![
+            [0, 2, 3],
+            [0, 3, 1], // -Z
+            [4, 5, 7],
+            [4, 7, 6], // +Z
+            [0, 4, 6],
+            [0, 6, 2], // -X
+            [1, 3, 7],
+            [1, 7, 5], // +X
+            [0, 1, 5],
+            [0, 5, 4], // -Y
+            [2, 6, 7],
+            [2, 7, 3], // +Y
+        ];
+        MapMesh {
+            vertices,
+            triangles,
+        }
+    }
+
+    /// `examples/assets/dumbbell.glb`: two 1-unit cubes centred at x = ±1.5 (two meshes, so
+    /// `Decompose` makes two welded parts) — a 4 × 1 × 1 box overall.
+    pub fn dumbbell() -> Vec<MapMesh> {
+        vec![
+            box_mesh([-1.5, 0.0, 0.0], [1.0; 3]),
+            box_mesh([1.5, 0.0, 0.0], [1.0; 3]),
+        ]
+    }
+
+    /// Every shipped asset: (path from the repository root, meshes).
+    pub fn all() -> Vec<(&'static str, Vec<MapMesh>)> {
+        vec![
+            ("examples/assets/terrain.glb", terrain()),
+            ("examples/assets/dumbbell.glb", dumbbell()),
+        ]
+    }
 }

@@ -50,6 +50,12 @@ fn the_daemon_survives_fuzzed_requests_and_serves_on() {
     assert_eq!(stats.crashes, 0, "seed {}", stats.seed);
     assert_eq!(stats.unanswered, 0, "seed {}", stats.seed);
     assert_eq!(stats.protocol_errors, 0, "seed {}", stats.seed);
+    // A plane that panics is caught and removed, but no client input may make one panic.
+    assert_eq!(
+        stats.plane_panics, 0,
+        "seed {}: planes panicked (see the findings above)",
+        stats.seed
+    );
     assert!(daemon.is_running());
 
     // It went well past validation: many commands, a good share of them applied, steps and

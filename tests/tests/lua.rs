@@ -214,6 +214,13 @@ fn runner_starts_a_daemon_when_none_answers_and_stops_it() {
     assert!(left.is_empty(), "left behind: {left:?}");
 }
 
+/// The numbers in a line, in order.
+fn numbers(line: &str) -> Vec<f32> {
+    line.split(|c: char| !(c.is_ascii_digit() || c == '.' || c == '-'))
+        .filter_map(|t| t.parse().ok())
+        .collect()
+}
+
 #[test]
 fn reference_examples_run() {
     let daemon = TestDaemon::start("lua-examples");
@@ -226,6 +233,39 @@ fn reference_examples_run() {
         let r = run(&daemon, script);
         r.assert_ok();
         assert!(r.stdout().contains(expect), "{script}: {}", r.stdout());
+    }
+    // The ragdoll example: knocked over, the head (5.4 up when standing) lies low, and the
+    // joints hold (error under 0.5: anchors part by ~0.5 only under a 1,000 u/s hit).
+    let r = run(&daemon, "examples/ragdoll.luau");
+    r.assert_ok();
+    let nums = numbers(&r.stdout());
+    assert!(
+        nums.len() == 2 && nums[0] < 2.0 && nums[1] < 0.5,
+        "{}",
+        r.stdout()
+    );
+    // The map example: the shipped 12 × 12-quad terrain (288 triangles, 169 shared
+    // vertices, no open edge inside, 48 boundary edges), the ground within the terrain's
+    // ±0.5 amplitude, balls (radius 0.5) resting on it within the map, the welded prop
+    // (half-height 0.5) on it.
+    let r = run(&daemon, "examples/map.luau");
+    r.assert_ok();
+    let out = r.stdout();
+    assert!(
+        out.contains("1 mesh(es), 288 triangles, 169 vertices"),
+        "{out}"
+    );
+    for line in out.lines() {
+        let n = numbers(line);
+        if line.starts_with("ground under") {
+            assert!(n[2].abs() <= 0.5, "{line}");
+        } else if line.starts_with("ball") {
+            let (x, y, z) = (n[1], n[2], n[3]);
+            assert!(x.abs() < 12.0 && z.abs() < 12.0, "{line}");
+            assert!((-0.05..=1.05).contains(&y), "{line}");
+        } else if line.starts_with("prop") {
+            assert!((-0.05..=1.05).contains(&n[0]), "{line}");
+        }
     }
     // The same shove of 100 on unit cubes: Δv = 100 / (density × 1), then about 0.1 s of the
     // default LinearDamping 0.10 (at most 1.5 % over the frames of `wait(0.1)`).
@@ -358,4 +398,26 @@ fn gui_snippet_npc_waypoints_loops_in_order() {
     let r = run(&daemon, "tests/lua/gui_npc.luau");
     r.assert_ok();
     assert!(r.stdout().contains("gui npc ok"), "{}", r.stdout());
+}
+
+#[test]
+fn joints_from_lua_match_the_pendulum_period_and_check_options() {
+    let daemon = TestDaemon::start("lua-joints");
+    let r = run(&daemon, "tests/lua/joints.luau");
+    r.assert_ok();
+    assert!(r.stdout().contains("joints ok"), "{}", r.stdout());
+}
+
+#[test]
+fn mesh_parts_and_props_from_lua_rest_where_their_meshes_say() {
+    let daemon = TestDaemon::start("lua-meshes");
+    let out = run_ok(&daemon, "tests/lua/meshes.luau", "meshes ok");
+    println!("{out}");
+}
+
+#[test]
+fn ragdolls_from_lua_keep_their_bones_joined_after_a_hit() {
+    let daemon = TestDaemon::start("lua-ragdoll");
+    let out = run_ok(&daemon, "tests/lua/ragdoll.luau", "ragdoll ok");
+    println!("{out}");
 }

@@ -1,12 +1,15 @@
 //! Contact events for scripts: `part.Touched(otherPart, contact)` and
 //! `part.TouchEnded(otherPart)`, fired from the plane's per-tick event stream in tick order,
-//! once per contact start and end. A plane reads its events only while one of its parts has
-//! touch handlers; `plane.EventsLost(n)` (or, with no handler, a line on stderr) says when a
+//! once per contact start and end; and `joint.Broke(force, position)`, once when a joint
+//! breaks. A plane reads its events only while one of its parts has touch handlers or one
+//! of its joints has Broke handlers; `plane.EventsLost(n)` (or, with no handler, a line on stderr) says when a
 //! script fell so far behind that the daemon's queue dropped events.
 
 use std::cell::{Cell, RefCell};
+use std::collections::HashMap;
+use std::rc::{Rc, Weak};
 
-use client_sdk::{Contact, Handle};
+use client_sdk::{Contact, Handle, JointBroke};
 use mlua::{Lua, MultiValue, Value};
 
 use super::part::BasePart;
@@ -21,6 +24,8 @@ pub struct ContactPump {
     reading: Cell<bool>,
     /// `plane.EventsLost`, created on first access.
     lost: RefCell<Option<Signal>>,
+    /// `joint.Broke` of the joints whose signal was read, by joint handle.
+    broke: RefCell<HashMap<Handle, Signal>>,
 }
 
 impl Default for ContactPump {
@@ -28,7 +33,36 @@ impl Default for ContactPump {
         ContactPump {
             reading: Cell::new(false),
             lost: RefCell::new(None),
+            broke: RefCell::default(),
         }
+    }
+}
+
+/// `joint.Broke` of joint `joint` of `plane`, created on first access; the plane starts
+/// reading its events when the signal gets its first handler.
+pub fn joint_broke_signal(plane: &Rc<PlaneState>, joint: Handle, name: &str) -> Signal {
+    let mut map = plane.contacts.broke.borrow_mut();
+    map.entry(joint)
+        .or_insert_with(|| {
+            let signal = Signal::new(format!("{name}.Broke"));
+            let weak: Weak<PlaneState> = Rc::downgrade(plane);
+            signal.on_listeners(move |n| {
+                if n > 0 {
+                    if let Some(plane) = weak.upgrade() {
+                        plane.listen_for_contacts();
+                    }
+                }
+            });
+            signal
+        })
+        .clone()
+}
+
+/// A destroyed joint's Broke signal goes (its handlers with it).
+pub fn forget_joint(plane: &PlaneState, joint: Handle) {
+    let signal = plane.contacts.broke.borrow_mut().remove(&joint);
+    if let Some(s) = signal {
+        s.disconnect_all();
     }
 }
 
@@ -51,16 +85,31 @@ impl PlaneState {
         if !self.alive() || self.contacts.reading.get() {
             return;
         }
-        match self.plane.events() {
-            Ok(_) => self.contacts.reading.set(true),
-            Err(e) => eprintln!("PhysicsPlane {}: cannot read events: {e}", self.plane.id()),
+        if let Err(e) = self.plane.subscribe_events() {
+            eprintln!(
+                "PhysicsPlane {}: cannot read contact events: {e}",
+                self.plane.id()
+            );
+            return;
+        }
+        // Reading starts here: what was queued before is not news, and what the next step
+        // publishes is (a joint that breaks on the first step after `Broke:Connect`).
+        if !self.contacts.reading.get() && self.plane.events().is_ok() {
+            self.contacts.reading.set(true);
         }
     }
 
-    /// Whether anyone listens to the plane's events: a part's touch handlers or a
-    /// controller's signals.
+    /// Whether anyone listens to the plane's events: a part's touch handlers, a
+    /// controller's signals or a joint's Broke.
     fn touch_handlers(&self) -> bool {
-        self.any_part(|p| p.touch_listeners() > 0) || self.controller_listeners()
+        self.any_part(|p| p.touch_listeners() > 0)
+            || self.controller_listeners()
+            || self
+                .contacts
+                .broke
+                .borrow()
+                .values()
+                .any(|s| s.listeners() > 0)
     }
 
     /// Delivers the events published since the last call to the parts' touch handlers.
@@ -81,6 +130,10 @@ impl PlaneState {
             self.report_lost(lua, events.lost)?;
         }
         for record in &events.records {
+            if let Some(broke) = JointBroke::from_record(record) {
+                self.joint_broke(lua, &broke)?;
+                continue;
+            }
             match Contact::from_record(record) {
                 Some(Contact::Started {
                     a,
@@ -156,6 +209,21 @@ impl PlaneState {
             _ => return Ok(()),
         };
         c.fire(lua, name, MultiValue::from_iter(args))
+    }
+
+    /// Fires the joint's Broke with the force that broke it and the world anchor on A.
+    fn joint_broke(&self, lua: &Lua, broke: &JointBroke) -> mlua::Result<()> {
+        let signal = self.contacts.broke.borrow().get(&broke.joint).cloned();
+        match signal {
+            Some(s) if s.listeners() > 0 => s.fire(
+                lua,
+                MultiValue::from_iter([
+                    Value::Number(broke.force as f64),
+                    new_vector(broke.position),
+                ]),
+            ),
+            _ => Ok(()),
+        }
     }
 
     fn report_lost(&self, lua: &Lua, n: u64) -> mlua::Result<()> {

@@ -9,10 +9,12 @@ pub mod gui_basic;
 pub mod gui_controller;
 pub mod gui_object;
 pub mod gui_plane;
+pub mod joint;
 pub mod object;
 pub mod part;
 pub mod plane;
 pub mod query;
+pub mod ragdoll;
 
 use std::rc::Rc;
 

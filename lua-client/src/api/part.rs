@@ -13,7 +13,9 @@ use crate::host::signal::Signal;
 use crate::host::Watched;
 use crate::props::part::PART;
 use crate::props::Target;
-use crate::values::{describe, expected, new_vector, sdk_error, CFrame, DESCRIBE};
+use crate::values::{
+    describe, expected, finite_number, finite_vector, new_vector, sdk_error, CFrame, DESCRIBE,
+};
 
 /// Shapes a BasePart can have (the collider the plane builds from it). The part's origin is
 /// the centre of its Size box for every shape.
@@ -32,6 +34,10 @@ pub enum PartShape {
     /// face at the back (+Z), slope falling from the top-back edge to the bottom-front edge
     /// (-Z). Its centre of mass is at (0, -Size.Y/6, +Size.Z/6).
     Wedge,
+    /// `Renderable.MeshPart(vertices, triangles)`: collides as the convex hull of its
+    /// vertices, scaled so that their bounding box is the part's Size (which starts as that
+    /// box). Not a `BasePart(shape)` name: it needs its mesh.
+    Mesh,
 }
 
 impl PartShape {
@@ -55,6 +61,7 @@ impl PartShape {
             PartShape::Capsule => "Capsule",
             PartShape::Cylinder => "Cylinder",
             PartShape::Wedge => "Wedge",
+            PartShape::Mesh => "MeshPart",
         }
     }
 
@@ -74,8 +81,89 @@ impl PartShape {
             PartShape::Capsule => Shape::Capsule { size },
             PartShape::Cylinder => Shape::Cylinder { size },
             PartShape::Wedge => Shape::Wedge { size },
+            PartShape::Mesh => unreachable!("a mesh part's collider comes from its mesh"),
         }
     }
+}
+
+/// The mesh of a `Renderable.MeshPart`: vertices relative to their bounding box centre,
+/// 0-based triangles, and the box's extent (the Size at which they are sent unscaled).
+pub struct MeshData {
+    vertices: Vec<[f32; 3]>,
+    triangles: Vec<[u32; 3]>,
+    extent: [f32; 3],
+}
+
+impl MeshData {
+    /// The collider at `size`: the vertices scaled by `size / extent` per axis (an axis
+    /// without extent keeps its coordinates).
+    fn collider(&self, size: [f32; 3]) -> Shape {
+        let k: [f32; 3] = std::array::from_fn(|i| {
+            if self.extent[i] > 0.0 {
+                size[i] / self.extent[i]
+            } else {
+                1.0
+            }
+        });
+        Shape::Mesh {
+            vertices: self
+                .vertices
+                .iter()
+                .map(|v| [v[0] * k[0], v[1] * k[1], v[2] * k[2]])
+                .collect(),
+            triangles: self.triangles.clone(),
+        }
+    }
+}
+
+/// `Renderable.MeshPart(vertices, triangles)`: `vertices` an array of Vectors, `triangles`
+/// an array of `{i, j, k}` 1-based indices into it. Errors name the entry and its value.
+fn mesh_part(vertices: Value, triangles: Value) -> mlua::Result<PartState> {
+    const WHAT: &str = "Renderable.MeshPart";
+    let Value::Table(vt) = &vertices else {
+        return Err(expected(WHAT, "an array of Vectors as vertices", &vertices));
+    };
+    let Value::Table(tt) = &triangles else {
+        return Err(expected(
+            WHAT,
+            "an array of {i, j, k} vertex indices as triangles",
+            &triangles,
+        ));
+    };
+    let mut verts = Vec::new();
+    for (i, v) in vt.clone().sequence_values::<Value>().enumerate() {
+        verts.push(finite_vector(&format!("{WHAT} vertices[{}]", i + 1), &v?)?);
+    }
+    if verts.len() < 4 {
+        return Err(mlua::Error::runtime(format!(
+            "{WHAT}: vertices needs at least 4 points (a solid), got {}",
+            verts.len()
+        )));
+    }
+    let mut tris = Vec::new();
+    for (i, t) in tt.clone().sequence_values::<Value>().enumerate() {
+        let what = format!("{WHAT} triangles[{}]", i + 1);
+        let t = t?;
+        let Value::Table(corners) = &t else {
+            return Err(expected(&what, "a table {i, j, k}", &t));
+        };
+        let mut tri = [0u32; 3];
+        for (c, slot) in tri.iter_mut().enumerate() {
+            let v: Value = corners.get(c + 1)?;
+            let n = finite_number(&what, &v)?;
+            if n.fract() != 0.0 || n < 1.0 || n > verts.len() as f64 {
+                return Err(mlua::Error::runtime(format!(
+                    "{what}[{}]: {} is not a vertex index (1 to {})",
+                    c + 1,
+                    describe(&v),
+                    verts.len()
+                )));
+            }
+            *slot = n as u32 - 1;
+        }
+        tris.push(tri);
+    }
+    Ok(PartState::mesh(verts, tris, CFrame::IDENTITY))
 }
 
 /// Why a body stopped being its part's.
@@ -145,10 +233,13 @@ pub struct PartState {
     last_fired: Cell<Option<CFrame>>,
     /// Whether its body was asked to report contacts (while Touched / TouchEnded listen).
     reporting: Cell<bool>,
+    /// The mesh of a MeshPart.
+    mesh: RefCell<Option<Rc<MeshData>>>,
 }
 
 impl PartState {
-    fn new(shape: PartShape) -> PartState {
+    /// A part of `shape` at the origin with Size (1, 1, 1).
+    pub fn new(shape: PartShape) -> PartState {
         PartState {
             shape,
             name: RefCell::new(shape.name().to_string()),
@@ -160,6 +251,46 @@ impl PartState {
             signals: RefCell::default(),
             last_fired: Cell::new(None),
             reporting: Cell::new(false),
+            mesh: RefCell::new(None),
+        }
+    }
+
+    /// A mesh part of `vertices` and 0-based `triangles` (indices checked by the caller):
+    /// its origin is the vertices' bounding box centre, its Size that box, and `cframe`
+    /// places the vertices' own frame (so the part's CFrame is `cframe` moved to the centre).
+    pub fn mesh(vertices: Vec<[f32; 3]>, triangles: Vec<[u32; 3]>, cframe: CFrame) -> PartState {
+        let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
+        for v in &vertices {
+            for k in 0..3 {
+                lo[k] = lo[k].min(v[k]);
+                hi[k] = hi[k].max(v[k]);
+            }
+        }
+        let centre: [f32; 3] = std::array::from_fn(|k| (lo[k] + hi[k]) / 2.0);
+        let extent: [f32; 3] = std::array::from_fn(|k| hi[k] - lo[k]);
+        let vertices = vertices
+            .iter()
+            .map(|v| std::array::from_fn(|k| v[k] - centre[k]))
+            .collect();
+        let part = PartState::new(PartShape::Mesh);
+        part.size.set(extent);
+        part.cframe.set(cframe.compose(&CFrame {
+            position: centre,
+            rotation: CFrame::IDENTITY.rotation,
+        }));
+        *part.mesh.borrow_mut() = Some(Rc::new(MeshData {
+            vertices,
+            triangles,
+            extent,
+        }));
+        part
+    }
+
+    /// The collider of the part at its current Size.
+    pub fn collider(&self) -> Shape {
+        match self.mesh.borrow().as_ref() {
+            Some(mesh) => mesh.collider(self.size()),
+            None => self.shape.collider(self.size()),
         }
     }
 
@@ -499,6 +630,12 @@ pub fn module(lua: &Lua) -> mlua::Result<Table> {
             }
             .ok_or_else(|| expected("Renderable.BasePart", PartShape::NAMES, &shape))?;
             Ok(BasePart(Rc::new(PartState::new(shape))))
+        })?,
+    )?;
+    renderable.set(
+        "MeshPart",
+        lua.create_function(|_, (vertices, triangles): (Value, Value)| {
+            Ok(BasePart(Rc::new(mesh_part(vertices, triangles)?)))
         })?,
     )?;
     Ok(renderable)

@@ -227,6 +227,8 @@ impl UserData for PhysicsPlane {
             "NewControlledController",
             |_, p, (part, opts): (Value, Value)| new_controller(&p.0, part, opts, true),
         );
+        super::joint::add_methods(methods);
+        super::ragdoll::add_methods(methods);
         methods.add_meta_method(MetaMethod::Index, |lua, p, key: Value| {
             PLANE.get(lua, &p.0, &key)
         });
@@ -243,7 +245,7 @@ impl UserData for PhysicsPlane {
     }
 }
 
-fn add(plane: &Rc<PlaneState>, part: Value) -> mlua::Result<PhysicsObject> {
+pub(crate) fn add(plane: &Rc<PlaneState>, part: Value) -> mlua::Result<PhysicsObject> {
     let Value::UserData(ud) = &part else {
         return Err(expected("PhysicsPlane:Add", "a BasePart", &part));
     };
@@ -270,7 +272,7 @@ fn add(plane: &Rc<PlaneState>, part: Value) -> mlua::Result<PhysicsObject> {
             what()
         )));
     }
-    let collider = state.shape.collider(state.size());
+    let collider = state.collider();
     // A part whose Touched already has handlers reports contacts from its first tick.
     let reporting = state.touch_listeners() > 0;
     let mut props = Vec::new();
@@ -364,6 +366,10 @@ fn option(o: &mut PlaneOptions, prop: PlaneProp) {
 pub fn module(lua: &Lua) -> mlua::Result<Table> {
     let m = lua.create_table()?;
     m.set("New", lua.create_function(new_plane)?)?;
+    m.set(
+        "HumanoidRagdoll",
+        lua.create_function(super::ragdoll::humanoid)?,
+    )?;
     super::collision_groups::install(lua, &m)?;
     m.set("NewGUI", lua.create_function(super::gui_plane::new_gui)?)?;
     Ok(m)

@@ -87,6 +87,8 @@ impl Backend for Plane {
             PlaneOp::AddObject { .. } => Err(not_for_gui("AddObject")),
             PlaneOp::Query(_) => Err(not_for_gui("Query")),
             PlaneOp::Controller(_) => Err(not_for_gui("Controller")),
+            PlaneOp::Joint(_) => Err(not_for_gui("Joint")),
+            PlaneOp::Map(_) => Err(not_for_gui("Map")),
             // Collision groups do not apply (ZIndex is the layer); a client sends its table to
             // every plane it owns, so a GUI plane takes it and ignores it.
             PlaneOp::CollisionGroups(_) => Ok(Reply::Done),

@@ -46,6 +46,8 @@ impl Backend for Plane {
                 ErrorKind::InvalidValue,
                 "GUI ops (PlaneOp::Gui) need a GUI plane; this is a 3D plane",
             )),
+            PlaneOp::Joint(op) => self.joint_op(op),
+            PlaneOp::Map(op) => self.map_op(op),
             PlaneOp::Step { .. } | PlaneOp::Destroy => Err(CommandError::new(
                 ErrorKind::Internal,
                 format!("{op:?} is handled by the server, not the plane"),
@@ -105,8 +107,8 @@ impl Backend for Plane {
 
     fn usage(&self) -> Usage {
         Usage {
-            objects: self.bodies.live() as u64,
-            mesh_vertices: self.mesh_vertices,
+            objects: self.bodies.live() as u64 + self.joints.live() as u64,
+            mesh_vertices: self.mesh_vertices + self.map_pending.cost(),
         }
     }
 }

@@ -138,6 +138,13 @@ fn drive(body: &mut RigidBody, part: &Part, env: &Env) -> bool {
         body.set_angvel(w, false);
     }
     let force = (v - v0) * (mass / dt);
+    if !force.is_finite() {
+        // A dt so small that mass / dt overflows (1e-45 s): a non-finite force would make
+        // rapier quarantine (disable) the body for good. Set the velocity the force would
+        // have given instead.
+        body.set_linvel(v, true);
+        return false;
+    }
     if force == Vector::ZERO {
         return false;
     }

@@ -8,13 +8,16 @@
 //! - `queries`, `collision_groups`: scene queries and the plane's collision-group table.
 //! - `controllers`: kinematic character controllers, ticked before each step.
 //! - `limits`: MaxLinearSpeed and MaxAngularSpeed.
+//! - `joints`: joints, their error figures and breaking; `maps`: triangle-mesh maps.
 
 mod backend;
 mod collision_groups;
 mod contacts;
 mod controllers;
 mod forces;
+mod joints;
 mod limits;
+mod maps;
 mod objects;
 mod part;
 mod properties;
@@ -92,6 +95,10 @@ pub struct Plane {
     /// Bodies an op added, moved or reshaped since the last step: a query first brings their
     /// colliders' poses and broad-phase boxes up to date, so it sees the change.
     query_stale: Vec<RigidBodyHandle>,
+    /// Joints (see `joints`).
+    joints: joints::Joints,
+    /// Map pieces uploaded since the last build (see `maps`).
+    map_pending: maps::PendingMap,
 }
 
 impl Plane {
@@ -132,6 +139,8 @@ impl Plane {
             controllers: Default::default(),
             pending_events: Vec::new(),
             query_stale: Vec::new(),
+            joints: joints::Joints::default(),
+            map_pending: maps::PendingMap::default(),
         };
         for prop in props {
             plane.apply_prop(*prop, true)?;
@@ -236,6 +245,7 @@ impl Plane {
         self.tick_controllers(dt);
         self.apply_forces(dt);
         self.limit_speeds_before_step();
+        self.joints_before_step();
         let hooks = contacts::RestThreshold(self.settings.rest_threshold);
         // Contacts of objects removed since the last step still end with an event.
         if self.reporting > 0 || !self.removed.is_empty() {
@@ -256,6 +266,7 @@ impl Plane {
         self.last_dt = dt;
         (self.max_penetration, self.contact_pairs) = self.contact_figures();
         self.collect_events();
+        self.joints_after_step(dt);
         self.removed.clear();
         self.last_step_us = started.elapsed().as_secs_f32() * 1e6;
         Ok(true)
@@ -279,7 +290,7 @@ impl Plane {
             slot_count: self.bodies.slot_count() as u32,
             body_count: self.bodies.live(),
             max_penetration: self.max_penetration,
-            max_joint_error: 0.0,
+            max_joint_error: self.joints.max_error,
             contact_pairs: self.contact_pairs,
             event_count: self.event_seq as u32,
         }

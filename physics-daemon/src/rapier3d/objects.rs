@@ -126,6 +126,7 @@ impl Plane {
         for c in self.world.bodies[h].colliders() {
             self.removed.push((*c, handle));
         }
+        self.remove_joints_of(h);
         self.world.remove_body(h);
         self.dirty.mark(handle.slot);
         Ok(())

@@ -41,6 +41,20 @@ pub(super) struct Part {
     pub forced_tick: u64,
     /// A character controller's capsule (its collider runs the contact hook).
     pub is_controller: bool,
+    /// A map object's triangle mesh (see `maps`): static, never reshaped.
+    pub map: Option<MapShape>,
+}
+
+/// A built map's collider shape and what it counts against the mesh quota.
+pub(super) struct MapShape {
+    pub shape: SharedShape,
+    pub cost: u64,
+}
+
+impl std::fmt::Debug for MapShape {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "MapShape({} quota units)", self.cost)
+    }
 }
 
 impl std::ops::Deref for Part {
@@ -83,6 +97,7 @@ impl Part {
             settings: ObjectSettings::default(),
             forced_tick: 0,
             is_controller: false,
+            map: None,
         };
         // A wedge's mass sits off its origin: CenterOfMass reads where it is.
         part.settings.center_of_mass = part.natural_center_of_mass();
@@ -116,14 +131,29 @@ impl Part {
         }
     }
 
-    /// Vertices of the part's mesh (0 for primitives).
+    /// A map object: an anchored triangle mesh spanning `size`; `cost` counts against the
+    /// mesh quota while it lives.
+    pub fn map(shape: SharedShape, size: Vec3, cost: u64) -> Part {
+        let mut part = Part::new(&Shape::Cube { size });
+        part.shape = ShapeKind::TriMesh;
+        part.map = Some(MapShape { shape, cost });
+        part
+    }
+
+    /// Vertices of the part's mesh (0 for primitives; vertices + triangles for a map).
     pub fn mesh_vertex_count(&self) -> usize {
+        if let Some(m) = &self.map {
+            return m.cost as usize;
+        }
         self.mesh.as_ref().map_or(0, |m| m.vertices.len())
     }
 
     /// The collision shape for the current Size.
     pub fn collider_shape(&self) -> Result<SharedShape, CommandError> {
         let [x, y, z] = self.size;
+        if let Some(m) = &self.map {
+            return Ok(m.shape.clone());
+        }
         Ok(match (&self.mesh, self.shape) {
             (_, ShapeKind::Cube) => SharedShape::cuboid(x / 2.0, y / 2.0, z / 2.0),
             (_, ShapeKind::Sphere) => SharedShape::ball(x.min(y).min(z) / 2.0),
@@ -166,7 +196,9 @@ impl Part {
                 }
                 hull
             }
-            (None, ShapeKind::Mesh) => unreachable!("mesh parts always carry their mesh"),
+            (None, ShapeKind::Mesh) | (_, ShapeKind::TriMesh) => {
+                unreachable!("mesh parts carry their mesh, maps their triangle mesh")
+            }
         })
     }
 
@@ -263,6 +295,10 @@ impl Part {
         } else {
             ActiveEvents::empty()
         });
+        if self.map.is_some() {
+            // Static: a surface mesh has no volume to take a mass from.
+            return Ok(());
+        }
         let unit = collider.shape().mass_properties(1.0);
         let volume = unit.mass();
         let mass = self.mass(volume);

@@ -23,6 +23,9 @@ impl Plane {
             }
         }
         let h = self.body_of(handle)?;
+        if self.part(handle).map.is_some() {
+            super::maps::check_map_prop(&prop)?;
+        }
         let part = &mut self.bodies.get_mut(handle)?.part;
         let was_driven = part.is_driven();
         let was_reporting = part.report_contacts;

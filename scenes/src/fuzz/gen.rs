@@ -6,10 +6,10 @@
 //! degenerate meshes and bad triangle indices).
 
 use shm_layout::{
-    CollisionGroups, Command, ControllerOp, ControllerProp, FilterType, GuiControllerOp,
-    GuiControllerProp, GuiObjectOp, GuiObjectProp, GuiOp, GuiPlaneProp, GuiShape, Handle, ObjectOp,
-    ObjectProp, Pin, PlaneId, PlaneKind, PlaneOp, PlaneProp, Pose, QueryFilter, QueryOp, Ray,
-    Restraint, RotateTo, Shape, Vec3, CRATE_VERSION,
+    AxisMode, CollisionGroups, Command, ControllerOp, ControllerProp, FilterType, GuiControllerOp,
+    GuiControllerProp, GuiObjectOp, GuiObjectProp, GuiOp, GuiPlaneProp, GuiShape, Handle,
+    JointKind, JointOp, JointProp, MapOp, ObjectOp, ObjectProp, Pin, PlaneId, PlaneKind, PlaneOp,
+    PlaneProp, Pose, QueryFilter, QueryOp, Ray, Restraint, RotateTo, Shape, Vec3, CRATE_VERSION,
 };
 
 use super::rng::Rng;
@@ -200,8 +200,10 @@ impl<'a> Gen<'a> {
             u if u < 0.45 => self.add_object(wild),
             u if u < 0.50 => PlaneOp::Query(self.query(wild, id)),
             u if u < 0.51 => PlaneOp::CollisionGroups(self.collision_groups(wild)),
-            u if u < 0.56 => PlaneOp::Controller(self.controller_op(wild, id)),
-            u if u < 0.62 => PlaneOp::Gui(self.gui_op(wild, id)),
+            u if u < 0.55 => PlaneOp::Controller(self.controller_op(wild, id)),
+            u if u < 0.60 => PlaneOp::Gui(self.gui_op(wild, id)),
+            u if u < 0.64 => PlaneOp::Joint(self.joint_op(wild, id)),
+            u if u < 0.66 => PlaneOp::Map(self.map_op(wild)),
             _ => {
                 let handle = self.handle(wild, id);
                 PlaneOp::Object {
@@ -553,6 +555,111 @@ impl<'a> Gen<'a> {
             }
         }
         self.rng.bogus_handle()
+    }
+
+    /// A joint op: creation between live objects (or the world) with valid or wild options,
+    /// and Set / Info / Destroy on handles that may or may not be joints.
+    fn joint_op(&mut self, wild: bool, id: PlaneId) -> JointOp {
+        let joint = self.handle(true, id);
+        match self.rng.below(100) {
+            0..=49 => {
+                let kind = *self.rng.pick(&JointKind::ALL);
+                let a = self.handle(wild, id);
+                let b = if self.rng.chance(0.3) {
+                    None
+                } else {
+                    Some(self.handle(wild, id))
+                };
+                let props = (0..self.rng.below(5))
+                    .map(|_| self.joint_prop(wild))
+                    .collect();
+                JointOp::Create { kind, a, b, props }
+            }
+            50..=74 => JointOp::Set {
+                joint,
+                prop: self.joint_prop(wild),
+            },
+            75..=89 => JointOp::Info { joint },
+            _ => JointOp::Destroy { joint },
+        }
+    }
+
+    fn joint_prop(&mut self, wild: bool) -> JointProp {
+        let f = |r: &mut Rng, sane: f32| r.maybe_wild(wild, sane);
+        let angle = f(self.rng, 1.5);
+        let dist = f(self.rng, 3.0);
+        let v = self.rng.vec3(wild, 2.0);
+        match self.rng.below(18) {
+            0 => JointProp::AnchorA(v),
+            1 => JointProp::AnchorB(v),
+            2 => JointProp::Axis(v),
+            3 => JointProp::LowerAngle(-angle.abs()),
+            4 => JointProp::UpperAngle(angle.abs()),
+            5 => JointProp::SwingLimit(angle.abs()),
+            6 => JointProp::TwistLimit(angle.abs()),
+            7 => JointProp::LowerDistance(-dist.abs()),
+            8 => JointProp::UpperDistance(dist.abs()),
+            9 => JointProp::RestLength(dist.abs()),
+            10 => JointProp::Stiffness(f(self.rng, 100.0).abs()),
+            11 => JointProp::Damping(f(self.rng, 10.0).abs()),
+            12 => JointProp::MotorSpeed(f(self.rng, 5.0)),
+            13 => JointProp::MotorTarget(angle),
+            14 => JointProp::MotorMaxForce(f(self.rng, 100.0).abs()),
+            15 => {
+                let modes = [AxisMode::Locked, AxisMode::Limited, AxisMode::Free];
+                JointProp::Axes(std::array::from_fn(|_| *self.rng.pick(&modes)))
+            }
+            16 => JointProp::BreakForce(f(self.rng, 500.0).abs()),
+            _ => JointProp::CollideConnected(self.rng.chance(0.5)),
+        }
+    }
+
+    /// A map op: small uploads (valid grids, or wild: NaN vertices, indices past the end,
+    /// degenerate triangles), builds at valid or wild poses and scales, discards.
+    fn map_op(&mut self, wild: bool) -> MapOp {
+        match self.rng.below(100) {
+            0..=59 => {
+                let n = self.rng.range(1, 6);
+                let mut vertices = Vec::new();
+                for i in 0..=n {
+                    for j in 0..=n {
+                        vertices.push([i as f32, 0.0, j as f32]);
+                    }
+                }
+                let mut triangles = Vec::new();
+                let w = n as u32 + 1;
+                for i in 0..n as u32 {
+                    for j in 0..n as u32 {
+                        let a = i * w + j;
+                        triangles.push([a, a + 1, a + w]);
+                        triangles.push([a + 1, a + w + 1, a + w]);
+                    }
+                }
+                if wild {
+                    match self.rng.below(4) {
+                        0 => vertices[0] = self.rng.vec3(true, 1.0),
+                        1 => triangles.push([0, 0, self.rng.special_u32()]),
+                        2 => triangles.push([0, 0, 1]),
+                        _ => triangles.clear(),
+                    }
+                }
+                MapOp::Upload {
+                    vertices,
+                    triangles,
+                }
+            }
+            60..=89 => MapOp::Build {
+                pose: self.rng.pose(wild, 30.0),
+                scale: if wild && self.rng.chance(0.5) {
+                    self.rng.vec3(true, 1.0)
+                } else {
+                    [self.rng.f32_in(0.5, 2.0); 3]
+                },
+                vertices: if wild { self.rng.u64() % 100 } else { 0 },
+                triangles: if wild { self.rng.u64() % 100 } else { 0 },
+            },
+            _ => MapOp::Discard,
+        }
     }
 
     fn object_op(&mut self, wild: bool) -> ObjectOp {

@@ -5,7 +5,7 @@ use std::collections::BTreeMap;
 
 use shm_layout::{
     Command, CommandResult, ControllerOp, ErrorKind, GuiControllerOp, GuiObjectOp, GuiOp, GuiShape,
-    ObjectOp, ObjectProp, PlaneOp, PlaneProp, QueryOp, Reply, Response, Shape,
+    JointOp, MapOp, ObjectOp, ObjectProp, PlaneOp, PlaneProp, QueryOp, Reply, Response, Shape,
 };
 
 /// How many failures a run keeps in full (the counters count all of them).
@@ -358,6 +358,9 @@ pub fn reply_name(reply: &Reply) -> &'static str {
         Reply::Controller(_) => "Controller",
         Reply::Flag(_) => "Flag",
         Reply::Gui(_) => "Gui",
+        Reply::Joint { .. } => "Joint",
+        Reply::JointInfo(_) => "JointInfo",
+        Reply::Map(_) => "Map",
     }
 }
 
@@ -395,6 +398,17 @@ pub fn op_name(command: &Command) -> String {
             PlaneOp::CollisionGroups(_) => "Plane.CollisionGroups".into(),
             PlaneOp::Controller(c) => format!("Plane.Controller.{}", controller_op_name(c)),
             PlaneOp::Gui(op) => gui_op_name(op),
+            PlaneOp::Joint(j) => match j {
+                JointOp::Create { kind, .. } => format!("Plane.Joint.Create.{}", kind.name()),
+                JointOp::Set { prop, .. } => format!("Plane.Joint.Set.{}", prop.name()),
+                JointOp::Info { .. } => "Plane.Joint.Info".into(),
+                JointOp::Destroy { .. } => "Plane.Joint.Destroy".into(),
+            },
+            PlaneOp::Map(m) => match m {
+                MapOp::Upload { .. } => "Plane.Map.Upload".into(),
+                MapOp::Build { .. } => "Plane.Map.Build".into(),
+                MapOp::Discard => "Plane.Map.Discard".into(),
+            },
         },
     }
 }

@@ -1,0 +1,424 @@
+//! `plane:NewJoint(kind, objA, objB?, opts?)` and the `Joint` it returns; `plane:LoadMap`.
+//! Options are the SDK's `JointProp`s by name; reads (`Error`, `Broken`, `Force`, options)
+//! ask the daemon (one round trip).
+
+use std::path::Path;
+use std::rc::Rc;
+
+use client_sdk::{AxisMode, Joint, JointInfo, JointKind, JointProp, MapOptions, Object};
+use mlua::{Lua, MetaMethod, Table, UserData, UserDataMethods, Value};
+
+use super::contacts::{forget_joint, joint_broke_signal};
+use super::object::PhysicsObject;
+use super::part::{BasePart, PartState};
+use super::plane::{add, PhysicsPlane, PlaneState};
+use crate::values::CFrame;
+use crate::values::{describe, expected, finite_number, finite_vector, new_vector, sdk_error};
+
+/// The option names `NewJoint` and the Joint's properties accept.
+const OPTIONS: [&str; 18] = [
+    "AnchorA",
+    "AnchorB",
+    "Axis",
+    "LowerAngle",
+    "UpperAngle",
+    "SwingLimit",
+    "TwistLimit",
+    "LowerDistance",
+    "UpperDistance",
+    "RestLength",
+    "Stiffness",
+    "Damping",
+    "MotorSpeed",
+    "MotorTarget",
+    "MotorMaxForce",
+    "Axes",
+    "BreakForce",
+    "CollideConnected",
+];
+
+/// One option from its name and Lua value; errors name the option and the value.
+fn joint_prop(name: &str, value: &Value) -> mlua::Result<JointProp> {
+    let what = format!("Joint.{name}");
+    let num = || finite_number(&what, value).map(|v| v as f32);
+    let vec = || finite_vector(&what, value);
+    Ok(match name {
+        "AnchorA" => JointProp::AnchorA(vec()?),
+        "AnchorB" => JointProp::AnchorB(vec()?),
+        "Axis" => JointProp::Axis(vec()?),
+        "LowerAngle" => JointProp::LowerAngle(num()?),
+        "UpperAngle" => JointProp::UpperAngle(num()?),
+        "SwingLimit" => JointProp::SwingLimit(num()?),
+        "TwistLimit" => JointProp::TwistLimit(num()?),
+        "LowerDistance" => JointProp::LowerDistance(num()?),
+        "UpperDistance" => JointProp::UpperDistance(num()?),
+        "RestLength" => JointProp::RestLength(num()?),
+        "Stiffness" => JointProp::Stiffness(num()?),
+        "Damping" => JointProp::Damping(num()?),
+        "MotorSpeed" => JointProp::MotorSpeed(num()?),
+        "MotorTarget" => JointProp::MotorTarget(num()?),
+        "MotorMaxForce" => JointProp::MotorMaxForce(num()?),
+        "BreakForce" => JointProp::BreakForce(num()?),
+        "CollideConnected" => match value {
+            Value::Boolean(b) => JointProp::CollideConnected(*b),
+            v => return Err(expected(&what, "a boolean", v)),
+        },
+        "Axes" => {
+            let Value::Table(t) = value else {
+                return Err(expected(
+                    &what,
+                    "a table {X = \"Locked\", ..., RotZ = ...}",
+                    value,
+                ));
+            };
+            let mut axes = [AxisMode::Locked; 6];
+            for pair in t.pairs::<Value, Value>() {
+                let (k, v) = pair?;
+                let key = match &k {
+                    Value::String(s) => s.to_string_lossy(),
+                    other => describe(other),
+                };
+                let Some(i) = shm_axis(&key) else {
+                    return Err(mlua::Error::runtime(format!(
+                        "Joint.Axes: unknown axis \"{key}\" (expected X, Y, Z, RotX, RotY, RotZ)"
+                    )));
+                };
+                let mode = match &v {
+                    Value::String(s) => AxisMode::from_name(&s.to_string_lossy()),
+                    _ => None,
+                };
+                axes[i] = mode.ok_or_else(|| {
+                    expected(
+                        &format!("Joint.Axes.{key}"),
+                        "\"Locked\", \"Limited\" or \"Free\"",
+                        &v,
+                    )
+                })?;
+            }
+            JointProp::Axes(axes)
+        }
+        _ => {
+            return Err(mlua::Error::runtime(format!(
+                "Joint: unknown option \"{name}\" (expected one of {})",
+                OPTIONS.join(", ")
+            )))
+        }
+    })
+}
+
+fn shm_axis(name: &str) -> Option<usize> {
+    ["X", "Y", "Z", "RotX", "RotY", "RotZ"]
+        .iter()
+        .position(|a| *a == name)
+}
+
+fn object_of(what: &str, v: &Value) -> mlua::Result<Object> {
+    match v {
+        Value::UserData(ud) => {
+            let o = ud
+                .borrow::<PhysicsObject>()
+                .map_err(|_| expected(what, "a PhysicsObject", v))?;
+            Ok(o.live(what)?.clone())
+        }
+        _ => Err(expected(what, "a PhysicsObject", v)),
+    }
+}
+
+fn info_value(lua: &Lua, info: &JointInfo, key: &str) -> mlua::Result<Value> {
+    let s = &info.settings;
+    let opt = |v: Option<f32>| v.map_or(Value::Nil, |x| Value::Number(x as f64));
+    Ok(match key {
+        "Error" => Value::Number(info.error as f64),
+        "AngularError" => Value::Number(info.angular_error as f64),
+        "Broken" => Value::Boolean(info.broken),
+        "Force" => Value::Number(info.force as f64),
+        "Position" => Value::Number(info.position as f64),
+        "Kind" => Value::String(lua.create_string(info.kind.name())?),
+        "AnchorA" => new_vector(s.anchor_a),
+        "AnchorB" => new_vector(s.anchor_b),
+        "Axis" => new_vector(s.axis),
+        "LowerAngle" => opt(s.lower_angle),
+        "UpperAngle" => opt(s.upper_angle),
+        "SwingLimit" => opt(s.swing_limit),
+        "TwistLimit" => opt(s.twist_limit),
+        "LowerDistance" => opt(s.lower_distance),
+        "UpperDistance" => opt(s.upper_distance),
+        "RestLength" => Value::Number(s.rest_length as f64),
+        "Stiffness" => Value::Number(s.stiffness as f64),
+        "Damping" => Value::Number(s.damping as f64),
+        "MotorSpeed" => opt(s.motor_speed),
+        "MotorTarget" => opt(s.motor_target),
+        "MotorMaxForce" => Value::Number(s.motor_max_force as f64),
+        "BreakForce" => Value::Number(s.break_force as f64),
+        "CollideConnected" => Value::Boolean(s.collide_connected),
+        _ => {
+            return Err(mlua::Error::runtime(format!(
+                "Joint.{key} is not a valid member of Joint"
+            )))
+        }
+    })
+}
+
+/// The Lua handle of a joint, with its plane (for its Broke signal).
+pub struct LuaJoint(pub Joint, pub Rc<PlaneState>);
+
+impl LuaJoint {
+    fn name(&self) -> String {
+        format!("Joint {} ({:?})", self.0.kind().name(), self.0.handle())
+    }
+}
+
+impl UserData for LuaJoint {
+    fn add_methods<M: UserDataMethods<Self>>(methods: &mut M) {
+        methods.add_method("Destroy", |_, j, ()| {
+            forget_joint(&j.1, j.0.handle());
+            j.0.destroy().map_err(|e| sdk_error("Joint:Destroy", e))
+        });
+        methods.add_meta_method(MetaMethod::Index, |lua, j, key: String| {
+            if key == "Broke" {
+                let signal = joint_broke_signal(&j.1, j.0.handle(), &j.name());
+                return Ok(Value::UserData(lua.create_userdata(signal)?));
+            }
+            let info =
+                j.0.info()
+                    .map_err(|e| sdk_error(&format!("Joint.{key}"), e))?;
+            info_value(lua, &info, &key)
+        });
+        methods.add_meta_method(
+            MetaMethod::NewIndex,
+            |_, j, (key, value): (String, Value)| {
+                let prop = joint_prop(&key, &value)?;
+                j.0.set(prop)
+                    .map_err(|e| sdk_error(&format!("Joint.{key}"), e))
+            },
+        );
+        methods.add_meta_method(MetaMethod::ToString, |_, j, ()| Ok(j.name()));
+    }
+}
+
+fn options(what: &str, opts: &Value) -> mlua::Result<Vec<(String, Value)>> {
+    match opts {
+        Value::Nil => Ok(Vec::new()),
+        Value::Table(t) => t
+            .pairs::<Value, Value>()
+            .map(|p| {
+                let (k, v) = p?;
+                match k {
+                    Value::String(s) => Ok((s.to_string_lossy(), v)),
+                    other => Err(expected(&format!("{what} option key"), "a string", &other)),
+                }
+            })
+            .collect(),
+        v => Err(expected(what, "an options table", v)),
+    }
+}
+
+fn new_joint(
+    plane: &PhysicsPlane,
+    (kind, a, b, opts): (Value, Value, Value, Value),
+) -> mlua::Result<LuaJoint> {
+    let what = "PhysicsPlane:NewJoint";
+    let kind = match &kind {
+        Value::String(s) => JointKind::from_name(&s.to_string_lossy()),
+        _ => None,
+    }
+    .ok_or_else(|| {
+        expected(
+            what,
+            "a joint kind (\"Ball\", \"Hinge\", \"ConeTwist\", \"SixDof\", \"Fixed\", \"Prismatic\", \"Rope\", \"Spring\")",
+            &kind,
+        )
+    })?;
+    let a = object_of(&format!("{what} objA"), &a)?;
+    let b = match &b {
+        Value::Nil => None,
+        v => Some(object_of(&format!("{what} objB"), v)?),
+    };
+    let props = options(what, &opts)?
+        .iter()
+        .map(|(k, v)| joint_prop(k, v))
+        .collect::<mlua::Result<Vec<_>>>()?;
+    plane
+        .0
+        .plane
+        .joint(kind, &a, b.as_ref(), &props)
+        .map(|j| LuaJoint(j, plane.0.clone()))
+        .map_err(|e| sdk_error(what, e))
+}
+
+fn map_options(what: &str, opts: &Value) -> mlua::Result<MapOptions> {
+    let mut o = MapOptions::default();
+    for (k, v) in options(what, opts)? {
+        match k.as_str() {
+            "Position" => o.pose.position = finite_vector(&format!("{what} Position"), &v)?,
+            "Rotation" => {
+                let e = finite_vector(&format!("{what} Rotation"), &v)?;
+                o.pose.rotation = crate::values::rotation::from_euler(e);
+            }
+            "Scale" => {
+                o.scale = match &v {
+                    Value::Number(_) | Value::Integer(_) => {
+                        [finite_number(&format!("{what} Scale"), &v)? as f32; 3]
+                    }
+                    _ => finite_vector(&format!("{what} Scale"), &v)?,
+                }
+            }
+            other => {
+                return Err(mlua::Error::runtime(format!(
+                    "{what}: unknown option \"{other}\" (expected Position, Rotation, Scale)"
+                )))
+            }
+        }
+    }
+    Ok(o)
+}
+
+fn load_map(lua: &Lua, plane: &PhysicsPlane, (path, opts): (String, Value)) -> mlua::Result<Table> {
+    let what = "PhysicsPlane:LoadMap";
+    let o = map_options(what, &opts)?;
+    let map = plane
+        .0
+        .plane
+        .load_map(Path::new(&path), &o)
+        .map_err(|e| sdk_error(what, e))?;
+    let r = &map.report;
+    let t = lua.create_table()?;
+    t.set("Meshes", map.meshes)?;
+    t.set("Triangles", r.triangles)?;
+    t.set("Vertices", r.vertices)?;
+    let v = lua.create_table()?;
+    v.set("DegenerateTriangles", r.degenerate_triangles)?;
+    v.set("DuplicateVerticesMerged", r.duplicate_vertices_merged)?;
+    v.set("NonManifoldEdges", r.non_manifold_edges)?;
+    v.set("WeldedEdges", r.welded_edges)?;
+    v.set("OpenEdges", r.open_edges)?;
+    t.set("Validation", v)?;
+    Ok(t)
+}
+
+/// `plane:LoadProp(path, cframe, opts?)`: the .glb as one dynamic mesh part (the convex
+/// hull of all its vertices) placed by `cframe`, or with `Decompose = true` one mesh part
+/// per mesh of the file welded to the first by Fixed joints. `Scale` (number or vector)
+/// scales the file's coordinates. Returns the first PhysicsObject and an array of all.
+fn load_prop(
+    lua: &Lua,
+    plane: &PhysicsPlane,
+    (path, cframe, opts): (String, Value, Value),
+) -> mlua::Result<(PhysicsObject, Table)> {
+    let what = "PhysicsPlane:LoadProp";
+    let cf = match &cframe {
+        Value::UserData(ud) => ud.borrow::<CFrame>().map(|c| *c).ok(),
+        _ => None,
+    }
+    .ok_or_else(|| expected(&format!("{what} cframe"), "a CFrame", &cframe))?;
+    let (mut scale, mut decompose) = ([1.0f32; 3], false);
+    for (k, v) in options(what, &opts)? {
+        match k.as_str() {
+            "Scale" => {
+                let w = format!("{what} Scale");
+                scale = match &v {
+                    Value::Number(_) | Value::Integer(_) => [finite_number(&w, &v)? as f32; 3],
+                    _ => finite_vector(&w, &v)?,
+                };
+                if scale.iter().any(|c| *c <= 0.0) {
+                    return Err(expected(&w, "positive scale factors", &v));
+                }
+            }
+            "Decompose" => {
+                decompose = match v {
+                    Value::Boolean(b) => b,
+                    other => {
+                        return Err(expected(&format!("{what} Decompose"), "a boolean", &other))
+                    }
+                }
+            }
+            other => {
+                return Err(mlua::Error::runtime(format!(
+                    "{what}: unknown option \"{other}\" (expected Scale, Decompose)"
+                )))
+            }
+        }
+    }
+    let meshes = client_sdk::map::read_meshes(Path::new(&path)).map_err(|e| sdk_error(what, e))?;
+    let scaled = |m: &client_sdk::MapMesh| -> Vec<[f32; 3]> {
+        m.vertices
+            .iter()
+            .map(|v| std::array::from_fn(|k| v[k] * scale[k]))
+            .collect()
+    };
+    // (vertices, triangles) of each part.
+    type Group = (Vec<[f32; 3]>, Vec<[u32; 3]>);
+    let groups: Vec<Group> = if decompose {
+        meshes
+            .iter()
+            .map(|m| (scaled(m), m.triangles.clone()))
+            .collect()
+    } else {
+        let mut all = (Vec::new(), Vec::new());
+        for m in &meshes {
+            let base = all.0.len() as u32;
+            all.1
+                .extend(m.triangles.iter().map(|t| t.map(|i| i + base)));
+            all.0.extend(scaled(m));
+        }
+        vec![all]
+    };
+    if groups.is_empty() || groups.iter().all(|g| g.0.is_empty()) {
+        return Err(mlua::Error::runtime(format!("{what}: {path} has no mesh")));
+    }
+    let mut objects: Vec<PhysicsObject> = Vec::new();
+    for (i, (vertices, triangles)) in groups.into_iter().enumerate() {
+        if vertices.len() < 4 {
+            return Err(mlua::Error::runtime(format!(
+                "{what}: {path}: mesh {i} has {} vertices (a solid needs at least 4)",
+                vertices.len()
+            )));
+        }
+        let part = Rc::new(PartState::mesh(vertices, triangles, cf));
+        let ud = lua.create_userdata(BasePart(part))?;
+        let obj = add(&plane.0, Value::UserData(ud))?;
+        if let Some(first) = objects.first() {
+            // Same rotation for every part: A's local anchor is the centres' difference.
+            let a = first.part.cframe().position;
+            let b = obj.part.cframe().position;
+            let d = crate::values::rotation::rotate(
+                crate::values::rotation::conjugate(cf.rotation),
+                std::array::from_fn(|k| b[k] - a[k]),
+            );
+            plane
+                .0
+                .plane
+                .joint(
+                    JointKind::Fixed,
+                    &first.body.object,
+                    Some(&obj.body.object),
+                    &[JointProp::AnchorA(d), JointProp::AnchorB([0.0; 3])],
+                )
+                .map_err(|e| sdk_error(what, e))?;
+        }
+        objects.push(obj);
+    }
+    let all = lua.create_table()?;
+    for o in &objects {
+        all.push(PhysicsObject {
+            body: o.body.clone(),
+            part: o.part.clone(),
+            part_ud: o.part_ud.clone(),
+        })?;
+    }
+    let first = objects.swap_remove(0);
+    Ok((first, all))
+}
+
+/// Registers `NewJoint`, `LoadMap` and `LoadProp` on PhysicsPlane.
+pub fn add_methods<M: UserDataMethods<PhysicsPlane>>(methods: &mut M) {
+    methods.add_method("NewJoint", |_, p, args: (Value, Value, Value, Value)| {
+        new_joint(p, args)
+    });
+    methods.add_method("LoadMap", |lua, p, args: (String, Value)| {
+        load_map(lua, p, args)
+    });
+    methods.add_method("LoadProp", |lua, p, args: (String, Value, Value)| {
+        load_prop(lua, p, args)
+    });
+}
