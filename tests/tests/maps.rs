@@ -245,3 +245,43 @@ fn shipped_example_glbs_are_the_generated_ones() {
         assert_eq!(read.len(), meshes.len(), "{path}: mesh count");
     }
 }
+
+#[test]
+fn a_character_controller_walks_across_a_tiled_map() {
+    let s = Scene::new("map-kcc", no_damping());
+    s.plane
+        .load_map_meshes(&[tiles(60, 1.0)], &MapOptions::default())
+        .unwrap();
+    // A capsule of radius 1 and height 5 standing on the map's top face (y = 0).
+    let c = s
+        .plane
+        .new_controller(Pose::at([-20.0, 2.51, 0.0]), [2.0, 5.0, 2.0], false, &[])
+        .unwrap();
+    s.run(1.0 / 60.0, 10);
+    assert!(c.on_ground().unwrap(), "stands on the map");
+    // Facing +X (yaw π/2), walking forward: 2 s at WalkSpeed 16 crosses 30 tile seams.
+    c.set(client_sdk::ControllerProp::Rotation([
+        0.0,
+        std::f32::consts::FRAC_PI_2,
+        0.0,
+    ]))
+    .unwrap();
+    c.set_move_vector(0.0, 1.0).unwrap();
+    let (mut lo, mut hi) = (f32::MAX, f32::MIN);
+    let mut airborne = 0;
+    for _ in 0..120 {
+        s.plane.step(1.0 / 60.0).unwrap();
+        let p = c.object().position().unwrap();
+        lo = lo.min(p[1]);
+        hi = hi.max(p[1]);
+        airborne += usize::from(!c.on_ground().unwrap());
+    }
+    let p = c.object().position().unwrap();
+    assert!(p[0] > 5.0, "walked across the seams: x {}", p[0]);
+    assert_eq!(airborne, 0, "never left the ground at a seam");
+    assert!(
+        hi - lo < 0.02,
+        "no bumps at the seams: height varied {}",
+        hi - lo
+    );
+}

@@ -80,6 +80,12 @@ pub const SCENES: &[Scene] = &[
         run: free_rotation,
     },
     Scene {
+        name: "hinge-pendulum",
+        measures: "|T − 2π√(L/g)(1 + θ0²/16)| / that, of a hinge pendulum (L = 2, θ0 = 0.3) over 6 s",
+        unit: "fraction",
+        run: hinge_pendulum,
+    },
+    Scene {
         name: "stack-drift",
         measures: "largest displacement of any box of a resting 5-box stack from 1 s (settled) to 3 s",
         unit: "units",
@@ -383,4 +389,57 @@ mod tests {
         assert!((l[0] - 6.0).abs() < 1e-6 && l[1].abs() < 1e-6, "{l:?}");
         assert!((e - 6.0).abs() < 1e-6, "{e}");
     }
+}
+
+/// A small ball on a hinge joint to the world at (0, 10, 0), released from θ0.
+fn hinge_pendulum(c: Config) -> BenchResult<Outcome> {
+    use physics_daemon::backend::Backend;
+    use shm_layout::{JointKind, JointOp, JointProp, PlaneOp};
+    let (l, theta0) = (2.0f64, 0.3f64);
+    let mut sim = Sim::new(c, &UNDAMPED)?;
+    let pivot = [0.0f32, 10.0, 0.0];
+    let start = [
+        (l * theta0.sin()) as f32,
+        (10.0 - l * theta0.cos()) as f32,
+        0.0,
+    ];
+    let bob = sim.add(
+        Shape::Sphere { radius: 0.05 },
+        Pose::at(start),
+        &[ObjectProp::Weight(1.0)],
+    )?;
+    Backend::apply(
+        &mut sim.plane,
+        PlaneOp::Joint(JointOp::Create {
+            kind: JointKind::Hinge,
+            a: bob,
+            b: None,
+            props: vec![
+                JointProp::AnchorA([pivot[0] - start[0], pivot[1] - start[1], 0.0]),
+                JointProp::AnchorB(pivot),
+                JointProp::Axis([0.0, 0.0, 1.0]),
+            ],
+        }),
+    )
+    .map_err(|e| crate::error::BenchError::Failed(e.to_string()))?;
+    // Upward zero crossings of x, interpolated within the tick.
+    let mut crossings = Vec::new();
+    let mut last = (0.0f64, sim.state(bob).position[0] as f64);
+    for _ in 0..sim.steps_for(6.0) {
+        sim.step()?;
+        let now = (sim.time(), sim.state(bob).position[0] as f64);
+        if last.1 < 0.0 && now.1 >= 0.0 {
+            crossings.push(last.0 + (now.0 - last.0) * (-last.1) / (now.1 - last.1));
+        }
+        last = now;
+    }
+    let exact = 2.0 * std::f64::consts::PI * (l / G).sqrt() * (1.0 + theta0 * theta0 / 16.0);
+    let error = match crossings.len() {
+        n if n >= 2 => {
+            let period = (crossings[n - 1] - crossings[0]) / (n - 1) as f64;
+            (period - exact).abs() / exact
+        }
+        _ => f64::INFINITY,
+    };
+    outcome(&sim, error)
 }

@@ -1,9 +1,8 @@
 //! Stress scenes after Box2D / Solver2D and PEEL, each with a pass criterion checked
 //! automatically. Every scene also fails when any body turns non-finite on any tick.
 //!
-//! The daemon has no joints yet, so PEEL's "chain with a heavy end" is replaced by its
-//! contact analogue: a column of light boxes carrying a heavy one (the load runs through
-//! every light body, as it would through chain links).
+//! PEEL's "chain with a heavy end" runs with ball joints (`chain-1000`), next to its
+//! contact analogue: a column of light boxes carrying a heavy one.
 
 use client_sdk::{Handle, ObjectProp, Pin, PlaneProp, Pose};
 use physics_scenes::{ball, column, floor, launched_box, overlapping_pile, thin_wall};
@@ -52,6 +51,16 @@ const Q4: Config = Config {
 };
 
 pub const SCENES: &[Scene] = &[
+    Scene {
+        name: "chain-1000",
+        criterion: "a 20-link ball-joint chain whose last link is 1,000× heavier: worst joint error (tick header) over 5 s ≤ 1.5 (three link spacings), at SolverIterations 16",
+        unit: "units",
+        config: Config {
+            solver_iterations: 16,
+            ..Config::DEFAULT
+        },
+        run: chain_1000,
+    },
     Scene {
         name: "stack-15",
         criterion: "top box of a 15-box stack (0.02 side offsets) drifts ≤ 0.05 sideways in 10 s, none falls",
@@ -451,4 +460,47 @@ mod tests {
         assert!(!c.pass && c.finite);
         assert!(!Check::at_most(&sim, f64::NAN, 0.05).pass);
     }
+}
+
+/// 20 balls 0.5 apart joined by ball joints, hung from the world, the last 1,000× heavier.
+fn chain_1000(c: Config) -> BenchResult<Check> {
+    use physics_daemon::backend::Backend;
+    use shm_layout::{JointKind, JointOp, JointProp, PlaneOp, Shape};
+    let mut sim = Sim::new(
+        c,
+        &[
+            PlaneProp::LinearDamping(0.0),
+            PlaneProp::AngularDamping(0.0),
+        ],
+    )?;
+    let mut prev: Option<Handle> = None;
+    for i in 0..20 {
+        let weight = if i == 19 { 1000.0 } else { 1.0 };
+        let link = sim.add(
+            Shape::Sphere { radius: 0.2 },
+            Pose::at([i as f32 * 0.5 + 0.5, 20.0, 0.0]),
+            &[ObjectProp::Weight(weight)],
+        )?;
+        let anchor_b = match prev {
+            Some(_) => [0.5, 0.0, 0.0],
+            None => [0.5, 20.0, 0.0],
+        };
+        Backend::apply(
+            &mut sim.plane,
+            PlaneOp::Joint(JointOp::Create {
+                kind: JointKind::Ball,
+                a: link,
+                b: prev,
+                props: vec![JointProp::AnchorA([0.0; 3]), JointProp::AnchorB(anchor_b)],
+            }),
+        )
+        .map_err(|e| crate::error::BenchError::Failed(e.to_string()))?;
+        prev = Some(link);
+    }
+    let mut worst = 0.0f64;
+    for _ in 0..sim.steps_for(5.0) {
+        sim.step()?;
+        worst = worst.max(sim.header().max_joint_error as f64);
+    }
+    Ok(Check::at_most(&sim, worst, 1.5))
 }
