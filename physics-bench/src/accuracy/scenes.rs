@@ -373,24 +373,6 @@ fn stack_penetration(c: Config) -> BenchResult<Outcome> {
     outcome(&sim, deepest)
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn angular_momentum_of_a_turned_body_is_rotated() {
-        // Body turned 90° about z, spinning about world x = its local −y axis.
-        let s = client_sdk::BodyState {
-            rotation: about_z(std::f32::consts::FRAC_PI_2),
-            angular_velocity: [2.0, 0.0, 0.0],
-            ..Default::default()
-        };
-        let (l, e) = momentum_energy(&s, [1.0, 3.0, 5.0]);
-        assert!((l[0] - 6.0).abs() < 1e-6 && l[1].abs() < 1e-6, "{l:?}");
-        assert!((e - 6.0).abs() < 1e-6, "{e}");
-    }
-}
-
 /// A small ball on a hinge joint to the world at (0, 10, 0), released from θ0.
 fn hinge_pendulum(c: Config) -> BenchResult<Outcome> {
     use physics_daemon::backend::Backend;
@@ -442,4 +424,22 @@ fn hinge_pendulum(c: Config) -> BenchResult<Outcome> {
         _ => f64::INFINITY,
     };
     outcome(&sim, error)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn angular_momentum_of_a_turned_body_is_rotated() {
+        // Body turned 90° about z, spinning about world x = its local −y axis.
+        let s = client_sdk::BodyState {
+            rotation: about_z(std::f32::consts::FRAC_PI_2),
+            angular_velocity: [2.0, 0.0, 0.0],
+            ..Default::default()
+        };
+        let (l, e) = momentum_energy(&s, [1.0, 3.0, 5.0]);
+        assert!((l[0] - 6.0).abs() < 1e-6 && l[1].abs() < 1e-6, "{l:?}");
+        assert!((e - 6.0).abs() < 1e-6, "{e}");
+    }
 }

@@ -447,21 +447,6 @@ fn extreme_pin(c: Config) -> BenchResult<Check> {
     Ok(Check::at_most(&sim, d, 0.01))
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn a_failed_or_non_finite_run_does_not_pass() {
-        let sim = Sim::new(Config::DEFAULT, &[]).unwrap();
-        assert!(Check::at_most(&sim, 0.01, 0.05).pass);
-        assert!(!Check::at_most(&sim, 0.06, 0.05).pass);
-        let c = Check::at_most(&sim, f64::INFINITY, 0.05);
-        assert!(!c.pass && c.finite);
-        assert!(!Check::at_most(&sim, f64::NAN, 0.05).pass);
-    }
-}
-
 /// 20 balls 0.5 apart joined by ball joints, hung from the world, the last 1,000× heavier.
 fn chain_1000(c: Config) -> BenchResult<Check> {
     use physics_daemon::backend::Backend;
@@ -503,4 +488,19 @@ fn chain_1000(c: Config) -> BenchResult<Check> {
         worst = worst.max(sim.header().max_joint_error as f64);
     }
     Ok(Check::at_most(&sim, worst, 1.5))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_failed_or_non_finite_run_does_not_pass() {
+        let sim = Sim::new(Config::DEFAULT, &[]).unwrap();
+        assert!(Check::at_most(&sim, 0.01, 0.05).pass);
+        assert!(!Check::at_most(&sim, 0.06, 0.05).pass);
+        let c = Check::at_most(&sim, f64::INFINITY, 0.05);
+        assert!(!c.pass && c.finite);
+        assert!(!Check::at_most(&sim, f64::NAN, 0.05).pass);
+    }
 }
