@@ -198,12 +198,14 @@ impl<'a> Gen<'a> {
                 }
             }
             u if u < 0.45 => self.add_object(wild),
-            u if u < 0.50 => PlaneOp::Query(self.query(wild, id)),
-            u if u < 0.51 => PlaneOp::CollisionGroups(self.collision_groups(wild)),
-            u if u < 0.55 => PlaneOp::Controller(self.controller_op(wild, id)),
-            u if u < 0.60 => PlaneOp::Gui(self.gui_op(wild, id)),
-            u if u < 0.64 => PlaneOp::Joint(self.joint_op(wild, id)),
-            u if u < 0.66 => PlaneOp::Map(self.map_op(wild)),
+            // The newer op families take small slices, so object ops (mostly applied) keep
+            // their share and a run still exercises the engine, not only the checks.
+            u if u < 0.48 => PlaneOp::Query(self.query(wild, id)),
+            u if u < 0.485 => PlaneOp::CollisionGroups(self.collision_groups(wild)),
+            u if u < 0.51 => PlaneOp::Controller(self.controller_op(wild, id)),
+            u if u < 0.53 => PlaneOp::Gui(self.gui_op(wild, id)),
+            u if u < 0.555 => PlaneOp::Joint(self.joint_op(wild, id)),
+            u if u < 0.565 => PlaneOp::Map(self.map_op(wild)),
             _ => {
                 let handle = self.handle(wild, id);
                 PlaneOp::Object {

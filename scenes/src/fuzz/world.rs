@@ -4,7 +4,10 @@
 
 use std::collections::BTreeMap;
 
-use shm_layout::{Command, CommandResult, ErrorKind, Handle, ObjectOp, PlaneId, PlaneOp, Reply};
+use shm_layout::{
+    Command, CommandResult, ControllerOp, ErrorKind, GuiOp, Handle, ObjectOp, PlaneId, PlaneOp,
+    Reply,
+};
 
 /// Handles remembered per plane, live and stale (older ones are forgotten).
 const MAX_REMEMBERED: usize = 512;
@@ -135,7 +138,14 @@ impl World {
             return;
         };
         match (op, result) {
-            (PlaneOp::AddObject { .. }, Ok(Reply::Object { handle, .. })) => {
+            // Controllers and GUI bodies are objects too (they count against the same quota
+            // and die by the same ObjectOp::Destroy).
+            (
+                PlaneOp::AddObject { .. }
+                | PlaneOp::Controller(ControllerOp::Create { .. })
+                | PlaneOp::Gui(GuiOp::Add { .. }),
+                Ok(Reply::Object { handle, .. }),
+            ) => {
                 plane.live.push(*handle);
                 if plane.live.len() > MAX_REMEMBERED * 16 {
                     plane.live.remove(0);
