@@ -563,8 +563,10 @@ impl<'a> Gen<'a> {
     /// and Set / Info / Destroy on handles that may or may not be joints.
     fn joint_op(&mut self, wild: bool, id: PlaneId) -> JointOp {
         let joint = self.handle(true, id);
+        // Joints count against the objects quota and few destroys find one: creating them
+        // rarely keeps valid commands from flooding the quota.
         match self.rng.below(100) {
-            0..=49 => {
+            0..=14 => {
                 let kind = *self.rng.pick(&JointKind::ALL);
                 let a = self.handle(wild, id);
                 let b = if self.rng.chance(0.3) {
@@ -577,11 +579,11 @@ impl<'a> Gen<'a> {
                     .collect();
                 JointOp::Create { kind, a, b, props }
             }
-            50..=74 => JointOp::Set {
+            15..=59 => JointOp::Set {
                 joint,
                 prop: self.joint_prop(wild),
             },
-            75..=89 => JointOp::Info { joint },
+            60..=79 => JointOp::Info { joint },
             _ => JointOp::Destroy { joint },
         }
     }
