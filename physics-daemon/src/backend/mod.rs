@@ -94,8 +94,17 @@ pub trait Backend {
     /// plane changed.
     fn drain_dirty(&mut self, into: &mut Vec<u32>) -> bool;
 
+    /// The published state of slot `i` (dead slots carry only their generation).
+    fn body_state(&self, i: usize) -> BodyState;
+
     /// Writes the state of the slots `filter` wants into `out` (one element per slot).
-    fn write_states(&self, out: &mut [MaybeUninit<BodyState>], filter: SlotFilter<'_>);
+    fn write_states(&self, out: &mut [MaybeUninit<BodyState>], filter: SlotFilter<'_>) {
+        for (i, dst) in out.iter_mut().enumerate() {
+            if filter.wants(i) {
+                dst.write(self.body_state(i));
+            }
+        }
+    }
 
     /// Events of the last step.
     fn events(&self) -> &[EventRecord];

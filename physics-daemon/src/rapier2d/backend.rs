@@ -1,14 +1,12 @@
 //! The GUI plane behind the backend seam: routes each op to the plane's methods.
 
-use std::mem::MaybeUninit;
-
 use shm_layout::{
     BodyState, CommandError, CommandResult, ErrorKind, EventRecord, GuiObjectOp, GuiOp, GuiReply,
     ObjectOp, PlaneKind, PlaneOp, Reply, TickHeader,
 };
 
 use super::Plane;
-use crate::backend::{Backend, SlotFilter, Usage};
+use crate::backend::{Backend, Usage};
 
 impl Plane {
     fn gui(&mut self, op: GuiOp) -> CommandResult {
@@ -137,12 +135,8 @@ impl Backend for Plane {
         self.dirty.drain(into)
     }
 
-    fn write_states(&self, out: &mut [MaybeUninit<BodyState>], filter: SlotFilter<'_>) {
-        for (i, dst) in out.iter_mut().enumerate() {
-            if filter.wants(i) {
-                dst.write(self.body_state(i));
-            }
-        }
+    fn body_state(&self, i: usize) -> BodyState {
+        Plane::body_state(self, i)
     }
 
     fn events(&self) -> &[EventRecord] {

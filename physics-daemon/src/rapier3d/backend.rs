@@ -1,14 +1,12 @@
 //! The rapier3d plane behind the backend seam: routes each op to the plane's methods.
 
-use std::mem::MaybeUninit;
-
 use shm_layout::{
     BodyState, CommandError, CommandResult, ErrorKind, EventRecord, ObjectOp, PlaneKind, PlaneOp,
     Reply, TickHeader,
 };
 
 use super::Plane;
-use crate::backend::{Backend, SlotFilter, Usage};
+use crate::backend::{Backend, Usage};
 
 impl Backend for Plane {
     fn kind(&self) -> PlaneKind {
@@ -93,12 +91,8 @@ impl Backend for Plane {
         self.dirty.drain(into)
     }
 
-    fn write_states(&self, out: &mut [MaybeUninit<BodyState>], filter: SlotFilter<'_>) {
-        for (i, dst) in out.iter_mut().enumerate() {
-            if filter.wants(i) {
-                dst.write(self.body_state(i));
-            }
-        }
+    fn body_state(&self, i: usize) -> BodyState {
+        Plane::body_state(self, i)
     }
 
     fn events(&self) -> &[EventRecord] {
