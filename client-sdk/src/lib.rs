@@ -18,6 +18,7 @@ mod controller;
 mod error;
 mod events;
 mod gui;
+mod inspect;
 mod joint;
 pub mod map;
 mod object;

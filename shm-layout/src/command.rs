@@ -80,6 +80,9 @@ pub enum Command {
     },
     /// Orderly goodbye: the daemon releases the client's planes.
     Goodbye,
+    /// Lists the ids of every plane of the daemon (any client may ask; read-only).
+    /// Replies [`Reply::PlaneIds`].
+    ListPlanes,
 }
 
 impl Command {
@@ -215,6 +218,8 @@ pub enum Reply {
     JointInfo(Box<JointInfo>),
     /// A built map.
     Map(Box<MapInfo>),
+    /// The ids of every plane of the daemon, ascending ([`Command::ListPlanes`]).
+    PlaneIds(Vec<PlaneId>),
 }
 
 /// The result of one command.

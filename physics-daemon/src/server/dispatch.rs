@@ -80,6 +80,10 @@ impl Daemon {
                 self.release_client(client);
                 Ok(Reply::Done)
             }
+            Command::ListPlanes => {
+                // The map is ordered: ids come ascending.
+                Ok(Reply::PlaneIds(self.planes.keys().copied().collect()))
+            }
             Command::CreatePlane { kind, props } => {
                 self.create_plane(client, kind, &props, Instant::now())
             }

@@ -106,6 +106,9 @@ impl<'a> Gen<'a> {
         if u < 0.0003 {
             return Command::Goodbye;
         }
+        if u < 0.002 {
+            return Command::ListPlanes;
+        }
         if u < 0.005 {
             return if self.rng.chance(0.5) {
                 hello()

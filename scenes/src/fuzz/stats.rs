@@ -222,6 +222,7 @@ pub fn all_op_names() -> Vec<String> {
     let mut names: Vec<String> = [
         "Hello",
         "Goodbye",
+        "ListPlanes",
         "CreatePlane",
         "Plane.Info",
         "Plane.Step",
@@ -361,6 +362,7 @@ pub fn reply_name(reply: &Reply) -> &'static str {
         Reply::Joint { .. } => "Joint",
         Reply::JointInfo(_) => "JointInfo",
         Reply::Map(_) => "Map",
+        Reply::PlaneIds(_) => "PlaneIds",
     }
 }
 
@@ -369,6 +371,7 @@ pub fn op_name(command: &Command) -> String {
     match command {
         Command::Hello { .. } => "Hello".into(),
         Command::Goodbye => "Goodbye".into(),
+        Command::ListPlanes => "ListPlanes".into(),
         Command::CreatePlane { .. } => "CreatePlane".into(),
         Command::Plane { op, .. } => match op {
             PlaneOp::Info => "Plane.Info".into(),

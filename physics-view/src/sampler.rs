@@ -1,0 +1,667 @@
+//! The viewer's one client of the daemon. `Client` and its ports are not `Send`, so they
+//! live on this thread alone: it lists the domain's planes, samples each plane's newest tick
+//! header a few times a second (the plane list and the plots), and answers the web server's
+//! jobs (a plane's bodies, a body's properties, controls) from the newest published tick.
+//! It only reads shared memory and asks read-only questions, except for the controls, which
+//! the server refuses unless `--allow-control` was given.
+
+use std::collections::{BTreeMap, HashMap, VecDeque};
+use std::sync::mpsc::{Receiver, RecvTimeoutError};
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+
+use client_sdk::{
+    BodyState, Client, Contact, Error, Handle, Plane, PlaneId, PlaneInfo, PlaneKind, PlaneProp,
+    ShapeKind, FLAG_ON_GROUND,
+};
+use serde::Serialize;
+use serde_json::{json, Value};
+use shm_layout::FLAG_CONTROLLER;
+use tokio::sync::oneshot;
+
+/// How often tick headers are sampled for the plane list and the plots.
+pub const SAMPLE_PERIOD: Duration = Duration::from_millis(100);
+/// How often the plane list and each plane's options are asked for again.
+const LIST_PERIOD: Duration = Duration::from_secs(1);
+/// How often a lost daemon is looked for again.
+const RECONNECT_PERIOD: Duration = Duration::from_secs(1);
+/// Shapes and sizes of bodies are asked for again after this long (Size can change).
+const SHAPE_REFRESH: Duration = Duration::from_secs(2);
+/// Most object descriptions fetched for one snapshot (a plane of 50,000 new bodies is
+/// described over several frames instead of stalling one).
+const SHAPE_FETCHES_PER_SNAPSHOT: usize = 500;
+/// Most contacts kept per plane for the overlay.
+const MAX_CONTACTS: usize = 4096;
+
+/// What the web server asks of the sampler; each job carries its answer's channel.
+pub enum Job {
+    /// Every live body of a plane at its newest tick, with shapes and overlays.
+    Snapshot {
+        /// The plane.
+        plane: PlaneId,
+        /// The answer.
+        reply: oneshot::Sender<Result<Value, String>>,
+    },
+    /// Every property of one body.
+    Body {
+        /// The plane.
+        plane: PlaneId,
+        /// The body's slot.
+        slot: u32,
+        /// The answer.
+        reply: oneshot::Sender<Result<Value, String>>,
+    },
+    /// Pause, step or resume a plane.
+    Control {
+        /// The plane.
+        plane: PlaneId,
+        /// What to do.
+        action: Action,
+        /// The answer.
+        reply: oneshot::Sender<Result<Value, String>>,
+    },
+    /// Say goodbye to the daemon and exit the process.
+    Shutdown,
+}
+
+/// A control of the page.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Action {
+    /// `Enabled = false`.
+    Pause,
+    /// `Enabled = true`.
+    Resume,
+    /// One `Step(1 / TickRate)` (1/60 s for a manual plane).
+    Step,
+}
+
+impl Action {
+    /// The action named in a URL.
+    pub fn parse(name: &str) -> Option<Action> {
+        match name {
+            "pause" => Some(Action::Pause),
+            "resume" => Some(Action::Resume),
+            "step" => Some(Action::Step),
+            _ => None,
+        }
+    }
+}
+
+/// One row of the plane list.
+#[derive(Debug, Clone, Serialize)]
+pub struct PlaneSummary {
+    /// The plane's id.
+    pub id: PlaneId,
+    /// `Rapier3d` or `Gui2d`.
+    pub kind: &'static str,
+    /// Live bodies at the newest tick.
+    pub body_count: u32,
+    /// The newest tick.
+    pub tick: u64,
+    /// Simulated seconds.
+    pub sim_time: f64,
+    /// `TickRate` (0: manual).
+    pub tick_rate: f32,
+    /// `Enabled`.
+    pub enabled: bool,
+    /// Wall time of the last step (µs).
+    pub step_time_us: f32,
+    /// Deepest contact penetration of the last step.
+    pub max_penetration: f32,
+    /// Contact pairs after the last step.
+    pub contact_pairs: u32,
+    /// Largest joint error after the last step.
+    pub max_joint_error: f32,
+}
+
+/// The last minutes of one plane's tick-header figures, one point per sampled tick.
+#[derive(Debug, Clone, Default, Serialize)]
+pub struct History {
+    /// Simulated time of each point (s).
+    pub sim_time: VecDeque<f64>,
+    /// `step_time_us`.
+    pub step_time_us: VecDeque<f32>,
+    /// `max_penetration`.
+    pub max_penetration: VecDeque<f32>,
+    /// `contact_pairs`.
+    pub contact_pairs: VecDeque<u32>,
+    /// `max_joint_error`.
+    pub max_joint_error: VecDeque<f32>,
+}
+
+impl History {
+    fn push(&mut self, h: &shm_layout::TickHeader, keep: usize) {
+        self.sim_time.push_back(h.sim_time);
+        self.step_time_us.push_back(h.step_time_us);
+        self.max_penetration.push_back(h.max_penetration);
+        self.contact_pairs.push_back(h.contact_pairs);
+        self.max_joint_error.push_back(h.max_joint_error);
+        while self.sim_time.len() > keep {
+            self.sim_time.pop_front();
+            self.step_time_us.pop_front();
+            self.max_penetration.pop_front();
+            self.contact_pairs.pop_front();
+            self.max_joint_error.pop_front();
+        }
+    }
+}
+
+/// What the sampler publishes for the web server: read under a short lock, never waiting
+/// for the daemon.
+#[derive(Debug, Default)]
+pub struct Overview {
+    /// Connected to a live daemon.
+    pub connected: bool,
+    /// Why not, when not.
+    pub error: Option<String>,
+    /// The daemon's process id (0 when not connected).
+    pub daemon_pid: u32,
+    /// Every plane, by id.
+    pub planes: Vec<PlaneSummary>,
+    /// Figures over time, by plane.
+    pub histories: HashMap<PlaneId, History>,
+}
+
+/// A body's shape as drawn, and what else its description adds (controllers, GUI).
+struct Known {
+    generation: u32,
+    fetched: Instant,
+    view: Value,
+}
+
+/// A contact reported by the event stream and not ended yet.
+#[derive(Clone, Copy)]
+struct Touch {
+    position: [f32; 3],
+    normal: [f32; 3],
+    impulse: f32,
+    tick: u64,
+}
+
+/// A plane the viewer reads.
+struct Watched {
+    plane: Plane,
+    info: PlaneInfo,
+    shapes: HashMap<u32, Known>,
+    contacts: HashMap<(Handle, Handle), Touch>,
+    last_tick: Option<u64>,
+}
+
+/// The sampler's state (lives on its own thread).
+struct Sampler {
+    domain: String,
+    client: Option<Client>,
+    planes: BTreeMap<PlaneId, Watched>,
+    shared: Arc<Mutex<Overview>>,
+    history_points: usize,
+    last_list: Option<Instant>,
+    last_connect: Option<Instant>,
+}
+
+/// Runs the sampler until the job channel closes or a `Shutdown` job arrives.
+pub fn run(
+    domain: String,
+    shared: Arc<Mutex<Overview>>,
+    jobs: Receiver<Job>,
+    history_seconds: f64,
+) {
+    let history_points =
+        ((history_seconds / SAMPLE_PERIOD.as_secs_f64()).ceil() as usize).clamp(10, 1_000_000);
+    let mut sampler = Sampler {
+        domain,
+        client: None,
+        planes: BTreeMap::new(),
+        shared,
+        history_points,
+        last_list: None,
+        last_connect: None,
+    };
+    let mut next = Instant::now();
+    loop {
+        if Instant::now() >= next {
+            sampler.housekeeping();
+            next = Instant::now() + SAMPLE_PERIOD;
+        }
+        match jobs.recv_timeout(next.saturating_duration_since(Instant::now())) {
+            Ok(Job::Shutdown) => {
+                // Dropping the client says goodbye to the daemon.
+                sampler.planes.clear();
+                sampler.client = None;
+                std::process::exit(0);
+            }
+            Ok(job) => sampler.handle(job),
+            Err(RecvTimeoutError::Timeout) => {}
+            Err(RecvTimeoutError::Disconnected) => return,
+        }
+    }
+}
+
+/// Whether an error means the daemon is gone (then the client is dropped and a new daemon
+/// of the domain is looked for), rather than one plane or body being gone.
+fn daemon_lost(e: &Error) -> bool {
+    matches!(
+        e,
+        Error::NoDaemon { .. }
+            | Error::DaemonGone { .. }
+            | Error::Stalled { .. }
+            | Error::Timeout(_)
+            | Error::Ipc(_)
+    )
+}
+
+fn kind_name(kind: PlaneKind) -> &'static str {
+    match kind {
+        PlaneKind::Rapier3d => "Rapier3d",
+        PlaneKind::Gui2d => "Gui2d",
+    }
+}
+
+impl Sampler {
+    fn housekeeping(&mut self) {
+        if self.client.is_none() {
+            if self
+                .last_connect
+                .is_some_and(|t| t.elapsed() < RECONNECT_PERIOD)
+            {
+                return;
+            }
+            self.last_connect = Some(Instant::now());
+            match Client::connect(&self.domain) {
+                Ok(client) => {
+                    tracing::info!(domain = self.domain, pid = client.daemon_pid(), "connected");
+                    let mut o = self.shared.lock().expect("overview lock");
+                    o.connected = true;
+                    o.error = None;
+                    o.daemon_pid = client.daemon_pid();
+                    drop(o);
+                    self.client = Some(client);
+                    self.last_list = None;
+                }
+                Err(e) => {
+                    let mut o = self.shared.lock().expect("overview lock");
+                    o.connected = false;
+                    o.error = Some(e.to_string());
+                    return;
+                }
+            }
+        }
+        if let Err(e) = self.sample() {
+            self.check(&e);
+        }
+    }
+
+    /// Drops the client when `e` says the daemon is gone.
+    fn check(&mut self, e: &Error) {
+        if daemon_lost(e) {
+            tracing::warn!("daemon lost: {e}");
+            self.planes.clear();
+            self.client = None;
+            let mut o = self.shared.lock().expect("overview lock");
+            o.connected = false;
+            o.daemon_pid = 0;
+            o.error = Some(e.to_string());
+            o.planes.clear();
+        }
+    }
+
+    /// Lists planes (once a second) and samples every plane's newest header.
+    fn sample(&mut self) -> Result<(), Error> {
+        let Some(client) = self.client.clone() else {
+            return Ok(());
+        };
+        if self.last_list.is_none_or(|t| t.elapsed() >= LIST_PERIOD) {
+            self.last_list = Some(Instant::now());
+            let ids = client.plane_ids()?;
+            let gone: Vec<PlaneId> = self
+                .planes
+                .keys()
+                .filter(|id| !ids.contains(id))
+                .copied()
+                .collect();
+            for id in gone {
+                self.planes.remove(&id);
+                client.detach_plane(id);
+            }
+            for id in ids {
+                match self.planes.get_mut(&id) {
+                    Some(w) => match w.plane.info() {
+                        Ok(info) => w.info = info,
+                        Err(e) if daemon_lost(&e) => return Err(e),
+                        Err(_) => {
+                            self.planes.remove(&id);
+                            client.detach_plane(id);
+                        }
+                    },
+                    None => match Self::attach(&client, id) {
+                        Ok(w) => {
+                            self.planes.insert(id, w);
+                        }
+                        Err(e) if daemon_lost(&e) => return Err(e),
+                        // Destroyed between the list and the attach: gone already.
+                        Err(_) => {}
+                    },
+                }
+            }
+        }
+        let mut summaries = Vec::with_capacity(self.planes.len());
+        let mut fresh = Vec::new();
+        for (id, w) in &mut self.planes {
+            let Ok(snap) = w.plane.snapshot() else {
+                continue;
+            };
+            let h = *snap.header();
+            drain_contacts(w)?;
+            summaries.push(PlaneSummary {
+                id: *id,
+                kind: kind_name(w.info.kind),
+                body_count: h.body_count,
+                tick: h.tick,
+                sim_time: h.sim_time,
+                tick_rate: w.info.tick_rate,
+                enabled: w.info.enabled,
+                step_time_us: h.step_time_us,
+                max_penetration: h.max_penetration,
+                contact_pairs: h.contact_pairs,
+                max_joint_error: h.max_joint_error,
+            });
+            if w.last_tick != Some(h.tick) {
+                w.last_tick = Some(h.tick);
+                fresh.push((*id, h));
+            }
+        }
+        let mut o = self.shared.lock().expect("overview lock");
+        o.planes = summaries;
+        let live: Vec<PlaneId> = self.planes.keys().copied().collect();
+        o.histories.retain(|id, _| live.contains(id));
+        for (id, h) in fresh {
+            o.histories
+                .entry(id)
+                .or_default()
+                .push(&h, self.history_points);
+        }
+        Ok(())
+    }
+
+    fn attach(client: &Client, id: PlaneId) -> Result<Watched, Error> {
+        let plane = client.attach_plane(id)?;
+        let info = plane.info()?;
+        // Contact events (of objects that report them) feed the contact overlay.
+        plane.subscribe_events()?;
+        Ok(Watched {
+            plane,
+            info,
+            shapes: HashMap::new(),
+            contacts: HashMap::new(),
+            last_tick: None,
+        })
+    }
+
+    /// The plane `id`, attached now if the list has not caught up with it yet.
+    fn watched(&mut self, id: PlaneId) -> Result<&mut Watched, Error> {
+        let client = self.client.clone().ok_or_else(|| Error::NoDaemon {
+            domain: self.domain.clone(),
+            detail: "not connected".into(),
+        })?;
+        if !self.planes.contains_key(&id) {
+            let w = Self::attach(&client, id)?;
+            self.planes.insert(id, w);
+        }
+        Ok(self.planes.get_mut(&id).expect("inserted above"))
+    }
+
+    fn handle(&mut self, job: Job) {
+        let (result, reply) = match job {
+            Job::Snapshot { plane, reply } => (self.snapshot(plane), reply),
+            Job::Body { plane, slot, reply } => (self.body(plane, slot), reply),
+            Job::Control {
+                plane,
+                action,
+                reply,
+            } => (self.control(plane, action), reply),
+            Job::Shutdown => unreachable!("handled by run"),
+        };
+        let result = result.map_err(|e| {
+            let message = e.to_string();
+            self.check(&e);
+            message
+        });
+        let _ = reply.send(result);
+    }
+
+    fn snapshot(&mut self, id: PlaneId) -> Result<Value, Error> {
+        let w = self.watched(id)?;
+        let snap = w.plane.snapshot()?;
+        drain_contacts(w)?;
+        let h = *snap.header();
+        let gui = w.info.kind == PlaneKind::Gui2d;
+        let mut fetches = 0;
+        let mut bodies = Vec::with_capacity(h.body_count as usize);
+        let mut controllers = Vec::new();
+        for (slot, b) in snap.bodies().iter().enumerate() {
+            let slot = slot as u32;
+            if !b.is_alive() {
+                w.shapes.remove(&slot);
+                continue;
+            }
+            let stale = w.shapes.get(&slot).is_none_or(|k| {
+                k.generation != b.generation || k.fetched.elapsed() > SHAPE_REFRESH
+            });
+            if stale && fetches < SHAPE_FETCHES_PER_SNAPSHOT {
+                fetches += 1;
+                let handle = Handle {
+                    slot,
+                    generation: b.generation,
+                };
+                match describe(&w.plane, handle, b, gui) {
+                    Ok(view) => {
+                        w.shapes.insert(
+                            slot,
+                            Known {
+                                generation: b.generation,
+                                fetched: Instant::now(),
+                                view,
+                            },
+                        );
+                    }
+                    Err(e) if daemon_lost(&e) => return Err(e),
+                    // Destroyed since the tick: drawn from the tick, as an unknown shape.
+                    Err(_) => {}
+                }
+            }
+            let view = w
+                .shapes
+                .get(&slot)
+                .filter(|k| k.generation == b.generation)
+                .map(|k| k.view.clone())
+                .unwrap_or_else(|| json!({"shape": "Unknown", "size": [1.0, 1.0, 1.0]}));
+            if b.flags & FLAG_CONTROLLER != 0 || view.get("controller").is_some() {
+                controllers.push(json!({
+                    "slot": slot,
+                    "position": b.position,
+                    "velocity": b.linear_velocity,
+                    "on_ground": b.flags & FLAG_ON_GROUND != 0,
+                    "controller": view.get("controller").cloned().unwrap_or(Value::Null),
+                }));
+            }
+            let mut body = body_json(slot, b);
+            if let (Value::Object(body), Value::Object(view)) = (&mut body, view) {
+                for (k, v) in view {
+                    if k != "controller" {
+                        body.insert(k, v);
+                    }
+                }
+            }
+            bodies.push(body);
+        }
+        let contacts: Vec<Value> = w
+            .contacts
+            .values()
+            .map(|t| {
+                json!({"position": t.position, "normal": t.normal, "impulse": t.impulse,
+                       "tick": t.tick})
+            })
+            .collect();
+        Ok(json!({
+            "id": id,
+            "kind": kind_name(w.info.kind),
+            "tick": h.tick,
+            "sim_time": h.sim_time,
+            "dt": h.dt,
+            "step_time_us": h.step_time_us,
+            "slot_count": h.slot_count,
+            "body_count": h.body_count,
+            "max_penetration": h.max_penetration,
+            "max_joint_error": h.max_joint_error,
+            "contact_pairs": h.contact_pairs,
+            "tick_rate": w.info.tick_rate,
+            "enabled": w.info.enabled,
+            "gravity": w.info.gravity,
+            "object_count": w.info.object_count,
+            "bodies": bodies,
+            "contacts": contacts,
+            "controllers": controllers,
+            "described": fetches < SHAPE_FETCHES_PER_SNAPSHOT,
+        }))
+    }
+
+    fn body(&mut self, id: PlaneId, slot: u32) -> Result<Value, Error> {
+        let w = self.watched(id)?;
+        let snap = w.plane.snapshot()?;
+        let Some(b) = snap.bodies().get(slot as usize).filter(|b| b.is_alive()) else {
+            return Err(Error::Invalid {
+                field: "slot".into(),
+                message: format!("plane {id} has no live body in slot {slot}"),
+            });
+        };
+        let handle = Handle {
+            slot,
+            generation: b.generation,
+        };
+        let mut out = json!({ "plane": id, "tick": snap.tick(), "state": body_json(slot, b) });
+        if w.info.kind == PlaneKind::Gui2d {
+            out["info"] = to_json(&w.plane.gui_object_info(handle)?);
+        } else {
+            out["info"] = to_json(&w.plane.object_info(handle)?);
+            if b.flags & FLAG_CONTROLLER != 0 {
+                out["controller"] = to_json(&w.plane.controller_info(handle)?);
+            }
+        }
+        Ok(out)
+    }
+
+    fn control(&mut self, id: PlaneId, action: Action) -> Result<Value, Error> {
+        let w = self.watched(id)?;
+        let plane = w.plane.clone();
+        let tick = match action {
+            Action::Pause | Action::Resume => {
+                plane.set(PlaneProp::Enabled(action == Action::Resume))?;
+                plane.client().flush()?;
+                plane.snapshot().map(|s| s.tick()).unwrap_or(0)
+            }
+            Action::Step => {
+                let rate = w.info.tick_rate;
+                plane.step(if rate > 0.0 { 1.0 / rate } else { 1.0 / 60.0 })?
+            }
+        };
+        w.info = plane.info()?;
+        Ok(json!({"plane": id, "tick": tick, "enabled": w.info.enabled}))
+    }
+}
+
+fn to_json<T: Serialize>(value: &T) -> Value {
+    serde_json::to_value(value).unwrap_or_else(|e| json!({ "error": e.to_string() }))
+}
+
+/// The published state of one body.
+fn body_json(slot: u32, b: &BodyState) -> Value {
+    json!({
+        "slot": slot,
+        "generation": b.generation,
+        "position": b.position,
+        "rotation": b.rotation,
+        "velocity": b.linear_velocity,
+        "angular_velocity": b.angular_velocity,
+        "sleeping": b.is_sleeping(),
+        "anchored": b.is_anchored(),
+        "controller": b.flags & FLAG_CONTROLLER != 0,
+        "on_ground": b.flags & FLAG_ON_GROUND != 0,
+    })
+}
+
+/// Asks the daemon for what the published record does not carry: the shape and size (and
+/// for controllers their capsule, for GUI objects ZIndex and path).
+fn describe(plane: &Plane, handle: Handle, b: &BodyState, gui: bool) -> Result<Value, Error> {
+    if gui {
+        let info = plane.gui_object_info(handle)?;
+        let mut view = json!({
+            "shape": info.shape.name(),
+            "size": [info.size[0], info.size[1], 0.0],
+            "z_index": info.z_index,
+        });
+        if info.controlled {
+            if let Ok(c) = plane.gui_controller_info(handle) {
+                view["controller"] = json!({ "waypoints": c.waypoints,
+                    "next_waypoint": c.next_waypoint, "on_ground": c.on_ground });
+            }
+        }
+        return Ok(view);
+    }
+    let info = plane.object_info(handle)?;
+    let shape = match info.shape {
+        ShapeKind::Cube => "Cube",
+        ShapeKind::Sphere => "Sphere",
+        ShapeKind::Mesh => "Mesh",
+        ShapeKind::Capsule => "Capsule",
+        ShapeKind::Cylinder => "Cylinder",
+        ShapeKind::Wedge => "Wedge",
+        ShapeKind::TriMesh => "TriMesh",
+    };
+    let mut view = json!({ "shape": shape, "size": info.size });
+    if b.flags & FLAG_CONTROLLER != 0 {
+        if let Ok(c) = plane.controller_info(handle) {
+            view["controller"] = json!({
+                "radius": c.capsule_radius,
+                "half_height": c.capsule_half_height,
+                "path_length": c.path_length,
+                "path_index": c.path_index,
+                "walk_speed": c.walk_speed,
+            });
+        }
+    }
+    Ok(view)
+}
+
+/// Takes the plane's new contact events into its set of touching pairs.
+fn drain_contacts(w: &mut Watched) -> Result<(), Error> {
+    let events = w.plane.events()?;
+    for r in &events.records {
+        match Contact::from_record(r) {
+            Some(Contact::Started {
+                a,
+                b,
+                position,
+                normal,
+                impulse,
+                tick,
+            }) => {
+                if w.contacts.len() < MAX_CONTACTS {
+                    w.contacts.insert(
+                        (a, b),
+                        Touch {
+                            position,
+                            normal,
+                            impulse,
+                            tick,
+                        },
+                    );
+                }
+            }
+            Some(Contact::Ended { a, b, .. }) => {
+                w.contacts.remove(&(a, b));
+                w.contacts.remove(&(b, a));
+            }
+            None => {}
+        }
+    }
+    Ok(())
+}

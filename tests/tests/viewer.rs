@@ -1,0 +1,519 @@
+//! `physics-view` in a real browser: a daemon with a known scene (anchored parts of every
+//! primitive shape at known poses and a ball resting on the floor, plus a GUI plane), the
+//! viewer as its own process on a free port, and headless Chromium loading the page. The
+//! page writes what it shows into data- attributes of `#view`; the test reads them from the
+//! DOM Chromium dumps and compares them with the poses the SDK reads from shared memory.
+//! It also saves a screenshot (`viewer.png` in the test's output folder).
+//!
+//! Chromium is required: without it the test fails and says how to install it.
+
+use std::io::{BufRead, BufReader, Read, Write};
+use std::net::TcpStream;
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+use std::sync::mpsc;
+use std::time::Duration;
+
+use client_sdk::{Client, GuiPlaneOptions, GuiShape, Plane, PlaneOptions, Pose, Shape};
+use integration_tests::{eventually, quat, TestDaemon};
+use serde_json::Value;
+use shm_layout::{GuiObjectProp, ObjectProp, FLAG_ANCHORED};
+
+/// The browser: `$CHROMIUM`, else the first of the usual names on `PATH`.
+fn chromium() -> PathBuf {
+    if let Some(p) = std::env::var_os("CHROMIUM") {
+        return PathBuf::from(p);
+    }
+    for name in ["chromium", "chromium-browser", "google-chrome", "chrome"] {
+        if let Some(dir) = std::env::var_os("PATH") {
+            for d in std::env::split_paths(&dir) {
+                let p = d.join(name);
+                if p.is_file() {
+                    return p;
+                }
+            }
+        }
+    }
+    panic!(
+        "Chromium not found (looked for $CHROMIUM, chromium, chromium-browser, google-chrome \
+         on PATH): the viewer test needs a real browser. Install it, e.g. \
+         `apt-get install chromium` (.ci/run does)."
+    );
+}
+
+/// The `physics-view` binary built next to this test by `cargo build --workspace --bins`.
+fn viewer_bin() -> PathBuf {
+    let exe = std::env::current_exe().expect("test executable");
+    exe.ancestors()
+        .skip(1)
+        .take(3)
+        .map(|dir| dir.join("physics-view"))
+        .find(|p| p.is_file())
+        .unwrap_or_else(|| {
+            panic!(
+                "physics-view not found near {} (run cargo build --workspace --bins first)",
+                exe.display()
+            )
+        })
+}
+
+/// A running viewer; killed when dropped.
+struct Viewer {
+    child: Child,
+    base: String,
+}
+
+impl Viewer {
+    fn start(domain: &str, extra: &[&str]) -> Viewer {
+        let mut child = Command::new(viewer_bin())
+            .args(["--domain", domain, "--port", "0"])
+            .args(extra)
+            .env("PHYSICS_LOG", "warn")
+            .stdin(Stdio::null())
+            .stdout(Stdio::piped())
+            .spawn()
+            .expect("spawn physics-view");
+        let out = child.stdout.take().expect("stdout");
+        let (tx, rx) = mpsc::channel();
+        std::thread::spawn(move || {
+            for line in BufReader::new(out).lines().map_while(Result::ok) {
+                let _ = tx.send(line);
+            }
+        });
+        let line = rx
+            .recv_timeout(Duration::from_secs(20))
+            .expect("physics-view printed no URL within 20 s");
+        let url = line
+            .split_whitespace()
+            .find(|w| w.starts_with("http://"))
+            .unwrap_or_else(|| panic!("no URL in {line:?}"));
+        assert!(
+            url.starts_with("http://127.0.0.1:"),
+            "binds to 127.0.0.1 by default: {line}"
+        );
+        Viewer {
+            child,
+            base: url.trim_end_matches('/').to_string(),
+        }
+    }
+
+    /// `METHOD path` over plain HTTP/1.1: (status, body).
+    fn request(&self, method: &str, path: &str) -> (u16, String) {
+        let host = self.base.trim_start_matches("http://");
+        let mut s = TcpStream::connect(host).expect("connect to the viewer");
+        s.set_read_timeout(Some(Duration::from_secs(20))).unwrap();
+        write!(
+            s,
+            "{method} {path} HTTP/1.1\r\nHost: {host}\r\nContent-Length: 0\r\nConnection: close\r\n\r\n"
+        )
+        .unwrap();
+        let mut raw = String::new();
+        s.read_to_string(&mut raw).expect("read the reply");
+        let (head, body) = raw.split_once("\r\n\r\n").expect("HTTP reply");
+        let status = head
+            .split_whitespace()
+            .nth(1)
+            .and_then(|c| c.parse().ok())
+            .expect("status code");
+        (status, body.to_string())
+    }
+
+    fn json(&self, path: &str) -> Value {
+        let (status, body) = self.request("GET", path);
+        assert_eq!(status, 200, "GET {path}: {body}");
+        serde_json::from_str(&body).unwrap_or_else(|e| panic!("GET {path}: {e}: {body}"))
+    }
+}
+
+impl Drop for Viewer {
+    fn drop(&mut self) {
+        // SAFETY: kill(2) on our own child: SIGINT lets it say goodbye to the daemon.
+        unsafe { libc::kill(self.child.id() as i32, libc::SIGINT) };
+        for _ in 0..100 {
+            if let Ok(Some(_)) = self.child.try_wait() {
+                return;
+            }
+            std::thread::sleep(Duration::from_millis(20));
+        }
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+/// Headless Chromium with a software WebGL (SwiftShader), a profile of its own, and
+/// `extra` (e.g. `--dump-dom`) on `url`. Returns stdout.
+fn chromium_run(profile: &Path, extra: &[String], url: &str) -> String {
+    let out = Command::new(chromium())
+        .args([
+            "--headless",
+            "--no-sandbox",
+            "--disable-gpu",
+            "--use-gl=swiftshader",
+            "--enable-unsafe-swiftshader",
+            "--no-first-run",
+            "--hide-scrollbars",
+            "--window-size=1280,800",
+            "--virtual-time-budget=3000",
+        ])
+        .arg(format!("--user-data-dir={}", profile.display()))
+        .args(extra)
+        .arg(url)
+        .stdin(Stdio::null())
+        .output()
+        .expect("run chromium");
+    assert!(
+        out.status.success(),
+        "chromium failed ({}): {}",
+        out.status,
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8_lossy(&out.stdout).into_owned()
+}
+
+/// The attributes of the element with `id="view"` in a serialized DOM, entities decoded.
+fn view_attributes(dom: &str) -> std::collections::HashMap<String, String> {
+    let start = dom
+        .find("id=\"view\"")
+        .and_then(|i| dom[..i].rfind('<'))
+        .unwrap_or_else(|| panic!("no #view in the page: {}", &dom[..dom.len().min(2000)]));
+    let tag = &dom[start..start + dom[start..].find('>').expect("end of the tag")];
+    let mut attrs = std::collections::HashMap::new();
+    let mut rest = tag.split_once(char::is_whitespace).map_or("", |(_, r)| r);
+    while let Some(eq) = rest.find("=\"") {
+        let name = rest[..eq].trim().to_string();
+        let after = &rest[eq + 2..];
+        let end = after.find('"').expect("closing quote");
+        let value = after[..end]
+            .replace("&quot;", "\"")
+            .replace("&lt;", "<")
+            .replace("&gt;", ">")
+            .replace("&#39;", "'")
+            .replace("&nbsp;", "\u{a0}")
+            .replace("&amp;", "&");
+        attrs.insert(name, value);
+        rest = &after[end + 1..];
+    }
+    attrs
+}
+
+/// Loads `url` until the page has drawn a snapshot (`data-ready="1"`); returns #view's
+/// attributes.
+fn load_view(profile: &Path, url: &str) -> std::collections::HashMap<String, String> {
+    let mut last = String::new();
+    for _ in 0..3 {
+        let dom = chromium_run(profile, &["--dump-dom".to_string()], url);
+        let attrs = view_attributes(&dom);
+        if attrs.get("data-ready").map(String::as_str) == Some("1") {
+            return attrs;
+        }
+        last = format!("{attrs:?}");
+    }
+    panic!("the page never drew a snapshot of {url}: #view = {last}");
+}
+
+fn vec3(v: &Value) -> [f64; 3] {
+    let a = v.as_array().expect("array");
+    [0, 1, 2].map(|i| a[i].as_f64().expect("number"))
+}
+
+/// The three.js view shows every body of a 3D plane with its shape at the pose shared
+/// memory holds, a GUI plane's bodies in pixels, the list and JSON API agree, controls are
+/// refused when read-only, and a screenshot is taken.
+#[test]
+fn the_page_shows_every_body_at_its_pose() {
+    let browser = chromium();
+    let daemon = TestDaemon::start("viewer");
+    let client: Client = daemon.client();
+
+    // A manual 3D plane: nothing moves unless the test steps it.
+    let plane: Plane = client.create_plane(&PlaneOptions::manual()).unwrap();
+    let anchored = [ObjectProp::Anchored(true)];
+    let tilt = quat([0.0, 1.0, 0.0], 0.6);
+    let parts: Vec<(&str, Shape, Pose)> = vec![
+        (
+            "Cube",
+            Shape::Cube {
+                size: [40.0, 1.0, 40.0],
+            },
+            Pose::at([0.0, -0.5, 0.0]),
+        ),
+        (
+            "Cube",
+            Shape::Cube {
+                size: [2.0, 2.0, 2.0],
+            },
+            Pose {
+                position: [6.0, 1.0, 0.0],
+                rotation: tilt,
+            },
+        ),
+        (
+            "Wedge",
+            Shape::Wedge {
+                size: [2.0, 2.0, 3.0],
+            },
+            Pose::at([-6.0, 1.0, 0.0]),
+        ),
+        (
+            "Cylinder",
+            Shape::Cylinder {
+                size: [2.0, 3.0, 2.0],
+            },
+            Pose::at([0.0, 1.5, -6.0]),
+        ),
+        (
+            "Capsule",
+            Shape::Capsule {
+                size: [1.0, 3.0, 1.0],
+            },
+            Pose::at([4.0, 1.5, -5.0]),
+        ),
+    ];
+    let mut objects = Vec::new();
+    for (name, shape, pose) in &parts {
+        objects.push((
+            *name,
+            plane.add(shape.clone(), *pose, &anchored).unwrap(),
+            *pose,
+        ));
+    }
+    // A ball of radius 1 dropped from 0.5 above the floor, settled for 3 s.
+    let ball = plane
+        .add(
+            Shape::Sphere { radius: 1.0 },
+            Pose::at([0.0, 1.5, 2.0]),
+            &[],
+        )
+        .unwrap();
+    for _ in 0..180 {
+        plane.step(1.0 / 60.0).unwrap();
+    }
+
+    // A manual GUI plane with no gravity: two anchored squares and a circle, in pixels.
+    let gui = client
+        .create_gui_plane(&GuiPlaneOptions {
+            gravity: Some([0.0, 0.0]),
+            ..GuiPlaneOptions::manual()
+        })
+        .unwrap();
+    let gui_parts = [
+        (GuiShape::Square, [400.0, 40.0], [320.0, 460.0]),
+        (GuiShape::Square, [60.0, 60.0], [120.0, 200.0]),
+        (GuiShape::Circle, [50.0, 50.0], [500.0, 150.0]),
+    ];
+    for (shape, size, position) in gui_parts {
+        gui.add(shape, size, position, &[GuiObjectProp::Anchored(true)])
+            .unwrap();
+    }
+    gui.step(1.0 / 60.0).unwrap();
+
+    let viewer = Viewer::start(&daemon.domain, &[]);
+
+    // The JSON API: both planes listed with their kind, body count and tick rate.
+    let planes = eventually(Duration::from_secs(10), || {
+        let v = viewer.json("/api/planes");
+        (v.as_array().unwrap().len() == 2).then_some(v)
+    })
+    .expect("/api/planes never listed both planes");
+    let row = |id: u32| {
+        planes
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|p| p["id"] == id)
+            .unwrap_or_else(|| panic!("plane {id} not listed: {planes}"))
+            .clone()
+    };
+    let (p3, p2) = (row(plane.id()), row(gui.plane().id()));
+    assert_eq!(p3["kind"], "Rapier3d");
+    assert_eq!(p3["body_count"], 6);
+    assert_eq!(p3["tick_rate"], 0.0);
+    assert_eq!(p3["tick"], 180);
+    assert_eq!(p2["kind"], "Gui2d");
+    assert_eq!(p2["body_count"], 3);
+    assert!(p3["step_time_us"].as_f64().unwrap() > 0.0, "{p3}");
+
+    // Controls change planes: refused unless the viewer was started with --allow-control.
+    let (status, body) = viewer.request("POST", &format!("/api/plane/{}/step", plane.id()));
+    assert_eq!(status, 403, "{body}");
+    assert!(body.contains("--allow-control"), "{body}");
+    assert_eq!(
+        plane.snapshot().unwrap().tick(),
+        180,
+        "the refused step ran"
+    );
+
+    // The page, in headless Chromium.
+    let tmp = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(format!(
+        "viewer-{}",
+        daemon
+            .domain
+            .replace(|c: char| !c.is_ascii_alphanumeric(), "-")
+    ));
+    std::fs::create_dir_all(&tmp).unwrap();
+    let url = format!("{}/?plane={}", viewer.base, plane.id());
+    let attrs = load_view(&tmp.join("profile"), &url);
+    assert_eq!(attrs["data-plane"], plane.id().to_string());
+    assert_eq!(attrs["data-kind"], "Rapier3d");
+    assert_eq!(attrs["data-tick"], "180");
+    assert_eq!(attrs["data-body-count"], "6");
+    assert_eq!(attrs["data-plane-count"], "2");
+    // three.js made one mesh per body and rendered with WebGL.
+    assert_eq!(attrs["data-meshes"], "6", "{attrs:?}");
+    assert_eq!(attrs["data-renderer"], "webgl", "{attrs:?}");
+
+    let shown: Vec<Value> = serde_json::from_str(&attrs["data-bodies"]).unwrap();
+    assert_eq!(shown.len(), 6);
+    let snap = plane.snapshot().unwrap();
+    let by_slot = |slot: u32| {
+        shown
+            .iter()
+            .find(|b| b["slot"] == slot)
+            .unwrap_or_else(|| panic!("slot {slot} not shown: {shown:?}"))
+    };
+    // Positions travel f32 → JSON (shortest round-trip decimal) → JS double → JSON: exact
+    // to f32 precision, so 1e-5 relative to the coordinate (or 1e-5 absolute) is ample.
+    let close = |a: f64, b: f64| (a - b).abs() <= 1e-5 * b.abs().max(1.0);
+    for (name, object, pose) in &objects {
+        let b = by_slot(object.handle().slot);
+        assert_eq!(b["shape"], *name, "{b}");
+        assert_eq!(b["anchored"], true, "{b}");
+        let p = vec3(&b["position"]);
+        for i in 0..3 {
+            assert!(
+                close(p[i], pose.position[i] as f64),
+                "{name}: {p:?} vs {pose:?}"
+            );
+        }
+        let q = b["rotation"].as_array().unwrap();
+        for i in 0..4 {
+            assert!(
+                close(q[i].as_f64().unwrap(), pose.rotation[i] as f64),
+                "{name}: rotation {q:?} vs {:?}",
+                pose.rotation
+            );
+        }
+    }
+    // The ball: exactly where shared memory has it (the plane is manual, so the page and
+    // the SDK read the same tick), and resting on the floor: its centre one radius above
+    // y = 0, within 0.05 (rapier keeps resting contacts a few hundredths apart or inside).
+    let b = by_slot(ball.handle().slot);
+    assert_eq!(b["shape"], "Sphere");
+    let state = snap.get(ball.handle()).unwrap();
+    assert_eq!(state.flags & FLAG_ANCHORED, 0);
+    let p = vec3(&b["position"]);
+    for (i, v) in p.iter().enumerate() {
+        assert!(
+            close(*v, state.position[i] as f64),
+            "ball {p:?} vs {state:?}"
+        );
+    }
+    assert!(
+        (p[1] - 1.0).abs() < 0.05,
+        "ball not resting on the floor: {p:?}"
+    );
+    assert!(
+        (p[0] - 0.0).abs() < 0.05 && (p[2] - 2.0).abs() < 0.05,
+        "ball moved: {p:?}"
+    );
+    assert_eq!(b["sleeping"], state.is_sleeping(), "{b}");
+    assert_eq!(vec3(&b["size"]), [2.0, 2.0, 2.0], "{b}");
+
+    // The screenshot, kept in the test's output folder.
+    let png = tmp.join("viewer.png");
+    let _ = std::fs::remove_file(&png);
+    chromium_run(
+        &tmp.join("profile"),
+        &[format!("--screenshot={}", png.display())],
+        &url,
+    );
+    let bytes = std::fs::read(&png).unwrap_or_else(|e| panic!("no screenshot at {png:?}: {e}"));
+    assert!(bytes.starts_with(b"\x89PNG\r\n\x1a\n"), "not a PNG");
+    // A blank 1280 × 800 page compresses to a few KiB; the drawn scene is far larger.
+    assert!(bytes.len() > 20_000, "screenshot is {} bytes", bytes.len());
+    eprintln!("screenshot: {}", png.display());
+
+    // The GUI plane: drawn on a 2D canvas, every body at its pixel position.
+    let url = format!("{}/?plane={}", viewer.base, gui.plane().id());
+    let attrs = load_view(&tmp.join("profile"), &url);
+    assert_eq!(attrs["data-kind"], "Gui2d");
+    assert_eq!(attrs["data-body-count"], "3");
+    assert_eq!(attrs["data-meshes"], "3");
+    let shown: Vec<Value> = serde_json::from_str(&attrs["data-bodies"]).unwrap();
+    for (shape, size, position) in gui_parts {
+        let b = shown
+            .iter()
+            .find(|b| {
+                let p = vec3(&b["position"]);
+                (p[0] - position[0] as f64).abs() < 1e-3 && (p[1] - position[1] as f64).abs() < 1e-3
+            })
+            .unwrap_or_else(|| panic!("no body at {position:?}: {shown:?}"));
+        assert_eq!(b["shape"], shape.name(), "{b}");
+        let s = vec3(&b["size"]);
+        assert_eq!([s[0], s[1]], [size[0] as f64, size[1] as f64], "{b}");
+    }
+    drop(viewer);
+    drop(browser);
+}
+
+/// With `--allow-control` the page's controls act on planes the viewer may change: a step
+/// of a shared manual plane advances it by one tick, pause and resume flip `Enabled`; a
+/// plane of another client that is not shared still refuses them (the daemon's rule).
+#[test]
+fn controls_need_allow_control_and_the_daemons_consent() {
+    let daemon = TestDaemon::start("viewer-ctl");
+    let client = daemon.client();
+    let shared = client
+        .create_plane(&PlaneOptions {
+            shared: Some(true),
+            ..PlaneOptions::manual()
+        })
+        .unwrap();
+    let private = client.create_plane(&PlaneOptions::manual()).unwrap();
+    let viewer = Viewer::start(&daemon.domain, &["--allow-control"]);
+    eventually(Duration::from_secs(10), || {
+        (viewer.json("/api/planes").as_array().unwrap().len() == 2).then_some(())
+    })
+    .expect("planes listed");
+
+    let (status, body) = viewer.request("POST", &format!("/api/plane/{}/step", shared.id()));
+    assert_eq!(status, 200, "{body}");
+    assert_eq!(shared.snapshot().unwrap().tick(), 1);
+    let (status, body) = viewer.request("POST", &format!("/api/plane/{}/pause", shared.id()));
+    assert_eq!(status, 200, "{body}");
+    assert!(!shared.info().unwrap().enabled);
+    let (status, _) = viewer.request("POST", &format!("/api/plane/{}/resume", shared.id()));
+    assert_eq!(status, 200);
+    assert!(shared.info().unwrap().enabled);
+
+    let (status, body) = viewer.request("POST", &format!("/api/plane/{}/step", private.id()));
+    assert_eq!(status, 409, "{body}");
+    assert!(body.contains("belongs to another client"), "{body}");
+    assert_eq!(private.snapshot().unwrap().tick(), 0);
+    let (status, body) = viewer.request("POST", &format!("/api/plane/{}/explode", shared.id()));
+    assert_eq!(status, 404, "{body}");
+
+    // A body's properties, as a click on it shows them.
+    let ball = shared
+        .add(
+            Shape::Sphere { radius: 0.5 },
+            Pose::at([1.0, 2.0, 3.0]),
+            &[],
+        )
+        .unwrap();
+    shared.step(1.0 / 60.0).unwrap();
+    let v = viewer.json(&format!(
+        "/api/plane/{}/body/{}",
+        shared.id(),
+        ball.handle().slot
+    ));
+    assert_eq!(v["info"]["shape"], "Sphere", "{v}");
+    assert!(
+        (v["info"]["mass"].as_f64().unwrap() - 1.0).abs() < 1e-6,
+        "{v}"
+    );
+    let (status, body) = viewer.request("GET", &format!("/api/plane/{}/body/999", shared.id()));
+    assert_eq!(status, 404, "{body}");
+    let (status, _) = viewer.request("GET", "/api/plane/4242");
+    assert_eq!(status, 404);
+}
