@@ -44,6 +44,10 @@ struct Args {
     /// second).
     #[arg(long, default_value_t = 300.0)]
     history_seconds: f64,
+    /// Exit (saying goodbye to the daemon) once the process PID is gone: what
+    /// `physics-lua --view` passes, so a runner that is killed leaves no viewer behind.
+    #[arg(long, value_name = "PID")]
+    exit_with: Option<u32>,
 }
 
 fn main() -> ExitCode {
@@ -81,6 +85,15 @@ fn main() -> ExitCode {
             eprintln!("physics-view: cannot install the signal handler: {e}");
             return ExitCode::FAILURE;
         }
+    }
+    if let Some(pid) = args.exit_with {
+        let jobs = jobs.clone();
+        std::thread::spawn(move || {
+            while std::path::Path::new(&format!("/proc/{pid}")).exists() {
+                std::thread::sleep(std::time::Duration::from_millis(250));
+            }
+            let _ = jobs.send(sampler::Job::Shutdown);
+        });
     }
     let state = server::AppState {
         overview,

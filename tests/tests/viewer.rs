@@ -15,7 +15,7 @@ use std::sync::mpsc;
 use std::time::Duration;
 
 use client_sdk::{Client, GuiPlaneOptions, GuiShape, Plane, PlaneOptions, Pose, Shape};
-use integration_tests::{eventually, quat, TestDaemon};
+use integration_tests::{eventually, physics_lua, quat, unique_domain, TestDaemon};
 use serde_json::Value;
 use shm_layout::{GuiObjectProp, ObjectProp, FLAG_ANCHORED};
 
@@ -97,25 +97,8 @@ impl Viewer {
         }
     }
 
-    /// `METHOD path` over plain HTTP/1.1: (status, body).
     fn request(&self, method: &str, path: &str) -> (u16, String) {
-        let host = self.base.trim_start_matches("http://");
-        let mut s = TcpStream::connect(host).expect("connect to the viewer");
-        s.set_read_timeout(Some(Duration::from_secs(20))).unwrap();
-        write!(
-            s,
-            "{method} {path} HTTP/1.1\r\nHost: {host}\r\nContent-Length: 0\r\nConnection: close\r\n\r\n"
-        )
-        .unwrap();
-        let mut raw = String::new();
-        s.read_to_string(&mut raw).expect("read the reply");
-        let (head, body) = raw.split_once("\r\n\r\n").expect("HTTP reply");
-        let status = head
-            .split_whitespace()
-            .nth(1)
-            .and_then(|c| c.parse().ok())
-            .expect("status code");
-        (status, body.to_string())
+        http(&self.base, method, path)
     }
 
     fn json(&self, path: &str) -> Value {
@@ -138,6 +121,30 @@ impl Drop for Viewer {
         let _ = self.child.kill();
         let _ = self.child.wait();
     }
+}
+
+/// `METHOD path` over plain HTTP/1.1 to `base` (`http://HOST:PORT`): (status, body).
+fn http(base: &str, method: &str, path: &str) -> (u16, String) {
+    try_http(base, method, path).unwrap_or_else(|e| panic!("{method} {base}{path}: {e}"))
+}
+
+fn try_http(base: &str, method: &str, path: &str) -> std::io::Result<(u16, String)> {
+    let host = base.trim_start_matches("http://");
+    let mut s = TcpStream::connect(host)?;
+    s.set_read_timeout(Some(Duration::from_secs(20)))?;
+    write!(
+        s,
+        "{method} {path} HTTP/1.1\r\nHost: {host}\r\nContent-Length: 0\r\nConnection: close\r\n\r\n"
+    )?;
+    let mut raw = String::new();
+    s.read_to_string(&mut raw)?;
+    let (head, body) = raw.split_once("\r\n\r\n").expect("HTTP reply");
+    let status = head
+        .split_whitespace()
+        .nth(1)
+        .and_then(|c| c.parse().ok())
+        .expect("status code");
+    Ok((status, body.to_string()))
 }
 
 /// Headless Chromium with a software WebGL (SwiftShader), a profile of its own, and
@@ -516,4 +523,64 @@ fn controls_need_allow_control_and_the_daemons_consent() {
     assert_eq!(status, 404, "{body}");
     let (status, _) = viewer.request("GET", "/api/plane/4242");
     assert_eq!(status, 404);
+}
+
+/// `physics-lua SCRIPT --view` starts the viewer on the script's domain, prints its URL, keeps
+/// the script's planes up after the script is done (until `--seconds` here), and stops the
+/// viewer when the run ends.
+#[test]
+fn physics_lua_view_shows_the_scripts_planes() {
+    let domain = unique_domain("viewer-lua");
+    let mut child = physics_lua(
+        &domain,
+        "examples/falling_ball.luau",
+        &["--view", "--view-port", "0", "--seconds", "6"],
+    )
+    .spawn()
+    .expect("spawn physics-lua");
+    let err = child.stderr.take().expect("stderr");
+    let (tx, rx) = mpsc::channel();
+    std::thread::spawn(move || {
+        for line in BufReader::new(err).lines().map_while(Result::ok) {
+            let _ = tx.send(line);
+        }
+    });
+    let mut seen = Vec::new();
+    let base = loop {
+        let line = rx
+            .recv_timeout(Duration::from_secs(20))
+            .unwrap_or_else(|_| panic!("no viewer URL on stderr: {seen:?}"));
+        if let Some(url) = line.split_whitespace().find(|w| w.starts_with("http://")) {
+            break url.trim_end_matches('/').to_string();
+        }
+        seen.push(line);
+    };
+    assert!(base.starts_with("http://127.0.0.1:"), "{base}");
+    // The script's plane: a ball and a floor.
+    let planes = eventually(Duration::from_secs(10), || {
+        let (status, body) = try_http(&base, "GET", "/api/planes").ok()?;
+        let v: Value = serde_json::from_str(&body).ok()?;
+        (status == 200 && v.as_array()?.len() == 1 && v[0]["body_count"] == 2).then_some(v)
+    })
+    .expect("the viewer never listed the script's plane");
+    let (status, body) = http(&base, "GET", &format!("/api/plane/{}", planes[0]["id"]));
+    assert_eq!(status, 200, "{body}");
+    let snap: Value = serde_json::from_str(&body).unwrap();
+    let mut shapes: Vec<&str> = snap["bodies"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|b| b["shape"].as_str().unwrap())
+        .collect();
+    shapes.sort();
+    assert_eq!(shapes, ["Cube", "Sphere"], "{snap}");
+
+    let status = eventually(Duration::from_secs(20), || child.try_wait().ok().flatten())
+        .expect("physics-lua did not end after --seconds 6");
+    assert!(status.success(), "physics-lua: {status}");
+    // The viewer went with the run.
+    eventually(Duration::from_secs(5), || {
+        try_http(&base, "GET", "/api/info").is_err().then_some(())
+    })
+    .expect("the viewer still answers after the run ended");
 }

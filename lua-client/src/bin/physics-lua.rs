@@ -44,6 +44,17 @@ struct Args {
     /// Longest wait for one reply of the daemon, in seconds.
     #[arg(long, default_value_t = 30.0)]
     request_timeout: f64,
+    /// Start the live browser viewer (`physics-view`, found next to this executable) on the
+    /// domain and print its URL. The run then lasts until Ctrl-C (or `--seconds`) even after
+    /// the script's work is done, so its planes stay on screen; the viewer stops with it.
+    #[arg(long)]
+    view: bool,
+    /// Port of the viewer started by `--view`; 0 picks a free one.
+    #[arg(long, default_value_t = 8080, requires = "view")]
+    view_port: u16,
+    /// Let the viewer's page pause, step and resume planes (its `--allow-control`).
+    #[arg(long, requires = "view")]
+    view_allow_control: bool,
 }
 
 /// How long the first signal lets a running script's run end before the runner stops the
@@ -262,6 +273,10 @@ fn run(args: &Args, signals: &Signals) -> Result<Ended, String> {
             .daemon_pid
             .store(daemon.pid(), Ordering::SeqCst);
     }
+    let viewer = match args.view {
+        true => Some(viewer::start(args)?),
+        false => None,
+    };
     signals.set_phase(RUNNING);
     let lua = Lua::new();
     let lua_err = |e: mlua::Error| e.to_string();
@@ -282,13 +297,137 @@ fn run(args: &Args, signals: &Signals) -> Result<Ended, String> {
     let started = Instant::now();
     let deadline = args.seconds.map(|s| started + Duration::from_secs_f64(s));
     host.set_deadline(deadline);
-    let ended = frames(&host, chunk, args.fps, deadline, signals)
+    let mut ended = frames(&host, chunk, args.fps, deadline, signals)
         .or_else(|e| failed(args, &host, signals, e));
+    if let (Some(v), Ok(Ended::Finished)) = (&viewer, &ended) {
+        // The script is done; its planes stay (and keep ticking) for the viewer.
+        ended = Ok(viewer::linger(v, &host, args.fps, deadline, signals));
+    }
     drop(host);
     drop(lua);
     signals.set_phase(CLEANING_UP);
+    // The viewer is a client too: it goes before the daemon this run may have started.
+    drop(viewer);
     drop(session);
     ended
+}
+
+/// `--view`: the `physics-view` process next to this runner.
+mod viewer {
+    use std::io::BufRead;
+    use std::path::PathBuf;
+    use std::process::{Child, Command, Stdio};
+    use std::time::{Duration, Instant};
+
+    use super::{Args, Ended, Signals};
+    use lua_client::Host;
+
+    /// A viewer this run started; stopped (SIGINT, then waited for) when dropped.
+    pub struct Viewer {
+        child: Child,
+    }
+
+    impl Drop for Viewer {
+        fn drop(&mut self) {
+            // SAFETY: kill(2) on our own child; SIGINT lets it say goodbye to the daemon.
+            unsafe { libc::kill(self.child.id() as libc::pid_t, libc::SIGINT) };
+            let deadline = Instant::now() + Duration::from_secs(3);
+            while Instant::now() < deadline {
+                if let Ok(Some(_)) = self.child.try_wait() {
+                    return;
+                }
+                std::thread::sleep(Duration::from_millis(10));
+            }
+            let _ = self.child.kill();
+            let _ = self.child.wait();
+        }
+    }
+
+    /// `$PHYSICS_VIEW_BIN`, else `physics-view` next to this executable, else from `PATH`.
+    fn executable() -> PathBuf {
+        if let Some(p) = std::env::var_os("PHYSICS_VIEW_BIN") {
+            return PathBuf::from(p);
+        }
+        if let Ok(exe) = std::env::current_exe() {
+            for dir in exe.ancestors().skip(1).take(2) {
+                let candidate = dir.join("physics-view");
+                if candidate.is_file() {
+                    return candidate;
+                }
+            }
+        }
+        PathBuf::from("physics-view")
+    }
+
+    /// Starts the viewer on the run's domain and prints its URL (on stderr, next to the
+    /// runner's other messages; stdout is the script's).
+    pub fn start(args: &Args) -> Result<Viewer, String> {
+        let exe = executable();
+        let mut command = Command::new(&exe);
+        command
+            .args(["--domain", &args.domain])
+            .args(["--port", &args.view_port.to_string()])
+            .args(["--exit-with", &std::process::id().to_string()])
+            .stdin(Stdio::null())
+            .stdout(Stdio::piped());
+        if args.view_allow_control {
+            command.arg("--allow-control");
+        }
+        let mut child = command.spawn().map_err(|e| {
+            format!(
+                "--view: cannot start {} ({e}); build it with cargo build --workspace --bins",
+                exe.display()
+            )
+        })?;
+        let out = child.stdout.take().expect("piped stdout");
+        let (tx, rx) = std::sync::mpsc::channel();
+        std::thread::spawn(move || {
+            let mut line = String::new();
+            let _ = std::io::BufReader::new(out).read_line(&mut line);
+            let _ = tx.send(line);
+        });
+        let viewer = Viewer { child };
+        match rx.recv_timeout(Duration::from_secs(10)) {
+            Ok(line) if line.contains("http://") => {
+                let url = line
+                    .split_whitespace()
+                    .find(|w| w.starts_with("http://"))
+                    .unwrap_or_default();
+                eprintln!("physics-lua: viewer at {url}");
+                Ok(viewer)
+            }
+            _ => Err(format!(
+                "--view: {} did not start (port {} taken? --view-port 0 picks a free one)",
+                exe.display(),
+                args.view_port
+            )),
+        }
+    }
+
+    /// After the script's work is done: keeps the run (and its planes) up for the viewer
+    /// until a signal or the deadline, running frames so planes that tick keep going.
+    pub fn linger(
+        _viewer: &Viewer,
+        host: &Host,
+        fps: f64,
+        deadline: Option<Instant>,
+        signals: &Signals,
+    ) -> Ended {
+        eprintln!("physics-lua: the script is done; the viewer stays up until Ctrl-C");
+        let frame = Duration::from_secs_f64(1.0 / fps);
+        loop {
+            let next = Instant::now() + frame;
+            if deadline.is_some_and(|d| next > d) {
+                return Ended::Finished;
+            }
+            signals.sleep_until(next);
+            if signals.stop_requested() {
+                // Ctrl-C is how a viewed run is meant to end.
+                return Ended::Finished;
+            }
+            let _ = host.flush();
+        }
+    }
 }
 
 /// Runs the script, then frames while there is work, until the deadline or a signal.
