@@ -19,6 +19,7 @@
 
 mod api;
 mod host;
+mod members;
 mod props;
 mod values;
 
@@ -29,6 +30,8 @@ use mlua::{Lua, Table, Value};
 
 use host::scheduler::{self, Scheduler};
 pub use host::{Host, Stop};
+#[doc(hidden)]
+pub use members::property_rows;
 
 /// Installs the API into `lua`, talking to the daemon through `client`: the globals, the
 /// watchdog's interrupt (see [`Host::set_max_run_time`]) and `pcall`, `xpcall` and

@@ -60,8 +60,8 @@ fn flag(v: &Value) -> bool {
 }
 
 /// A GuiPhysicsPlane row.
-struct PlaneRow {
-    name: &'static str,
+pub(crate) struct PlaneRow {
+    pub(crate) name: &'static str,
     takes: Takes,
     prop: fn(&Value) -> PlaneProp,
     get: fn(&Lua, &client_sdk::GuiPlaneInfo) -> mlua::Result<Value>,
@@ -97,7 +97,7 @@ fn count(v: &Value) -> u32 {
 const NON_NEG: Takes = Takes::Number(0.0, f64::INFINITY);
 
 /// The rows of `GuiPhysicsPlane` (options of `NewGUI` as well).
-static GUI_PLANE_ROWS: &[PlaneRow] = &[
+pub(crate) static GUI_PLANE_ROWS: &[PlaneRow] = &[
     gui_row!("Gravity", Takes::Dim, Gravity, dim, gravity, out_dim),
     gui_row!(
         "LinearDamping",
@@ -248,13 +248,13 @@ pub fn plane_set(p: &GuiPlaneState, key: &Value, value: &Value) -> mlua::Result<
 }
 
 /// A PhysicsGuiObject row.
-struct ObjectRow {
-    name: &'static str,
+pub(crate) struct ObjectRow {
+    pub(crate) name: &'static str,
     takes: Takes,
     prop: fn(&Value) -> GuiObjectProp,
 }
 
-static GUI_OBJECT_ROWS: &[ObjectRow] = &[
+pub(crate) static GUI_OBJECT_ROWS: &[ObjectRow] = &[
     ObjectRow {
         name: "Position",
         takes: Takes::Dim,
