@@ -402,11 +402,12 @@ impl Sampler {
             domain: self.domain.clone(),
             detail: "not connected".into(),
         })?;
-        if !self.planes.contains_key(&id) {
-            let w = Self::attach(&client, id)?;
-            self.planes.insert(id, w);
+        match self.planes.entry(id) {
+            std::collections::btree_map::Entry::Occupied(e) => Ok(e.into_mut()),
+            std::collections::btree_map::Entry::Vacant(e) => {
+                Ok(e.insert(Self::attach(&client, id)?))
+            }
         }
-        Ok(self.planes.get_mut(&id).expect("inserted above"))
     }
 
     fn handle(&mut self, job: Job) {
@@ -643,24 +644,22 @@ fn drain_contacts(w: &mut Watched) -> Result<(), Error> {
                 normal,
                 impulse,
                 tick,
-            }) => {
-                if w.contacts.len() < MAX_CONTACTS {
-                    w.contacts.insert(
-                        (a, b),
-                        Touch {
-                            position,
-                            normal,
-                            impulse,
-                            tick,
-                        },
-                    );
-                }
+            }) if w.contacts.len() < MAX_CONTACTS => {
+                w.contacts.insert(
+                    (a, b),
+                    Touch {
+                        position,
+                        normal,
+                        impulse,
+                        tick,
+                    },
+                );
             }
             Some(Contact::Ended { a, b, .. }) => {
                 w.contacts.remove(&(a, b));
                 w.contacts.remove(&(b, a));
             }
-            None => {}
+            Some(Contact::Started { .. }) | None => {}
         }
     }
     Ok(())

@@ -129,6 +129,7 @@ function draw3d(s) {
       const wire = b.shape === 'Mesh' || b.shape === 'TriMesh' || b.shape === 'Unknown';
       m = new THREE.Mesh(geometryFor(b), new THREE.MeshStandardMaterial({
         roughness: 0.75, metalness: 0.05, wireframe: wire,
+        side: b.shape === 'Wedge' ? THREE.DoubleSide : THREE.FrontSide,
         transparent: b.controller, opacity: b.controller ? 0.55 : 1,
       }));
       m.userData.geoKey = geoKey;
@@ -204,27 +205,27 @@ function drawOverlays3d(s) {
 }
 
 function fitCamera(s) {
-  // Frame the bodies, ignoring floors far larger than the rest (over 8× the median size).
-  const box = new THREE.Box3();
-  const sizes = s.bodies.map((b) => Math.max(...b.size)).sort((a, b) => a - b);
-  const median = sizes.length ? sizes[Math.floor(sizes.length / 2)] : 1;
-  const small = s.bodies.filter((b) => Math.max(...b.size) <= 8 * median);
-  for (const b of small.length ? small : s.bodies) {
-    const h = Math.max(...b.size) / 2;
-    box.expandByPoint(new THREE.Vector3(b.position[0] - h, b.position[1] - h, b.position[2] - h));
-    box.expandByPoint(new THREE.Vector3(b.position[0] + h, b.position[1] + h, b.position[2] + h));
-  }
-  if (box.isEmpty()) box.set(new THREE.Vector3(-5, -1, -5), new THREE.Vector3(5, 5, 5));
-  const centre = box.getCenter(new THREE.Vector3());
-  const radius = Math.max(box.getSize(new THREE.Vector3()).length() / 2, 2);
-  const d = radius / Math.sin((camera.fov * Math.PI) / 360) * 0.9;
+  // Frame most bodies: around the median position, out to the 90th percentile of the
+  // distances (a body falling off the world must not shrink everything else to a dot), and
+  // ignoring floors far larger than the rest (over 8x the median size) for the size.
+  const med = (xs) => { const v = [...xs].sort((a, b) => a - b); return v.length ? v[Math.floor(v.length / 2)] : 0; };
+  const bodies = s.bodies.length ? s.bodies : [{ position: [0, 0, 0], size: [10, 10, 10] }];
+  const centre = new THREE.Vector3(...[0, 1, 2].map((i) => med(bodies.map((b) => b.position[i]))));
+  const medianSize = med(bodies.map((b) => Math.max(...b.size)));
+  const reach = bodies
+    .filter((b) => Math.max(...b.size) <= 8 * medianSize)
+    .map((b) => centre.distanceTo(new THREE.Vector3(...b.position)) + Math.max(...b.size) / 2)
+    .sort((a, b) => a - b);
+  const radius = Math.max(reach.length ? reach[Math.floor((reach.length - 1) * 0.9)] : 5, 2);
+  const d = radius / Math.sin((camera.fov * Math.PI) / 360) * 1.05;
   camera.position.copy(centre).add(new THREE.Vector3(0.55, 0.45, 0.7).normalize().multiplyScalar(d));
   camera.near = Math.max(d / 1000, 0.01);
   camera.far = d * 100;
   camera.updateProjectionMatrix();
   controls.target.copy(centre);
   controls.update();
-  grid.position.y = Math.min(0, box.min.y);
+  const floorY = Math.min(...bodies.map((b) => b.position[1] - b.size[1] / 2));
+  grid.position.y = Math.max(Math.min(0, floorY), centre.y - 4 * radius);
   fittedPlane = s.id;
 }
 
