@@ -237,7 +237,9 @@ pub fn run(
 }
 
 /// Whether an error means the daemon is gone (then the client is dropped and a new daemon
-/// of the domain is looked for), rather than one plane or body being gone.
+/// of the domain is looked for), rather than one plane or body being gone (a plane's
+/// services vanish when it is destroyed: those are `Ipc` errors, and a daemon that died
+/// shows up as `DaemonGone` at the next request).
 fn daemon_lost(e: &Error) -> bool {
     matches!(
         e,
@@ -245,7 +247,6 @@ fn daemon_lost(e: &Error) -> bool {
             | Error::DaemonGone { .. }
             | Error::Stalled { .. }
             | Error::Timeout(_)
-            | Error::Ipc(_)
     )
 }
 

@@ -584,3 +584,59 @@ fn physics_lua_view_shows_the_scripts_planes() {
     })
     .expect("the viewer still answers after the run ended");
 }
+
+/// `physics-lua --help` and `physics-view --help` document every flag.
+#[test]
+fn help_documents_every_flag() {
+    let lua = physics_lua("unused", "examples/falling_ball.luau", &[])
+        .get_program()
+        .to_owned();
+    for (exe, flags) in [
+        (
+            PathBuf::from(lua),
+            &[
+                "--domain",
+                "--seconds",
+                "--fps",
+                "--max-run-ms",
+                "--max-memory-mb",
+                "--request-timeout",
+                "--view",
+                "--view-port",
+                "--view-allow-control",
+            ][..],
+        ),
+        (
+            viewer_bin(),
+            &[
+                "--domain",
+                "--bind",
+                "--port",
+                "--allow-control",
+                "--history-seconds",
+                "--exit-with",
+            ][..],
+        ),
+    ] {
+        let out = Command::new(&exe).arg("--help").output().unwrap();
+        assert!(out.status.success());
+        let help = String::from_utf8_lossy(&out.stdout);
+        for flag in flags {
+            // Each flag has its own line with a description after it.
+            let line = help
+                .lines()
+                .find(|l| l.trim_start().starts_with(&format!("{flag} ")) || l.trim() == *flag)
+                .unwrap_or_else(|| panic!("{} --help lacks {flag}:\n{help}", exe.display()));
+            let at = help.find(line).unwrap();
+            let described = help[at + line.len()..]
+                .lines()
+                .next()
+                .unwrap_or("")
+                .trim()
+                .len()
+                > 10
+                || line.trim().len() > flag.len() + 20;
+            assert!(described, "{flag} has no description:\n{help}");
+        }
+    }
+}

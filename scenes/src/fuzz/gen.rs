@@ -57,6 +57,9 @@ impl<'a> Gen<'a> {
         let mut batch = Vec::with_capacity(n + 1);
         if !self.world.connected[self.client] {
             batch.push(hello());
+            // A read-only listing, once per (re)connection: outside the random stream, so
+            // every other command comes out as it would without it.
+            batch.push(Command::ListPlanes);
         }
         for _ in 0..n {
             let command = self.command();
@@ -105,9 +108,6 @@ impl<'a> Gen<'a> {
         let u = self.rng.unit();
         if u < 0.0003 {
             return Command::Goodbye;
-        }
-        if u < 0.002 {
-            return Command::ListPlanes;
         }
         if u < 0.005 {
             return if self.rng.chance(0.5) {
