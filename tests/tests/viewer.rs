@@ -621,21 +621,16 @@ fn help_documents_every_flag() {
         let out = Command::new(&exe).arg("--help").output().unwrap();
         assert!(out.status.success());
         let help = String::from_utf8_lossy(&out.stdout);
+        let lines: Vec<&str> = help.lines().collect();
         for flag in flags {
-            // Each flag has its own line with a description after it.
-            let line = help
-                .lines()
-                .find(|l| l.trim_start().starts_with(&format!("{flag} ")) || l.trim() == *flag)
+            // Each flag has its own line, its description on the next one.
+            let i = lines
+                .iter()
+                .position(|l| l.trim_start().starts_with(&format!("{flag} ")) || l.trim() == *flag)
                 .unwrap_or_else(|| panic!("{} --help lacks {flag}:\n{help}", exe.display()));
-            let at = help.find(line).unwrap();
-            let described = help[at + line.len()..]
-                .lines()
-                .next()
-                .unwrap_or("")
-                .trim()
-                .len()
-                > 10
-                || line.trim().len() > flag.len() + 20;
+            let described = lines
+                .get(i + 1)
+                .is_some_and(|d| d.trim().len() > 10 && !d.trim_start().starts_with("--"));
             assert!(described, "{flag} has no description:\n{help}");
         }
     }
