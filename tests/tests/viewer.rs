@@ -635,3 +635,47 @@ fn help_documents_every_flag() {
         }
     }
 }
+
+/// The viewer outlives its daemon: it reports the daemon gone within a few seconds and
+/// shows the planes of the next daemon of the domain.
+#[test]
+fn the_viewer_follows_a_restarted_daemon() {
+    let daemon = TestDaemon::start("viewer-restart");
+    let domain = daemon.domain.clone();
+    let viewer = Viewer::start(&domain, &[]);
+    let first_pid = eventually(Duration::from_secs(10), || {
+        let info = viewer.json("/api/info");
+        (info["connected"] == true).then(|| info["daemon_pid"].as_u64().unwrap())
+    })
+    .expect("the viewer never connected");
+    assert_eq!(first_pid, daemon.pid() as u64);
+    drop(daemon);
+    let info = eventually(Duration::from_secs(10), || {
+        let info = viewer.json("/api/info");
+        (info["connected"] == false).then_some(info)
+    })
+    .expect("the viewer never noticed that the daemon was gone");
+    assert!(info["error"].as_str().unwrap().contains(&domain), "{info}");
+
+    let daemon = TestDaemon::start_in(&domain);
+    let client = daemon.client();
+    let plane = client.create_plane(&PlaneOptions::manual()).unwrap();
+    plane
+        .add(
+            Shape::Sphere { radius: 1.0 },
+            Pose::at([0.0, 5.0, 0.0]),
+            &[],
+        )
+        .unwrap();
+    plane.step(1.0 / 60.0).unwrap();
+    let planes = eventually(Duration::from_secs(10), || {
+        let v = viewer.json("/api/planes");
+        (v.as_array().unwrap().len() == 1 && v[0]["body_count"] == 1).then_some(v)
+    })
+    .expect("the viewer never showed the new daemon's plane");
+    assert_eq!(planes[0]["id"], plane.id());
+    assert_eq!(
+        viewer.json("/api/info")["daemon_pid"].as_u64().unwrap(),
+        daemon.pid() as u64
+    );
+}
