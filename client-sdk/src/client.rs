@@ -143,14 +143,17 @@ impl Client {
 
     /// Creates a plane owned by this client (released when the client goes away).
     pub fn create_plane(&self, options: &PlaneOptions) -> Result<Plane, Error> {
-        let id = match self.call(Command::CreatePlane {
+        let info = match self.call(Command::CreatePlane {
             kind: options.kind.unwrap_or_default(),
             props: options.props(),
         })? {
-            Reply::Plane(info) => info.id,
+            Reply::Plane(info) => info,
             other => return Err(unexpected(other)),
         };
+        let id = info.id;
         let plane = self.attach_plane(id)?;
+        *plane.shared.mirror.borrow_mut() =
+            crate::mirror::Mirror::exclusive(info, options.shared == Some(true));
         self.note_owned(id);
         let table = {
             let state = self.inner.state.borrow_mut();
@@ -233,16 +236,35 @@ impl Client {
         let queued = std::mem::take(&mut self.inner.state.borrow_mut().queue);
         let n_queued = queued.len();
         let mut confirms = Vec::with_capacity(n_queued);
+        let mut targets = Vec::with_capacity(n_queued);
         let mut commands = Vec::with_capacity(n_queued + extra.len());
         for q in queued {
             confirms.push(q.confirms);
+            targets.push(match &q.command {
+                Command::Plane {
+                    plane,
+                    op: PlaneOp::Object { handle, .. },
+                } => Some((*plane, Some(*handle))),
+                Command::Plane { plane, .. } => Some((*plane, None)),
+                _ => None,
+            });
             commands.push(q.command);
         }
         commands.extend(extra);
         let mut results = self.inner.round_trip(commands)?;
         let extra_results = results.split_off(n_queued.min(results.len()));
         let mut state = self.inner.state.borrow_mut();
-        for (result, confirm) in results.into_iter().zip(confirms) {
+        for ((result, confirm), target) in results.into_iter().zip(confirms).zip(targets) {
+            if let (Err(_), Some((plane, handle))) = (&result, target) {
+                // A rejected write must not linger in the mirror either.
+                if let Some(p) = state.planes.get(&plane) {
+                    let mut mirror = p.mirror.borrow_mut();
+                    match handle {
+                        Some(h) => mirror.forget_object(h),
+                        None => mirror.forget_plane(),
+                    }
+                }
+            }
             match (result, confirm) {
                 (Ok(Reply::Applied { tick }), Some((plane, handle))) => {
                     if let Some(p) = state.planes.get(&plane) {

@@ -19,6 +19,7 @@ mod error;
 mod events;
 mod gui;
 mod joint;
+mod mirror;
 pub mod map;
 mod object;
 mod overlay;

@@ -11,6 +11,7 @@ use shm_layout::{
 
 use crate::client::LIVENESS_PERIOD;
 use crate::events::EventReader;
+use crate::mirror::Mirror;
 use crate::overlay::{Entry, Overlay};
 use crate::transport::{BodySample, BodySubscriber, TickListener, Transport};
 use crate::{Client, Error, Object};
@@ -101,6 +102,8 @@ pub(crate) struct PlaneShared {
     ticks: RefCell<Option<TickListener>>,
     pub(crate) events: RefCell<Option<EventReader>>,
     alive: Cell<bool>,
+    /// The plane's options and its objects' properties as this process knows them.
+    pub(crate) mirror: RefCell<Mirror>,
 }
 
 impl PlaneShared {
@@ -114,6 +117,7 @@ impl PlaneShared {
             ticks: RefCell::new(None),
             events: RefCell::new(None),
             alive: Cell::new(true),
+            mirror: RefCell::default(),
         })
     }
 
@@ -237,14 +241,36 @@ impl Plane {
     /// Every option and figure of the plane (sends the queue first).
     pub fn info(&self) -> Result<PlaneInfo, Error> {
         match self.client.call(Command::plane(self.id(), PlaneOp::Info))? {
-            Reply::Plane(info) => Ok(info),
+            Reply::Plane(info) => {
+                self.shared.mirror.borrow_mut().store_plane(&info);
+                Ok(info)
+            }
             other => Err(Error::Protocol(format!("unexpected reply {other:?}"))),
+        }
+    }
+
+    /// The plane's options without a round trip where this process mirrors them (a plane
+    /// it created and did not share: filled by the creation reply and its own writes);
+    /// otherwise [`Plane::info`]. `tick` is the newest published tick; `object_count` and
+    /// `effective_solver_iterations` are as of the last `info` read: ask [`Plane::info`]
+    /// for those.
+    pub fn properties(&self) -> Result<PlaneInfo, Error> {
+        let mirrored = self.shared.mirror.borrow().plane().cloned();
+        match mirrored {
+            Some(mut info) if self.shared.alive.get() => {
+                if let Some(tick) = self.shared.current_tick() {
+                    info.tick = tick;
+                }
+                Ok(info)
+            }
+            _ => self.info(),
         }
     }
 
     /// Changes a plane option (checked now, sent with the next flush).
     pub fn set(&self, prop: PlaneProp) -> Result<(), Error> {
         let prop = prop.checked().map_err(Error::invalid_value)?;
+        self.shared.mirror.borrow_mut().plane_written(&prop);
         self.client
             .queue(Command::plane(self.id(), PlaneOp::Set(prop)), None);
         Ok(())
