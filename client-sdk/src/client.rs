@@ -78,6 +78,9 @@ struct Inner {
     daemon_node: u128,
     daemon_pid: u32,
     state: RefCell<State>,
+    /// The frame number of [`Client::begin_frame`] (0: no frames, every read looks for the
+    /// newest sample).
+    frame: std::cell::Cell<u64>,
 }
 
 /// A connection to the physics daemon of one domain. Cheap to clone; not `Send` (shared
@@ -102,6 +105,7 @@ impl Client {
             daemon_node: 0,
             daemon_pid: 0,
             state: RefCell::default(),
+            frame: std::cell::Cell::new(0),
         };
         let hello = Command::Hello {
             crate_version: inner.options.crate_version.clone(),
@@ -206,6 +210,20 @@ impl Client {
         } else {
             Err(Error::Batch(deferred))
         }
+    }
+
+    /// Starts a frame of a host's frame loop: from now until the next call, object reads
+    /// (`pose`, `state`, ...) take each plane's newest sample once, at their first read in
+    /// the frame, instead of looking for a newer one at every read (`Plane::step`,
+    /// `wait_tick` and `snapshot` still take the newest at once). Without it every read
+    /// looks.
+    pub fn begin_frame(&self) {
+        self.inner.frame.set(self.inner.frame.get() + 1);
+    }
+
+    /// The frame of [`Client::begin_frame`] (0 before the first).
+    pub(crate) fn frame(&self) -> u64 {
+        self.inner.frame.get()
     }
 
     /// Number of writes waiting for the next flush.

@@ -102,6 +102,8 @@ pub(crate) struct PlaneShared {
     ticks: RefCell<Option<TickListener>>,
     pub(crate) events: RefCell<Option<EventReader>>,
     alive: Cell<bool>,
+    /// The client frame in which `latest` was last refreshed.
+    refreshed_in: Cell<u64>,
     /// The plane's options and its objects' properties as this process knows them.
     pub(crate) mirror: RefCell<Mirror>,
 }
@@ -117,6 +119,7 @@ impl PlaneShared {
             ticks: RefCell::new(None),
             events: RefCell::new(None),
             alive: Cell::new(true),
+            refreshed_in: Cell::new(0),
             mirror: RefCell::default(),
         })
     }
@@ -147,6 +150,15 @@ impl PlaneShared {
     fn latest(&self) -> Result<Option<Rc<BodySample>>, Error> {
         self.refresh()?;
         Ok(self.latest.borrow().clone())
+    }
+
+    /// Looks for a newer sample once per client frame (`frame` 0: every time).
+    fn refresh_in_frame(&self, frame: u64) -> Result<(), Error> {
+        if frame == 0 || self.refreshed_in.get() != frame {
+            self.refresh()?;
+            self.refreshed_in.set(frame);
+        }
+        Ok(())
     }
 
     fn current_tick(&self) -> Option<u64> {
@@ -220,12 +232,17 @@ impl Plane {
     /// The state of `handle` as this process should see it: the newest sample with this
     /// process's unconfirmed writes on top. `None` when the object does not exist.
     pub(crate) fn body(&self, handle: Handle) -> Result<Option<BodyState>, Error> {
-        let sample = self.shared.latest()?;
-        let tick = sample.as_ref().map_or(0, |s| s.user_header().tick);
-        let base = sample
-            .as_ref()
-            .and_then(|s| s.payload().get(handle.slot as usize).copied())
-            .filter(|s| s.matches(handle));
+        let (tick, base) = {
+            self.shared.refresh_in_frame(self.client.frame())?;
+            let latest = self.shared.latest.borrow();
+            let sample = latest.as_ref();
+            (
+                sample.map_or(0, |s| s.user_header().tick),
+                sample
+                    .and_then(|s| s.payload().get(handle.slot as usize).copied())
+                    .filter(|s| s.matches(handle)),
+            )
+        };
         let mut overlay = self.shared.overlay.borrow_mut();
         Ok(match overlay.get(handle, tick) {
             Some(entry) => entry.apply(handle, base),

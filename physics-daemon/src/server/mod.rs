@@ -146,11 +146,11 @@ pub fn run_with(domain: &str, shutdown: &AtomicBool, options: Options) -> Result
     let config = names::config(domain)?;
     files::check_ownership(domain)?;
     remove_dead_nodes(&config);
-    let stop_beating = AtomicBool::new(false);
+    let beats = heartbeat::Control::default();
     std::thread::scope(|s| {
-        s.spawn(|| heartbeat::run(&config, &stop_beating));
-        let served = serve(domain, &config, shutdown, options);
-        stop_beating.store(true, Ordering::Relaxed);
+        s.spawn(|| heartbeat::run(&config, &beats));
+        let served = serve(domain, &config, shutdown, options, &beats);
+        beats.stop();
         served
     })?;
     release_domain(&config);
@@ -195,6 +195,7 @@ fn serve(
     config: &Config,
     shutdown: &AtomicBool,
     options: Options,
+    beats: &heartbeat::Control,
 ) -> Result<(), DaemonError> {
     let node = NodeBuilder::new()
         .name(&NodeName::new(names::DAEMON_NODE_NAME).expect("valid node name"))
@@ -290,6 +291,7 @@ fn serve(
         daemon.waker.disarm();
         daemon.handle_events();
         daemon.serve_requests();
+        beats.beat(!daemon.clients.is_empty());
         if daemon.clients.is_empty() {
             if Instant::now() >= next_housekeeping {
                 if daemon.starter_gone() {
