@@ -244,7 +244,11 @@ impl Object {
             .call(self.op(ObjectOp::RecalculateCenterOfMass))?
         {
             Reply::CenterOfMass(c) => {
-                self.plane.shared.mirror.borrow_mut().forget_object(self.handle);
+                self.plane
+                    .shared
+                    .mirror
+                    .borrow_mut()
+                    .forget_object(self.handle);
                 Ok(c)
             }
             other => Err(Error::Protocol(format!("unexpected reply {other:?}"))),
@@ -287,7 +291,11 @@ impl Object {
 
     /// Removes the object (sent with the next flush; reads see it gone at once).
     pub fn destroy(&self) {
-        self.plane.shared.mirror.borrow_mut().forget_object(self.handle);
+        self.plane
+            .shared
+            .mirror
+            .borrow_mut()
+            .forget_object(self.handle);
         self.plane
             .overlay_write(self.handle, |e| e.destroyed = true);
         let plane = self.plane.id();

@@ -31,7 +31,11 @@ fn heavy_plane(client: &Client, boxes: usize) -> client_sdk::Plane {
         .unwrap();
     let cube = Shape::Cube { size: [1.0; 3] };
     for i in 0..boxes {
-        let (x, z, y) = ((i % 10) as f32 * 0.8, ((i / 10) % 10) as f32 * 0.8, (i / 100) as f32 * 0.8);
+        let (x, z, y) = (
+            (i % 10) as f32 * 0.8,
+            ((i / 10) % 10) as f32 * 0.8,
+            (i / 100) as f32 * 0.8,
+        );
         plane
             .add(cube.clone(), Pose::at([x - 4.0, 0.5 + y, z - 4.0]), &[])
             .unwrap();
@@ -64,7 +68,11 @@ fn a_small_plane_is_served_while_another_plane_steps() {
     let client = daemon.client();
     let small = client.create_plane(&PlaneOptions::manual()).unwrap();
     let ball = small
-        .add(Shape::Sphere { radius: 0.5 }, Pose::at([0.0, 5.0, 0.0]), &[])
+        .add(
+            Shape::Sphere { radius: 0.5 },
+            Pose::at([0.0, 5.0, 0.0]),
+            &[],
+        )
         .unwrap();
     while !ready.load(Ordering::SeqCst) {
         std::thread::sleep(Duration::from_millis(5));
@@ -77,18 +85,17 @@ fn a_small_plane_is_served_while_another_plane_steps() {
     }
     heavy.join().unwrap();
     assert!(ball.position().unwrap()[1] < 5.0, "the small plane stepped");
-    assert_eq!(ticks as usize, replies.len(), "every small step was its own tick");
+    assert_eq!(
+        ticks as usize,
+        replies.len(),
+        "every small step was its own tick"
+    );
     let steps = steps.lock().unwrap();
     // Requests for the small plane were answered while a heavy step was in progress (one
     // loop serving both planes in turn answers at most one of them per heavy step).
     let most_inside = steps
         .iter()
-        .map(|(start, end)| {
-            replies
-                .iter()
-                .filter(|t| *t > start && *t < end)
-                .count()
-        })
+        .map(|(start, end)| replies.iter().filter(|t| *t > start && *t < end).count())
         .max()
         .unwrap();
     let longest = steps.iter().map(|(s, e)| *e - *s).max().unwrap();
@@ -126,7 +133,11 @@ fn a_request_alternating_between_planes_applies_in_order() {
     };
     let (ha, hb) = (ball(&a), ball(&b));
     let set_v = |plane: u32, h: Handle, vx: f32| {
-        Cmd::object(plane, h, ObjectOp::Set(ObjectProp::Velocity([vx, 0.0, 0.0])))
+        Cmd::object(
+            plane,
+            h,
+            ObjectOp::Set(ObjectProp::Velocity([vx, 0.0, 0.0])),
+        )
     };
     let stale = Handle {
         slot: ha.slot,
@@ -159,11 +170,19 @@ fn a_request_alternating_between_planes_applies_in_order() {
             "command {i}: {result:?}"
         );
     }
-    assert!(matches!(r[150], Ok(Reply::Stepped { tick: 1 })), "{:?}", r[150]);
+    assert!(
+        matches!(r[150], Ok(Reply::Stepped { tick: 1 })),
+        "{:?}",
+        r[150]
+    );
     assert_eq!(r[151].as_ref().unwrap_err().kind, ErrorKind::StaleHandle);
     assert_eq!(r[152].as_ref().unwrap_err().kind, ErrorKind::UnknownPlane);
     assert!(matches!(r[153], Ok(Reply::Applied { .. })));
-    assert!(matches!(r[154], Ok(Reply::Stepped { tick: 1 })), "{:?}", r[154]);
+    assert!(
+        matches!(r[154], Ok(Reply::Stepped { tick: 1 })),
+        "{:?}",
+        r[154]
+    );
     assert!(matches!(r[155], Ok(Reply::Applied { .. })));
     // Plane a stepped with vx = 49.5 (the last write before its step) for 0.5 s.
     let pa = client_sdk::Object::from_handle(&a, ha);
@@ -211,7 +230,10 @@ fn reads_answer_from_the_mirror_and_derived_values_are_refetched() {
     assert_eq!(local.friction, 0.75);
     assert_eq!(local.bounciness, 0.25);
     assert_eq!(local.mass, 2.0);
-    assert_eq!(plane_local.expect("mirrored plane read").linear_damping, 0.5);
+    assert_eq!(
+        plane_local.expect("mirrored plane read").linear_damping,
+        0.5
+    );
     // The mirror agrees with the daemon.
     assert_eq!(cube.info().unwrap().settings, local.settings);
     assert_eq!(plane.info().unwrap().settings.linear_damping, 0.5);

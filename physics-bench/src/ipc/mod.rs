@@ -38,6 +38,9 @@ pub struct IpcArgs {
 
 /// The size at which the goals are judged (and the only size of `--quick`).
 pub const GOAL_BODIES: usize = 10_000;
+/// Bodies of the Threads = 2 against 1 scene (free-flying, all awake: one thread needs
+/// several milliseconds per step).
+pub const THREADS_BODIES: usize = 20_000;
 
 /// How much to measure.
 #[derive(Debug, Clone, serde::Serialize)]
@@ -82,7 +85,7 @@ impl Plan {
                 round_trips: 5_000,
                 batch_size: 1_000,
                 batches: 30,
-                idle_window_s: 10,
+                idle_window_s: 60,
                 head_of_line_round_trips: 3_000,
                 multi_plane_s: 6.0,
             }
@@ -134,9 +137,9 @@ pub fn run(args: &IpcArgs) -> BenchResult<()> {
     ));
 
     progress.phase(format!(
-        "threads: {GOAL_BODIES}-body pile, Threads = 1 vs 2"
+        "threads: {THREADS_BODIES} free-flying bodies, Threads = 1 vs 2"
     ));
-    let threads = threads::run(GOAL_BODIES)?;
+    let threads = threads::run(Kind::Free, THREADS_BODIES)?;
     progress.done();
     progress.note(format!(
         "threads: step {:.0} µs with 1, {:.0} µs with 2 → {:.2}×",

@@ -77,7 +77,10 @@ pub fn head_of_line(busy_bodies: usize, n: usize) -> BenchResult<HeadOfLine> {
     let busy_ticks_per_s =
         (busy.snapshot()?.tick() - tick0) as f64 / started.elapsed().as_secs_f64();
     let none = || BenchError::Failed("no round trip was measured".into());
-    let (alone, beside) = (spread(&alone).ok_or_else(none)?, spread(&beside).ok_or_else(none)?);
+    let (alone, beside) = (
+        spread(&alone).ok_or_else(none)?,
+        spread(&beside).ok_or_else(none)?,
+    );
     Ok(HeadOfLine {
         busy_bodies,
         busy_tick_rate: rate,

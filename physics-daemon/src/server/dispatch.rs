@@ -112,12 +112,7 @@ impl Daemon {
 
     /// Any client may read any plane; only the owner changes it unless the owner shared
     /// it; only the owner destroys it.
-    fn check_access(
-        &self,
-        client: u128,
-        id: PlaneId,
-        op: &PlaneOp,
-    ) -> Result<(), CommandError> {
+    fn check_access(&self, client: u128, id: PlaneId, op: &PlaneOp) -> Result<(), CommandError> {
         let entry = self.plane(id)?;
         if entry.owner == client || op.is_read_only() {
             return Ok(());

@@ -387,8 +387,7 @@ impl Daemon {
     /// left.
     fn advance(&mut self, client: u128) {
         loop {
-            let Some(mut pending) = self.queues.get_mut(&client).and_then(|q| q.pop_front())
-            else {
+            let Some(mut pending) = self.queues.get_mut(&client).and_then(|q| q.pop_front()) else {
                 self.queues.remove(&client);
                 return;
             };
@@ -475,7 +474,16 @@ impl Daemon {
         let budget = self.budget(id);
         let n = ops.len();
         match self.planes.get(&id) {
-            Some(entry) if entry.jobs.send(Job::Run { ticket, ops, budget }).is_ok() => {
+            Some(entry)
+                if entry
+                    .jobs
+                    .send(Job::Run {
+                        ticket,
+                        ops,
+                        budget,
+                    })
+                    .is_ok() =>
+            {
                 Routed::Wait(ticket)
             }
             _ => Routed::Now((0..n).map(|_| Err(dispatch::unknown_plane(id))).collect()),

@@ -191,7 +191,11 @@ pub(super) fn run(setup: Setup, jobs: Receiver<Job>) {
         };
         match job {
             Some(Job::Stop) => return,
-            Some(Job::Run { ticket, ops, budget }) => {
+            Some(Job::Run {
+                ticket,
+                ops,
+                budget,
+            }) => {
                 let (results, failed) = worker.run_ops(ops, budget);
                 worker.usage.set(worker.plane.usage());
                 report(Event::Done {
@@ -226,7 +230,6 @@ fn drain(id: PlaneId, jobs: Receiver<Job>, report: &dyn Fn(Event)) {
     }
 }
 
-
 struct Worker {
     id: PlaneId,
     plane: Box<dyn Backend>,
@@ -249,7 +252,11 @@ fn create(setup: &Setup) -> Result<(Worker, Reply), CommandError> {
         .config(&setup.config)
         .signal_handling_mode(SignalHandlingMode::Disabled)
         .create::<ipc::Service>()
-        .map_err(|e| internal(DaemonError::Ipc(format!("plane {id}: cannot create node: {e:?}"))))?;
+        .map_err(|e| {
+            internal(DaemonError::Ipc(format!(
+                "plane {id}: cannot create node: {e:?}"
+            )))
+        })?;
     let out = PlaneOutput::new(&node, id).map_err(internal)?;
     // Publish tick 0 so readers see the plane (and late joiners get history) at once.
     out.publish(plane.as_mut()).map_err(internal)?;
@@ -294,8 +301,7 @@ impl Worker {
 
     /// Runs the automatic tick when it is due. False when the plane panicked.
     fn tick_if_due(&mut self, now: Instant) -> bool {
-        let (Some(due), Some(period)) = (self.next_tick.filter(|t| *t <= now), self.period)
-        else {
+        let (Some(due), Some(period)) = (self.next_tick.filter(|t| *t <= now), self.period) else {
             return true;
         };
         let (plane, out) = (&mut self.plane, &self.out);
