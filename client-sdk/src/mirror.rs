@@ -53,7 +53,7 @@ impl Mirror {
         );
         match &mut self.plane {
             Some(info) if !derived => {
-                if info.settings.apply(prop.clone(), false).is_err() {
+                if info.settings.apply(*prop, false).is_err() {
                     self.plane = None;
                 }
             }
