@@ -78,6 +78,9 @@ struct Inner {
     daemon_node: u128,
     daemon_pid: u32,
     state: RefCell<State>,
+    /// The frame number of [`Client::begin_frame`] (0: no frames, every read looks for the
+    /// newest sample).
+    frame: std::cell::Cell<u64>,
 }
 
 /// A connection to the physics daemon of one domain. Cheap to clone; not `Send` (shared
@@ -102,6 +105,7 @@ impl Client {
             daemon_node: 0,
             daemon_pid: 0,
             state: RefCell::default(),
+            frame: std::cell::Cell::new(0),
         };
         let hello = Command::Hello {
             crate_version: inner.options.crate_version.clone(),
@@ -143,14 +147,17 @@ impl Client {
 
     /// Creates a plane owned by this client (released when the client goes away).
     pub fn create_plane(&self, options: &PlaneOptions) -> Result<Plane, Error> {
-        let id = match self.call(Command::CreatePlane {
+        let info = match self.call(Command::CreatePlane {
             kind: options.kind.unwrap_or_default(),
             props: options.props(),
         })? {
-            Reply::Plane(info) => info.id,
+            Reply::Plane(info) => info,
             other => return Err(unexpected(other)),
         };
+        let id = info.id;
         let plane = self.attach_plane(id)?;
+        *plane.shared.mirror.borrow_mut() =
+            crate::mirror::Mirror::exclusive(info, options.shared == Some(true));
         self.note_owned(id);
         let table = {
             let state = self.inner.state.borrow_mut();
@@ -205,6 +212,20 @@ impl Client {
         }
     }
 
+    /// Starts a frame of a host's frame loop: from now until the next call, object reads
+    /// (`pose`, `state`, ...) take each plane's newest sample once, at their first read in
+    /// the frame, instead of looking for a newer one at every read (`Plane::step`,
+    /// `wait_tick` and `snapshot` still take the newest at once). Without it every read
+    /// looks.
+    pub fn begin_frame(&self) {
+        self.inner.frame.set(self.inner.frame.get() + 1);
+    }
+
+    /// The frame of [`Client::begin_frame`] (0 before the first).
+    pub(crate) fn frame(&self) -> u64 {
+        self.inner.frame.get()
+    }
+
     /// Number of writes waiting for the next flush.
     pub fn queued(&self) -> usize {
         self.inner.state.borrow().queue.len()
@@ -233,16 +254,35 @@ impl Client {
         let queued = std::mem::take(&mut self.inner.state.borrow_mut().queue);
         let n_queued = queued.len();
         let mut confirms = Vec::with_capacity(n_queued);
+        let mut targets = Vec::with_capacity(n_queued);
         let mut commands = Vec::with_capacity(n_queued + extra.len());
         for q in queued {
             confirms.push(q.confirms);
+            targets.push(match &q.command {
+                Command::Plane {
+                    plane,
+                    op: PlaneOp::Object { handle, .. },
+                } => Some((*plane, Some(*handle))),
+                Command::Plane { plane, .. } => Some((*plane, None)),
+                _ => None,
+            });
             commands.push(q.command);
         }
         commands.extend(extra);
         let mut results = self.inner.round_trip(commands)?;
         let extra_results = results.split_off(n_queued.min(results.len()));
         let mut state = self.inner.state.borrow_mut();
-        for (result, confirm) in results.into_iter().zip(confirms) {
+        for ((result, confirm), target) in results.into_iter().zip(confirms).zip(targets) {
+            if let (Err(_), Some((plane, handle))) = (&result, target) {
+                // A rejected write must not linger in the mirror either.
+                if let Some(p) = state.planes.get(&plane) {
+                    let mut mirror = p.mirror.borrow_mut();
+                    match handle {
+                        Some(h) => mirror.forget_object(h),
+                        None => mirror.forget_plane(),
+                    }
+                }
+            }
             match (result, confirm) {
                 (Ok(Reply::Applied { tick }), Some((plane, handle))) => {
                     if let Some(p) = state.planes.get(&plane) {

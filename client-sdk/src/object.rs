@@ -86,6 +86,11 @@ impl Object {
     /// the next flush. Pose, velocities and Anchored read back at once.
     pub fn set(&self, prop: ObjectProp) -> Result<(), Error> {
         let prop = prop.checked().map_err(Error::invalid_value)?;
+        self.plane
+            .shared
+            .mirror
+            .borrow_mut()
+            .object_written(self.handle, &prop);
         let plane = self.plane.id();
         let published = prop.is_published();
         if published {
@@ -198,8 +203,34 @@ impl Object {
     /// Every property as the daemon holds it (sends the queue first).
     pub fn info(&self) -> Result<ObjectInfo, Error> {
         match self.plane.client().call(self.op(ObjectOp::Info))? {
-            Reply::ObjectInfo(info) => Ok(*info),
+            Reply::ObjectInfo(info) => {
+                self.plane.shared.mirror.borrow_mut().store_object(&info);
+                Ok(*info)
+            }
             other => Err(Error::Protocol(format!("unexpected reply {other:?}"))),
+        }
+    }
+
+    /// Every property without a round trip where this process mirrors them (objects of a
+    /// plane it created and did not share: after one [`Object::info`], kept current by its
+    /// own writes); otherwise [`Object::info`]. `anchored` and `sleeping` come from the
+    /// newest tick (with this process's writes on top).
+    pub fn properties(&self) -> Result<ObjectInfo, Error> {
+        let mirrored = self
+            .plane
+            .shared
+            .mirror
+            .borrow()
+            .object(self.handle)
+            .cloned();
+        match mirrored {
+            Some(mut info) => {
+                let state = self.state()?;
+                info.anchored = state.is_anchored();
+                info.sleeping = state.is_sleeping();
+                Ok(info)
+            }
+            None => self.info(),
         }
     }
 
@@ -212,7 +243,14 @@ impl Object {
             .client()
             .call(self.op(ObjectOp::RecalculateCenterOfMass))?
         {
-            Reply::CenterOfMass(c) => Ok(c),
+            Reply::CenterOfMass(c) => {
+                self.plane
+                    .shared
+                    .mirror
+                    .borrow_mut()
+                    .forget_object(self.handle);
+                Ok(c)
+            }
             other => Err(Error::Protocol(format!("unexpected reply {other:?}"))),
         }
     }
@@ -253,6 +291,11 @@ impl Object {
 
     /// Removes the object (sent with the next flush; reads see it gone at once).
     pub fn destroy(&self) {
+        self.plane
+            .shared
+            .mirror
+            .borrow_mut()
+            .forget_object(self.handle);
         self.plane
             .overlay_write(self.handle, |e| e.destroyed = true);
         let plane = self.plane.id();

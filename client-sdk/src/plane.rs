@@ -11,6 +11,7 @@ use shm_layout::{
 
 use crate::client::LIVENESS_PERIOD;
 use crate::events::EventReader;
+use crate::mirror::Mirror;
 use crate::overlay::{Entry, Overlay};
 use crate::transport::{BodySample, BodySubscriber, TickListener, Transport};
 use crate::{Client, Error, Object};
@@ -101,6 +102,10 @@ pub(crate) struct PlaneShared {
     ticks: RefCell<Option<TickListener>>,
     pub(crate) events: RefCell<Option<EventReader>>,
     alive: Cell<bool>,
+    /// The client frame in which `latest` was last refreshed.
+    refreshed_in: Cell<u64>,
+    /// The plane's options and its objects' properties as this process knows them.
+    pub(crate) mirror: RefCell<Mirror>,
 }
 
 impl PlaneShared {
@@ -114,6 +119,8 @@ impl PlaneShared {
             ticks: RefCell::new(None),
             events: RefCell::new(None),
             alive: Cell::new(true),
+            refreshed_in: Cell::new(0),
+            mirror: RefCell::default(),
         })
     }
 
@@ -143,6 +150,15 @@ impl PlaneShared {
     fn latest(&self) -> Result<Option<Rc<BodySample>>, Error> {
         self.refresh()?;
         Ok(self.latest.borrow().clone())
+    }
+
+    /// Looks for a newer sample once per client frame (`frame` 0: every time).
+    fn refresh_in_frame(&self, frame: u64) -> Result<(), Error> {
+        if frame == 0 || self.refreshed_in.get() != frame {
+            self.refresh()?;
+            self.refreshed_in.set(frame);
+        }
+        Ok(())
     }
 
     fn current_tick(&self) -> Option<u64> {
@@ -216,12 +232,17 @@ impl Plane {
     /// The state of `handle` as this process should see it: the newest sample with this
     /// process's unconfirmed writes on top. `None` when the object does not exist.
     pub(crate) fn body(&self, handle: Handle) -> Result<Option<BodyState>, Error> {
-        let sample = self.shared.latest()?;
-        let tick = sample.as_ref().map_or(0, |s| s.user_header().tick);
-        let base = sample
-            .as_ref()
-            .and_then(|s| s.payload().get(handle.slot as usize).copied())
-            .filter(|s| s.matches(handle));
+        let (tick, base) = {
+            self.shared.refresh_in_frame(self.client.frame())?;
+            let latest = self.shared.latest.borrow();
+            let sample = latest.as_ref();
+            (
+                sample.map_or(0, |s| s.user_header().tick),
+                sample
+                    .and_then(|s| s.payload().get(handle.slot as usize).copied())
+                    .filter(|s| s.matches(handle)),
+            )
+        };
         let mut overlay = self.shared.overlay.borrow_mut();
         Ok(match overlay.get(handle, tick) {
             Some(entry) => entry.apply(handle, base),
@@ -237,14 +258,36 @@ impl Plane {
     /// Every option and figure of the plane (sends the queue first).
     pub fn info(&self) -> Result<PlaneInfo, Error> {
         match self.client.call(Command::plane(self.id(), PlaneOp::Info))? {
-            Reply::Plane(info) => Ok(info),
+            Reply::Plane(info) => {
+                self.shared.mirror.borrow_mut().store_plane(&info);
+                Ok(info)
+            }
             other => Err(Error::Protocol(format!("unexpected reply {other:?}"))),
+        }
+    }
+
+    /// The plane's options without a round trip where this process mirrors them (a plane
+    /// it created and did not share: filled by the creation reply and its own writes);
+    /// otherwise [`Plane::info`]. `tick` is the newest published tick; `object_count` and
+    /// `effective_solver_iterations` are as of the last `info` read: ask [`Plane::info`]
+    /// for those.
+    pub fn properties(&self) -> Result<PlaneInfo, Error> {
+        let mirrored = self.shared.mirror.borrow().plane().cloned();
+        match mirrored {
+            Some(mut info) if self.shared.alive.get() => {
+                if let Some(tick) = self.shared.current_tick() {
+                    info.tick = tick;
+                }
+                Ok(info)
+            }
+            _ => self.info(),
         }
     }
 
     /// Changes a plane option (checked now, sent with the next flush).
     pub fn set(&self, prop: PlaneProp) -> Result<(), Error> {
         let prop = prop.checked().map_err(Error::invalid_value)?;
+        self.shared.mirror.borrow_mut().plane_written(&prop);
         self.client
             .queue(Command::plane(self.id(), PlaneOp::Set(prop)), None);
         Ok(())

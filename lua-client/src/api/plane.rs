@@ -39,8 +39,9 @@ impl PlaneState {
         self.alive.get()
     }
 
-    /// The plane's options and counters as the daemon holds them (one round trip, which
-    /// sends the queued writes first); `what` names the property read, for errors.
+    /// The plane's options: a local lookup in the SDK's mirror for a plane this script
+    /// created (not shared), otherwise one round trip that sends the queued writes first;
+    /// `what` names the property read, for errors.
     pub fn info(&self, what: &str) -> mlua::Result<PlaneInfo> {
         if !self.alive() {
             return Err(mlua::Error::runtime(format!(
@@ -48,7 +49,7 @@ impl PlaneState {
             )));
         }
         self.plane
-            .info()
+            .properties()
             .map_err(|e| sdk_error(&format!("PhysicsPlane.{what}"), e))
     }
 

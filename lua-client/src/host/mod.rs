@@ -52,6 +52,8 @@ impl Host {
 
     /// One frame of `dt` seconds, ending with the flush of every write it made.
     pub fn frame(&self, dt: f64) -> mlua::Result<()> {
+        // Reads in this frame take each plane's newest sample once.
+        self.client.begin_frame();
         self.scheduler.frame(&self.lua, dt)?;
         self.flush()
     }

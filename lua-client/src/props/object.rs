@@ -1,6 +1,7 @@
 //! PhysicsObject properties. Pose, velocities and Anchored read the SDK's read-your-writes
-//! view of the newest tick in shared memory (no request); the other properties read back
-//! from the daemon (`object.info()`, one round trip); Size reads through to the wrapped part.
+//! view of the newest tick in shared memory (no request); the other properties read the
+//! SDK's property mirror (`object.properties()`: a local lookup after the object's first
+//! read, one round trip then); Size reads through to the wrapped part.
 //! Every SDK write is one `ObjectProp`.
 
 use client_sdk::validate::MAX_HIT_BOX_QUALITY;
@@ -11,10 +12,10 @@ use super::{Get, Kind, Props, Row, Set};
 use crate::api::object::PhysicsObject;
 use crate::values::{new_vector, sdk_error, CFrame};
 
-/// The object's properties as the daemon holds them (one round trip).
+/// The object's properties (the SDK's mirror; one round trip the first time).
 fn info(o: &PhysicsObject, what: &str) -> Result<ObjectInfo, LuaError> {
     o.live_for(|| format!("PhysicsObject.{what}"))?
-        .info()
+        .properties()
         .map_err(|e| sdk_error(&format!("PhysicsObject.{what}"), e))
 }
 

@@ -1,6 +1,8 @@
 //! PhysicsPlane properties, which are also the options of `PhysicsService.New`. Every option
-//! reads back from the daemon (`plane.info()`, one round trip that sends the queued writes
-//! first, so a script reads what it wrote) and writes one `PlaneProp`. Rows marked
+//! reads the SDK's property mirror (`plane.properties()`: a local lookup for a plane the
+//! script created and did not share, kept current by the script's own writes; otherwise one
+//! round trip that sends the queued writes first, so a script reads what it wrote) and
+//! writes one `PlaneProp`. Rows marked
 //! `not_yet` are documented but belong to a backend not built yet.
 
 use client_sdk::validate::{MAX_SOLVER_ITERATIONS, MAX_THREADS, MAX_TICK_RATE};

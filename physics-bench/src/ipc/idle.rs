@@ -19,6 +19,8 @@ pub struct IdleCpu {
 
 pub fn run(window: Duration, progress: &Progress) -> BenchResult<IdleCpu> {
     let daemon = DaemonProcess::start("idle")?;
+    // Let the start-up (and the readiness check's connection) finish before the window.
+    std::thread::sleep(Duration::from_secs(2));
     progress.phase(format!("idle CPU, no clients ({} s)", window.as_secs()));
     let no_clients = cpu_percent_over(daemon.pid(), window)?;
     progress.done();
@@ -34,6 +36,7 @@ pub fn run(window: Duration, progress: &Progress) -> BenchResult<IdleCpu> {
         Pose::at([0.0, 1.0, 0.0]),
         &[],
     )?;
+    std::thread::sleep(Duration::from_secs(1));
     let idle_manual_plane = cpu_percent_over(daemon.pid(), window)?;
     progress.done();
     Ok(IdleCpu {

@@ -48,9 +48,28 @@ pub fn method() -> BTreeMap<&'static str, &'static str> {
         ),
         (
             "threads",
-            "10,000-body pile while still awake (ticks 10-99 after building), Threads = 1 and \
+            "20,000 free-flying bodies (all awake; ticks 10-99 after building), Threads = 1 and \
              Threads = 2 planes in one daemon stepped alternately; medians of the step time in \
              the tick header.",
+        ),
+        (
+            "head_of_line",
+            "Step round trips of a one-ball manual plane (a client alone in the daemon), then \
+             the same while another client's 10,000-body free-flying plane ticks at 60 Hz in \
+             the same daemon; p50 / p99 / max of each, goal judged on p99.",
+        ),
+        (
+            "multi_plane",
+            "10,000 free-flying bodies per plane, each plane stepped back to back by a client \
+             thread of its own for the window: ticks per second of one plane, then of two \
+             planes together in one daemon.",
+        ),
+        (
+            "lua",
+            "physics-lua (next to the bench) runs examples/cframe_cost.luau (medians per frame \
+             of 1,000 part.CFrame reads of falling parts at 60 Hz) and \
+             examples/property_cost.luau (medians of 1,000 obj.Weight and \
+             plane.LinearDamping reads, per read), each against a daemon of its own.",
         ),
         (
             "idle_cpu_percent",
@@ -147,9 +166,10 @@ pub fn render(r: &IpcReport) -> String {
     let th = &r.threads;
     let _ = writeln!(
         md,
-        "\n## Threads ({}-body pile, awake)\n\n\
+        "\n## Threads ({} {} bodies, awake)\n\n\
          Step {} µs with Threads = 1, {} µs with Threads = 2: speedup {}× ({} ticks each).",
         th.bodies,
+        th.scene.name(),
         num(Some(th.threads1_step_us)),
         num(Some(th.threads2_step_us)),
         num(Some(th.speedup)),

@@ -2,7 +2,9 @@
 //! game process, and how delivery compares with the usual serialise-over-a-socket way.
 
 mod idle;
+mod lua;
 mod markdown;
+mod planes;
 mod scene_run;
 mod socket;
 mod threads;
@@ -18,6 +20,8 @@ use super::scene::{Kind, Scene};
 use super::stats::Spread;
 
 pub use idle::IdleCpu;
+pub use lua::LuaReads;
+pub use planes::{HeadOfLine, MultiPlane};
 pub use scene_run::{Delivery, Memory, Overhead, Requests};
 pub use threads::Threads;
 
@@ -34,6 +38,9 @@ pub struct IpcArgs {
 
 /// The size at which the goals are judged (and the only size of `--quick`).
 pub const GOAL_BODIES: usize = 10_000;
+/// Bodies of the Threads = 2 against 1 scene (free-flying, all awake: one thread needs
+/// several milliseconds per step).
+pub const THREADS_BODIES: usize = 20_000;
 
 /// How much to measure.
 #[derive(Debug, Clone, serde::Serialize)]
@@ -48,6 +55,10 @@ pub struct Plan {
     pub batch_size: usize,
     pub batches: usize,
     pub idle_window_s: u64,
+    /// Round trips per side of the head-of-line figure.
+    pub head_of_line_round_trips: usize,
+    /// Seconds per side of the multi-plane figure.
+    pub multi_plane_s: f64,
 }
 
 impl Plan {
@@ -62,6 +73,8 @@ impl Plan {
                 batch_size: 1_000,
                 batches: 10,
                 idle_window_s: 10,
+                head_of_line_round_trips: 1_000,
+                multi_plane_s: 3.0,
             }
         } else {
             Plan {
@@ -72,7 +85,9 @@ impl Plan {
                 round_trips: 5_000,
                 batch_size: 1_000,
                 batches: 30,
-                idle_window_s: 10,
+                idle_window_s: 60,
+                head_of_line_round_trips: 3_000,
+                multi_plane_s: 6.0,
             }
         }
     }
@@ -98,6 +113,9 @@ pub struct IpcReport {
     pub batched_writes_per_s: f64,
     pub requests: Requests,
     pub threads: Threads,
+    pub head_of_line: HeadOfLine,
+    pub multi_plane: MultiPlane,
+    pub lua: LuaReads,
     pub idle_cpu_percent: IdleCpu,
     pub memory: Vec<Memory>,
     pub goals: Vec<Goal>,
@@ -109,7 +127,7 @@ pub fn run(args: &IpcArgs) -> BenchResult<()> {
     let started = Instant::now();
     let plan = Plan::new(args.quick);
     let kinds = [Kind::Pile, Kind::Free];
-    let phases = 2 + 1 + (plan.sizes.len() * kinds.len() * 4) as u64 + 1;
+    let phases = 2 + 1 + 3 + (plan.sizes.len() * kinds.len() * 4) as u64 + 1;
     let progress = Progress::new(phases);
 
     let idle = idle::run(Duration::from_secs(plan.idle_window_s), &progress)?;
@@ -119,13 +137,48 @@ pub fn run(args: &IpcArgs) -> BenchResult<()> {
     ));
 
     progress.phase(format!(
-        "threads: {GOAL_BODIES}-body pile, Threads = 1 vs 2"
+        "threads: {THREADS_BODIES} free-flying bodies, Threads = 1 vs 2"
     ));
-    let threads = threads::run(GOAL_BODIES)?;
+    let threads = threads::run(Kind::Free, THREADS_BODIES)?;
     progress.done();
     progress.note(format!(
         "threads: step {:.0} µs with 1, {:.0} µs with 2 → {:.2}×",
         threads.threads1_step_us, threads.threads2_step_us, threads.speedup
+    ));
+
+    progress.phase(format!(
+        "head-of-line: a small plane alone and beside a {GOAL_BODIES}-body plane at 60 Hz"
+    ));
+    let head_of_line = planes::head_of_line(GOAL_BODIES, plan.head_of_line_round_trips)?;
+    progress.done();
+    let h = &head_of_line;
+    progress.note(format!(
+        "head-of-line: p50/p99/max {:.0}/{:.0}/{:.0} µs alone, {:.0}/{:.0}/{:.0} µs beside          ({:.0} ticks/s) → p99 {:.2}×",
+        h.alone_us.p50,
+        h.alone_us.p99,
+        h.alone_us.max,
+        h.beside_busy_us.p50,
+        h.beside_busy_us.p99,
+        h.beside_busy_us.max,
+        h.busy_ticks_per_s,
+        h.p99_ratio
+    ));
+    progress.phase(format!(
+        "multi-plane: two {GOAL_BODIES}-body planes stepped at once vs one"
+    ));
+    let multi_plane = planes::multi_plane(GOAL_BODIES, plan.multi_plane_s)?;
+    progress.done();
+    progress.note(format!(
+        "multi-plane: {:.1} ticks/s with one, {:.1} with two → {:.2}×",
+        multi_plane.one_plane_ticks_per_s, multi_plane.two_planes_ticks_per_s, multi_plane.ratio
+    ));
+    progress.phase("Lua: part.CFrame and obj.Weight reads".to_string());
+    let lua = lua::measure()?;
+    progress.done();
+    progress.note(format!(
+        "Lua: 1,000 part.CFrame reads {:.0} µs per frame; one obj.Weight read {:.3} µs, \
+         plane.LinearDamping {:.3} µs",
+        lua.cframe_x1000_us, lua.weight_read_us, lua.linear_damping_read_us
     ));
 
     let mut scenes = Vec::new();
@@ -186,6 +239,9 @@ pub fn run(args: &IpcArgs) -> BenchResult<()> {
         batched_writes_per_s: requests.batched_writes_per_s,
         requests,
         threads,
+        head_of_line,
+        multi_plane,
+        lua,
         idle_cpu_percent: idle,
         memory,
         goals: Vec::new(),
@@ -285,10 +341,67 @@ fn goals(r: &IpcReport) -> Vec<Goal> {
         ("one idle manual plane", idle.idle_manual_plane),
     ] {
         goals.push(Goal {
-            goal: format!("idle CPU < 0.5 % ({what})"),
+            goal: format!("idle CPU ≤ 0.1 % ({what})"),
             value: format!("{v:.3} %"),
-            met: Some(v < 0.5),
+            met: Some(v <= 0.1),
         });
     }
+    let t = &r.threads;
+    goals.push(Goal {
+        goal: format!(
+            "Threads = 2 against 1 ≥ 1.6× on a scene whose step takes ≥ 5 ms ({} {})",
+            t.bodies,
+            t.scene.name()
+        ),
+        value: format!(
+            "{:.2}× (step {:.0} µs with 1, {:.0} µs with 2)",
+            t.speedup, t.threads1_step_us, t.threads2_step_us
+        ),
+        met: (t.threads1_step_us >= 5_000.0).then_some(t.speedup >= 1.6),
+    });
+    let h = &r.head_of_line;
+    goals.push(Goal {
+        goal: format!(
+            "head-of-line: small-plane round trip p99 beside a {}-body plane at {} Hz ≤ 2× alone",
+            h.busy_bodies, h.busy_tick_rate
+        ),
+        value: format!(
+            "{:.2}× (p50/p99/max {:.0}/{:.0}/{:.0} µs alone, {:.0}/{:.0}/{:.0} µs beside)",
+            h.p99_ratio,
+            h.alone_us.p50,
+            h.alone_us.p99,
+            h.alone_us.max,
+            h.beside_busy_us.p50,
+            h.beside_busy_us.p99,
+            h.beside_busy_us.max
+        ),
+        met: Some(h.p99_ratio <= 2.0),
+    });
+    let m = &r.multi_plane;
+    goals.push(Goal {
+        goal: format!(
+            "multi-plane: two {}-body planes ≥ 1.7× the ticks/s of one",
+            m.bodies
+        ),
+        value: format!(
+            "{:.2}× ({:.1} → {:.1} ticks/s)",
+            m.ratio, m.one_plane_ticks_per_s, m.two_planes_ticks_per_s
+        ),
+        met: Some(m.ratio >= 1.7),
+    });
+    let l = &r.lua;
+    goals.push(Goal {
+        goal: "Lua: 1,000 part.CFrame reads per frame ≤ 0.2 ms".into(),
+        value: format!("{:.3} ms", l.cframe_x1000_us / 1000.0),
+        met: Some(l.cframe_x1000_us <= 200.0),
+    });
+    goals.push(Goal {
+        goal: "Lua: one obj.Weight read ≤ 1 µs".into(),
+        value: format!(
+            "{:.3} µs (plane.LinearDamping {:.3} µs)",
+            l.weight_read_us, l.linear_damping_read_us
+        ),
+        met: Some(l.weight_read_us <= 1.0),
+    });
     goals
 }

@@ -1,6 +1,7 @@
-//! Threads = 2 against Threads = 1 on the same pile, both in one daemon, stepped alternately
-//! so both see the same machine load. Timed while the pile is still awake (a sleeping pile
-//! has nothing to parallelise).
+//! Threads = 2 against Threads = 1 on the same scene, both in one daemon, stepped alternately
+//! so both see the same machine load. Timed while the scene is awake (a sleeping pile has
+//! nothing to parallelise); the scene is chosen so one thread needs several milliseconds per
+//! step (a pile of 10,000 settles too fast for that).
 
 use client_sdk::Plane;
 
@@ -25,11 +26,8 @@ pub struct Threads {
     pub ticks: usize,
 }
 
-pub fn run(bodies: usize) -> BenchResult<Threads> {
-    let scene = Scene {
-        kind: Kind::Pile,
-        bodies,
-    };
+pub fn run(kind: Kind, bodies: usize) -> BenchResult<Threads> {
+    let scene = Scene { kind, bodies };
     let daemon = DaemonProcess::start("threads")?;
     let client = daemon.connect()?;
     let (one, _) = scene.build_remote(&client, 1)?;

@@ -57,7 +57,7 @@ pub struct Usage {
 }
 
 /// A plane as the server and the publisher see it.
-pub trait Backend {
+pub trait Backend: Send {
     /// Which kind of plane this is.
     fn kind(&self) -> PlaneKind;
 

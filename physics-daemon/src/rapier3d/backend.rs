@@ -95,6 +95,14 @@ impl Backend for Plane {
         Plane::body_state(self, i)
     }
 
+    fn write_states(
+        &self,
+        out: &mut [std::mem::MaybeUninit<BodyState>],
+        filter: crate::backend::SlotFilter<'_>,
+    ) {
+        self.write_sample(out, filter)
+    }
+
     fn events(&self) -> &[EventRecord] {
         Plane::events(self)
     }

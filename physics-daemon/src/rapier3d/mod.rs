@@ -21,6 +21,7 @@ mod maps;
 mod objects;
 mod part;
 mod properties;
+mod publish;
 mod queries;
 mod solver;
 
@@ -32,7 +33,7 @@ use rapier3d::prelude::*;
 use shm_layout::validate::{self, MAX_DT, MAX_HIT_BOX_QUALITY};
 use shm_layout::{
     BodyState, CollisionGroups, CommandError, EventRecord, PlaneId, PlaneInfo, PlaneKind,
-    PlaneProp, PlaneSettings, TickHeader, FLAG_ALIVE, FLAG_ANCHORED, FLAG_SLEEPING, LAYOUT_VERSION,
+    PlaneProp, PlaneSettings, TickHeader, LAYOUT_VERSION,
 };
 
 use crate::backend::{Dirty, SlotTable};
@@ -317,33 +318,6 @@ impl Plane {
 
     /// The published state of slot `i` (dead slots carry only their generation).
     pub fn body_state(&self, i: usize) -> BodyState {
-        let generation = self.bodies.generation(i);
-        let Some((body, extra)) = self
-            .bodies
-            .at(i)
-            .and_then(|b| Some((self.world.bodies.get(b.handle)?, b.flags)))
-        else {
-            return BodyState {
-                generation,
-                ..BodyState::default()
-            };
-        };
-        let pose = body.position();
-        let mut flags = FLAG_ALIVE | extra;
-        if body.is_sleeping() {
-            flags |= FLAG_SLEEPING;
-        }
-        if body.is_fixed() {
-            flags |= FLAG_ANCHORED;
-        }
-        BodyState {
-            position: pose.translation.into(),
-            flags,
-            rotation: pose.rotation.into(),
-            linear_velocity: body.linvel().into(),
-            generation,
-            angular_velocity: body.angvel().into(),
-            _reserved: 0,
-        }
+        publish::body_state(&self.bodies, &self.world.bodies, i)
     }
 }

@@ -1,9 +1,10 @@
-//! Requests: decoding, and routing each command by plane id to the plane's backend. Only
-//! the lifecycle ops (create, step, destroy) are handled here; every other op goes to the
-//! backend unread, so a new op family never changes this file.
+//! Requests: decoding, and routing each command by plane id to the plane's worker. Only the
+//! lifecycle ops (create, destroy) are handled here; every other op goes to the plane's
+//! worker unread (a run of consecutive commands for one plane as one job), so a new op
+//! family never changes this file.
 
-use std::panic::{catch_unwind, AssertUnwindSafe};
-use std::time::Instant;
+use std::collections::VecDeque;
+use std::sync::{mpsc, Arc};
 
 use shm_layout::codec::{self, Frame};
 use shm_layout::{
@@ -12,22 +13,23 @@ use shm_layout::{
 };
 
 use super::limits::exceeded;
-use super::{Daemon, Origin, PlaneEntry, MAX_PLANES};
-use crate::backend;
-use crate::publish::PlaneOutput;
+use super::worker::{self, Budget, SharedUsage};
+use super::{Daemon, Origin, PlaneEntry, Routed, MAX_PLANES};
+use crate::backend::Usage;
 use crate::DaemonError;
 
 impl Daemon {
-    /// Decodes one request and executes its commands. Never panics on any input.
-    pub fn handle_bytes(&mut self, origin: Origin, bytes: &[u8]) -> Vec<u8> {
+    /// Decodes one request into its commands, or the reply that rejects it. Never panics on
+    /// any input.
+    pub(super) fn decode(&self, bytes: &[u8]) -> Result<Vec<Command>, Vec<u8>> {
         let limits = &self.options.limits;
         if bytes.len() > limits.request_bytes {
-            return codec::encode_response(&Response::Rejected(exceeded(
+            return Err(codec::encode_response(&Response::Rejected(exceeded(
                 "request bytes",
                 limits.request_bytes,
                 "max-request-bytes",
                 bytes.len(),
-            )));
+            ))));
         }
         let rejected = |e: String| {
             codec::encode_response(&Response::Rejected(CommandError::new(
@@ -36,73 +38,85 @@ impl Daemon {
             )))
         };
         match Frame::parse(bytes) {
-            Err(e) => return rejected(e.to_string()),
+            Err(e) => return Err(rejected(e.to_string())),
             Ok(frame) if frame.version != LAYOUT_VERSION => {
-                return codec::encode_version_mismatch()
+                return Err(codec::encode_version_mismatch())
             }
             Ok(_) => {}
         }
-        let request = match codec::decode_request(bytes) {
-            Ok(r) => r,
-            Err(e) => return rejected(e.to_string()),
-        };
-        let max_commands = self.options.limits.commands_per_request;
+        let request = codec::decode_request(bytes).map_err(|e| rejected(e.to_string()))?;
+        let max_commands = limits.commands_per_request;
         if request.commands.len() > max_commands {
-            return codec::encode_response(&Response::Rejected(exceeded(
+            return Err(codec::encode_response(&Response::Rejected(exceeded(
                 "commands per request",
                 max_commands,
                 "max-commands-per-request",
                 request.commands.len(),
-            )));
+            ))));
         }
-        let results: Vec<CommandResult> = request
-            .commands
-            .into_iter()
-            .map(|c| self.execute(origin, c))
-            .collect();
-        codec::encode_response(&Response::Results(results))
+        Ok(request.commands)
     }
 
-    fn execute(&mut self, origin: Origin, command: Command) -> CommandResult {
+    /// Serves `command` at once, or hands it (with the commands after it in `rest` that go
+    /// to the same plane) to the plane's worker.
+    pub(super) fn route(
+        &mut self,
+        origin: Origin,
+        command: Command,
+        rest: &mut VecDeque<Command>,
+    ) -> Routed {
         let client = origin.id;
+        let now = |result: CommandResult| Routed::Now(vec![result]);
         if let Command::Hello { crate_version, .. } = &command {
-            return self.hello(origin, crate_version);
+            return now(self.hello(origin, crate_version));
         }
         if !self.clients.is_connected(client) {
-            return Err(CommandError::new(
+            return now(Err(CommandError::new(
                 ErrorKind::NotConnected,
                 "the first command of a client must be Hello",
-            ));
+            )));
         }
         match command {
             Command::Hello { .. } => unreachable!("handled above"),
             Command::Goodbye => {
                 self.release_client(client);
-                Ok(Reply::Done)
+                now(Ok(Reply::Done))
             }
             Command::ListPlanes => {
                 // The map is ordered: ids come ascending.
-                Ok(Reply::PlaneIds(self.planes.keys().copied().collect()))
+                now(Ok(Reply::PlaneIds(self.planes.keys().copied().collect())))
             }
-            Command::CreatePlane { kind, props } => {
-                self.create_plane(client, kind, &props, Instant::now())
-            }
+            Command::CreatePlane { kind, props } => self.create_plane(client, kind, props),
             Command::Plane { plane, op } => {
-                self.check_access(client, plane, &op)?;
-                self.check_quota(plane, &op)?;
-                self.plane_op(plane, op)
+                if let Err(e) = self.check_access(client, plane, &op) {
+                    return now(Err(e));
+                }
+                if op == PlaneOp::Destroy {
+                    self.remove_plane(plane);
+                    tracing::info!(plane, "plane destroyed");
+                    return now(Ok(Reply::Done));
+                }
+                let mut ops = vec![op];
+                while let Some(Command::Plane { plane: next, op }) = rest.front() {
+                    if *next != plane
+                        || *op == PlaneOp::Destroy
+                        || self.check_access(client, plane, op).is_err()
+                    {
+                        break;
+                    }
+                    let Some(Command::Plane { op, .. }) = rest.pop_front() else {
+                        unreachable!("just looked at it")
+                    };
+                    ops.push(op);
+                }
+                self.send_job(plane, ops)
             }
         }
     }
 
     /// Any client may read any plane; only the owner changes it unless the owner shared
     /// it; only the owner destroys it.
-    fn check_access(
-        &mut self,
-        client: u128,
-        id: PlaneId,
-        op: &PlaneOp,
-    ) -> Result<(), CommandError> {
+    fn check_access(&self, client: u128, id: PlaneId, op: &PlaneOp) -> Result<(), CommandError> {
         let entry = self.plane(id)?;
         if entry.owner == client || op.is_read_only() {
             return Ok(());
@@ -123,83 +137,26 @@ impl Daemon {
         }
     }
 
-    /// What `op` adds must fit the quotas of the plane's owner.
-    fn check_quota(&mut self, id: PlaneId, op: &PlaneOp) -> Result<(), CommandError> {
-        let cost = op.cost();
-        if cost == Default::default() {
-            return Ok(());
-        }
-        let limits = &self.options.limits;
-        if cost.mesh_vertices > limits.mesh_vertices_per_object {
-            return Err(exceeded(
-                "mesh vertices per object",
-                limits.mesh_vertices_per_object,
-                "max-mesh-vertices",
-                cost.mesh_vertices,
-            ));
-        }
-        let owner = self.plane(id)?.owner;
-        let (mut objects, mut vertices) = (cost.objects as u64, cost.mesh_vertices);
-        for p in self.clients.planes_of_process(owner) {
-            if let Some(entry) = self.planes.get(&p) {
-                let usage = entry.plane.usage();
-                objects += usage.objects;
-                vertices += usage.mesh_vertices;
+    /// The quotas a run for plane `id` is checked against: what the other planes of its
+    /// owner's process hold.
+    pub(super) fn budget(&self, id: PlaneId) -> Budget {
+        let mut other = Usage::default();
+        if let Some(owner) = self.planes.get(&id).map(|p| p.owner) {
+            for p in self.clients.planes_of_process(owner) {
+                if p == id {
+                    continue;
+                }
+                if let Some(entry) = self.planes.get(&p) {
+                    let usage = entry.usage.get();
+                    other.objects += usage.objects;
+                    other.mesh_vertices += usage.mesh_vertices;
+                }
             }
         }
-        let limits = &self.options.limits;
-        if objects > limits.objects_per_client {
-            return Err(exceeded(
-                "objects per client",
-                limits.objects_per_client,
-                "max-objects-per-client",
-                objects,
-            ));
+        Budget {
+            limits: self.options.limits,
+            other,
         }
-        if vertices > limits.mesh_vertices_per_client {
-            return Err(exceeded(
-                "mesh vertices per client",
-                limits.mesh_vertices_per_client,
-                "max-mesh-vertices-per-client",
-                vertices,
-            ));
-        }
-        Ok(())
-    }
-
-    /// Routes `op` to plane `id`. A panic inside the plane fails that plane alone: it is
-    /// removed, the command gets an error naming it, and the daemon serves on.
-    fn plane_op(&mut self, id: PlaneId, op: PlaneOp) -> CommandResult {
-        if op == PlaneOp::Destroy {
-            self.remove_plane(id);
-            tracing::info!(plane = id, "plane destroyed");
-            return Ok(Reply::Done);
-        }
-        let panic_dt = self.options.panic_on_step_dt;
-        let entry = self.plane(id)?;
-        let outcome = catch_unwind(AssertUnwindSafe(|| match op {
-            PlaneOp::Step { dt } => {
-                if panic_dt == Some(dt) {
-                    panic!("injected fault: Step({dt})");
-                }
-                if entry.plane.step(dt)? {
-                    entry.out.publish(entry.plane.as_mut()).map_err(internal)?;
-                }
-                Ok(Reply::Stepped {
-                    tick: entry.plane.tick(),
-                })
-            }
-            op => {
-                if op == PlaneOp::Info {
-                    // A reader that just subscribed gets the newest tick at once.
-                    entry.out.connect_readers();
-                }
-                let result = entry.plane.apply(op);
-                entry.reschedule_if_changed(Instant::now());
-                result
-            }
-        }));
-        outcome.unwrap_or_else(|panic| Err(self.fail_plane(id, panic)))
     }
 
     fn hello(&mut self, origin: Origin, crate_version: &str) -> CommandResult {
@@ -227,24 +184,16 @@ impl Daemon {
         })
     }
 
-    fn plane(&mut self, id: PlaneId) -> Result<&mut PlaneEntry, CommandError> {
-        self.planes.get_mut(&id).ok_or_else(|| {
-            CommandError::new(
-                ErrorKind::UnknownPlane,
-                format!("plane {id} does not exist"),
-            )
-        })
+    fn plane(&self, id: PlaneId) -> Result<&PlaneEntry, CommandError> {
+        self.planes.get(&id).ok_or_else(|| unknown_plane(id))
     }
 
-    fn create_plane(
-        &mut self,
-        owner: u128,
-        kind: PlaneKind,
-        props: &[PlaneProp],
-        now: Instant,
-    ) -> CommandResult {
+    /// Starts the worker of a new plane; it answers the command once the plane exists
+    /// (tick 0 published) or failed to.
+    fn create_plane(&mut self, owner: u128, kind: PlaneKind, props: Vec<PlaneProp>) -> Routed {
+        let refuse = |e: CommandError| Routed::Now(vec![Err(e)]);
         if self.planes.len() >= MAX_PLANES {
-            return Err(CommandError::new(
+            return refuse(CommandError::new(
                 ErrorKind::Quota,
                 format!("the daemon already hosts {MAX_PLANES} planes"),
             ));
@@ -252,7 +201,7 @@ impl Daemon {
         let owned = self.clients.planes_of_process(owner).count();
         let max = self.options.limits.planes_per_client;
         if owned >= max {
-            return Err(exceeded(
+            return refuse(exceeded(
                 "planes per client",
                 max,
                 "max-planes-per-client",
@@ -260,34 +209,57 @@ impl Daemon {
             ));
         }
         let id = self.next_plane_id;
-        let created = catch_unwind(AssertUnwindSafe(|| backend::create(kind, id, props)));
-        let mut plane = created.unwrap_or_else(|panic| {
-            Err(CommandError::new(
-                ErrorKind::Internal,
-                format!("creating plane {id} failed: {}", panic_message(&panic)),
-            ))
-        })?;
-        let out = PlaneOutput::new(&self.node, id).map_err(internal)?;
-        // Publish tick 0 so readers see the plane (and late joiners get history) at once.
-        out.publish(plane.as_mut()).map_err(internal)?;
-        let info = plane.apply(PlaneOp::Info)?;
-        let mut entry = PlaneEntry {
-            plane,
-            owner,
-            shared: PlaneProp::shared_in(props),
-            out,
-            period: None,
-            next_tick: None,
+        let ticket = self.next_ticket;
+        let usage = Arc::new(SharedUsage::default());
+        let (jobs, receiver) = mpsc::channel();
+        let shared = PlaneProp::shared_in(&props);
+        let setup = worker::Setup {
+            id,
+            kind,
+            props,
+            ticket,
+            config: self.config.clone(),
+            usage: usage.clone(),
+            events: self.events_tx.clone(),
+            waker: self.waker.clone(),
+            panic_on_step_dt: self.options.panic_on_step_dt,
         };
-        entry.reschedule_if_changed(now);
-        self.planes.insert(id, entry);
+        let spawned = std::thread::Builder::new()
+            .name(format!("plane-{id}"))
+            .spawn(move || worker::run(setup, receiver));
+        match spawned {
+            Ok(handle) => self.workers.push(handle),
+            Err(e) => {
+                return refuse(CommandError::new(
+                    ErrorKind::Internal,
+                    format!("cannot start the thread of plane {id}: {e}"),
+                ))
+            }
+        }
+        self.next_ticket += 1;
+        self.next_plane_id += 1;
+        self.planes.insert(
+            id,
+            PlaneEntry {
+                owner,
+                shared,
+                jobs,
+                usage,
+            },
+        );
         if let Some(c) = self.clients.get_mut(owner) {
             c.planes.push(id);
         }
-        self.next_plane_id += 1;
-        tracing::info!(plane = id, ?kind, ?info, "plane created");
-        Ok(info)
+        Routed::Wait(ticket)
     }
+}
+
+/// The error for a plane that is not (or no longer) there.
+pub(super) fn unknown_plane(id: PlaneId) -> CommandError {
+    CommandError::new(
+        ErrorKind::UnknownPlane,
+        format!("plane {id} does not exist"),
+    )
 }
 
 /// A daemon failure as the error of the command that met it.

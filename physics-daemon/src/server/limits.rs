@@ -6,7 +6,7 @@
 use shm_layout::{CommandError, ErrorKind};
 
 /// The daemon's per-client and per-request limits.
-#[derive(Debug, Clone, PartialEq, clap::Args)]
+#[derive(Debug, Clone, Copy, PartialEq, clap::Args)]
 pub struct Limits {
     /// Clients (connections) one process may hold at once.
     #[arg(long = "max-clients-per-process", default_value_t = Limits::DEFAULT.clients_per_process)]

@@ -1,34 +1,46 @@
-//! The daemon's event loop. It sleeps in an iceoryx2 WaitSet until a client announces a
-//! request or the earliest plane tick is due, so an idle daemon costs no CPU.
+//! The daemon's request loop. It sleeps in an iceoryx2 WaitSet until a client announces a
+//! request, a plane worker reports, or (while clients are connected) housekeeping is due, so
+//! an idle daemon costs no CPU.
+//!
+//! Every plane lives on a worker thread of its own (`worker`): it applies the command runs
+//! the loop hands it, in order, steps and publishes. The loop itself never steps: a request
+//! whose commands wait on a plane is parked (its client's later requests queue behind it)
+//! while the loop serves everyone else, and its reply goes out when the last of its commands
+//! is answered. So planes step in parallel, a heavy tick of one plane never delays a request
+//! for another, and `Step` replies once its tick is published.
 //!
 //! - `clients`: who is connected, and noticing clients that died.
 //! - `dispatch`: decoding requests and routing each command to its plane by id.
 //!
-//! The server knows planes only through [`Backend`]: it never names an engine type, an
-//! object property or a per-feature op.
+//! The server knows planes only through [`crate::backend::Backend`]: it never names an
+//! engine type, an object property or a per-feature op.
 
 pub mod clients;
 mod dispatch;
 pub mod files;
 pub mod heartbeat;
 pub mod limits;
+mod worker;
 
-use std::collections::BTreeMap;
-use std::panic::{catch_unwind, AssertUnwindSafe};
+use std::collections::{BTreeMap, HashMap, VecDeque};
 use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::mpsc::{self, Receiver, Sender};
+use std::sync::Arc;
+use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
+use iceoryx2::active_request::ActiveRequest;
 use iceoryx2::config::Config;
 use iceoryx2::port::server::Server;
 use iceoryx2::prelude::*;
-use iceoryx2::service::header::payload_header::PayloadHeader;
-use shm_layout::{names, CommandError, ErrorKind, PlaneId};
+use iceoryx2_bb_posix::socket_pair::StreamingSocket;
+use shm_layout::{names, Command, CommandResult, PlaneId};
 
-use crate::backend::Backend;
-use crate::publish::{PlaneOutput, MAX_NODES};
+use crate::publish::MAX_NODES;
 use crate::DaemonError;
 use clients::{Clients, MAX_CLIENTS};
 pub use limits::Limits;
+use worker::{Event, Job, SharedUsage, Waker};
 
 /// How the daemon runs beyond its domain.
 #[derive(Debug, Clone, Default)]
@@ -43,8 +55,9 @@ pub struct Options {
     pub panic_on_step_dt: Option<f32>,
 }
 
-/// How often dead clients are looked for while clients are connected. Without clients the
-/// daemon has nothing to look for and sleeps until a request (or a shutdown wake-up).
+/// How often dead clients are looked for while clients are connected (and, for a daemon
+/// started on demand, whether its starter is gone). Otherwise the daemon has nothing to look
+/// for and sleeps until a request (or a shutdown wake-up).
 const HOUSEKEEPING: Duration = Duration::from_millis(500);
 /// Planes one daemon hosts at once.
 pub const MAX_PLANES: usize = 1024;
@@ -52,45 +65,34 @@ pub const MAX_PLANES: usize = 1024;
 /// The user header (u128) is what older clients sent as their id; it is ignored (identity
 /// comes from the transport) but kept so the service layout never changes across versions.
 type ControlServer = Server<ipc::Service, [u8], u128, [u8], ()>;
+type Request = ActiveRequest<ipc::Service, [u8], u128, [u8], ()>;
 
+/// The loop's view of a plane: who may do what, and the way to its worker.
 struct PlaneEntry {
-    plane: Box<dyn Backend>,
     /// Client that created the plane; the plane is released when that client goes away.
     owner: u128,
     /// Other clients may change the plane (only the owner destroys it).
     shared: bool,
-    out: PlaneOutput,
-    /// The tick period the schedule was made for; `None` for manual or disabled planes.
-    period: Option<Duration>,
-    /// When the next automatic tick is due; `None` for manual or disabled planes.
-    next_tick: Option<Instant>,
+    jobs: Sender<Job>,
+    /// What the plane holds, as its worker last saw it (for the owner's other quotas).
+    usage: Arc<SharedUsage>,
 }
 
-impl PlaneEntry {
-    /// The period the plane asks for now: `None` when manual, disabled, or not
-    /// representable (validation keeps rates within bounds; this never panics).
-    fn wanted_period(&self) -> Option<Duration> {
-        let rate = self.plane.tick_rate();
-        if !(rate > 0.0 && self.plane.enabled()) {
-            return None;
-        }
-        Duration::try_from_secs_f64(1.0 / rate as f64)
-            .ok()
-            .filter(|p| !p.is_zero())
-    }
-
-    /// Restarts the schedule when the plane's rate or Enabled changed.
-    fn reschedule_if_changed(&mut self, now: Instant) {
-        let period = self.wanted_period();
-        if period != self.period {
-            self.period = period;
-            self.next_tick = period.and_then(|p| now.checked_add(p));
-        }
-    }
+/// A request being served: its commands run in order; the loop parks it while one of its
+/// runs is with a plane worker.
+struct Pending {
+    request: Request,
+    origin: Origin,
+    commands: VecDeque<Command>,
+    results: Vec<CommandResult>,
+    /// The job whose answer it waits for.
+    waiting: Option<u64>,
+    /// A reply decided without running commands (malformed, over a limit).
+    early: Option<Vec<u8>>,
 }
 
-/// Everything the daemon owns except the WaitSet and the request listener, which stay on
-/// the stack of [`run`] (the WaitSet borrows the listener).
+/// Everything the daemon owns except the WaitSet, the request listener and the workers'
+/// wake-up socket, which stay on the stack of [`run`] (the WaitSet borrows them).
 pub struct Daemon {
     domain: String,
     config: Config,
@@ -100,6 +102,15 @@ pub struct Daemon {
     planes: BTreeMap<PlaneId, PlaneEntry>,
     next_plane_id: PlaneId,
     options: Options,
+    /// Per client, its requests in arrival order; the first one is being served.
+    queues: HashMap<u128, VecDeque<Pending>>,
+    /// Jobs with a worker, and the client whose request waits for each.
+    tickets: HashMap<u64, u128>,
+    next_ticket: u64,
+    events: Receiver<Event>,
+    events_tx: Sender<Event>,
+    waker: Arc<Waker>,
+    workers: Vec<JoinHandle<()>>,
 }
 
 /// Wakes the loop of the daemon of `domain` (e.g. from a signal handler thread after setting
@@ -135,11 +146,11 @@ pub fn run_with(domain: &str, shutdown: &AtomicBool, options: Options) -> Result
     let config = names::config(domain)?;
     files::check_ownership(domain)?;
     remove_dead_nodes(&config);
-    let stop_beating = AtomicBool::new(false);
+    let beats = heartbeat::Control::default();
     std::thread::scope(|s| {
-        s.spawn(|| heartbeat::run(&config, &stop_beating));
-        let served = serve(domain, &config, shutdown, options);
-        stop_beating.store(true, Ordering::Relaxed);
+        s.spawn(|| heartbeat::run(&config, &beats));
+        let served = serve(domain, &config, shutdown, options, &beats);
+        beats.stop();
         served
     })?;
     release_domain(&config);
@@ -184,6 +195,7 @@ fn serve(
     config: &Config,
     shutdown: &AtomicBool,
     options: Options,
+    beats: &heartbeat::Control,
 ) -> Result<(), DaemonError> {
     let node = NodeBuilder::new()
         .name(&NodeName::new(names::DAEMON_NODE_NAME).expect("valid node name"))
@@ -228,6 +240,13 @@ fn serve(
     let _request_guard = waitset
         .attach_notification(&listener)
         .map_err(|e| DaemonError::Ipc(format!("cannot attach the request listener: {e:?}")))?;
+    // Plane workers wake the loop through a socket pair the WaitSet watches.
+    let (worker_wake, wake_end) = StreamingSocket::create_pair()
+        .map_err(|e| DaemonError::Ipc(format!("cannot create the worker wake-up: {e:?}")))?;
+    let _worker_guard = waitset
+        .attach_notification(&worker_wake)
+        .map_err(|e| DaemonError::Ipc(format!("cannot attach the worker wake-up: {e:?}")))?;
+    let (events_tx, events) = mpsc::channel();
 
     let mut daemon = Daemon {
         domain: domain.to_string(),
@@ -238,6 +257,13 @@ fn serve(
         planes: BTreeMap::new(),
         next_plane_id: 1,
         options,
+        queues: HashMap::new(),
+        tickets: HashMap::new(),
+        next_ticket: 1,
+        events,
+        events_tx,
+        waker: Arc::new(Waker::new(wake_end)),
+        workers: Vec::new(),
     };
     // iceoryx2 creates its node-counter segment world-writable: narrow it to this user.
     files::restrict(domain);
@@ -245,37 +271,46 @@ fn serve(
 
     let mut next_housekeeping = Instant::now() + HOUSEKEEPING;
     while !shutdown.load(Ordering::Relaxed) {
-        let now = Instant::now();
-        let wake_at = daemon
-            .next_tick()
-            .map_or(next_housekeeping, |t| t.min(next_housekeeping));
-        let timeout = wake_at.saturating_duration_since(now);
-        if let Err(e) =
+        let housekeeping = !daemon.clients.is_empty() || daemon.options.starter_pid.is_some();
+        let waited = if housekeeping {
+            let timeout = next_housekeeping.saturating_duration_since(Instant::now());
             waitset.wait_and_process_once_with_timeout(|_| CallbackProgression::Continue, timeout)
-        {
+        } else {
+            // Nothing to look after: sleep until a request, a worker or a shutdown wake-up.
+            waitset.wait_and_process_once(|_| CallbackProgression::Continue)
+        };
+        if let Err(e) = waited {
             tracing::warn!("waitset: {e:?}");
         }
         // Consume the wake-ups, then serve everything that is queued.
         if let Err(e) = listener.try_wait(|_| {}) {
             tracing::warn!("request listener: {e:?}");
         }
+        let mut buf = [0u8; 256];
+        while matches!(worker_wake.try_receive(&mut buf), Ok(n) if n > 0) {}
+        daemon.waker.disarm();
+        daemon.handle_events();
         daemon.serve_requests();
-        daemon.tick_due_planes(Instant::now());
+        beats.beat(!daemon.clients.is_empty());
         if daemon.clients.is_empty() {
-            if Instant::now() >= next_housekeeping && daemon.starter_gone() {
-                tracing::info!(
-                    starter = daemon.options.starter_pid,
-                    "the process that started this daemon is gone and no client is left"
-                );
-                break;
+            if Instant::now() >= next_housekeeping {
+                if daemon.starter_gone() {
+                    tracing::info!(
+                        starter = daemon.options.starter_pid,
+                        "the process that started this daemon is gone and no client is left"
+                    );
+                    break;
+                }
+                next_housekeeping = Instant::now() + HOUSEKEEPING;
             }
-            next_housekeeping = Instant::now() + HOUSEKEEPING;
         } else if Instant::now() >= next_housekeeping {
             daemon.release_gone_clients();
+            daemon.workers.retain(|w| !w.is_finished());
             next_housekeeping = Instant::now() + HOUSEKEEPING;
         }
     }
     tracing::info!(domain = daemon.domain, "shutting down");
+    daemon.stop_workers();
     Ok(())
 }
 
@@ -304,10 +339,8 @@ pub struct Origin {
 }
 
 impl Daemon {
-    fn next_tick(&self) -> Option<Instant> {
-        self.planes.values().filter_map(|p| p.next_tick).min()
-    }
-
+    /// Takes every request that arrived: each joins its client's queue and runs at once
+    /// unless an earlier request of the same client is still being served.
     fn serve_requests(&mut self) {
         loop {
             let request = match self.server.receive() {
@@ -323,89 +356,176 @@ impl Daemon {
             let node = request.header().node_id();
             let client = node.value();
             let pid = node.pid::<ipc::Service>().map_or(0, |p| p.value() as u32);
-            let reply = self.handle_bytes(Origin { id: client, pid }, request.payload());
-            let sent = request
-                .loan_slice_uninit(reply.len())
-                .map_err(|e| format!("{e:?}"))
-                .and_then(|r| {
-                    r.write_from_slice(&reply)
-                        .send()
-                        .map_err(|e| format!("{e:?}"))
-                });
-            if let Err(e) = sent {
-                tracing::warn!(client = format!("{client:032x}"), "reply failed: {e}");
+            let origin = Origin { id: client, pid };
+            let pending = match self.decode(request.payload()) {
+                Ok(commands) => Pending {
+                    request,
+                    origin,
+                    results: Vec::with_capacity(commands.len()),
+                    commands: commands.into(),
+                    waiting: None,
+                    early: None,
+                },
+                Err(reply) => Pending {
+                    request,
+                    origin,
+                    commands: VecDeque::new(),
+                    results: Vec::new(),
+                    waiting: None,
+                    early: Some(reply),
+                },
+            };
+            let queue = self.queues.entry(client).or_default();
+            queue.push_back(pending);
+            if queue.len() == 1 {
+                self.advance(client);
             }
-            self.clients.wake(&self.node, client);
         }
     }
 
-    fn tick_due_planes(&mut self, now: Instant) {
-        let mut failed = Vec::new();
-        for (id, entry) in self.planes.iter_mut() {
-            let (Some(due), Some(period)) = (entry.next_tick.filter(|t| *t <= now), entry.period)
-            else {
-                continue;
+    /// Serves the requests of `client` in order until one waits for a worker or none is
+    /// left.
+    fn advance(&mut self, client: u128) {
+        loop {
+            let Some(mut pending) = self.queues.get_mut(&client).and_then(|q| q.pop_front()) else {
+                self.queues.remove(&client);
+                return;
             };
-            let stepped = catch_unwind(AssertUnwindSafe(|| {
-                entry.plane.step(period.as_secs_f32()).and_then(|stepped| {
-                    if stepped {
-                        entry
-                            .out
-                            .publish(entry.plane.as_mut())
-                            .map_err(dispatch::internal)?;
+            if pending.waiting.is_some() {
+                self.queues.entry(client).or_default().push_front(pending);
+                return;
+            }
+            while let Some(command) = pending.commands.pop_front() {
+                match self.route(pending.origin, command, &mut pending.commands) {
+                    Routed::Now(results) => pending.results.extend(results),
+                    Routed::Wait(ticket) => {
+                        pending.waiting = Some(ticket);
+                        self.tickets.insert(ticket, client);
+                        break;
                     }
-                    Ok(())
-                })
-            }));
-            match stepped {
-                Ok(Ok(())) => {}
-                Ok(Err(e)) => tracing::warn!(plane = id, "tick failed: {e}"),
-                Err(panic) => {
-                    failed.push((*id, panic));
-                    continue;
                 }
             }
-            // Keep the cadence; after a stall, restart from now instead of catching up.
-            let next = due + period;
-            entry.next_tick = Some(if next + period * 4 < now {
-                now + period
-            } else {
-                next
+            if pending.waiting.is_some() {
+                self.queues.entry(client).or_default().push_front(pending);
+                return;
+            }
+            self.reply(pending);
+        }
+    }
+
+    /// Sends the reply of a finished request and wakes its client.
+    fn reply(&self, pending: Pending) {
+        let client = pending.origin.id;
+        let bytes = pending.early.unwrap_or_else(|| {
+            shm_layout::codec::encode_response(&shm_layout::Response::Results(pending.results))
+        });
+        let sent = pending
+            .request
+            .loan_slice_uninit(bytes.len())
+            .map_err(|e| format!("{e:?}"))
+            .and_then(|r| {
+                r.write_from_slice(&bytes)
+                    .send()
+                    .map_err(|e| format!("{e:?}"))
             });
+        if let Err(e) = sent {
+            tracing::warn!(client = format!("{client:032x}"), "reply failed: {e}");
         }
-        for (id, panic) in failed {
-            self.fail_plane(id, panic);
+        self.clients.wake(&self.node, client);
+    }
+
+    /// What the plane workers reported: answers of parked requests, failed planes.
+    fn handle_events(&mut self) {
+        while let Ok(event) = self.events.try_recv() {
+            match event {
+                Event::Done {
+                    ticket,
+                    plane,
+                    results,
+                    failed,
+                } => {
+                    if failed {
+                        self.remove_plane(plane);
+                    }
+                    let Some(client) = self.tickets.remove(&ticket) else {
+                        continue;
+                    };
+                    let Some(pending) = self
+                        .queues
+                        .get_mut(&client)
+                        .and_then(|q| q.front_mut())
+                        .filter(|p| p.waiting == Some(ticket))
+                    else {
+                        continue;
+                    };
+                    pending.results.extend(results);
+                    pending.waiting = None;
+                    self.advance(client);
+                }
+                Event::Failed { plane } => self.remove_plane(plane),
+            }
         }
     }
 
-    /// Removes a plane whose code panicked (its state cannot be trusted) and returns the
-    /// error its clients get. The daemon and every other plane serve on.
-    fn fail_plane(&mut self, id: PlaneId, panic: Box<dyn std::any::Any + Send>) -> CommandError {
-        let message = dispatch::panic_message(panic.as_ref());
-        tracing::error!(plane = id, "plane failed and was removed: {message}");
-        self.remove_plane(id);
-        CommandError::new(
-            ErrorKind::Internal,
-            format!("plane {id} failed and was removed: {message}"),
-        )
+    /// Hands a job to the worker of plane `id`; the ticket names its answer.
+    fn send_job(&mut self, id: PlaneId, ops: Vec<shm_layout::PlaneOp>) -> Routed {
+        let ticket = self.next_ticket;
+        self.next_ticket += 1;
+        let budget = self.budget(id);
+        let n = ops.len();
+        match self.planes.get(&id) {
+            Some(entry)
+                if entry
+                    .jobs
+                    .send(Job::Run {
+                        ticket,
+                        ops,
+                        budget,
+                    })
+                    .is_ok() =>
+            {
+                Routed::Wait(ticket)
+            }
+            _ => Routed::Now((0..n).map(|_| Err(dispatch::unknown_plane(id))).collect()),
+        }
     }
 
-    /// Drops a plane and forgets it in its owner's list.
+    /// Drops a plane (its worker finishes what is queued, then ends) and forgets it in its
+    /// owner's list.
     fn remove_plane(&mut self, id: PlaneId) {
         if let Some(entry) = self.planes.remove(&id) {
+            let _ = entry.jobs.send(Job::Stop);
             if let Some(c) = self.clients.get_mut(entry.owner) {
                 c.planes.retain(|p| *p != id);
             }
         }
     }
 
+    /// Ends every worker and waits for them (their planes' shared memory is gone after).
+    fn stop_workers(&mut self) {
+        let ids: Vec<PlaneId> = self.planes.keys().copied().collect();
+        for id in ids {
+            self.remove_plane(id);
+        }
+        for worker in self.workers.drain(..) {
+            let _ = worker.join();
+        }
+    }
+
     fn release_client(&mut self, client: u128) {
-        let before = self.planes.len();
-        self.planes.retain(|_, p| p.owner != client);
+        let owned: Vec<PlaneId> = self
+            .planes
+            .iter()
+            .filter(|(_, p)| p.owner == client)
+            .map(|(id, _)| *id)
+            .collect();
+        for id in &owned {
+            self.remove_plane(*id);
+        }
         self.clients.disconnect(client);
         tracing::info!(
             client = format!("{client:032x}"),
-            planes_released = before - self.planes.len(),
+            planes_released = owned.len(),
             "client released"
         );
     }
@@ -428,7 +548,17 @@ impl Daemon {
     fn release_gone_clients(&mut self) {
         for client in self.clients.reap(&self.config) {
             tracing::warn!(client = format!("{client:032x}"), "client process is gone");
+            // Its requests go unanswered: nobody waits for them.
+            self.queues.remove(&client);
             self.release_client(client);
         }
     }
+}
+
+/// How a command was served.
+enum Routed {
+    /// Answered at once (one result per command taken).
+    Now(Vec<CommandResult>),
+    /// Handed to a plane worker; the answer comes with this ticket.
+    Wait(u64),
 }
