@@ -1,7 +1,6 @@
 //! PhysicsPlane properties, which are also the options of `PhysicsService.New`. Every option
 //! reads back from the daemon (`plane.info()`, one round trip that sends the queued writes
-//! first, so a script reads what it wrote) and writes one `PlaneProp`. Rows marked
-//! `not_yet` are documented but belong to a backend not built yet.
+//! first, so a script reads what it wrote) and writes one `PlaneProp`.
 
 use client_sdk::validate::{MAX_SOLVER_ITERATIONS, MAX_THREADS, MAX_TICK_RATE};
 use client_sdk::PlaneProp;
@@ -159,6 +158,6 @@ pub static PLANE: Props<PlaneState> = Props {
             max_angular_speed,
             PlaneProp::MaxAngularSpeed
         ),
-        Row::not_yet("DeferGpu", Kind::Boolean),
+        bool_row!("DeferGpu", defer_gpu, PlaneProp::DeferGpu),
     ],
 };
