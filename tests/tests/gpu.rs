@@ -70,6 +70,7 @@ fn free_fall_matches_the_closed_form_and_the_cpu_path() {
         let q = on_cpu.position().unwrap();
         worst_cpu_gap = worst_cpu_gap.max((p[1] - q[1]).abs());
     }
+    println!("GPU − CPU height, worst over 1 s: {worst_cpu_gap}");
     // The CPU path runs the same integrator: the two agree to f32 rounding.
     assert!(
         worst_cpu_gap < 2e-3,
@@ -99,6 +100,7 @@ fn a_ball_bounces_with_apex_ratio_e_squared() {
         last_vy = vy;
     }
     assert!(apexes.len() >= 3, "apexes {apexes:?}");
+    println!("apexes {apexes:?}");
     let mut previous = h0;
     for (i, apex) in apexes.iter().take(3).enumerate() {
         let ratio = apex / previous;
