@@ -96,12 +96,53 @@ pub struct Containment {
     pub tick_ms: f64,
 }
 
+/// One accuracy scene (`physics-bench accuracy`'s) at the defaults on both paths.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct Accuracy {
+    pub scene: String,
+    pub measures: String,
+    pub unit: String,
+    pub cpu_error: Option<f64>,
+    /// `None` with `gpu_refused` when the GPU path refuses the scene.
+    pub gpu_error: Option<f64>,
+    pub gpu_refused: Option<String>,
+}
+
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct GpuReport {
     pub adapter: String,
     pub cells: Vec<Cell>,
     pub ratios: Vec<Ratio>,
     pub containment: Option<Containment>,
+    pub accuracy: Vec<Accuracy>,
+}
+
+/// The accuracy report's scenes at the plane defaults (60 Hz, 4 iterations), on the CPU and
+/// on the GPU path.
+fn accuracy() -> Vec<Accuracy> {
+    use super::sim::Config;
+    super::accuracy::scenes::SCENES
+        .iter()
+        .map(|s| {
+            let cpu = (s.run)(Config::DEFAULT).ok().map(|o| o.error);
+            let gpu = (s.run)(Config {
+                gpu: true,
+                ..Config::DEFAULT
+            });
+            let (gpu_error, gpu_refused) = match gpu {
+                Ok(o) => (Some(o.error), None),
+                Err(e) => (None, Some(e.to_string())),
+            };
+            Accuracy {
+                scene: s.name.into(),
+                measures: s.measures.into(),
+                unit: s.unit.into(),
+                cpu_error: cpu,
+                gpu_error,
+                gpu_refused,
+            }
+        })
+        .collect()
 }
 
 fn err(e: impl std::fmt::Display) -> BenchError {
@@ -147,6 +188,29 @@ fn time(plane: &mut LocalPlane) -> BenchResult<(f64, usize)> {
         super::stats::median(&samples).ok_or_else(|| err("no samples"))?,
         n,
     ))
+}
+
+/// time(4N) / time(N) with the two planes' ticks interleaved after 30 ticks each, so a
+/// change in the machine's load hits both alike: median of up to 20 rounds or 4 s.
+fn interleaved_ratio(path: Path, n: usize) -> BenchResult<f64> {
+    let mut small = scene(n, path)?;
+    let mut big = scene(4 * n, path)?;
+    for _ in 0..30 {
+        small.step(DT)?;
+        big.step(DT)?;
+    }
+    let started = Instant::now();
+    let (mut a, mut b) = (Vec::new(), Vec::new());
+    while a.len() < 20 && (a.len() < 3 || started.elapsed().as_secs_f64() < 4.0) {
+        let t = Instant::now();
+        small.step(DT)?;
+        a.push(t.elapsed().as_secs_f64());
+        let t = Instant::now();
+        big.step(DT)?;
+        b.push(t.elapsed().as_secs_f64());
+    }
+    let median = |v: &[f64]| super::stats::median(v).ok_or_else(|| err("no samples"));
+    Ok(median(&b)? / median(&a)?)
 }
 
 /// 100,000 (10,000 quick) bodies in the container for 10 s: finite, inside, penetration.
@@ -226,15 +290,25 @@ pub fn run(args: &GpuArgs) -> BenchResult<()> {
     let mut ratios = Vec::new();
     for a in &cells {
         for b in &cells {
-            if a.path == b.path && b.bodies == 4 * a.bodies {
-                if let (Some(x), Some(y)) = (a.tick_ms, b.tick_ms) {
-                    ratios.push(Ratio {
-                        path: a.path,
-                        from: a.bodies,
-                        to: b.bodies,
-                        ratio: y / x,
-                    });
-                }
+            if a.path == b.path
+                && b.bodies == 4 * a.bodies
+                && a.tick_ms.is_some()
+                && b.tick_ms.is_some()
+            {
+                let ratio = interleaved_ratio(a.path, a.bodies)?;
+                println!(
+                    "{:<22} {} → {}: ×{}",
+                    a.path.name(),
+                    a.bodies,
+                    b.bodies,
+                    num(Some(ratio))
+                );
+                ratios.push(Ratio {
+                    path: a.path,
+                    from: a.bodies,
+                    to: b.bodies,
+                    ratio,
+                });
             }
         }
     }
@@ -244,6 +318,7 @@ pub fn run(args: &GpuArgs) -> BenchResult<()> {
         cells,
         ratios,
         containment: Some(containment),
+        accuracy: accuracy(),
     };
     let md = markdown(&report);
     let (json, md_path) = report::write(&args.out, "gpu", &report, &md)?;
@@ -295,7 +370,8 @@ fn markdown(r: &GpuReport) -> String {
     md.push_str(&t.finish());
     let _ = writeln!(
         md,
-        "\nScaling, time(4N) / time(N) (O(N): ≤ {GOAL_RATIO}; O(N²): ≈ 16):\n"
+        "\nScaling, time(4N) / time(N) (O(N): ≤ {GOAL_RATIO}; O(N²): ≈ 16), measured with \
+         the two sizes' ticks interleaved (a change of the machine's load hits both):\n"
     );
     let mut t = report::Table::new(&["path", "N → 4N", "ratio"]);
     for x in &r.ratios {
@@ -341,5 +417,24 @@ fn markdown(r: &GpuReport) -> String {
         ));
     }
     let _ = writeln!(md, "\n{}", goals_table(&goals));
+    let _ = writeln!(
+        md,
+        "\n## Accuracy: the accuracy report's scenes at the defaults (60 Hz, 4 iterations)\n"
+    );
+    let mut t = report::Table::new(&["scene", "error measured", "unit", "CPU", "GPU"]);
+    for a in &r.accuracy {
+        t.row(&[
+            a.scene.clone(),
+            a.measures.clone(),
+            a.unit.clone(),
+            a.cpu_error.map_or("—".into(), |e| format!("{e:.3e}")),
+            match (&a.gpu_error, &a.gpu_refused) {
+                (Some(e), _) => format!("{e:.3e}"),
+                (None, Some(why)) => format!("refused: {why}"),
+                _ => "—".into(),
+            },
+        ]);
+    }
+    md.push_str(&t.finish());
     md
 }
