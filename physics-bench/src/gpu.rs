@@ -24,7 +24,7 @@ use super::scene::DT;
 /// Options of the `gpu` subcommand.
 #[derive(Debug, Clone, clap::Args)]
 pub struct GpuArgs {
-    /// Small sizes only (1k to 40k bodies) and a 10,000-body stay-in-the-box scene.
+    /// Small sizes only (1k to 40k bodies) and a 1,000-body stay-in-the-box scene.
     #[arg(long)]
     pub quick: bool,
     /// Largest per-tick time (s) a path may be expected to take at a size; above it the
@@ -312,7 +312,7 @@ pub fn run(args: &GpuArgs) -> BenchResult<()> {
             }
         }
     }
-    let containment = containment(if args.quick { 10_000 } else { 100_000 })?;
+    let containment = containment(if args.quick { 1_000 } else { 100_000 })?;
     let report = GpuReport {
         adapter,
         cells,
