@@ -55,6 +55,9 @@ pub struct PlaneOptions {
     /// `MaxAngularSpeed` (rad/s): no body spins faster. Default 1,000
     /// (`shm_layout::settings::plane::DEFAULT_MAX_ANGULAR_SPEED`).
     pub max_angular_speed: Option<f32>,
+    /// `DeferGpu`: run the plane on the GPU (wgpu compute) instead of rapier on the CPU.
+    /// Refused, naming the reason, when the daemon has no GPU adapter.
+    pub defer_gpu: Option<bool>,
 }
 
 impl PlaneOptions {
@@ -85,6 +88,7 @@ impl PlaneOptions {
             o.shared.map(PlaneProp::Shared),
             o.max_linear_speed.map(PlaneProp::MaxLinearSpeed),
             o.max_angular_speed.map(PlaneProp::MaxAngularSpeed),
+            o.defer_gpu.map(PlaneProp::DeferGpu),
         ]
         .into_iter()
         .flatten()

@@ -8,6 +8,7 @@
 //! `physics-bench stability [--out DIR]` writes DIR/stability.json and DIR/stability.md.
 //! `physics-bench queries [--quick] [--out DIR]` writes DIR/queries.json and DIR/queries.md.
 //! `physics-bench controllers [--quick] [--out DIR]` writes DIR/controllers.json and .md.
+//! `physics-bench gpu [--quick] [--out DIR]` writes DIR/gpu.json and DIR/gpu.md.
 //!
 //! Its parts, shared by the subcommands:
 //!
@@ -27,6 +28,7 @@ mod controllers;
 mod daemon;
 mod error;
 mod fuzz;
+mod gpu;
 mod ipc;
 mod load;
 mod maps;
@@ -79,6 +81,9 @@ enum Bench {
     /// 4 planes × 1,000 bodies at 60 Hz with a client writing every frame for N minutes:
     /// daemon RSS and shared-memory growth against a bound.
     Soak(soak::SoakArgs),
+    /// The GPU path (DeferGpu) against the CPU: time per tick of 1k to 1M bodies falling
+    /// into a container (spatial hash, every pair, rapier), scaling ratios, the adapter.
+    Gpu(gpu::GpuArgs),
 }
 
 fn main() -> ExitCode {
@@ -103,6 +108,7 @@ fn main() -> ExitCode {
         Bench::Queries(args) => queries::run(args),
         Bench::Controllers(args) => controllers::run(args),
         Bench::Maps(args) => maps::run(args),
+        Bench::Gpu(args) => gpu::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

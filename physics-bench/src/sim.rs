@@ -15,6 +15,9 @@ pub struct Config {
     pub solver_iterations: u32,
     pub loop_solver: bool,
     pub hit_box_quality: u32,
+    /// Runs the plane on the GPU path (DeferGpu), switched on at the first step, once the
+    /// scene is built.
+    pub gpu: bool,
 }
 
 impl Config {
@@ -24,6 +27,7 @@ impl Config {
         solver_iterations: 4,
         loop_solver: false,
         hit_box_quality: 1,
+        gpu: false,
     };
 
     /// The most accurate setting the API offers at 240 Hz: LoopSolver (64 iterations) and
@@ -33,6 +37,7 @@ impl Config {
         solver_iterations: 64,
         loop_solver: true,
         hit_box_quality: 32,
+        gpu: false,
     };
 
     pub fn dt(&self) -> f32 {
@@ -103,6 +108,9 @@ impl Sim {
 
     /// One timed step.
     pub fn step(&mut self) -> BenchResult<()> {
+        if self.config.gpu && !self.plane.on_gpu() {
+            self.plane.set(PlaneProp::DeferGpu(true))?;
+        }
         let started = Instant::now();
         self.plane.step(self.dt)?;
         self.step_wall += started.elapsed();

@@ -5,11 +5,14 @@
 //! - [`backend`]: the seam every plane kind implements, and the reusable [`backend::SlotTable`].
 //! - [`rapier3d`]: the 3D plane kind (a rapier world with stable handles and the options).
 //! - `rapier2d`: the 2D GUI plane kind (`PhysicsService.NewGUI`), behind the `gui` feature.
+//! - `gpu`: the GPU path of 3D planes (`DeferGpu`, wgpu compute), behind the `gpu` feature.
 //! - [`publish`]: writing a plane's tick into loaned shared-memory samples.
 
 #![warn(missing_docs)]
 
 pub mod backend;
+#[cfg(feature = "gpu")]
+pub mod gpu;
 pub mod publish;
 #[cfg(feature = "gui")]
 pub mod rapier2d;

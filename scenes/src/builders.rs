@@ -247,6 +247,69 @@ impl Rng {
     }
 }
 
+/// An anchored open box for debris scenes: a floor whose top is y = 0 spanning `width` ×
+/// `width` inside, and four walls 1 thick and `height` tall around it. Returns floor, then
+/// walls (−x, +x, −z, +z).
+pub fn container<T: SceneTarget + ?Sized>(
+    target: &mut T,
+    width: f32,
+    height: f32,
+) -> Built<T, Vec<T::Handle>> {
+    let outer = width + 2.0;
+    let mut all = vec![anchored_box(
+        target,
+        [outer, 1.0, outer],
+        Pose::at([0.0, -0.5, 0.0]),
+        &[],
+    )?];
+    let y = height / 2.0;
+    let off = width / 2.0 + 0.5;
+    for (at, size) in [
+        ([-off, y, 0.0], [1.0, height, outer]),
+        ([off, y, 0.0], [1.0, height, outer]),
+        ([0.0, y, -off], [outer, height, 1.0]),
+        ([0.0, y, off], [outer, height, 1.0]),
+    ] {
+        all.push(anchored_box(target, size, Pose::at(at), &[])?);
+    }
+    Ok(all)
+}
+
+/// Where [`debris`] puts `n` unit cubes: columns `per_row` × `per_row` spaced 1.25 apart,
+/// centred on the y axis, layers 1.25 apart from y = `base` up. Also the inner width of a
+/// container that holds the columns with 0.5 to spare on each side.
+pub fn debris_layout(n: usize, per_row: usize, base: f32) -> (Vec<[f32; 3]>, f32) {
+    let spacing = 1.25;
+    let span = (per_row - 1) as f32 * spacing;
+    let positions = (0..n)
+        .map(|i| {
+            let (col, layer) = (i % (per_row * per_row), i / (per_row * per_row));
+            let (cx, cz) = (col % per_row, col / per_row);
+            [
+                cx as f32 * spacing - span / 2.0,
+                base + layer as f32 * spacing,
+                cz as f32 * spacing - span / 2.0,
+            ]
+        })
+        .collect();
+    (positions, span + 1.0 + 1.0)
+}
+
+/// `n` unit cubes laid out by [`debris_layout`] (falling debris), each with `props`.
+pub fn debris<T: SceneTarget + ?Sized>(
+    target: &mut T,
+    n: usize,
+    per_row: usize,
+    base: f32,
+    props: &[ObjectProp],
+) -> Built<T, Vec<T::Handle>> {
+    debris_layout(n, per_row, base)
+        .0
+        .into_iter()
+        .map(|at| target.add(cube(1.0), Pose::at(at), props))
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -87,11 +87,11 @@ fn bad_input_errors_name_property_type_and_value() {
 }
 
 #[test]
-fn documented_properties_read_back_and_only_the_gpu_backend_is_missing() {
+fn documented_properties_read_back() {
     let daemon = TestDaemon::start("lua-props");
     let r = run(&daemon, "tests/lua/properties.luau");
     r.assert_ok();
-    // 20 properties read back what was written; DeferGpu alone says "not supported yet".
+    // 21 properties read back what was written (DeferGpu included); none is missing.
     let fields: Vec<usize> = r
         .stdout()
         .trim()
@@ -99,7 +99,7 @@ fn documented_properties_read_back_and_only_the_gpu_backend_is_missing() {
         .skip(1)
         .map(|n| n.parse().expect("count"))
         .collect();
-    assert_eq!(fields, vec![20, 1], "{}", r.stdout());
+    assert_eq!(fields, vec![21, 0], "{}", r.stdout());
 }
 
 #[test]
@@ -420,4 +420,12 @@ fn ragdolls_from_lua_keep_their_bones_joined_after_a_hit() {
     let daemon = TestDaemon::start("lua-ragdoll");
     let out = run_ok(&daemon, "tests/lua/ragdoll.luau", "ragdoll ok");
     println!("{out}");
+}
+
+#[test]
+fn defer_gpu_from_lua_falls_flips_and_refuses() {
+    let daemon = TestDaemon::start("lua-gpu");
+    let r = run(&daemon, "tests/lua/gpu.luau");
+    r.assert_ok();
+    assert!(r.stdout().contains("gpu ok\t60"), "{}", r.stdout());
 }

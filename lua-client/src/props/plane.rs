@@ -2,8 +2,7 @@
 //! reads the SDK's property mirror (`plane.properties()`: a local lookup for a plane the
 //! script created and did not share, kept current by the script's own writes; otherwise one
 //! round trip that sends the queued writes first, so a script reads what it wrote) and
-//! writes one `PlaneProp`. Rows marked
-//! `not_yet` are documented but belong to a backend not built yet.
+//! writes one `PlaneProp`.
 
 use client_sdk::validate::{MAX_SOLVER_ITERATIONS, MAX_THREADS, MAX_TICK_RATE};
 use client_sdk::PlaneProp;
@@ -161,6 +160,6 @@ pub static PLANE: Props<PlaneState> = Props {
             max_angular_speed,
             PlaneProp::MaxAngularSpeed
         ),
-        Row::not_yet("DeferGpu", Kind::Boolean),
+        bool_row!("DeferGpu", defer_gpu, PlaneProp::DeferGpu),
     ],
 };

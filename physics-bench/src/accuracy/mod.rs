@@ -5,7 +5,7 @@
 mod chart;
 pub mod markdown;
 mod pareto;
-mod scenes;
+pub(crate) mod scenes;
 mod scenes_2d;
 pub mod sweep;
 

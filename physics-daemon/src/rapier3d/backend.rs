@@ -8,12 +8,9 @@ use shm_layout::{
 use super::Plane;
 use crate::backend::{Backend, Usage};
 
-impl Backend for Plane {
-    fn kind(&self) -> PlaneKind {
-        PlaneKind::Rapier3d
-    }
-
-    fn apply(&mut self, op: PlaneOp) -> CommandResult {
+impl Plane {
+    /// Applies one op to the rapier world (on the GPU path, `gpu.rs` wraps this).
+    pub(super) fn apply_on_cpu(&mut self, op: PlaneOp) -> CommandResult {
         let applied = |plane: &Plane| Reply::Applied { tick: plane.tick };
         match op {
             PlaneOp::Info => Ok(Reply::Plane(self.info())),
@@ -52,6 +49,20 @@ impl Backend for Plane {
             )),
         }
     }
+}
+
+impl Backend for Plane {
+    fn kind(&self) -> PlaneKind {
+        PlaneKind::Rapier3d
+    }
+
+    fn apply(&mut self, op: PlaneOp) -> CommandResult {
+        #[cfg(feature = "gpu")]
+        if self.on_gpu() {
+            return self.apply_on_gpu(op);
+        }
+        self.apply_on_cpu(op)
+    }
 
     fn step(&mut self, dt: f32) -> Result<bool, CommandError> {
         Plane::step(self, dt)
@@ -82,6 +93,12 @@ impl Backend for Plane {
     }
 
     fn for_each_awake(&self, f: &mut dyn FnMut(usize)) {
+        #[cfg(feature = "gpu")]
+        if self.on_gpu() {
+            // Nothing sleeps on the GPU path.
+            (0..self.slot_count()).for_each(f);
+            return;
+        }
         for slot in self.awake_slots() {
             f(slot);
         }

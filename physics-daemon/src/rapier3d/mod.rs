@@ -15,6 +15,8 @@ mod collision_groups;
 mod contacts;
 mod controllers;
 mod forces;
+#[cfg(feature = "gpu")]
+mod gpu;
 mod joints;
 mod limits;
 mod maps;
@@ -100,6 +102,9 @@ pub struct Plane {
     joints: joints::Joints,
     /// Map pieces uploaded since the last build (see `maps`).
     map_pending: maps::PendingMap,
+    /// The GPU world while `DeferGpu` is on (see `gpu`).
+    #[cfg(feature = "gpu")]
+    gpu: Option<crate::gpu::GpuWorld>,
 }
 
 impl Plane {
@@ -142,6 +147,8 @@ impl Plane {
             query_stale: Vec::new(),
             joints: joints::Joints::default(),
             map_pending: maps::PendingMap::default(),
+            #[cfg(feature = "gpu")]
+            gpu: None,
         };
         for prop in props {
             plane.apply_prop(*prop, true)?;
@@ -155,7 +162,14 @@ impl Plane {
     }
 
     fn apply_prop(&mut self, prop: PlaneProp, creating: bool) -> Result<(), CommandError> {
+        let before = self.settings;
         let prop = self.settings.apply(prop, creating)?;
+        if let PlaneProp::DeferGpu(on) = prop {
+            if let Err(e) = self.set_defer_gpu(on) {
+                self.settings = before;
+                return Err(e);
+            }
+        }
         // Mapping onto rapier: options read at step time need nothing here.
         match prop {
             PlaneProp::Gravity(g) => self.world.gravity = Vector::from(g),
@@ -168,6 +182,18 @@ impl Plane {
             self.world.wake_up_all(true);
         }
         self.dirty.mark_all();
+        Ok(())
+    }
+
+    #[cfg(not(feature = "gpu"))]
+    fn set_defer_gpu(&mut self, on: bool) -> Result<(), CommandError> {
+        if on {
+            return Err(CommandError::invalid_field(
+                "DeferGpu",
+                "DeferGpu = true failed: this daemon was built without the GPU path (cargo \
+                 feature \"gpu\"); the plane stays on the CPU",
+            ));
+        }
         Ok(())
     }
 
@@ -241,6 +267,16 @@ impl Plane {
             return Ok(false);
         }
         let started = Instant::now();
+        #[cfg(feature = "gpu")]
+        if self.gpu.is_some() {
+            self.step_on_gpu(dt)?;
+            self.dirty.stepped(self.bodies.slot_count());
+            self.tick += 1;
+            self.sim_time += dt as f64;
+            self.last_dt = dt;
+            self.last_step_us = started.elapsed().as_secs_f32() * 1e6;
+            return Ok(true);
+        }
         self.world.integration_parameters.dt = dt;
         self.tune_solver();
         self.tick_controllers(dt);
@@ -313,11 +349,43 @@ impl Plane {
 
     /// Number of bodies in [`Plane::awake_slots`].
     pub fn awake_count(&self) -> usize {
+        #[cfg(feature = "gpu")]
+        if self.gpu.is_some() {
+            return self.bodies.slot_count();
+        }
         self.world.islands.num_active_bodies()
     }
 
     /// The published state of slot `i` (dead slots carry only their generation).
     pub fn body_state(&self, i: usize) -> BodyState {
+        #[cfg(feature = "gpu")]
+        if let Some(gpu) = &self.gpu {
+            let generation = self.bodies.generation(i);
+            let Some((p, b)) = gpu.pose(i).zip(self.bodies.at(i)) else {
+                return BodyState {
+                    generation,
+                    ..BodyState::default()
+                };
+            };
+            let mut flags = FLAG_ALIVE | b.flags;
+            if self
+                .world
+                .bodies
+                .get(b.handle)
+                .is_some_and(|r| r.is_fixed())
+            {
+                flags |= FLAG_ANCHORED;
+            }
+            return BodyState {
+                position: p.position,
+                flags,
+                rotation: p.rotation,
+                linear_velocity: p.velocity,
+                generation,
+                angular_velocity: p.angular_velocity,
+                _reserved: 0,
+            };
+        }
         publish::body_state(&self.bodies, &self.world.bodies, i)
     }
 }

@@ -44,6 +44,10 @@ pub enum PlaneProp {
     /// Largest angular speed of a body (rad/s), enforced before and after every step.
     /// Default [`DEFAULT_MAX_ANGULAR_SPEED`]. Positive and finite.
     MaxAngularSpeed(f32),
+    /// Runs the plane on the GPU (wgpu compute: spheres and axis-aligned boxes, single-point
+    /// contacts, a spatial-hash broadphase) instead of rapier on the CPU. Default false. Safe
+    /// to flip at run time: poses and velocities carry over.
+    DeferGpu(bool),
     /// An option of a GUI plane (`PhysicsService.NewGUI`); 3D planes refuse it.
     Gui(super::gui_plane::GuiPlaneProp),
 }
@@ -96,6 +100,8 @@ pub struct PlaneSettings {
     pub max_linear_speed: f32,
     /// `MaxAngularSpeed`, default [`DEFAULT_MAX_ANGULAR_SPEED`] (1,000 rad/s).
     pub max_angular_speed: f32,
+    /// `DeferGpu`, default false (the CPU, rapier).
+    pub defer_gpu: bool,
 }
 
 impl Default for PlaneSettings {
@@ -117,6 +123,7 @@ impl Default for PlaneSettings {
             shared: false,
             max_linear_speed: DEFAULT_MAX_LINEAR_SPEED,
             max_angular_speed: DEFAULT_MAX_ANGULAR_SPEED,
+            defer_gpu: false,
         }
     }
 }
@@ -153,6 +160,7 @@ impl PlaneSettings {
             PlaneProp::Shared(on) => self.shared = on,
             PlaneProp::MaxLinearSpeed(v) => self.max_linear_speed = v,
             PlaneProp::MaxAngularSpeed(w) => self.max_angular_speed = w,
+            PlaneProp::DeferGpu(on) => self.defer_gpu = on,
             PlaneProp::Gui(g) => {
                 return Err(CommandError::invalid_field(
                     g.name(),
@@ -187,6 +195,7 @@ impl PlaneProp {
             PlaneProp::Shared(_) => "Shared",
             PlaneProp::MaxLinearSpeed(_) => "MaxLinearSpeed",
             PlaneProp::MaxAngularSpeed(_) => "MaxAngularSpeed",
+            PlaneProp::DeferGpu(_) => "DeferGpu",
             PlaneProp::Gui(g) => g.name(),
         }
     }
@@ -224,7 +233,8 @@ impl PlaneProp {
             PlaneProp::Enabled(b)
             | PlaneProp::LoopSolver(b)
             | PlaneProp::NeverSleep(b)
-            | PlaneProp::Shared(b) => b.to_string(),
+            | PlaneProp::Shared(b)
+            | PlaneProp::DeferGpu(b) => b.to_string(),
             PlaneProp::Gui(g) => format!("{g:?}"),
         }
     }
