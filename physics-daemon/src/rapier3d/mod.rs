@@ -37,6 +37,8 @@ use shm_layout::{
     BodyState, CollisionGroups, CommandError, EventRecord, PlaneId, PlaneInfo, PlaneKind,
     PlaneProp, PlaneSettings, TickHeader, LAYOUT_VERSION,
 };
+#[cfg(feature = "gpu")]
+use shm_layout::{FLAG_ALIVE, FLAG_ANCHORED};
 
 use crate::backend::{Dirty, SlotTable};
 use part::Part;
