@@ -3,6 +3,7 @@
 
 mod markdown;
 pub mod scenes;
+mod stress;
 mod sweeps;
 
 use std::path::PathBuf;

@@ -32,7 +32,8 @@ use rapier3d::prelude::*;
 use shm_layout::validate::{self, MAX_DT, MAX_HIT_BOX_QUALITY};
 use shm_layout::{
     BodyState, CollisionGroups, CommandError, EventRecord, PlaneId, PlaneInfo, PlaneKind,
-    PlaneProp, PlaneSettings, TickHeader, FLAG_ALIVE, FLAG_ANCHORED, FLAG_SLEEPING, LAYOUT_VERSION,
+    PlaneProp, PlaneSettings, StateHasher, TickHeader, FLAG_ALIVE, FLAG_ANCHORED, FLAG_SLEEPING,
+    LAYOUT_VERSION,
 };
 
 use crate::backend::{Dirty, SlotTable};
@@ -223,7 +224,7 @@ impl Plane {
             settings: self.settings,
             tick: self.tick,
             object_count: self.bodies.live(),
-            effective_solver_iterations: self.solver_settings().iterations as u32,
+            effective_solver_iterations: self.solver_settings(self.nominal_dt()).iterations as u32,
             max_hit_box_quality: self.max_quality(),
         }
     }
@@ -241,12 +242,16 @@ impl Plane {
         }
         let started = Instant::now();
         self.world.integration_parameters.dt = dt;
-        self.tune_solver();
+        self.tune_solver(dt);
         self.tick_controllers(dt);
         self.apply_forces(dt);
         self.limit_speeds_before_step();
+        self.predict_fast_bodies(dt);
         self.joints_before_step();
-        let hooks = contacts::RestThreshold(self.settings.rest_threshold);
+        let hooks = contacts::RestThreshold {
+            threshold: self.settings.rest_threshold,
+            gravity: self.world.gravity,
+        };
         // Contacts of objects removed since the last step still end with an event.
         if self.reporting > 0 || !self.removed.is_empty() {
             let collector = ChannelEventCollector::new(
@@ -293,7 +298,18 @@ impl Plane {
             max_joint_error: self.joints.max_error,
             contact_pairs: self.contact_pairs,
             event_count: self.event_seq as u32,
+            state_hash: self.state_hash(),
         }
+    }
+
+    /// [`StateHasher`] over every slot's published state, in slot order (what the tick
+    /// header carries: any reader can recompute it from the sample's bodies).
+    pub fn state_hash(&self) -> u64 {
+        let mut h = StateHasher::new();
+        for i in 0..self.slot_count() {
+            h.add(&self.body_state(i));
+        }
+        h.finish()
     }
 
     /// Length of the published body array.
