@@ -279,6 +279,15 @@ pub const SCENES: &[Scene] = &[
     },
 ];
 
+/// `--quick`'s stand-in for `pyramid-100`.
+pub const PYRAMID_40: Scene = Scene {
+    name: "pyramid-40",
+    criterion: "no box of a base-40 pyramid (820 boxes, sleeping off) moves ≥ 0.1 from t = 1 s to t = 10 s (`--quick`'s stand-in for pyramid-100)",
+    unit: "units",
+    config: Config::DEFAULT,
+    run: |c| stress::large_pyramid(c, 40),
+};
+
 const G: f64 = 50.0;
 
 /// Largest sideways (x, z) distance between two positions.
