@@ -100,6 +100,8 @@ pub struct Plane {
     joints: joints::Joints,
     /// Map pieces uploaded since the last build (see `maps`).
     map_pending: maps::PendingMap,
+    /// [`StateHasher`] over every slot as the last step left it (the tick header's).
+    state_hash: u64,
 }
 
 impl Plane {
@@ -142,6 +144,7 @@ impl Plane {
             query_stale: Vec::new(),
             joints: joints::Joints::default(),
             map_pending: maps::PendingMap::default(),
+            state_hash: 0,
         };
         for prop in props {
             plane.apply_prop(*prop, true)?;
@@ -241,6 +244,11 @@ impl Plane {
             return Ok(false);
         }
         let started = Instant::now();
+        // Whether this step can change any published state: bodies awake, or ops since the
+        // last step. A settled plane keeps its hash without rehashing every slot.
+        let moving = self.tick == 0
+            || self.world.islands.num_active_bodies() > 0
+            || !self.dirty.since_step().is_empty();
         self.world.integration_parameters.dt = dt;
         self.tune_solver(dt);
         self.tick_controllers(dt);
@@ -273,6 +281,9 @@ impl Plane {
         self.collect_events();
         self.joints_after_step(dt);
         self.removed.clear();
+        if moving || self.awake_count() > 0 {
+            self.state_hash = self.state_hash();
+        }
         self.last_step_us = started.elapsed().as_secs_f32() * 1e6;
         Ok(true)
     }
@@ -298,12 +309,14 @@ impl Plane {
             max_joint_error: self.joints.max_error,
             contact_pairs: self.contact_pairs,
             event_count: self.event_seq as u32,
-            state_hash: self.state_hash(),
+            state_hash: self.state_hash,
         }
     }
 
-    /// [`StateHasher`] over every slot's published state, in slot order (what the tick
-    /// header carries: any reader can recompute it from the sample's bodies).
+    /// [`StateHasher`] over every slot's state now, in slot order. The tick header carries
+    /// it as the last step left it (0 before the first step): right after a step any
+    /// reader recomputes it from the sample's bodies; ops applied since show in the next
+    /// tick's.
     pub fn state_hash(&self) -> u64 {
         let mut h = StateHasher::new();
         for i in 0..self.slot_count() {

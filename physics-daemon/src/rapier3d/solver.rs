@@ -120,19 +120,26 @@ impl Plane {
             s.contact_frequency * base_static.natural_frequency / base.natural_frequency;
     }
 
-    /// Before a step: soft CCD for the bodies whose velocity moves them more than half the
-    /// prediction distance in the step, none for the others.
+    /// Before a step: soft CCD for the bodies the step moves by more than half the
+    /// prediction distance (gravity's share included), none for the others.
     pub(super) fn predict_fast_bodies(&mut self, dt: f32) {
         let p = &self.world.integration_parameters;
         let threshold = 0.5 * p.prediction_distance();
+        let g_dt = self.world.gravity.length() * dt;
         let bodies = &mut self.world.bodies;
         let mut set = |h: RigidBodyHandle| {
             let Some(body) = bodies.get_mut(h).filter(|b| b.is_dynamic()) else {
                 return;
             };
-            // Gravity's share is left out: a body that just landed (velocity 0) keeps the
-            // plain prediction, whose contact rapier's soft-CCD pair test would drop.
-            let travel = body.linvel().length() * dt;
+            // Gravity's share of the tick counts, except for a body standing exactly still
+            // (one that just landed): it keeps the plain prediction, whose contact rapier's
+            // soft-CCD pair test would drop (its contact events would stop and start again).
+            let speed = body.linvel().length();
+            let travel = if speed > 0.0 {
+                (speed + g_dt) * dt
+            } else {
+                0.0
+            };
             let reach = if travel > threshold {
                 SOFT_CCD_REACH
             } else {
