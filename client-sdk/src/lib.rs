@@ -51,8 +51,9 @@ pub use shm_layout::{
     GuiObjectProp, GuiPlaneProp, GuiShape, Handle, Hit, JointInfo, JointKind, JointProp,
     JointSettings, MapReport, ObjectInfo, ObjectOp, ObjectProp, ObjectSettings, Pin, PlaneId,
     PlaneInfo, PlaneKind, PlaneOp, PlaneProp, PlaneSettings, Pose, Ray, Restraint, RotateTo, Shape,
-    ShapeKind, TickHeader, Vec2, Vec3, EVENT_CONTROLLER_JUMPED, EVENT_CONTROLLER_LANDED,
-    EVENT_CONTROLLER_MOVED, EVENT_PATH_FINISHED, EVENT_WAYPOINT_REACHED, FLAG_ON_GROUND,
+    ShapeKind, StateHasher, TickHeader, Vec2, Vec3, EVENT_CONTROLLER_JUMPED,
+    EVENT_CONTROLLER_LANDED, EVENT_CONTROLLER_MOVED, EVENT_PATH_FINISHED, EVENT_WAYPOINT_REACHED,
+    FLAG_ON_GROUND,
 };
 pub use spawn::{
     connect_or_start, daemon_executable, start_daemon, start_daemon_with, DaemonChild, Session,

@@ -259,6 +259,14 @@ impl Plane {
         self.shared.overlay.borrow_mut().write(handle, f);
     }
 
+    /// The determinism hash of the newest published tick ([`TickHeader::state_hash`]: every
+    /// body's pose, velocities, flags and generation, bit for bit, in slot order). Two runs
+    /// of the same commands agree on it tick by tick; a replay that diverges shows it on the
+    /// first tick it differs. Reads shared memory only.
+    pub fn state_hash(&self) -> Result<u64, Error> {
+        Ok(self.snapshot()?.header().state_hash)
+    }
+
     /// Every option and figure of the plane (sends the queue first).
     pub fn info(&self) -> Result<PlaneInfo, Error> {
         match self.client.call(Command::plane(self.id(), PlaneOp::Info))? {

@@ -10,10 +10,11 @@ use crate::target::SceneTarget;
 /// What a builder returns: the handles of the target, or its error.
 pub type Built<T, V> = Result<V, <T as SceneTarget>::Error>;
 
-/// Contact gap a resting pair keeps at HitBoxQuality `quality`: each collider has a skin
-/// of 0.01 / quality.
+/// Contact gap a resting pair keeps at HitBoxQuality `quality`: none at any quality (the
+/// planes give colliders no contact skin; resting bodies touch).
 pub fn pair_gap(quality: u32) -> f32 {
-    0.02 / quality as f32
+    let _ = quality;
+    0.0
 }
 
 /// A cube of side `side`.
@@ -176,6 +177,37 @@ pub fn stack_and_ball<T: SceneTarget + ?Sized>(
         &[],
     )?;
     Ok(StackAndBall { boxes, ball })
+}
+
+/// The determinism scene: on a floor (top y = 0), a base-6 pyramid of unit cubes and 12
+/// bouncy balls thrown at it from both sides, every object at HitBoxQuality 4 (free
+/// rotation, CCD): one island of contacts, rotations, bounces and friction, all of which
+/// must come out bit-identical in every run. Returns the cubes, then the balls.
+pub fn determinism_scene<T: SceneTarget + ?Sized>(target: &mut T) -> Built<T, Vec<T::Handle>> {
+    let q = ObjectProp::HitBoxQuality(4);
+    floor(target, 60.0, &[q])?;
+    let mut out = Vec::new();
+    let pitch = 1.03;
+    for row in 0..6 {
+        let count = 6 - row;
+        let x0 = -(count as f32 - 1.0) * pitch / 2.0;
+        for i in 0..count {
+            let p = [x0 + i as f32 * pitch, 0.5 + row as f32, 0.0];
+            out.push(target.add(cube(1.0), Pose::at(p), &[q])?);
+        }
+    }
+    for i in 0..12 {
+        let side = if i % 2 == 0 { -1.0 } else { 1.0 };
+        let (x, y, z) = (side * 8.0, 2.0 + i as f32 * 0.7, (i as f32 - 5.5) * 0.15);
+        let props = [
+            q,
+            ObjectProp::Bounciness(0.5),
+            ObjectProp::Velocity([-side * 12.0, 3.0, 0.3 * side]),
+            ObjectProp::AngularVelocity([0.0, 2.0, side]),
+        ];
+        out.push(target.add(Shape::Sphere { radius: 0.3 }, Pose::at([x, y, z]), &props)?);
+    }
+    Ok(out)
 }
 
 /// Cubes per column of a [`pile`].
@@ -352,12 +384,12 @@ mod tests {
     fn a_pyramid_of_base_twenty_has_210_boxes_whose_neighbours_do_not_touch() {
         let spawns = record(|t| pyramid(t, 20, pair_gap(1)));
         assert_eq!(spawns.len(), 210);
-        // Rows 1.02 apart from 0.52 up, neighbours 1.05 apart: to the last bit.
-        let x0 = -19.0 * 1.05 / 2.0;
+        // Rows 1 apart from 0.5 up (no gap), neighbours 1.03 apart: to the last bit.
+        let x0 = -19.0 * 1.03 / 2.0;
         for (i, s) in spawns[..20].iter().enumerate() {
-            assert_eq!(s.pose.position, [x0 + i as f32 * 1.05, 0.52, 0.0]);
+            assert_eq!(s.pose.position, [x0 + i as f32 * 1.03, 0.5, 0.0]);
         }
-        assert_eq!(spawns[20].pose.position[1], 0.52 + 1.02);
+        assert_eq!(spawns[20].pose.position[1], 0.5 + 1.0);
     }
 
     #[test]

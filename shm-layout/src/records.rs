@@ -108,6 +108,72 @@ pub struct TickHeader {
     /// event's [`EventRecord::seq`], wrapped): a new event reader learns from the newest
     /// tick where its stream starts, so it can count losses from its very first read.
     pub event_count: u32,
+    /// Hash of every slot's state as the step left it ([`StateHasher`] over the published
+    /// [`BodyState`]s in slot order): two runs agree on a tick exactly when every body's
+    /// pose, velocities, flags and generation agree to the bit. A game replaying a command
+    /// log compares it tick by tick.
+    pub state_hash: u64,
+}
+
+/// The hash of [`TickHeader::state_hash`]: 64-bit FNV-1a over the 32-bit words of each
+/// [`BodyState`] (all 16 of them, in field order), slot after slot. Word-wise rather than
+/// byte-wise to stay cheap (16 multiplies per body); any process can recompute it from a
+/// sample's bodies.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct StateHasher(u64);
+
+impl StateHasher {
+    const OFFSET: u64 = 0xcbf2_9ce4_8422_2325;
+    const PRIME: u64 = 0x0000_0100_0000_01b3;
+
+    /// An empty hash.
+    pub fn new() -> StateHasher {
+        StateHasher(Self::OFFSET)
+    }
+
+    fn word(&mut self, w: u32) {
+        self.0 = (self.0 ^ w as u64).wrapping_mul(Self::PRIME);
+    }
+
+    /// Adds the next slot's state.
+    pub fn add(&mut self, s: &BodyState) {
+        let f = |x: &f32| x.to_bits();
+        for w in s.position.iter().map(f) {
+            self.word(w);
+        }
+        self.word(s.flags);
+        for w in s.rotation.iter().map(f) {
+            self.word(w);
+        }
+        for w in s.linear_velocity.iter().map(f) {
+            self.word(w);
+        }
+        self.word(s.generation);
+        for w in s.angular_velocity.iter().map(f) {
+            self.word(w);
+        }
+        self.word(s._reserved);
+    }
+
+    /// The hash of the states added so far.
+    pub fn finish(&self) -> u64 {
+        self.0
+    }
+
+    /// The hash of `states` in order (what a sample's bodies hash to).
+    pub fn of(states: &[BodyState]) -> u64 {
+        let mut h = StateHasher::new();
+        for s in states {
+            h.add(s);
+        }
+        h.finish()
+    }
+}
+
+impl Default for StateHasher {
+    fn default() -> Self {
+        StateHasher::new()
+    }
 }
 
 /// Event kind: two objects started touching.
@@ -209,7 +275,26 @@ mod tests {
     fn record_sizes_are_fixed() {
         assert_eq!(core::mem::size_of::<BodyState>(), 64);
         assert_eq!(core::mem::size_of::<EventRecord>(), 64);
-        assert_eq!(core::mem::size_of::<TickHeader>(), 64);
+        assert_eq!(core::mem::size_of::<TickHeader>(), 72);
+    }
+
+    #[test]
+    fn state_hash_sees_every_bit_and_the_order() {
+        let a = BodyState {
+            position: [1.0, 2.0, 3.0],
+            flags: FLAG_ALIVE,
+            ..Default::default()
+        };
+        let mut b = a;
+        b.linear_velocity[2] = f32::from_bits(1); // the smallest subnormal
+        assert_ne!(StateHasher::of(&[a]), StateHasher::of(&[b]));
+        assert_ne!(StateHasher::of(&[a, b]), StateHasher::of(&[b, a]));
+        assert_eq!(StateHasher::of(&[a, b]), StateHasher::of(&[a, b]));
+        // -0.0 and 0.0 differ in their bits, and so in the hash.
+        let mut z = a;
+        z.angular_velocity[1] = -0.0;
+        assert_ne!(StateHasher::of(&[a]), StateHasher::of(&[z]));
+        assert_eq!(StateHasher::of(&[]), StateHasher::new().finish());
     }
 
     #[test]

@@ -145,6 +145,14 @@ fn step_driven_free_fall_matches_the_substep_formula() {
 }
 
 #[test]
+fn state_hash_from_luau_agrees_between_identical_planes() {
+    let daemon = TestDaemon::start("lua-hash");
+    let r = run(&daemon, "tests/lua/state_hash.luau");
+    r.assert_ok();
+    assert!(r.stdout().contains("state hashes agree"), "{}", r.stdout());
+}
+
+#[test]
 fn uncaught_error_exits_1_with_message_and_traceback() {
     let daemon = TestDaemon::start("lua-fails");
     let r = run(&daemon, "tests/lua/fails.luau");

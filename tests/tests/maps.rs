@@ -111,7 +111,7 @@ fn a_tiled_map_has_no_ghost_bumps_and_rays_hit_it_exactly() {
         worst_dy = worst_dy.max((ball.position().unwrap()[1] - 3.5).abs());
     }
     println!("ball: worst |y - (3 + r)| {worst_dy}");
-    // Contact skin 0.01 per collider: resting height differs from r by about that.
+    // Resting contact (no skins) keeps the height within the solver's allowed error.
     assert!(worst_dy < 0.03, "the ball hopped by {worst_dy}");
 
     // The map is static: reshaping it is refused with the property named.
@@ -218,7 +218,7 @@ fn a_prop_loads_as_one_convex_object() {
     assert_eq!(objs.len(), 1);
     s.run(1.0 / 60.0, 120);
     let y = objs[0].position().unwrap()[1];
-    // A 2-unit cube rests with its centre 1 above the floor (+ contact skins).
+    // A 2-unit cube rests with its centre 1 above the floor.
     assert!((y - 1.0).abs() < 0.05, "prop rests at {y}");
 }
 

@@ -174,9 +174,9 @@ fn slide_on_slope(theta: f32, mu_block: f32, mu_slope: f32) -> (f32, f32) {
         },
     );
     slope.set_friction(mu_slope).unwrap();
-    // Up the slope's normal by half the slope, half the block and the contact skins.
+    // Up the slope's normal by half the slope and half the block (no contact skins).
     let (s, c) = theta.sin_cos();
-    let lift = 0.5 + 0.5 + 0.02;
+    let lift = 0.5 + 0.5;
     let block = scene
         .plane
         .add(
@@ -223,10 +223,10 @@ fn anchored_parts_never_move_and_anchoring_zeroes_velocity() {
     scene.run(1.0 / 60.0, 120);
     assert_eq!(a.position().unwrap(), [0.0, 5.0, 0.0]);
     assert_eq!(a.velocity().unwrap(), [0.0; 3]);
-    // b landed on it: top of a (5.5) + half of b + skins.
+    // b landed on it: top of a (5.5) + half of b (no skins).
     let yb = b.position().unwrap()[1];
     assert!(
-        (yb - 6.02).abs() < 0.02,
+        (yb - 6.0).abs() < 0.02,
         "b rests on the anchored part: {yb}"
     );
     b.set_velocity([3.0, 0.0, 0.0]).unwrap();
@@ -250,7 +250,7 @@ fn can_collide_false_passes_through_the_floor() {
     scene.run(1.0 / 60.0, 60);
     // Free fall for 1 s from 2: y = 2 − 25 (minus the integrator's lag).
     assert!(ghost.position().unwrap()[1] < -20.0);
-    assert!((solid.position().unwrap()[1] - 0.52).abs() < 0.02);
+    assert!((solid.position().unwrap()[1] - 0.5).abs() < 0.02);
     assert!(!ghost.info().unwrap().can_collide);
 }
 
@@ -261,15 +261,15 @@ fn size_resizes_the_collider() {
     let b = cube(&scene, 1.0, [0.0, 0.52, 0.0], &[]);
     let s = sphere(&scene, 0.5, [5.0, 0.52, 0.0], &[]);
     scene.run(1.0 / 60.0, 30);
-    assert!((b.position().unwrap()[1] - 0.52).abs() < 0.01);
+    assert!((b.position().unwrap()[1] - 0.5).abs() < 0.01);
     b.set_size([3.0, 3.0, 3.0]).unwrap();
     // A sphere's radius is half the smallest side.
     s.set_size([4.0, 2.0, 6.0]).unwrap();
     scene.run(1.0 / 60.0, 120);
     let yb = b.position().unwrap()[1];
     let ys = s.position().unwrap()[1];
-    assert!((yb - 1.52).abs() < 0.02, "resized cube rests at {yb}");
-    assert!((ys - 1.02).abs() < 0.02, "resized sphere rests at {ys}");
+    assert!((yb - 1.5).abs() < 0.02, "resized cube rests at {yb}");
+    assert!((ys - 1.0).abs() < 0.02, "resized sphere rests at {ys}");
     assert_eq!(s.info().unwrap().size, [4.0, 2.0, 6.0]);
 }
 
@@ -290,15 +290,12 @@ fn hit_box_quality_locks_rotation_at_one_tightens_contacts_and_enables_ccd() {
     assert_eq!(plane.max_hit_box_quality, 32);
     assert_eq!(plane.effective_solver_iterations, 10);
     assert!(ball.info().unwrap().ccd);
-    // Skins: 0.01 per collider at quality 1, 0.01/32 at 32.
+    // No contact skins at any quality: both rest touching the floor.
     scene.run(1.0 / 60.0, 120);
     let y_ball = ball.position().unwrap()[1];
     assert!((y_ball - 0.5).abs() < 0.003, "tight contact: {y_ball}");
     let y_low = low.position().unwrap()[1];
-    assert!(
-        (y_low - (0.5 + 0.01 + 0.01 / 32.0)).abs() < 0.005,
-        "loose contact: {y_low}"
-    );
+    assert!((y_low - 0.5).abs() < 0.005, "quality-1 contact: {y_low}");
     // Clamped to [1, 32].
     low.set_hit_box_quality(1000).unwrap();
     assert_eq!(low.info().unwrap().hit_box_quality, 32);

@@ -223,9 +223,6 @@ fn a_threaded_plane_simulates_the_same_physics() {
     let one = run(1);
     let two = run(2);
     for (a, b) in one.iter().zip(&two) {
-        assert!(
-            (a - b).abs() < 1e-3 && (a - 0.52).abs() < 0.02,
-            "{a} vs {b}"
-        );
+        assert!((a - b).abs() < 1e-3 && (a - 0.5).abs() < 0.02, "{a} vs {b}");
     }
 }

@@ -104,11 +104,13 @@ fn hit_ragdoll(max_angular_speed: Option<f32>, weight: f32, iterations: u32) -> 
 ///
 /// Bounds: rapier's swing and twist limits are per-axis rows solved like contacts, and a
 /// 1,000 u/s hit (the torso leaves at ~100 u/s, limbs lag by a tick's 1.7 units) drives
-/// limbs well past them before the rows catch up: measured ~0.95 rad at worst and ~0.7 rad
-/// still after 1 s (a limb pinned past its limit against the floor), anchors ~0.5 apart at
-/// worst and ~0.3 after 1 s. The bounds are those figures plus about 25 %: they catch a
-/// regression (a joint that fails outright leaves radians and units of error that grow),
-/// and the figures say plainly that the limits are overshot, not held, under such a hit.
+/// limbs well past them before the rows catch up: measured 1.23 rad at worst, still 1.23 rad
+/// after 1 s (the right lower leg pinned past its limit against the floor, now that bodies
+/// rest on the floor without a contact skin and fast ones are stopped in the tick they hit),
+/// anchors 0.36 apart at worst and after 1 s (before those changes: ~0.95 / ~0.7 rad and
+/// ~0.5 / ~0.3). The bounds are those figures plus about 25 %: they catch a regression (a
+/// joint that fails outright leaves radians and units of error that grow), and the figures
+/// say plainly that the limits are overshot, not held, under such a hit.
 #[test]
 fn a_humanoid_ragdoll_hit_at_1000_stays_finite_and_within_its_limits() {
     let (w, cap) = hit_ragdoll(None, 1.0, 16);
@@ -129,10 +131,10 @@ fn a_humanoid_ragdoll_hit_at_1000_stays_finite_and_within_its_limits() {
     );
     assert!(w.torso_speed > 20.0, "the ball hit the chest: {w:?}");
     assert!(w.spin <= cap * 1.001, "spin {} above the cap {cap}", w.spin);
-    assert!(w.angle.0 < 1.2, "limit violation {w:?}");
-    assert!(w.settled.0 < 0.9, "limit violation after 1 s {w:?}");
+    assert!(w.angle.0 < 1.55, "limit violation {w:?}");
+    assert!(w.settled.0 < 1.55, "limit violation after 1 s {w:?}");
     assert!(w.separation.0 < 0.65, "anchor separation {w:?}");
-    assert!(w.settled.1 < 0.35, "anchor separation after 1 s {w:?}");
+    assert!(w.settled.1 < 0.45, "anchor separation after 1 s {w:?}");
 }
 
 /// With MaxAngularSpeed 20 rad/s the bones' spins stay at or under 20 while the hit lands.

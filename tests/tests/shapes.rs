@@ -8,8 +8,8 @@
 //! operations: a relative 1e-4 leaves two orders of magnitude of margin and still catches
 //! any wrong radius, height or half-size (those are off by 10 % or more).
 //!
-//! Resting heights: at HitBoxQuality 1 every collider has a contact skin of 0.01, so a body
-//! resting on the floor keeps 0.02 above it (as in object_properties.rs); 0.02 of tolerance.
+//! Resting heights: colliders have no contact skin, so a body rests touching the floor (as in
+//! object_properties.rs); 0.02 of tolerance.
 
 use std::f32::consts::PI;
 
@@ -19,8 +19,8 @@ use shm_layout::codec::{decode_response, encode_request};
 use shm_layout::{Command, PlaneOp, Request, Response};
 
 const REL: f32 = 1e-4;
-/// Two quality-1 skins.
-const SKINS: f32 = 0.02;
+/// Gap a resting pair keeps (no contact skins).
+const SKINS: f32 = 0.0;
 
 fn close(a: f32, b: f32) -> bool {
     (a - b).abs() <= REL * b.abs()
@@ -237,9 +237,9 @@ fn a_capsule_rests_upright_on_its_cap_and_lying_on_its_radius() {
     assert!((y - (1.5 + SKINS)).abs() < 0.02, "upright capsule at {y}");
     let up = up_axis(upright.pose().unwrap().rotation);
     assert!(up[1] > 0.999, "still upright: {up:?}");
-    // Quality 4 on the capsule, 1 on the floor: skins 0.01/4 + 0.01.
+    // Quality 4 on the capsule, 1 on the floor: no skins either.
     let y = lying.position().unwrap()[1];
-    assert!((y - (0.5 + 0.0125)).abs() < 0.02, "lying capsule at {y}");
+    assert!((y - 0.5).abs() < 0.02, "lying capsule at {y}");
 }
 
 #[test]
@@ -265,7 +265,7 @@ fn a_cylinder_rests_on_its_flat_face() {
     let up = up_axis(pose.rotation);
     assert!(up[1] > 0.9999, "flat on its face: axis {up:?}");
     let y = pose.position[1];
-    assert!((y - (0.5 + 0.0125)).abs() < 0.02, "centre at {y}");
+    assert!((y - 0.5).abs() < 0.02, "centre at {y}");
     let v = c.velocity().unwrap();
     assert!(v.iter().all(|c| c.abs() < 0.05), "at rest: {v:?}");
 }

@@ -96,7 +96,7 @@ fn pyramid_of_base_twenty_stands_ten_seconds() {
     // and t = 10 s.
     let scene = Scene::new("pyramid", PlaneOptions::default());
     quality_floor(&scene, 1);
-    // Rows 0.02 apart (their rest height), neighbours in a row 1.05 apart: they do not touch.
+    // Rows touching (their rest height), neighbours in a row 1.03 apart: they do not touch.
     let boxes = pyramid(&mut &scene.plane, 20, pair_gap(1)).unwrap();
     assert_eq!(boxes.len(), 210);
     run_finite(&scene, DT, 60);

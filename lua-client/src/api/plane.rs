@@ -220,6 +220,14 @@ impl UserData for PhysicsPlane {
             p.0.destroy()
                 .map_err(|e| sdk_error("PhysicsPlane:Destroy", e))
         });
+        // The newest tick's determinism hash as 16 hex digits (a u64 does not fit a Luau
+        // number): equal strings on the same tick of two runs mean bit-identical states.
+        methods.add_method("StateHash", |_, p, ()| {
+            p.0.plane
+                .state_hash()
+                .map(|h| format!("{h:016x}"))
+                .map_err(|e| sdk_error("PhysicsPlane:StateHash", e))
+        });
         super::query::add_methods(methods);
         methods.add_method("NewController", |_, p, (part, opts): (Value, Value)| {
             new_controller(&p.0, part, opts, false)

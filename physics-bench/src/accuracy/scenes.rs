@@ -86,6 +86,18 @@ pub const SCENES: &[Scene] = &[
         run: hinge_pendulum,
     },
     Scene {
+        name: "elastic-collision",
+        measures: "max(|Δp|/|p|, |ΔE|/E) of a head-on collision in zero gravity, Bounciness 1, masses 1 and 2 (exact: v1' = −v/3, v2' = 2v/3)",
+        unit: "fraction",
+        run: elastic_collision,
+    },
+    Scene {
+        name: "pile-666",
+        measures: "deepest contact penetration (tick header) over the last second of 216 unit balls (6×6×6) dropped into a 7-wide bin, after 3 s",
+        unit: "units",
+        run: pile_666,
+    },
+    Scene {
         name: "stack-drift",
         measures: "largest displacement of any box of a resting 5-box stack from 1 s (settled) to 3 s",
         unit: "units",
@@ -361,6 +373,71 @@ fn resting_stack(c: Config) -> BenchResult<(Sim, f64, f64)> {
         .map(|(h, p)| distance(sim.state(*h).position, *p))
         .fold(0.0, f64::max);
     Ok((sim, drift, deepest))
+}
+
+fn elastic_collision(c: Config) -> BenchResult<Outcome> {
+    let mut props = UNDAMPED.to_vec();
+    props.push(PlaneProp::Gravity([0.0; 3]));
+    props.push(PlaneProp::RestThreshold(0.0));
+    let mut sim = Sim::new(c, &props)?;
+    let v = 10.0f64;
+    let e1 = [ObjectProp::Bounciness(1.0), ObjectProp::Friction(0.0)];
+    let a = ball(
+        &mut sim,
+        [-3.0, 0.0, 0.0],
+        &[
+            e1[0],
+            e1[1],
+            ObjectProp::Weight(1.0),
+            ObjectProp::Velocity([v as f32, 0.0, 0.0]),
+        ],
+    )?;
+    let b = ball(
+        &mut sim,
+        [0.0, 0.0, 0.0],
+        &[e1[0], e1[1], ObjectProp::Weight(2.0)],
+    )?;
+    // Both balls at HitBoxQuality 1 have locked rotation; masses are set by Weight.
+    let (m1, m2) = (1.0f64, 2.0f64);
+    let p0 = m1 * v;
+    let e0 = 0.5 * m1 * v * v;
+    sim.run_for(1.0)?;
+    let (va, vb) = (sim.state(a).linear_velocity, sim.state(b).linear_velocity);
+    let p = [0, 1, 2].map(|i| m1 * va[i] as f64 + m2 * vb[i] as f64);
+    let dp = ((p[0] - p0).powi(2) + p[1].powi(2) + p[2].powi(2)).sqrt() / p0;
+    let e = 0.5 * m1 * distance(va, [0.0; 3]).powi(2) + 0.5 * m2 * distance(vb, [0.0; 3]).powi(2);
+    outcome(&sim, dp.max((e - e0).abs() / e0))
+}
+
+fn pile_666(c: Config) -> BenchResult<Outcome> {
+    let mut sim = Sim::new(c, &[])?;
+    floor(&mut sim, 20.0, &[])?;
+    // Four walls around a 7 × 7 bin.
+    for (x, z, sx, sz) in [
+        (4.0f32, 0.0f32, 1.0f32, 9.0f32),
+        (-4.0, 0.0, 1.0, 9.0),
+        (0.0, 4.0, 9.0, 1.0),
+        (0.0, -4.0, 9.0, 1.0),
+    ] {
+        anchored_box(&mut sim, [sx, 20.0, sz], Pose::at([x, 10.0, z]), &[])?;
+    }
+    for i in 0..6 {
+        for j in 0..6 {
+            for k in 0..6 {
+                let at = |n: usize| (n as f32 - 2.5) * 1.1;
+                ball(&mut sim, [at(i), 1.0 + j as f32 * 1.1, at(k)], &[])?;
+            }
+        }
+    }
+    let mut deepest = 0.0f64;
+    let steps = sim.steps_for(3.0);
+    for n in 0..steps {
+        sim.step()?;
+        if n >= steps - sim.steps_for(1.0) {
+            deepest = deepest.max(sim.header().max_penetration as f64);
+        }
+    }
+    outcome(&sim, deepest)
 }
 
 fn stack_drift(c: Config) -> BenchResult<Outcome> {

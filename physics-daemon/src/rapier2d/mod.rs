@@ -29,7 +29,7 @@ use shm_layout::settings::{GuiObjectSettings, GuiPlaneProp, GuiPlaneSettings, Gu
 use shm_layout::validate::{self, MAX_DT};
 use shm_layout::{
     BodyState, CommandError, EventRecord, PlaneId, PlaneInfo, PlaneKind, PlaneProp, PlaneSettings,
-    TickHeader, FLAG_ALIVE, FLAG_ANCHORED, FLAG_SLEEPING, LAYOUT_VERSION,
+    StateHasher, TickHeader, FLAG_ALIVE, FLAG_ANCHORED, FLAG_SLEEPING, LAYOUT_VERSION,
 };
 
 use crate::backend::{Dirty, SlotTable};
@@ -298,7 +298,18 @@ impl Plane {
             max_joint_error: 0.0,
             contact_pairs: self.contact_pairs,
             event_count: self.event_seq as u32,
+            state_hash: self.state_hash(),
         }
+    }
+
+    /// [`StateHasher`] over every slot's published state, in slot order (what the tick
+    /// header carries: any reader can recompute it from the sample's bodies).
+    pub fn state_hash(&self) -> u64 {
+        let mut h = StateHasher::new();
+        for i in 0..self.slot_count() {
+            h.add(&self.body_state(i));
+        }
+        h.finish()
     }
 
     /// Length of the published body array.

@@ -4,9 +4,14 @@
 //!
 //! - Buoyancy (acceleration), ConstantForce (plane + object, divided by mass),
 //!   ImpulseDirection (acceleration): exact for constant forces.
-//! - Drag `F = -Drag·|v|·v`, integrated with backward Euler solved in closed form, so it
-//!   never overshoots or reverses a velocity at any dt (unconditionally stable).
-//! - LinearDamping / AngularDamping: `v *= max(0, 1 - k·dt)`, as documented.
+//! - LinearDamping / AngularDamping: `v *= max(0, 1 - k·dt)`, as documented, applied to the
+//!   velocity the tick starts with; the tick's accelerations (gravity included) come after.
+//! - Drag `F = -Drag·|v|·v`: backward Euler over the whole tick, gravity and the other
+//!   forces included: `v' = u - (Drag/m)·dt·|v'|·v'` with `u = keep·v + (g + a)·dt`, solved
+//!   in closed form. It never overshoots or reverses a velocity at any dt, and its steady
+//!   state is exact at any dt: `v' = v` gives `Drag·|v|·v = m·(g + a) - (k·m)·v`, the
+//!   terminal velocity `√(m·g/Drag)` without damping. (Drag applied before gravity settled
+//!   at `v_t + g·dt`.)
 //! - RotateTo and SetPin: controllers that set the velocities they need, capped.
 //!
 //! The linear part becomes one force for the step, handed to rapier's force accumulator:
@@ -107,9 +112,10 @@ fn drive(body: &mut RigidBody, part: &Part, env: &Env) -> bool {
     let inv_mass = if mass > 0.0 { 1.0 / mass } else { 0.0 };
     let (v0, w0) = (body.linvel(), body.angvel());
     let forces = env.force + Vector::from(part.constant_force);
-    // The velocity this step should end at, before gravity and contacts.
-    let mut v =
-        v0 + (env.acceleration + Vector::from(part.impulse_direction) + forces * inv_mass) * dt;
+    // The velocity this step should end at, before gravity and contacts: damping acts on
+    // the velocity the tick starts with, the accelerations are added after it.
+    let mut v = v0 * env.linear_keep
+        + (env.acceleration + Vector::from(part.impulse_direction) + forces * inv_mass) * dt;
     let mut w = w0;
     let mut w_driven = false;
     if let Some(pin) = &part.pin {
@@ -121,9 +127,10 @@ fn drive(body: &mut RigidBody, part: &Part, env: &Env) -> bool {
         w_driven = true;
     }
     if env.drag > 0.0 {
-        v = implicit_drag(v, env.drag * inv_mass * dt);
+        // Backward Euler with gravity inside: rapier adds `g·dt` after this pass.
+        let g_dt = env.gravity * (body.gravity_scale() * dt);
+        v = implicit_drag(v + g_dt, env.drag * inv_mass * dt) - g_dt;
     }
-    v *= env.linear_keep;
     if !w_driven {
         w *= env.angular_keep;
     }
@@ -243,6 +250,18 @@ mod tests {
         // Small c·dt: s' ≈ s - c·dt·s².
         let s = implicit_drag(Vector::new(10.0, 0.0, 0.0), 1e-4).x;
         assert!((s - (10.0 - 1e-4 * 100.0)).abs() < 1e-3, "{s}");
+    }
+
+    #[test]
+    fn drag_with_gravity_inside_holds_the_terminal_velocity_at_any_dt() {
+        // g = 50, Drag/m = 2: v_t = 5. The tick starts at -v_t; gravity adds g·dt, the
+        // backward-Euler drag must bring it back to exactly -v_t.
+        let g = Vector::new(0.0, -50.0, 0.0);
+        for dt in [0.1f32, 1.0 / 60.0, 1.0 / 240.0] {
+            let v = Vector::new(0.0, -5.0, 0.0);
+            let next = implicit_drag(v + g * dt, 2.0 * dt);
+            assert!((next.y + 5.0).abs() < 1e-5, "dt {dt}: {next:?}");
+        }
     }
 
     #[test]

@@ -35,7 +35,7 @@ use rapier3d::prelude::*;
 use shm_layout::validate::{self, MAX_DT, MAX_HIT_BOX_QUALITY};
 use shm_layout::{
     BodyState, CollisionGroups, CommandError, EventRecord, PlaneId, PlaneInfo, PlaneKind,
-    PlaneProp, PlaneSettings, TickHeader, LAYOUT_VERSION,
+    PlaneProp, PlaneSettings, StateHasher, TickHeader, LAYOUT_VERSION,
 };
 #[cfg(feature = "gpu")]
 use shm_layout::{FLAG_ALIVE, FLAG_ANCHORED};
@@ -107,6 +107,8 @@ pub struct Plane {
     /// The GPU world while `DeferGpu` is on (see `gpu`).
     #[cfg(feature = "gpu")]
     gpu: Option<crate::gpu::GpuWorld>,
+    /// [`StateHasher`] over every slot as the last step left it (the tick header's).
+    state_hash: u64,
 }
 
 impl Plane {
@@ -151,6 +153,7 @@ impl Plane {
             map_pending: maps::PendingMap::default(),
             #[cfg(feature = "gpu")]
             gpu: None,
+            state_hash: 0,
         };
         for prop in props {
             plane.apply_prop(*prop, true)?;
@@ -252,7 +255,7 @@ impl Plane {
             settings: self.settings,
             tick: self.tick,
             object_count: self.bodies.live(),
-            effective_solver_iterations: self.solver_settings().iterations as u32,
+            effective_solver_iterations: self.solver_settings(self.nominal_dt()).iterations as u32,
             max_hit_box_quality: self.max_quality(),
         }
     }
@@ -269,6 +272,11 @@ impl Plane {
             return Ok(false);
         }
         let started = Instant::now();
+        // Whether this step can change any published state: bodies awake, or ops since the
+        // last step. A settled plane keeps its hash without rehashing every slot.
+        let moving = self.tick == 0
+            || self.world.islands.num_active_bodies() > 0
+            || !self.dirty.since_step().is_empty();
         #[cfg(feature = "gpu")]
         if self.gpu.is_some() {
             self.step_on_gpu(dt)?;
@@ -276,16 +284,22 @@ impl Plane {
             self.tick += 1;
             self.sim_time += dt as f64;
             self.last_dt = dt;
+            // Nothing sleeps on the GPU path: every step can move every body.
+            self.state_hash = self.state_hash();
             self.last_step_us = started.elapsed().as_secs_f32() * 1e6;
             return Ok(true);
         }
         self.world.integration_parameters.dt = dt;
-        self.tune_solver();
+        self.tune_solver(dt);
         self.tick_controllers(dt);
         self.apply_forces(dt);
         self.limit_speeds_before_step();
+        self.predict_fast_bodies(dt);
         self.joints_before_step();
-        let hooks = contacts::RestThreshold(self.settings.rest_threshold);
+        let hooks = contacts::RestThreshold {
+            threshold: self.settings.rest_threshold,
+            gravity: self.world.gravity,
+        };
         // Contacts of objects removed since the last step still end with an event.
         if self.reporting > 0 || !self.removed.is_empty() {
             let collector = ChannelEventCollector::new(
@@ -307,6 +321,9 @@ impl Plane {
         self.collect_events();
         self.joints_after_step(dt);
         self.removed.clear();
+        if moving || self.awake_count() > 0 {
+            self.state_hash = self.state_hash();
+        }
         self.last_step_us = started.elapsed().as_secs_f32() * 1e6;
         Ok(true)
     }
@@ -332,7 +349,20 @@ impl Plane {
             max_joint_error: self.joints.max_error,
             contact_pairs: self.contact_pairs,
             event_count: self.event_seq as u32,
+            state_hash: self.state_hash,
         }
+    }
+
+    /// [`StateHasher`] over every slot's state now, in slot order. The tick header carries
+    /// it as the last step left it (0 before the first step): right after a step any
+    /// reader recomputes it from the sample's bodies; ops applied since show in the next
+    /// tick's.
+    pub fn state_hash(&self) -> u64 {
+        let mut h = StateHasher::new();
+        for i in 0..self.slot_count() {
+            h.add(&self.body_state(i));
+        }
+        h.finish()
     }
 
     /// Length of the published body array.

@@ -10,9 +10,10 @@
 use rapier3d::prelude::*;
 use shm_layout::{CollisionGroups, CommandError, ObjectSettings, Shape, ShapeKind, Vec3};
 
-/// Contact skin of one collider at HitBoxQuality 1 (a pair of them keeps 0.02 apart); it
-/// shrinks as 1 / quality.
-const BASE_CONTACT_SKIN: f32 = 0.01;
+/// Contact skin of a map (triangle mesh): bodies rest 0.005 above it (not visible), and
+/// one sliding across it at 20 units/s rides over the seams of its triangles instead of
+/// catching their inner edges (it stopped within 60 units without a skin).
+const MAP_CONTACT_SKIN: f32 = 0.005;
 
 /// Most points a mesh part's collision hull is built from. Larger vertex sets are reduced
 /// to their support points along this many directions first (PhysX likewise caps convex
@@ -281,7 +282,16 @@ impl Part {
         collider.set_friction_combine_rule(CoefficientCombineRule::Multiply);
         collider.set_restitution(self.bounciness);
         collider.set_restitution_combine_rule(CoefficientCombineRule::Max);
-        collider.set_contact_skin(BASE_CONTACT_SKIN / self.hit_box_quality as f32);
+        // No contact skin: resting bodies touch. A skin of 0.01 per collider kept every
+        // resting pair 0.02 apart, visibly, and with soft CCD (see `solver`) a pair moving
+        // along such a gap loses its contact. Stacks and piles stand as well without it.
+        // Maps keep [`MAP_CONTACT_SKIN`]: a box sliding over a triangle mesh without one
+        // catches the triangles' inner edges.
+        collider.set_contact_skin(if self.map.is_some() {
+            MAP_CONTACT_SKIN
+        } else {
+            0.0
+        });
         collider.set_collision_groups(self.interaction_groups(groups));
         // The rest-threshold hook only matters where something can bounce; a controller's
         // capsule needs it for its capped pushes.
