@@ -233,6 +233,13 @@ pub const SCENES: &[Scene] = &[
         run: stress::friction_ramp,
     },
     Scene {
+        name: "card-house-q4",
+        criterion: "at HitBoxQuality 4 (cards free to rotate), Box2D's card house (0.4 × 0.002 cards, μ 0.7, ±25°, 5 levels, 25 cards, g = 9.81) stands: no card gets more than 0.02 from where it started in 4 s",
+        unit: "units",
+        config: Q4,
+        run: stress::card_house,
+    },
+    Scene {
         name: "confined-625",
         criterion: "625 unit balls started 10 % overlapping in a closed box, no gravity: no ball faster than 5 units/s in the 4th second, and its kinetic energy no larger than the 2nd second's (no growing jitter)",
         unit: "units/s",

@@ -1,6 +1,6 @@
 //! The stress scenes of Box2D v3 / Solver2D and PEEL beyond stacks and mass ratios: a
-//! friction ramp, 625 over-packed balls without gravity, rush and smash, a base-100
-//! pyramid, thin fast rods (CCD), and determinism (the state hash of every tick).
+//! friction ramp, a card house, 625 over-packed balls without gravity, rush and smash, a
+//! base-100 pyramid, thin fast rods (CCD), and determinism (the state hash of every tick).
 
 use client_sdk::{Handle, ObjectProp, PlaneProp, Pose, Shape};
 use physics_scenes::{anchored_box, cube, determinism_scene, floor, pyramid, thin_wall};
@@ -252,6 +252,57 @@ pub fn large_pyramid(c: Config, base: usize) -> BenchResult<Check> {
         .map(|(h, p)| distance(sim.state(*h).position, *p))
         .fold(0.0, f64::max);
     Ok(Check::at_most(&sim, worst, 0.1))
+}
+
+/// Box2D v3's card house: 0.4 × 0.002 cards (0.3 deep), friction 0.7, leaning in pairs at
+/// ±25° with a flat card across each two pairs, 5 levels (5 + 4 + 3 + 2 + 1 pairs, 25 cards),
+/// g = 9.81. Cards start as Box2D places them (1.6 mm into the floor or each other). Figure =
+/// the largest distance a card got from where it started, over 4 s (bound 0.02, 5 % of a
+/// card: a collapse moves cards by tenths).
+pub fn card_house(c: Config) -> BenchResult<Check> {
+    let mut sim = Sim::new(c, &[PlaneProp::Gravity([0.0, -9.81, 0.0])])?;
+    let grip = [ObjectProp::Friction(0.7)];
+    floor(&mut sim, 20.0, &grip)?;
+    let (half_height, depth) = (0.2f32, 0.3f32);
+    let card = Shape::Cube {
+        size: [0.002, 2.0 * half_height, depth],
+    };
+    let lean = 25f32.to_radians();
+    let mut cards = Vec::new();
+    let (mut pairs, mut x0, mut y) = (5, 0.0f32, half_height - 0.02);
+    while pairs > 0 {
+        let mut x = x0;
+        for i in 0..pairs {
+            if i != pairs - 1 {
+                let at = [x + 0.25, y + half_height - 0.015, 0.0];
+                let flat = Pose {
+                    position: at,
+                    rotation: about_z(std::f32::consts::FRAC_PI_2),
+                };
+                cards.push((sim.add(card.clone(), flat, &grip)?, at));
+            }
+            for (dx, angle) in [(0.0, -lean), (0.175, lean)] {
+                x += dx;
+                let pose = Pose {
+                    position: [x, y, 0.0],
+                    rotation: about_z(angle),
+                };
+                cards.push((sim.add(card.clone(), pose, &grip)?, pose.position));
+            }
+            x += 0.175;
+        }
+        y += 2.0 * half_height - 0.03;
+        x0 += 0.175;
+        pairs -= 1;
+    }
+    let mut worst = 0.0f64;
+    for _ in 0..sim.steps_for(4.0) {
+        sim.step()?;
+        for (h, start) in &cards {
+            worst = worst.max(distance(sim.state(*h).position, *start));
+        }
+    }
+    Ok(Check::at_most(&sim, worst, 0.02))
 }
 
 /// Thin fast rods: 0.05 × 0.05 × 2 rods flying broadside (0.05 along their motion) at 200
