@@ -56,5 +56,6 @@ pub use shm_layout::{
     FLAG_ON_GROUND,
 };
 pub use spawn::{
-    connect_or_start, daemon_executable, start_daemon, start_daemon_with, DaemonChild, Session,
+    connect_or_start, daemon_executable, sibling_executable, start_daemon, start_daemon_with,
+    DaemonChild, Session,
 };

@@ -42,18 +42,25 @@ impl Drop for DaemonChild {
 /// The daemon executable: `$PHYSICS_DAEMON_BIN`, else `physics-daemon` next to the
 /// current executable (cargo puts all workspace binaries together), else from `PATH`.
 pub fn daemon_executable() -> PathBuf {
-    if let Some(p) = std::env::var_os("PHYSICS_DAEMON_BIN") {
+    sibling_executable("physics-daemon", "PHYSICS_DAEMON_BIN")
+}
+
+/// A workspace executable: `$env_var`, else `name` next to the current executable (or one
+/// folder up, where cargo puts binaries beside its test and example folders), else `name`
+/// from `PATH`.
+pub fn sibling_executable(name: &str, env_var: &str) -> PathBuf {
+    if let Some(p) = std::env::var_os(env_var) {
         return PathBuf::from(p);
     }
     if let Ok(exe) = std::env::current_exe() {
         for dir in exe.ancestors().skip(1).take(2) {
-            let candidate = dir.join("physics-daemon");
+            let candidate = dir.join(name);
             if candidate.is_file() {
                 return candidate;
             }
         }
     }
-    PathBuf::from("physics-daemon")
+    PathBuf::from(name)
 }
 
 /// A client plus the daemon it started, if it had to. Dropping it says goodbye to the

@@ -345,18 +345,7 @@ mod viewer {
 
     /// `$PHYSICS_VIEW_BIN`, else `physics-view` next to this executable, else from `PATH`.
     fn executable() -> PathBuf {
-        if let Some(p) = std::env::var_os("PHYSICS_VIEW_BIN") {
-            return PathBuf::from(p);
-        }
-        if let Ok(exe) = std::env::current_exe() {
-            for dir in exe.ancestors().skip(1).take(2) {
-                let candidate = dir.join("physics-view");
-                if candidate.is_file() {
-                    return candidate;
-                }
-            }
-        }
-        PathBuf::from("physics-view")
+        client_sdk::sibling_executable("physics-view", "PHYSICS_VIEW_BIN")
     }
 
     /// Starts the viewer on the run's domain and prints its URL (on stderr, next to the

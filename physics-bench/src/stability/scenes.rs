@@ -322,18 +322,7 @@ pub fn stack(c: Config, n: usize, seconds: f32) -> BenchResult<Check> {
 }
 
 fn pyramid(c: Config) -> BenchResult<Check> {
-    let mut sim = Sim::new(c, &[])?;
-    floor(&mut sim, 100.0, &[])?;
-    let boxes = physics_scenes::pyramid(&mut sim, 20, c.pair_gap())?;
-    sim.run_for(1.0)?;
-    let settled: Vec<[f32; 3]> = boxes.iter().map(|h| sim.state(*h).position).collect();
-    sim.run_for(9.0)?;
-    let worst = boxes
-        .iter()
-        .zip(&settled)
-        .map(|(h, p)| distance(sim.state(*h).position, *p))
-        .fold(0.0, f64::max);
-    Ok(Check::at_most(&sim, worst, 0.1))
+    super::stress::pyramid_drift(c, 20, &[], 100.0)
 }
 
 /// `light` unit boxes of mass 1 with a unit box of mass `ratio` on top; figure = how far the

@@ -74,6 +74,28 @@ fn hash_cell(c: vec3<i32>) -> u32 {
     return h & (env.counts.y - 1u);
 }
 
+// The distinct hash buckets of the 27 cells around `c`, written to `out` (two neighbour
+// cells may share a bucket: it is listed once). Returns how many.
+fn neighbour_buckets(c: vec3<i32>, out: ptr<function, array<u32, 27>>) -> u32 {
+    var m = 0u;
+    for (var dz = -1; dz <= 1; dz++) {
+        for (var dy = -1; dy <= 1; dy++) {
+            for (var dx = -1; dx <= 1; dx++) {
+                let cell = hash_cell(c + vec3<i32>(dx, dy, dz));
+                var dup = false;
+                for (var q = 0u; q < m; q++) {
+                    dup = dup || (*out)[q] == cell;
+                }
+                if (!dup) {
+                    (*out)[m] = cell;
+                    m++;
+                }
+            }
+        }
+    }
+    return m;
+}
+
 fn hashed(i: u32) -> bool {
     let f = flags(i);
     return (f & F_ALIVE) != 0u && (f & F_COLLIDE) != 0u && (f & F_LARGE) == 0u;
@@ -369,29 +391,13 @@ fn solve(@builtin(global_invocation_id) gid: vec3<u32>) {
             for (var k = 0u; k < large; k++) {
                 touch(i, pi, vi, wi, lists[k], &acc);
             }
-            let c = cell_of(pi);
-            var seen: array<u32, 27>;
-            var m = 0u;
-            for (var dz = -1; dz <= 1; dz++) {
-                for (var dy = -1; dy <= 1; dy++) {
-                    for (var dx = -1; dx <= 1; dx++) {
-                        let cell = hash_cell(c + vec3<i32>(dx, dy, dz));
-                        // Two neighbour cells may share a bucket: visit it once.
-                        var dup = false;
-                        for (var q = 0u; q < m; q++) {
-                            dup = dup || seen[q] == cell;
-                        }
-                        if (dup) {
-                            continue;
-                        }
-                        seen[m] = cell;
-                        m++;
-                        let first = index[cell];
-                        let last = first + atomicLoad(&atoms[cell]);
-                        for (var k = first; k < last; k++) {
-                            touch(i, pi, vi, wi, index[t + k], &acc);
-                        }
-                    }
+            var buckets: array<u32, 27>;
+            let m = neighbour_buckets(cell_of(pi), &buckets);
+            for (var b = 0u; b < m; b++) {
+                let first = index[buckets[b]];
+                let last = first + atomicLoad(&atoms[buckets[b]]);
+                for (var k = first; k < last; k++) {
+                    touch(i, pi, vi, wi, index[t + k], &acc);
                 }
             }
         }
@@ -469,28 +475,13 @@ fn pairs(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (is_large) {
         return;
     }
-    let c = cell_of(state_in[i].pos.xyz);
-    var seen: array<u32, 27>;
-    var m = 0u;
-    for (var dz = -1; dz <= 1; dz++) {
-        for (var dy = -1; dy <= 1; dy++) {
-            for (var dx = -1; dx <= 1; dx++) {
-                let cell = hash_cell(c + vec3<i32>(dx, dy, dz));
-                var dup = false;
-                for (var q = 0u; q < m; q++) {
-                    dup = dup || seen[q] == cell;
-                }
-                if (dup) {
-                    continue;
-                }
-                seen[m] = cell;
-                m++;
-                let first = index[cell];
-                let last = first + atomicLoad(&atoms[cell]);
-                for (var k = first; k < last; k++) {
-                    pair(i, index[t + k]);
-                }
-            }
+    var buckets: array<u32, 27>;
+    let m = neighbour_buckets(cell_of(state_in[i].pos.xyz), &buckets);
+    for (var b = 0u; b < m; b++) {
+        let first = index[buckets[b]];
+        let last = first + atomicLoad(&atoms[buckets[b]]);
+        for (var k = first; k < last; k++) {
+            pair(i, index[t + k]);
         }
     }
 }
