@@ -7,8 +7,8 @@ use std::time::{Duration, Instant};
 
 use shm_layout::codec;
 use shm_layout::{
-    CollisionGroups, Command, CommandError, CommandResult, ErrorKind, Handle, PlaneId, PlaneOp,
-    Reply, Request, Response, CRATE_VERSION, LAYOUT_VERSION,
+    CollisionGroups, Command, CommandError, CommandResult, ErrorKind, Handle, ObjectOp, PlaneId,
+    PlaneOp, Reply, Request, Response, CRATE_VERSION, LAYOUT_VERSION,
 };
 
 use crate::plane::{PlaneOptions, PlaneShared};
@@ -261,9 +261,9 @@ impl Client {
             targets.push(match &q.command {
                 Command::Plane {
                     plane,
-                    op: PlaneOp::Object { handle, .. },
-                } => Some((*plane, Some(*handle))),
-                Command::Plane { plane, .. } => Some((*plane, None)),
+                    op: PlaneOp::Object { handle, op },
+                } => Some((*plane, Some(*handle), matches!(op, ObjectOp::Destroy))),
+                Command::Plane { plane, .. } => Some((*plane, None, false)),
                 _ => None,
             });
             commands.push(q.command);
@@ -273,13 +273,23 @@ impl Client {
         let extra_results = results.split_off(n_queued.min(results.len()));
         let mut state = self.inner.state.borrow_mut();
         for ((result, confirm), target) in results.into_iter().zip(confirms).zip(targets) {
-            if let (Err(_), Some((plane, handle))) = (&result, target) {
+            if let (Err(_), Some((plane, handle, _))) = (&result, target) {
                 // A rejected write must not linger in the mirror either.
                 if let Some(p) = state.planes.get(&plane) {
                     let mut mirror = p.mirror.borrow_mut();
                     match handle {
                         Some(h) => mirror.forget_object(h),
                         None => mirror.forget_plane(),
+                    }
+                }
+            }
+            if let Some((plane, Some(handle), true)) = target {
+                // A removal counts in the plane's object count until a tick shows it.
+                if let Some(p) = state.planes.get(&plane) {
+                    let mut members = p.members.borrow_mut();
+                    match &result {
+                        Ok(Reply::Applied { tick }) => members.removal_applied(handle, *tick),
+                        _ => members.removal_refused(handle),
                     }
                 }
             }

@@ -45,6 +45,7 @@ impl Plane {
                     e.velocity = Some([0.0; 3]);
                 });
                 self.shared.confirm(handle, tick);
+                self.shared.members.borrow_mut().added(tick);
                 Ok(Controller { object })
             }
             other => Err(Error::Protocol(format!("unexpected reply {other:?}"))),

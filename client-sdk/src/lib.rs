@@ -21,6 +21,7 @@ mod gui;
 mod inspect;
 mod joint;
 pub mod map;
+mod members;
 mod mirror;
 mod object;
 mod overlay;

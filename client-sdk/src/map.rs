@@ -413,6 +413,8 @@ impl Plane {
                 return Err(e);
             }
         };
+        // The map's body joins the plane's objects (and its tick is not in the reply).
+        self.shared.members.borrow_mut().unknown_change();
         match reply {
             Reply::Map(info) => Ok(Map {
                 object: Object::from_handle(self, info.handle),

@@ -297,6 +297,11 @@ impl Object {
             .borrow_mut()
             .forget_object(self.handle);
         self.plane
+            .shared
+            .members
+            .borrow_mut()
+            .removal_queued(self.handle);
+        self.plane
             .overlay_write(self.handle, |e| e.destroyed = true);
         let plane = self.plane.id();
         self.plane

@@ -11,6 +11,7 @@ use shm_layout::{
 
 use crate::client::LIVENESS_PERIOD;
 use crate::events::EventReader;
+use crate::members::Members;
 use crate::mirror::Mirror;
 use crate::overlay::{Entry, Overlay};
 use crate::transport::{BodySample, BodySubscriber, TickListener, Transport};
@@ -110,6 +111,8 @@ pub(crate) struct PlaneShared {
     refreshed_in: Cell<u64>,
     /// The plane's options and its objects' properties as this process knows them.
     pub(crate) mirror: RefCell<Mirror>,
+    /// Adds and removals the newest header may not count yet ([`Plane::object_count`]).
+    pub(crate) members: RefCell<Members>,
 }
 
 impl PlaneShared {
@@ -125,6 +128,7 @@ impl PlaneShared {
             alive: Cell::new(true),
             refreshed_in: Cell::new(0),
             mirror: RefCell::default(),
+            members: RefCell::default(),
         })
     }
 
@@ -319,9 +323,28 @@ impl Plane {
         }
     }
 
-    /// Live objects of the plane (asks the daemon, so it counts unpublished adds too).
+    /// Live objects of the plane (controllers and maps included), without a round trip:
+    /// the newest tick header's count (taken once per client frame, like poses) with this
+    /// process's adds and removals that tick does not show yet. Asks the daemon only when
+    /// nothing was published yet, the plane is gone, or after a map build.
     pub fn object_count(&self) -> Result<u32, Error> {
-        Ok(self.info()?.object_count)
+        if self.shared.alive.get() {
+            self.shared.refresh_in_frame(self.client.frame())?;
+            let header = self
+                .shared
+                .latest
+                .borrow()
+                .as_ref()
+                .map(|s| *s.user_header());
+            if let Some(h) = header {
+                if let Some(n) = self.shared.members.borrow_mut().count(h.tick, h.body_count) {
+                    return Ok(n);
+                }
+            }
+        }
+        let info = self.info()?;
+        self.shared.members.borrow_mut().asked(info.tick);
+        Ok(info.object_count)
     }
 
     /// Adds an object; sends the queue and waits for the new handle.
@@ -355,6 +378,7 @@ impl Plane {
             }
         });
         overlay.confirm(handle, tick);
+        self.shared.members.borrow_mut().added(tick);
         Ok(Object::new(self.clone(), handle))
     }
 
