@@ -33,7 +33,7 @@ fn the_count_follows_adds_and_removals_at_once_while_the_plane_ticks() {
     let mut seed = 12345u32;
     for step in 0..300 {
         seed = seed.wrapping_mul(1_103_515_245).wrapping_add(12_345);
-        let remove = !live.is_empty() && (seed >> 16) % 3 == 0;
+        let remove = !live.is_empty() && (seed >> 16).is_multiple_of(3);
         if remove {
             let i = (seed >> 8) as usize % live.len();
             let o: client_sdk::Object = live.swap_remove(i);
@@ -47,7 +47,7 @@ fn the_count_follows_adds_and_removals_at_once_while_the_plane_ticks() {
             live.len() as u32,
             "step {step}: right after the change"
         );
-        if step % 25 == 0 {
+        if step.is_multiple_of(25) {
             std::thread::sleep(Duration::from_millis(3));
             client.begin_frame();
             assert_eq!(plane.object_count().unwrap(), live.len() as u32);
@@ -57,7 +57,10 @@ fn the_count_follows_adds_and_removals_at_once_while_the_plane_ticks() {
     // Once ticks show everything, the header alone carries it.
     std::thread::sleep(Duration::from_millis(50));
     client.begin_frame();
-    assert_eq!(plane.snapshot().unwrap().header().body_count, live.len() as u32);
+    assert_eq!(
+        plane.snapshot().unwrap().header().body_count,
+        live.len() as u32
+    );
     assert_eq!(plane.object_count().unwrap(), live.len() as u32);
 }
 
