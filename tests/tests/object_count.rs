@@ -31,7 +31,7 @@ fn the_count_follows_adds_and_removals_at_once_while_the_plane_ticks() {
     // A fixed pseudo-random walk of adds and removals, read back after every change (the
     // plane publishes every ~4 ms, so reads land before, between and after ticks).
     let mut seed = 12345u32;
-    for step in 0..300 {
+    for step in 0..300u32 {
         seed = seed.wrapping_mul(1_103_515_245).wrapping_add(12_345);
         let remove = !live.is_empty() && (seed >> 16).is_multiple_of(3);
         if remove {
