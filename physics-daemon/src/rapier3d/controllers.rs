@@ -267,7 +267,7 @@ impl Plane {
         self.quality_counts[part.hit_box_quality as usize] += 1;
         let handle = self.bodies.insert(Body {
             handle: h,
-            part,
+            part: Box::new(part),
             flags: shm_layout::FLAG_CONTROLLER,
         })?;
         self.dirty.mark(handle.slot);

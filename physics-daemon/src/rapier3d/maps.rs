@@ -242,7 +242,7 @@ impl Plane {
         self.mesh_vertices += part.mesh_vertex_count() as u64;
         let handle = self.bodies.insert(Body {
             handle: h,
-            part,
+            part: Box::new(part),
             flags: 0,
         })?;
         self.dirty.mark(handle.slot);

@@ -49,7 +49,9 @@ pub use objects::MAX_SLOTS;
 #[derive(Debug)]
 struct Body {
     handle: RigidBodyHandle,
-    part: Part,
+    /// Boxed: the slot table stays small, so the publisher's pass over every slot reads one
+    /// short entry per body (the part's settings are read only where they matter).
+    part: Box<Part>,
     /// `FLAG_*` bits the plane adds to the published state (controllers).
     flags: u32,
 }

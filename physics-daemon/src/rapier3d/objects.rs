@@ -52,7 +52,7 @@ impl Plane {
         self.mesh_vertices += shape.mesh_vertices() as u64;
         let handle = self.bodies.insert(Body {
             handle: h,
-            part,
+            part: Box::new(part),
             flags: 0,
         })?;
         debug_assert_eq!(handle.slot, slot);
