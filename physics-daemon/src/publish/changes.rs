@@ -16,6 +16,9 @@ pub struct Changes {
     slot_count: usize,
     /// Per slot: the publish from which on its state may differ from earlier publishes.
     changed_at: Vec<u64>,
+    /// The last publish at which every slot counted as changed (most bodies awake): one
+    /// number instead of rewriting `changed_at` whole at every such publish.
+    all_changed_at: u64,
     /// Slots awake at the last publish: they may have moved, or fallen asleep, since.
     awake_before: Vec<usize>,
     /// Most bodies were awake at the last publish: every slot counted as changed.
@@ -53,7 +56,7 @@ impl Changes {
         // When most bodies are awake, looking up each one costs more than rewriting all.
         let mostly_awake = plane.awake_count() * 2 >= n;
         if mostly_awake || self.mostly_awake_before {
-            changed_at.fill(seq);
+            self.all_changed_at = seq;
             self.awake_before.clear();
         }
         if !mostly_awake {
@@ -74,10 +77,12 @@ impl Changes {
     /// Which slots of the sample at `addr` need writing for the current publish.
     pub fn filter(&self, addr: usize) -> SlotFilter<'_> {
         match self.written_at(addr) {
-            Some(written) if !self.mostly_awake_before => SlotFilter::ChangedAfter {
-                changed_at: &self.changed_at,
-                written,
-            },
+            Some(written) if !self.mostly_awake_before && self.all_changed_at <= written => {
+                SlotFilter::ChangedAfter {
+                    changed_at: &self.changed_at,
+                    written,
+                }
+            }
             _ => SlotFilter::All,
         }
     }
