@@ -7,8 +7,8 @@ use std::time::{Duration, Instant};
 
 use shm_layout::codec;
 use shm_layout::{
-    CollisionGroups, Command, CommandError, CommandResult, ErrorKind, Handle, ObjectOp, PlaneId,
-    PlaneOp, Reply, Request, Response, CRATE_VERSION, LAYOUT_VERSION,
+    CollisionGroups, Command, CommandError, CommandResult, ErrorKind, GuiObjectOp, GuiOp, Handle,
+    ObjectOp, PlaneId, PlaneOp, Reply, Request, Response, CRATE_VERSION, LAYOUT_VERSION,
 };
 
 use crate::plane::{PlaneOptions, PlaneShared};
@@ -263,6 +263,14 @@ impl Client {
                     plane,
                     op: PlaneOp::Object { handle, op },
                 } => Some((*plane, Some(*handle), matches!(op, ObjectOp::Destroy))),
+                Command::Plane {
+                    plane,
+                    op:
+                        PlaneOp::Gui(GuiOp::Object {
+                            handle,
+                            op: GuiObjectOp::Destroy,
+                        }),
+                } => Some((*plane, Some(*handle), true)),
                 Command::Plane { plane, .. } => Some((*plane, None, false)),
                 _ => None,
             });

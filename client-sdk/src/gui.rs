@@ -145,6 +145,16 @@ impl GuiPlane {
         }
     }
 
+    /// Live bodies of the plane without a round trip (see [`Plane::object_count`]).
+    pub fn object_count(&self) -> Result<u32, Error> {
+        if let Some(n) = self.plane.published_object_count()? {
+            return Ok(n);
+        }
+        let info = self.info()?;
+        self.plane.shared.members.borrow_mut().asked(info.tick);
+        Ok(info.object_count)
+    }
+
     /// Changes a GUI option (checked now, sent with the next flush).
     pub fn set(&self, prop: GuiPlaneProp) -> Result<(), Error> {
         self.plane.set(PlaneProp::Gui(prop))
@@ -197,6 +207,7 @@ impl GuiPlane {
             e.angular_velocity = Some([0.0; 3]);
         });
         self.plane.shared.confirm(handle, tick);
+        self.plane.shared.members.borrow_mut().added(tick);
         Ok(GuiObject {
             plane: self.clone(),
             handle,
@@ -423,6 +434,12 @@ impl GuiObject {
         self.plane
             .plane
             .overlay_write(self.handle, |e| e.destroyed = true);
+        self.plane
+            .plane
+            .shared
+            .members
+            .borrow_mut()
+            .removal_queued(self.handle);
         self.plane
             .queue(self.op(GuiObjectOp::Destroy), Some(self.handle));
     }

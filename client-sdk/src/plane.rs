@@ -258,6 +258,22 @@ impl Plane {
         })
     }
 
+    /// [`Plane::object_count`] from the newest header and this process's pending changes;
+    /// `None` when only the daemon can say.
+    pub(crate) fn published_object_count(&self) -> Result<Option<u32>, Error> {
+        if !self.shared.alive.get() {
+            return Ok(None);
+        }
+        self.shared.refresh_in_frame(self.client.frame())?;
+        let header = self
+            .shared
+            .latest
+            .borrow()
+            .as_ref()
+            .map(|s| *s.user_header());
+        Ok(header.and_then(|h| self.shared.members.borrow_mut().count(h.tick, h.body_count)))
+    }
+
     /// Records this process's write to `handle` so reads see it until a tick shows it.
     pub(crate) fn overlay_write(&self, handle: Handle, f: impl FnOnce(&mut Entry)) {
         self.shared.overlay.borrow_mut().write(handle, f);
@@ -328,19 +344,8 @@ impl Plane {
     /// process's adds and removals that tick does not show yet. Asks the daemon only when
     /// nothing was published yet, the plane is gone, or after a map build.
     pub fn object_count(&self) -> Result<u32, Error> {
-        if self.shared.alive.get() {
-            self.shared.refresh_in_frame(self.client.frame())?;
-            let header = self
-                .shared
-                .latest
-                .borrow()
-                .as_ref()
-                .map(|s| *s.user_header());
-            if let Some(h) = header {
-                if let Some(n) = self.shared.members.borrow_mut().count(h.tick, h.body_count) {
-                    return Ok(n);
-                }
-            }
+        if let Some(n) = self.published_object_count()? {
+            return Ok(n);
         }
         let info = self.info()?;
         self.shared.members.borrow_mut().asked(info.tick);

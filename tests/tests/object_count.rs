@@ -164,3 +164,36 @@ fn reading_the_count_sends_nothing_to_the_daemon() {
     client.flush().unwrap();
     assert_eq!(daemon_count(&plane), 3);
 }
+
+#[test]
+fn a_gui_planes_count_follows_its_adds_and_removals_while_it_ticks() {
+    let daemon = TestDaemon::start("count-gui");
+    let client = daemon.client();
+    let plane = client
+        .create_gui_plane(&client_sdk::GuiPlaneOptions {
+            tick_rate: Some(240.0),
+            ..Default::default()
+        })
+        .unwrap();
+    let mut live = Vec::new();
+    for step in 0..120u32 {
+        if step % 3 == 2 {
+            let o: client_sdk::GuiObject = live.remove(0);
+            o.destroy();
+        } else {
+            let x = 40.0 * (step % 20) as f32;
+            let shape = client_sdk::GuiShape::Circle;
+            live.push(plane.add(shape, [20.0, 20.0], [x, 100.0], &[]).unwrap());
+        }
+        assert_eq!(
+            plane.object_count().unwrap(),
+            live.len() as u32,
+            "step {step}"
+        );
+    }
+    client.flush().unwrap();
+    assert_eq!(plane.info().unwrap().object_count, live.len() as u32);
+    std::thread::sleep(Duration::from_millis(50));
+    client.begin_frame();
+    assert_eq!(plane.object_count().unwrap(), live.len() as u32);
+}

@@ -58,7 +58,7 @@ impl PlaneState {
         if !self.alive() {
             return Ok(0);
         }
-        Ok(self.plane.info()?.object_count)
+        self.plane.object_count()
     }
 
     /// Forgets `part`, whose body `handle` left the plane.

@@ -204,7 +204,14 @@ pub fn plane_get(lua: &Lua, p: &GuiPlaneState, key: &Value) -> mlua::Result<Valu
             .map_err(|e| sdk_error(&format!("GuiPhysicsPlane.{what}"), e))
     };
     match name.as_str() {
-        "ObjectCount" => Ok(Value::Integer(info("ObjectCount")?.object_count as i64)),
+        "ObjectCount" => {
+            p.check_alive("ObjectCount")?;
+            let n = p
+                .plane
+                .object_count()
+                .map_err(|e| sdk_error("GuiPhysicsPlane.ObjectCount", e))?;
+            Ok(Value::Integer(n as i64))
+        }
         "BoundsMin" | "BoundsMax" => match info(&name)?.bounds {
             Some((min, max)) => out_dim(lua, if name == "BoundsMin" { min } else { max }),
             None => Ok(Value::Nil),

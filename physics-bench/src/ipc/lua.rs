@@ -21,6 +21,9 @@ pub struct LuaReads {
     /// Median per read, µs.
     pub weight_read_us: f64,
     pub linear_damping_read_us: f64,
+    /// Values the daemon derives each tick: the tick header's count, a body's flags.
+    pub object_count_read_us: f64,
+    pub sleeping_read_us: f64,
 }
 
 fn physics_lua() -> BenchResult<PathBuf> {
@@ -77,5 +80,7 @@ pub fn measure() -> BenchResult<LuaReads> {
         table_x1000_us: median(&cframe, "table.field x1000")?,
         weight_read_us: median(&props, "obj.Weight x1000")? / 1000.0,
         linear_damping_read_us: median(&props, "plane.LinearDamping x1000")? / 1000.0,
+        object_count_read_us: median(&props, "plane.ObjectCount x1000")? / 1000.0,
+        sleeping_read_us: median(&props, "obj.Sleeping x1000")? / 1000.0,
     })
 }

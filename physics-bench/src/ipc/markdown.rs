@@ -68,8 +68,9 @@ pub fn method() -> BTreeMap<&'static str, &'static str> {
             "lua",
             "physics-lua (next to the bench) runs examples/cframe_cost.luau (medians per frame \
              of 1,000 part.CFrame reads of falling parts at 60 Hz) and \
-             examples/property_cost.luau (medians of 1,000 obj.Weight and \
-             plane.LinearDamping reads, per read), each against a daemon of its own.",
+             examples/property_cost.luau (medians of 1,000 obj.Weight, \
+             plane.LinearDamping, plane.ObjectCount and obj.Sleeping reads, per read), each \
+             against a daemon of its own.",
         ),
         (
             "idle_cpu_percent",
