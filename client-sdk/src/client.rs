@@ -39,6 +39,12 @@ pub struct ConnectOptions {
     /// Test support: claim another layout version in every request.
     #[doc(hidden)]
     pub layout_version: u32,
+    /// Objects this client adds start held (`ObjectProp::Held`) and are released by its
+    /// next flush: the writes it queues right after an add apply before the object's first
+    /// step, even on a plane that ticks by itself. For clients that flush every frame (the
+    /// Lua host does); a client that never flushes leaves new objects held for
+    /// `MAX_HELD_TICKS` ticks. Default off.
+    pub hold_adds_until_flush: bool,
 }
 
 impl ConnectOptions {
@@ -49,6 +55,7 @@ impl ConnectOptions {
             request_timeout: Duration::from_secs(30),
             crate_version: CRATE_VERSION.to_string(),
             layout_version: LAYOUT_VERSION,
+            hold_adds_until_flush: false,
         }
     }
 }
@@ -133,6 +140,11 @@ impl Client {
         Ok(Client {
             inner: Rc::new(inner),
         })
+    }
+
+    /// Whether adds start held until the next flush ([`ConnectOptions::hold_adds_until_flush`]).
+    pub(crate) fn holds_adds(&self) -> bool {
+        self.inner.options.hold_adds_until_flush
     }
 
     /// The domain this client talks to.
@@ -256,8 +268,10 @@ impl Client {
         let mut confirms = Vec::with_capacity(n_queued);
         let mut targets = Vec::with_capacity(n_queued);
         let mut commands = Vec::with_capacity(n_queued + extra.len());
+        let mut releases = Vec::with_capacity(n_queued);
         for q in queued {
             confirms.push(q.confirms);
+            releases.push(is_release(&q.command));
             targets.push(match &q.command {
                 Command::Plane {
                     plane,
@@ -280,7 +294,13 @@ impl Client {
         let mut results = self.inner.round_trip(commands)?;
         let extra_results = results.split_off(n_queued.min(results.len()));
         let mut state = self.inner.state.borrow_mut();
-        for ((result, confirm), target) in results.into_iter().zip(confirms).zip(targets) {
+        let each = results.into_iter().zip(confirms).zip(targets).zip(releases);
+        for (((result, confirm), target), release) in each {
+            if release {
+                // The SDK's own release of a held add: nothing the caller asked for, and an
+                // object already gone has nothing left to release.
+                continue;
+            }
             if let (Err(_), Some((plane, handle, _))) = (&result, target) {
                 // A rejected write must not linger in the mirror either.
                 if let Some(p) = state.planes.get(&plane) {
@@ -513,4 +533,24 @@ impl std::fmt::Debug for Client {
             .field("daemon_pid", &self.daemon_pid())
             .finish()
     }
+}
+
+/// Whether `command` is the release of a held add ([`ConnectOptions::hold_adds_until_flush`]).
+fn is_release(command: &Command) -> bool {
+    matches!(
+        command,
+        Command::Plane {
+            op: PlaneOp::Object {
+                op: ObjectOp::Set(shm_layout::ObjectProp::Held(false)),
+                ..
+            },
+            ..
+        } | Command::Plane {
+            op: PlaneOp::Gui(GuiOp::Object {
+                op: GuiObjectOp::Set(shm_layout::GuiObjectProp::Held(false)),
+                ..
+            }),
+            ..
+        }
+    )
 }

@@ -182,15 +182,28 @@ impl GuiPlane {
             .checked()
             .map_err(Error::invalid_value)?;
         finite2("Position", position).map_err(Error::invalid_value)?;
+        let hold = self.plane.client().holds_adds();
+        let mut sent = props.clone();
+        if hold {
+            sent.push(GuiObjectProp::Held(true));
+        }
         let reply = self.call(GuiOp::Add {
             shape,
             size,
             position,
-            props: props.clone(),
+            props: sent,
         })?;
         let Reply::Object { handle, tick } = reply else {
             return Err(unexpected(reply));
         };
+        if hold {
+            // Released by the next flush, together with what the caller writes until then.
+            let release = GuiOp::Object {
+                handle,
+                op: GuiObjectOp::Set(GuiObjectProp::Held(false)),
+            };
+            self.queue(release, None);
+        }
         let mut pose = Pose::at([position[0], position[1], 0.0]);
         let mut velocity = [0.0; 3];
         for p in &props {

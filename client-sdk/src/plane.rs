@@ -361,17 +361,30 @@ impl Plane {
             .map(|p| p.checked())
             .collect::<Result<Vec<_>, _>>()
             .map_err(Error::invalid_value)?;
+        let hold = self.client.holds_adds();
+        let mut sent = props.clone();
+        if hold {
+            sent.push(ObjectProp::Held(true));
+        }
         let reply = self.client.call(Command::plane(
             self.id(),
             PlaneOp::AddObject {
                 shape,
                 pose,
-                props: props.clone(),
+                props: sent,
             },
         ))?;
         let Reply::Object { handle, tick } = reply else {
             return Err(Error::Protocol(format!("unexpected reply {reply:?}")));
         };
+        if hold {
+            // Released by the next flush, together with what the caller writes until then.
+            let release = PlaneOp::Object {
+                handle,
+                op: shm_layout::ObjectOp::Set(ObjectProp::Held(false)),
+            };
+            self.client.queue(Command::plane(self.id(), release), None);
+        }
         // Until a sample shows it, the object reads back as created.
         let mut overlay = self.shared.overlay.borrow_mut();
         overlay.write(handle, |e| {

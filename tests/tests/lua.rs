@@ -388,6 +388,14 @@ fn gui_snippet_layers_runs_unmodified() {
 }
 
 #[test]
+fn writes_right_after_an_add_apply_before_its_first_step() {
+    let daemon = TestDaemon::start("lua-held-adds");
+    let r = run(&daemon, "tests/lua/held_adds.luau");
+    r.assert_ok();
+    assert!(r.stdout().contains("held adds ok"), "{}", r.stdout());
+}
+
+#[test]
 fn gui_snippet_cursor_drag_runs_with_a_stubbed_mouse() {
     let daemon = TestDaemon::start("lua-gui-drag");
     let r = run_in(

@@ -204,6 +204,8 @@ fn install_print(lua: &Lua) -> mlua::Result<()> {
 /// longest wait for a reply.
 fn connect(domain: &str, timeout: Duration) -> Result<Session, client_sdk::Error> {
     let mut options = ConnectOptions::new(domain);
+    // The host flushes every frame: writes right after an Add apply before its first step.
+    options.hold_adds_until_flush = true;
     options.request_timeout = timeout;
     match Client::connect_with(options.clone()) {
         Ok(client) => Ok(Session {

@@ -6,6 +6,7 @@
 //! [`Backend`], a [`PlaneKind`] variant in shm-layout, and one line in [`create`].
 
 mod dirty;
+pub(crate) mod held;
 mod slot_table;
 
 use std::mem::MaybeUninit;

@@ -16,6 +16,10 @@
 mod backend;
 mod controllers;
 mod forces;
+mod held {
+    //! Held bodies: see `crate::backend::held`.
+    crate::backend::held::held_bodies!(rapier2d);
+}
 mod hooks;
 mod objects;
 mod queries;
@@ -66,6 +70,8 @@ pub struct Plane {
     dirty: Dirty,
     /// An op moved, added or reshaped a body since the last step (queries refresh first).
     query_stale: Vec<RigidBodyHandle>,
+    /// Bodies a step must leave where it found them (see `held`).
+    held: Vec<held::HeldBody>,
     tick: u64,
     sim_time: f64,
     last_step_us: f32,
@@ -94,6 +100,7 @@ impl Plane {
             driven: 0,
             dirty: Dirty::default(),
             query_stale: Vec::new(),
+            held: Vec::new(),
             tick: 0,
             sim_time: 0.0,
             last_step_us: 0.0,
@@ -250,7 +257,9 @@ impl Plane {
             self.settings.solver_iterations as usize;
         self.drive_controllers(dt);
         self.apply_forces(dt);
+        self.held_before_step();
         self.world.step_with_events(&hooks::Hooks, &());
+        self.held_after_step();
         self.query_stale.clear();
         self.dirty.stepped(self.bodies.slot_count());
         self.tick += 1;

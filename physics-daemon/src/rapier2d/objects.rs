@@ -156,6 +156,7 @@ impl Plane {
                     rb.set_angvel(0.0, true);
                 }
             }
+            Held(on) => self.hold(h, on),
             Mass(m) => {
                 self.world.colliders[c].set_mass(m);
                 self.world.bodies[h].wake_up(true);

@@ -104,6 +104,7 @@ pub(super) fn check_map_prop(prop: &ObjectProp) -> Result<(), CommandError> {
         | ObjectProp::CanCollide(_)
         | ObjectProp::CollisionGroup(_)
         | ObjectProp::ReportContacts(_)
+        | ObjectProp::Held(_)
         | ObjectProp::Anchored(true) => return Ok(()),
         ObjectProp::Anchored(false) => "Anchored",
         ObjectProp::Size(_) => "Size",

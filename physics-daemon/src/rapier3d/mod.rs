@@ -15,6 +15,10 @@ mod collision_groups;
 mod contacts;
 mod controllers;
 mod forces;
+mod held {
+    //! Held objects: see `crate::backend::held`.
+    crate::backend::held::held_bodies!(rapier3d);
+}
 #[cfg(feature = "gpu")]
 mod gpu;
 mod joints;
@@ -75,6 +79,8 @@ pub struct Plane {
     /// Bodies the last force pass left a force on (reset at the next pass).
     forced: Vec<RigidBodyHandle>,
     scratch: Vec<RigidBodyHandle>,
+    /// Objects a step must leave where it found them (see `held`).
+    held: Vec<held::HeldBody>,
     tick: u64,
     sim_time: f64,
     last_step_us: f32,
@@ -133,6 +139,7 @@ impl Plane {
             dirty: Dirty::default(),
             forced: Vec::new(),
             scratch: Vec::new(),
+            held: Vec::new(),
             tick: 0,
             sim_time: 0.0,
             last_step_us: 0.0,
@@ -302,6 +309,7 @@ impl Plane {
             threshold: self.settings.rest_threshold,
             gravity: self.world.gravity,
         };
+        self.held_before_step();
         // Contacts of objects removed since the last step still end with an event.
         if self.reporting > 0 || !self.removed.is_empty() {
             let collector = ChannelEventCollector::new(
@@ -313,6 +321,7 @@ impl Plane {
         } else {
             self.world.step_with_events(&hooks, &());
         }
+        self.held_after_step();
         self.query_stale.clear();
         self.limit_speeds_after_step();
         self.dirty.stepped(self.bodies.slot_count());

@@ -70,6 +70,7 @@ impl Plane {
                 body_changed = true;
             }
             ObjectProp::FieldRestraint(_) => body_changed = true,
+            ObjectProp::Held(_) => {}
             // Read by the force pass every tick.
             ObjectProp::ImpulseDirection(_)
             | ObjectProp::ConstantForce(_)
@@ -78,8 +79,11 @@ impl Plane {
         }
         debug_assert_eq!(
             stored,
-            !prop.is_published() && !matches!(prop, ObjectProp::Size(_))
+            !prop.is_published() && !matches!(prop, ObjectProp::Size(_) | ObjectProp::Held(_))
         );
+        if let ObjectProp::Held(on) = prop {
+            self.hold(h, on);
+        }
         let part = &self.bodies.get(handle)?.part;
         if shape_changed {
             // Rapier recycles the contacts of pairs whose poses did not move, even when a

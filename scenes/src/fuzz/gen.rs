@@ -867,7 +867,8 @@ impl<'a> Gen<'a> {
             let v = r.f32_in(lo, hi);
             r.maybe_wild(wild, v)
         };
-        match r.below(19) {
+        match r.below(20) {
+            19 => ObjectProp::Held(r.chance(0.5)),
             18 => ObjectProp::CollisionGroup(if wild { r.byte() } else { r.below(3) as u8 }),
             0 => ObjectProp::Pose(r.pose(wild, 30.0)),
             1 => ObjectProp::Velocity(r.vec3(wild, 20.0)),

@@ -438,6 +438,7 @@ pub fn object_prop_name(prop: &ObjectProp) -> &'static str {
         ObjectProp::RotateTo(_) => "RotateTo",
         ObjectProp::Pin(_) => "Pin",
         ObjectProp::CollisionGroup(_) => "CollisionGroup",
+        ObjectProp::Held(_) => "Held",
     }
 }
 

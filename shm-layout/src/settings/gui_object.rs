@@ -83,6 +83,9 @@ pub enum GuiObjectProp {
     ZIndex(i32),
     /// Size of the primitive's box (px), each side within [0.001, 100,000].
     Size(Vec2),
+    /// Held: steps leave the body where it is until `Held(false)`, or for at most
+    /// [`crate::settings::object::MAX_HELD_TICKS`] ticks (see `ObjectProp::Held`).
+    Held(bool),
 }
 
 /// The stored properties of a GUI object (the ones not read from the engine).
@@ -161,6 +164,7 @@ impl GuiObjectProp {
             LockedRotation(_) => "LockedRotation",
             ZIndex(_) => "ZIndex",
             Size(_) => "Size",
+            Held(_) => "Held",
         }
     }
 
@@ -210,7 +214,7 @@ impl GuiObjectSettings {
                     self.impulse_direction[1] + j[1],
                 ]
             }
-            Position(_) | Velocity(_) | Rotation(_) | AngularVelocity(_) => {}
+            Position(_) | Velocity(_) | Rotation(_) | AngularVelocity(_) | Held(_) => {}
         }
         Ok(prop)
     }

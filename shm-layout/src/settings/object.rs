@@ -104,7 +104,15 @@ pub enum ObjectProp {
     Pin(Option<Pin>),
     /// The object's collision group: an index into the plane's collision-group table.
     CollisionGroup(u8),
+    /// Held: steps leave the object where it is (pose and velocities as before the step)
+    /// until `Held(false)`, or for at most [`MAX_HELD_TICKS`] ticks. The SDK adds objects
+    /// held on planes that tick by themselves and releases them with its next flush, so
+    /// properties written right after an add apply before the object's first step.
+    Held(bool),
 }
+
+/// Ticks a held object waits at most for its release (about half a second at 60 Hz).
+pub const MAX_HELD_TICKS: u32 = 30;
 
 /// The stored (not per-tick) properties of an object. [`Default`] holds the documented
 /// defaults. Pose, velocities, Anchored and Size live in the engine's body and shape.
@@ -190,7 +198,8 @@ impl ObjectSettings {
             | ObjectProp::Velocity(_)
             | ObjectProp::AngularVelocity(_)
             | ObjectProp::Anchored(_)
-            | ObjectProp::Size(_) => return false,
+            | ObjectProp::Size(_)
+            | ObjectProp::Held(_) => return false,
         }
         true
     }

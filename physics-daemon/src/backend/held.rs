@@ -1,0 +1,72 @@
+//! Held objects (`ObjectProp::Held`, `GuiObjectProp::Held`): a step leaves them exactly
+//! where it found them (pose and velocities restored after the step) until they are
+//! released, or for at most `MAX_HELD_TICKS` ticks. The SDK adds objects held on planes
+//! that tick by themselves and releases them with its next flush, so the writes a script
+//! makes right after an add apply before the object's first step, whenever the plane's
+//! ticks fall.
+//!
+//! Both rapier backends use the same code: `held_bodies!(rapier3d)` in the 3D plane's
+//! module, `held_bodies!(rapier2d)` in the GUI plane's. The plane keeps a
+//! `held: Vec<held::HeldBody>` and calls `held_before_step` / `held_after_step` around
+//! rapier's step.
+
+/// Expands the held-body bookkeeping for the `Plane` of the module it is used in.
+macro_rules! held_bodies {
+    ($rapier:ident) => {
+        use shm_layout::settings::object::MAX_HELD_TICKS;
+        use $rapier::prelude::*;
+
+        use super::Plane;
+
+        /// One held body and its state before the current step.
+        pub(super) struct HeldBody {
+            handle: RigidBodyHandle,
+            ticks: u32,
+            saved: Option<(Pose, Vector, AngVector)>,
+        }
+
+        impl Plane {
+            /// Holds (`on`) or releases the rapier body `h`.
+            pub(super) fn hold(&mut self, h: RigidBodyHandle, on: bool) {
+                self.held.retain(|b| b.handle != h);
+                if on {
+                    self.held.push(HeldBody {
+                        handle: h,
+                        ticks: 0,
+                        saved: None,
+                    });
+                }
+            }
+
+            /// Before a step: forgets bodies gone or held long enough, remembers the
+            /// others' state.
+            pub(super) fn held_before_step(&mut self) {
+                if self.held.is_empty() {
+                    return;
+                }
+                let bodies = &self.world.bodies;
+                self.held
+                    .retain(|b| b.ticks < MAX_HELD_TICKS && bodies.get(b.handle).is_some());
+                for b in &mut self.held {
+                    let body = &bodies[b.handle];
+                    b.saved = Some((*body.position(), body.linvel(), body.angvel()));
+                    b.ticks += 1;
+                }
+            }
+
+            /// After a step: puts every held body back where the step found it.
+            pub(super) fn held_after_step(&mut self) {
+                for b in &self.held {
+                    let body = self.world.bodies.get_mut(b.handle);
+                    if let (Some((pose, v, w)), Some(body)) = (b.saved, body) {
+                        body.set_position(pose, false);
+                        body.set_linvel(v, false);
+                        body.set_angvel(w, false);
+                    }
+                }
+            }
+        }
+    };
+}
+
+pub(crate) use held_bodies;
