@@ -94,6 +94,10 @@ impl Overlay {
 
     /// The entry of `handle` if it still matters at `sample_tick`.
     pub fn get(&mut self, handle: Handle, sample_tick: u64) -> Option<&Entry> {
+        // Most reads find no pending write at all: skip hashing the handle twice.
+        if self.entries.is_empty() {
+            return None;
+        }
         if matches!(self.entries.get(&handle), Some(Entry { applied_at: Some(t), .. }) if sample_tick > *t)
         {
             self.entries.remove(&handle);

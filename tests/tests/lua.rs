@@ -332,6 +332,12 @@ fn stale_objects_never_reach_the_parts_new_body() {
 }
 
 #[test]
+fn pose_reads_reuse_a_value_only_while_the_pose_is_the_same() {
+    let daemon = TestDaemon::start("lua-pose-reads");
+    run_ok(&daemon, "tests/lua/pose_reads.luau", "pose reads ok");
+}
+
+#[test]
 fn resizing_a_simulated_part_resizes_its_body() {
     let daemon = TestDaemon::start("lua-resize");
     run_ok(&daemon, "tests/lua/resize.luau", "resize ok");

@@ -198,6 +198,27 @@ fn max_memory_mb_stops_an_allocation_loop() {
 }
 
 #[test]
+fn max_memory_mb_holds_for_cframes_that_pose_reads_make() {
+    // Pose reads make their CFrame values outside mlua's per-value protected call (the limit
+    // is lifted for that one allocation): the limit must still end a script that keeps them.
+    let daemon = TestDaemon::start("lua-memory-cframes");
+    let r = Runner::start(
+        &daemon.domain,
+        "tests/lua/hog_cframes.luau",
+        &["--max-memory-mb", "32"],
+    )
+    .wait(Duration::from_secs(30));
+    assert_eq!(r.status.code(), Some(1), "stderr:\n{}", r.stderr);
+    r.assert_stderr_has(&["out of memory", "--max-memory-mb 32"]);
+    // 32 MiB of Lua, the Rust side of each CFrame and the runner itself.
+    assert!(
+        r.peak_rss_kb > 0 && r.peak_rss_kb < 400 * 1024,
+        "peak RSS {} kB",
+        r.peak_rss_kb
+    );
+}
+
+#[test]
 fn the_first_signal_ends_a_busy_script_and_stops_the_daemon_it_started() {
     for (sig, name) in [(libc::SIGTERM, "term"), (libc::SIGINT, "int")] {
         let domain = unique_domain(&format!("lua-sig{name}"));

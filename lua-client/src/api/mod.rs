@@ -68,7 +68,7 @@ pub fn index<T: Target>(
     key: Value,
 ) -> mlua::Result<Value> {
     match props.row(&key) {
-        Some(_) => props.get(lua, target, &key),
+        Some(row) => props.read(lua, target, row),
         None => methods(&method_tables(lua))
             .raw_get::<Option<Function>>(key.clone())?
             .map(Value::Function)

@@ -14,7 +14,8 @@ use crate::host::Watched;
 use crate::props::part::PART;
 use crate::props::Target;
 use crate::values::{
-    describe, expected, finite_number, finite_vector, new_vector, sdk_error, CFrame, DESCRIBE,
+    describe, expected, finite_number, finite_vector, new_vector, sdk_error, CFrame, CFrameCache,
+    DESCRIBE,
 };
 
 /// Shapes a BasePart can have (the collider the plane builds from it). The part's origin is
@@ -235,6 +236,8 @@ pub struct PartState {
     reporting: Cell<bool>,
     /// The mesh of a MeshPart.
     mesh: RefCell<Option<Rc<MeshData>>>,
+    /// The CFrame value last handed to scripts (reads of an unmoved pose reuse it).
+    cframe_value: CFrameCache,
 }
 
 impl PartState {
@@ -252,6 +255,7 @@ impl PartState {
             last_fired: Cell::new(None),
             reporting: Cell::new(false),
             mesh: RefCell::new(None),
+            cframe_value: CFrameCache::default(),
         }
     }
 
@@ -438,6 +442,12 @@ impl PartState {
         self.cframe.get()
     }
 
+    /// `cf` (a pose of this part) as a Lua value: the one last handed out while the pose is
+    /// the same, so repeated reads of an unmoved part allocate nothing.
+    pub fn cframe_value(&self, lua: &Lua, cf: CFrame) -> mlua::Result<Value> {
+        self.cframe_value.value(lua, cf)
+    }
+
     /// Stores a pose for a part that is not simulated.
     pub fn store_cframe(&self, cf: CFrame) {
         self.cframe.set(cf);
@@ -514,7 +524,7 @@ impl PartState {
             return Ok(());
         }
         self.last_fired.set(Some(cf));
-        self.changed(lua, "CFrame", Value::UserData(lua.create_userdata(cf)?))
+        self.changed(lua, "CFrame", self.cframe_value(lua, cf)?)
     }
 }
 

@@ -327,6 +327,11 @@ impl<T: Target> Props<T> {
     /// Reads the property `key` of `target`.
     pub fn get(&self, lua: &Lua, target: &T, key: &Value) -> Result<Value, LuaError> {
         let row = self.row(key).ok_or_else(|| self.unknown(key))?;
+        self.read(lua, target, row)
+    }
+
+    /// Reads the property of `row` (one of this table's rows) of `target`.
+    pub fn read(&self, lua: &Lua, target: &T, row: &Row<T>) -> Result<Value, LuaError> {
         match row.get {
             Get::Fn(f) => f(lua, target),
             Get::NotYet => Err(self.not_supported(row.name)),

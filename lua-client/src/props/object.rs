@@ -63,15 +63,20 @@ macro_rules! state_row {
 pub static OBJECT: Props<PhysicsObject> = Props {
     owner: "PhysicsObject",
     rows: &[
-        state_row!(
-            "CFrame",
-            Kind::CFrame,
-            |lua, s| Value::UserData(lua.create_userdata(CFrame::from_pose(Pose {
-                position: s.position,
-                rotation: s.rotation,
-            }))?),
-            |a| ObjectProp::Pose(a.cframe()?.pose())
-        ),
+        // The part's CFrame value is reused while the pose is the same (as `part.CFrame`).
+        Row {
+            name: "CFrame",
+            kind: Kind::CFrame,
+            get: Get::Fn(|lua, o| {
+                let s = state(o, "CFrame")?;
+                let cf = CFrame::from_pose(Pose {
+                    position: s.position,
+                    rotation: s.rotation,
+                });
+                o.part.cframe_value(lua, cf)
+            }),
+            set: Set::Prop(|a| Ok(ObjectProp::Pose(a.cframe()?.pose()))),
+        },
         state_row!(
             "Velocity",
             Kind::Vector,

@@ -15,7 +15,7 @@ pub static PART: Props<BasePart> = Props {
         Row {
             name: "CFrame",
             kind: Kind::CFrame,
-            get: Get::Fn(|lua, p| Ok(Value::UserData(lua.create_userdata(p.0.cframe())?))),
+            get: Get::Fn(|lua, p| p.0.cframe_value(lua, p.0.cframe())),
             // Writing the CFrame of a simulated part teleports its body (sent with the frame's
             // batch; the per-tick pass announces the move). Otherwise it just moves the part.
             set: Set::Fn(|lua, p, a| {
@@ -26,7 +26,7 @@ pub static PART: Props<BasePart> = Props {
                         .map_err(|e| sdk_error("BasePart.CFrame", e)),
                     None => {
                         p.0.store_cframe(cf);
-                        p.0.changed(lua, "CFrame", Value::UserData(lua.create_userdata(cf)?))
+                        p.0.changed(lua, "CFrame", p.0.cframe_value(lua, cf)?)
                     }
                 }
             }),

@@ -1,10 +1,13 @@
 //! `CFrame`: an immutable position + rotation. Rotation is read and written as Euler radians
 //! (see `rotation` for the convention) and kept as a quaternion.
 
+use std::cell::RefCell;
 use std::fmt;
 
 use client_sdk::Pose;
-use mlua::{Lua, MetaMethod, UserData, UserDataFields, UserDataMethods, Value, Variadic};
+use mlua::{
+    AnyUserData, Lua, MetaMethod, UserData, UserDataFields, UserDataMethods, Value, Variadic,
+};
 
 use super::convert::{describe, expected, finite_vector, new_vector, number, vector};
 use super::rotation::{self, Quat, V3};
@@ -71,6 +74,61 @@ impl CFrame {
 
     fn axis(&self, v: V3) -> Value {
         new_vector(rotation::rotate(self.rotation, v))
+    }
+}
+
+/// The Lua value of a CFrame that something (a part, an object) hands out again and again:
+/// its last value, returned as long as the pose is bit for bit the same, so reading the pose
+/// of a body that did not move since the last read (a second read in the same tick, a body
+/// at rest) allocates nothing. CFrame values are immutable, so a script cannot tell a
+/// returned value from a fresh equal one (except by `rawequal`).
+#[derive(Default)]
+pub struct CFrameCache(RefCell<Option<(CFrame, AnyUserData)>>);
+
+impl CFrameCache {
+    /// `cf` as a Lua value: the cached one when it is the same pose, else a new one (which
+    /// the cache keeps).
+    pub fn value(&self, lua: &Lua, cf: CFrame) -> mlua::Result<Value> {
+        if let Some((cached, ud)) = &*self.0.borrow() {
+            if cached.same_bits(&cf) {
+                return Ok(Value::UserData(ud.clone()));
+            }
+        }
+        let ud = cf.new_userdata(lua)?;
+        *self.0.borrow_mut() = Some((cf, ud.clone()));
+        Ok(Value::UserData(ud))
+    }
+}
+
+impl CFrame {
+    /// Whether both hold the same bits (unlike `==`, tells -0 from 0, as `tostring` does).
+    fn same_bits(&self, other: &CFrame) -> bool {
+        let bits = |cf: &CFrame| {
+            let mut b = [0u32; 7];
+            for (i, c) in cf.position.iter().chain(&cf.rotation).enumerate() {
+                b[i] = c.to_bits();
+            }
+            b
+        };
+        bits(self) == bits(other)
+    }
+
+    /// A new CFrame userdata. While the Lua state has a memory limit, mlua makes every
+    /// userdata in a protected call (a closure allocated and called per value), which costs
+    /// more than the value itself; a CFrame is a few dozen bytes, so the limit is lifted for
+    /// this one allocation and restored at once: the next allocation past the limit still
+    /// fails with Lua's memory error.
+    pub fn new_userdata(self, lua: &Lua) -> mlua::Result<AnyUserData> {
+        match lua.set_memory_limit(0) {
+            Ok(0) => lua.create_userdata(self),
+            Ok(limit) => {
+                let ud = lua.create_userdata(self);
+                lua.set_memory_limit(limit)?;
+                ud
+            }
+            // No memory control (a module's Lua state): nothing to lift.
+            Err(_) => lua.create_userdata(self),
+        }
     }
 }
 

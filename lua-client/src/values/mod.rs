@@ -11,7 +11,7 @@ mod dim;
 pub mod rotation;
 mod vector;
 
-pub use cframe::CFrame;
+pub use cframe::{CFrame, CFrameCache};
 pub use convert::{
     describe, expected, finite_number, finite_vector, new_vector, number, sdk_error, vector,
     DESCRIBE,
