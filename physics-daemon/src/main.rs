@@ -47,8 +47,9 @@ fn main() -> ExitCode {
         tracing::error!("cannot install the SIGINT/SIGTERM handler: {e}");
         return ExitCode::FAILURE;
     }
-    // Planes with Threads = 1 run on the global pool: keep it at one worker so they never
-    // spread over the machine's cores uninvited.
+    // Each plane steps on its own worker (a one-thread pool of its own, or the pool its
+    // Threads asks for); the global pool is for anything else: keep it at one worker so
+    // nothing spreads over the machine's cores uninvited.
     let _ = rapier3d::rayon::ThreadPoolBuilder::new()
         .num_threads(1)
         .build_global();

@@ -249,3 +249,191 @@ fn reads_answer_from_the_mirror_and_derived_values_are_refetched() {
     let theirs = client_sdk::Object::from_handle(&seen, cube.handle());
     assert_eq!(theirs.properties().unwrap().friction, 0.75);
 }
+
+/// The friction an `Object Info` result reports.
+fn friction(result: &shm_layout::CommandResult) -> f32 {
+    match result {
+        Ok(Reply::ObjectInfo(info)) => info.settings.friction,
+        other => panic!("expected object info, got {other:?}"),
+    }
+}
+
+#[test]
+fn runs_applied_inline_and_handed_over_keep_their_order_and_stay_whole() {
+    // The loop applies a short run itself while the plane's worker is idle and hands it
+    // over while the worker steps or has runs queued. Two clients on one shared plane mix
+    // both: every batch must apply whole (no other run between its commands), each client's
+    // requests in order, and a Step reply only once its tick is published.
+    let daemon = TestDaemon::start("inline");
+    let owner = daemon.client();
+    let plane = owner
+        .create_plane(&PlaneOptions {
+            shared: Some(true),
+            solver_iterations: Some(8),
+            ..PlaneOptions::manual()
+        })
+        .unwrap();
+    // Enough bodies that a step takes a while (the other client's runs meet a busy worker).
+    plane
+        .add(
+            Shape::Cube {
+                size: [40.0, 1.0, 40.0],
+            },
+            Pose::at([0.0, -0.5, 0.0]),
+            &[ObjectProp::Anchored(true)],
+        )
+        .unwrap();
+    for i in 0..400 {
+        let (x, z, y) = ((i % 10) as f32 * 0.9, ((i / 10) % 10) as f32 * 0.9, i / 100);
+        plane
+            .add(
+                Shape::Cube { size: [1.0; 3] },
+                Pose::at([x - 4.0, 0.5 + y as f32 * 0.9, z - 4.0]),
+                &[],
+            )
+            .unwrap();
+    }
+    let ball = |y: f32| {
+        plane
+            .add(
+                Shape::Sphere { radius: 0.5 },
+                Pose::at([30.0, y, 30.0]),
+                &[],
+            )
+            .unwrap()
+            .handle()
+    };
+    let (mine, theirs) = (ball(100.0), ball(200.0));
+    let id = plane.id();
+    let set = move |h: Handle, f: f32| Cmd::object(id, h, ObjectOp::Set(ObjectProp::Friction(f)));
+    let info = move |h: Handle| Cmd::object(id, h, ObjectOp::Info);
+    let rounds = 300;
+
+    let domain = daemon.domain.clone();
+    let other = std::thread::spawn(move || {
+        let client = Client::connect(&domain).unwrap();
+        for i in 0..rounds {
+            // Short runs (no step): applied inline whenever the worker is idle.
+            let (f, g) = (0.3 + i as f32 * 1e-3, 0.7 + i as f32 * 1e-3);
+            let r = results(
+                client
+                    .raw_request(&encode_request(&Request {
+                        commands: vec![set(theirs, f), info(theirs), set(theirs, g)],
+                    }))
+                    .unwrap(),
+            );
+            assert_eq!(friction(&r[1]), f, "round {i}: their batch was split");
+            assert!(matches!(r[2], Ok(Reply::Applied { .. })), "{:?}", r[2]);
+            // The next request sees the last write of the previous one.
+            let r = results(
+                client
+                    .raw_request(&encode_request(&Request {
+                        commands: vec![info(theirs)],
+                    }))
+                    .unwrap(),
+            );
+            assert_eq!(friction(&r[0]), g, "round {i}: their requests out of order");
+        }
+    });
+
+    let mut last_tick = 0;
+    for i in 0..rounds {
+        let f = 0.1 + i as f32 * 1e-4;
+        let mut commands = vec![set(mine, f), info(mine)];
+        if i % 2 == 1 {
+            // A run with a step goes to the worker; the info after it must still see f.
+            commands.push(Cmd::plane(id, PlaneOp::Step { dt: 1.0 / 60.0 }));
+            commands.push(info(mine));
+        }
+        let r = results(
+            owner
+                .raw_request(&encode_request(&Request { commands }))
+                .unwrap(),
+        );
+        assert_eq!(friction(&r[1]), f, "round {i}: my batch was split");
+        if i % 2 == 1 {
+            let Ok(Reply::Stepped { tick }) = r[2] else {
+                panic!("round {i}: {:?}", r[2]);
+            };
+            assert_eq!(tick, last_tick + 1, "round {i}: steps out of order");
+            last_tick = tick;
+            assert_eq!(
+                friction(&r[3]),
+                f,
+                "round {i}: my batch was split by a step"
+            );
+            // The reply came after the tick was published.
+            assert!(
+                plane.snapshot().unwrap().tick() >= tick,
+                "round {i}: Step answered before tick {tick} was published"
+            );
+        }
+        // A short request right after a stepping one applies after it.
+        let g = 0.2 + i as f32 * 1e-4;
+        owner
+            .raw_request(&encode_request(&Request {
+                commands: vec![set(mine, g)],
+            }))
+            .unwrap();
+        let r = results(
+            owner
+                .raw_request(&encode_request(&Request {
+                    commands: vec![info(mine)],
+                }))
+                .unwrap(),
+        );
+        assert_eq!(friction(&r[0]), g, "round {i}: my requests out of order");
+    }
+    other.join().unwrap();
+    assert_eq!(last_tick, rounds as u64 / 2);
+}
+
+#[test]
+fn a_tick_rate_set_between_steps_starts_and_stops_the_schedule() {
+    // A rate change is a short run the loop may apply itself: the plane's worker must
+    // still pick up the new schedule at once.
+    let daemon = TestDaemon::start("resched");
+    let client = daemon.client();
+    let plane = client.create_plane(&PlaneOptions::manual()).unwrap();
+    plane
+        .add(Shape::Sphere { radius: 0.5 }, Pose::at([0.0; 3]), &[])
+        .unwrap();
+    let tick = |p: &client_sdk::Plane| p.snapshot().unwrap().tick();
+    std::thread::sleep(Duration::from_millis(100));
+    assert_eq!(tick(&plane), 0, "a manual plane does not tick");
+    plane.set(PlaneProp::TickRate(100.0)).unwrap();
+    client.flush().unwrap();
+    let started = Instant::now();
+    while tick(&plane) < 10 {
+        assert!(
+            started.elapsed() < Duration::from_secs(5),
+            "TickRate 100 made {} ticks in {:?}",
+            tick(&plane),
+            started.elapsed()
+        );
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    plane.set(PlaneProp::Enabled(false)).unwrap();
+    client.flush().unwrap();
+    // A tick may have been under way when the change applied.
+    let stopped = tick(&plane);
+    std::thread::sleep(Duration::from_millis(200));
+    assert!(
+        tick(&plane) <= stopped + 1,
+        "a disabled plane went on ticking: {stopped} → {}",
+        tick(&plane)
+    );
+    let stopped = tick(&plane);
+    plane.set(PlaneProp::Enabled(true)).unwrap();
+    client.flush().unwrap();
+    let started = Instant::now();
+    while tick(&plane) < stopped + 10 {
+        assert!(
+            started.elapsed() < Duration::from_secs(5),
+            "re-enabled, {} ticks in {:?}",
+            tick(&plane) - stopped,
+            started.elapsed()
+        );
+        std::thread::sleep(Duration::from_millis(5));
+    }
+}

@@ -13,7 +13,7 @@ use shm_layout::{
 };
 
 use super::limits::exceeded;
-use super::worker::{self, Budget, SharedUsage};
+use super::worker::{self, Budget, PlaneCell, SharedUsage};
 use super::{Daemon, Origin, PlaneEntry, Routed, MAX_PLANES};
 use crate::backend::Usage;
 use crate::DaemonError;
@@ -211,6 +211,7 @@ impl Daemon {
         let id = self.next_plane_id;
         let ticket = self.next_ticket;
         let usage = Arc::new(SharedUsage::default());
+        let cell = Arc::new(PlaneCell::default());
         let (jobs, receiver) = mpsc::channel();
         let shared = PlaneProp::shared_in(&props);
         let setup = worker::Setup {
@@ -219,14 +220,13 @@ impl Daemon {
             props,
             ticket,
             config: self.config.clone(),
+            cell: cell.clone(),
             usage: usage.clone(),
             events: self.events_tx.clone(),
             waker: self.waker.clone(),
             panic_on_step_dt: self.options.panic_on_step_dt,
         };
-        let spawned = std::thread::Builder::new()
-            .name(format!("plane-{id}"))
-            .spawn(move || worker::run(setup, receiver));
+        let spawned = worker::spawn(setup, receiver);
         match spawned {
             Ok(handle) => self.workers.push(handle),
             Err(e) => {
@@ -244,6 +244,7 @@ impl Daemon {
                 owner,
                 shared,
                 jobs,
+                cell,
                 usage,
             },
         );

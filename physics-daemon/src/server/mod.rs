@@ -9,6 +9,12 @@
 //! is answered. So planes step in parallel, a heavy tick of one plane never delays a request
 //! for another, and `Step` replies once its tick is published.
 //!
+//! A short run that neither steps nor touches shared memory (a write, a query) is applied
+//! by the loop itself when the plane's worker is idle and no run is queued for it: it then
+//! lands exactly where a hand-over would have put it, and its round trip costs no thread
+//! wake-ups. A busy worker (stepping, publishing, or with runs queued) gets the run handed
+//! over as before, so the loop never waits for a plane.
+//!
 //! - `clients`: who is connected, and noticing clients that died.
 //! - `dispatch`: decoding requests and routing each command to its plane by id.
 //!
@@ -40,7 +46,7 @@ use crate::publish::MAX_NODES;
 use crate::DaemonError;
 use clients::{Clients, MAX_CLIENTS};
 pub use limits::Limits;
-use worker::{Event, Job, SharedUsage, Waker};
+use worker::{Event, Inline, Job, PlaneCell, SharedUsage, Waker};
 
 /// How the daemon runs beyond its domain.
 #[derive(Debug, Clone, Default)]
@@ -74,6 +80,8 @@ struct PlaneEntry {
     /// Other clients may change the plane (only the owner destroys it).
     shared: bool,
     jobs: Sender<Job>,
+    /// The plane, shared with its worker (short runs apply inline while the worker idles).
+    cell: Arc<PlaneCell>,
     /// What the plane holds, as its worker last saw it (for the owner's other quotas).
     usage: Arc<SharedUsage>,
 }
@@ -467,26 +475,40 @@ impl Daemon {
         }
     }
 
-    /// Hands a job to the worker of plane `id`; the ticket names its answer.
+    /// Applies a run of ops for plane `id` at once when its worker is idle and nothing is
+    /// queued for it (see [`PlaneCell::try_apply`]); otherwise hands it to the worker, and
+    /// the ticket names its answer.
     fn send_job(&mut self, id: PlaneId, ops: Vec<shm_layout::PlaneOp>) -> Routed {
-        let ticket = self.next_ticket;
-        self.next_ticket += 1;
         let budget = self.budget(id);
         let n = ops.len();
-        match self.planes.get(&id) {
-            Some(entry)
-                if entry
-                    .jobs
-                    .send(Job::Run {
-                        ticket,
-                        ops,
-                        budget,
-                    })
-                    .is_ok() =>
-            {
-                Routed::Wait(ticket)
+        let Some(entry) = self.planes.get(&id) else {
+            return Routed::Now((0..n).map(|_| Err(dispatch::unknown_plane(id))).collect());
+        };
+        let ops = match entry.cell.try_apply(id, ops, budget, &entry.usage) {
+            Inline::Applied {
+                results,
+                failed,
+                reschedule,
+            } => {
+                if failed {
+                    self.remove_plane(id);
+                } else if reschedule {
+                    let _ = entry.jobs.send(Job::Reschedule);
+                }
+                return Routed::Now(results);
             }
-            _ => Routed::Now((0..n).map(|_| Err(dispatch::unknown_plane(id))).collect()),
+            Inline::HandOver(ops) => ops,
+        };
+        let ticket = self.next_ticket;
+        self.next_ticket += 1;
+        entry.cell.handed_over();
+        match entry.jobs.send(Job::Run {
+            ticket,
+            ops,
+            budget,
+        }) {
+            Ok(()) => Routed::Wait(ticket),
+            Err(_) => Routed::Now((0..n).map(|_| Err(dispatch::unknown_plane(id))).collect()),
         }
     }
 

@@ -4,12 +4,22 @@
 //! back to the request loop. Planes therefore step side by side, and a heavy tick of one
 //! plane never holds up a request for another.
 //!
+//! The plane itself sits behind a mutex ([`PlaneCell`]) so that the request loop can apply a
+//! short run of ops inline, with no hand-over, when the worker is idle and nothing is queued
+//! for the plane ([`PlaneCell::try_apply`]): one round trip then costs no thread wake-ups.
+//! Steps and anything that touches the plane's shared-memory output stay on the worker.
+//!
+//! The worker thread is the only thread of a rayon pool of its own, so the parallel parts of
+//! a plane's step (rapier's, for planes without a pool of their own) run on the plane's own
+//! thread instead of queueing on the process-wide pool behind every other plane's step.
+//!
 //! The worker has an iceoryx2 node of its own (ports stay on the thread that made them).
 
 use std::panic::{catch_unwind, AssertUnwindSafe};
-use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
 use std::sync::mpsc::{Receiver, RecvTimeoutError, Sender};
-use std::sync::{Arc, Mutex};
+use std::sync::{Arc, Mutex, MutexGuard, TryLockError};
+use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
 use iceoryx2::config::Config;
@@ -34,6 +44,8 @@ pub(super) enum Job {
         ops: Vec<PlaneOp>,
         budget: Budget,
     },
+    /// The loop changed the plane's tick rate or Enabled inline: restart the schedule.
+    Reschedule,
     /// Finish the queued jobs, then drop the plane and end.
     Stop,
 }
@@ -82,6 +94,98 @@ impl SharedUsage {
     }
 }
 
+/// The plane, shared by its worker and the request loop.
+#[derive(Default)]
+pub(super) struct PlaneCell {
+    /// `None` until the worker created the plane, and after the plane failed.
+    plane: Mutex<Option<Box<dyn Backend>>>,
+    /// Runs handed to the worker that it has not finished applying. While any is, the loop
+    /// never applies a run inline (it would overtake them).
+    queued: AtomicUsize,
+}
+
+/// What [`PlaneCell::try_apply`] did.
+pub(super) enum Inline {
+    /// The run was applied; `failed`: the plane panicked and is gone. `reschedule`: the
+    /// run changed the tick rate or Enabled (the worker must restart its schedule).
+    Applied {
+        results: Vec<CommandResult>,
+        failed: bool,
+        reschedule: bool,
+    },
+    /// The worker is busy, runs are queued, or the run must go to the worker: hand it over.
+    HandOver(Vec<PlaneOp>),
+}
+
+impl PlaneCell {
+    /// Whether the loop may apply `op` itself: a short op that neither steps nor touches the
+    /// plane's shared-memory output (which lives on the worker's thread), and that is cheap
+    /// enough not to hold up the other clients (no meshes, no maps).
+    pub fn inline_op(op: &PlaneOp) -> bool {
+        !matches!(op, PlaneOp::Step { .. } | PlaneOp::Info | PlaneOp::Map(_))
+            && op.cost().mesh_vertices == 0
+    }
+
+    /// Notes a run handed to the worker (before sending it).
+    pub fn handed_over(&self) {
+        self.queued.fetch_add(1, Ordering::SeqCst);
+    }
+
+    /// Applies the run `ops` on the calling thread (the request loop) when the worker is
+    /// idle and no run is queued for the plane: the run then applies exactly where a
+    /// hand-over would have (after every earlier run, between two ticks). Otherwise the run
+    /// comes back to be handed over.
+    pub fn try_apply(
+        &self,
+        id: PlaneId,
+        ops: Vec<PlaneOp>,
+        budget: Budget,
+        usage: &SharedUsage,
+    ) -> Inline {
+        if !ops.iter().all(PlaneCell::inline_op) || self.queued.load(Ordering::SeqCst) != 0 {
+            return Inline::HandOver(ops);
+        }
+        let mut guard = match self.plane.try_lock() {
+            Ok(guard) => guard,
+            Err(TryLockError::WouldBlock) => return Inline::HandOver(ops),
+            Err(TryLockError::Poisoned(p)) => p.into_inner(),
+        };
+        // Checked again under the lock: the worker finishes a run before it lets go.
+        if self.queued.load(Ordering::SeqCst) != 0 {
+            return Inline::HandOver(ops);
+        }
+        let Some(plane) = guard.as_mut() else {
+            return Inline::HandOver(ops);
+        };
+        let before = schedule_of(plane.as_ref());
+        let (results, failed) = run_ops(id, plane.as_mut(), ops, &budget, None, None);
+        if failed {
+            *guard = None;
+            return Inline::Applied {
+                results,
+                failed,
+                reschedule: false,
+            };
+        }
+        usage.set(plane.usage());
+        let reschedule = schedule_of(plane.as_ref()) != before;
+        Inline::Applied {
+            results,
+            failed,
+            reschedule,
+        }
+    }
+
+    fn lock(&self) -> MutexGuard<'_, Option<Box<dyn Backend>>> {
+        self.plane.lock().unwrap_or_else(|p| p.into_inner())
+    }
+}
+
+/// What the tick schedule depends on.
+fn schedule_of(plane: &dyn Backend) -> (u32, bool) {
+    (plane.tick_rate().to_bits(), plane.enabled())
+}
+
 /// Wakes the request loop (its WaitSet watches the other end of the socket pair). One byte
 /// stands for any number of events: the loop drains them all.
 pub(super) struct Waker {
@@ -119,14 +223,44 @@ pub(super) struct Setup {
     /// The ticket of the creating command: the creation's `Done` carries it.
     pub ticket: u64,
     pub config: Config,
+    pub cell: Arc<PlaneCell>,
     pub usage: Arc<SharedUsage>,
     pub events: Sender<Event>,
     pub waker: Arc<Waker>,
     pub panic_on_step_dt: Option<f32>,
 }
 
+/// Starts the worker of a plane: a thread that is the only thread of a rayon pool of its
+/// own (so the plane's parallel work runs on it), running [`run`]. Returns the thread.
+pub(super) fn spawn(setup: Setup, jobs: Receiver<Job>) -> std::io::Result<JoinHandle<()>> {
+    let id = setup.id;
+    let mut thread = None;
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .thread_name(move |_| format!("plane-{id}"))
+        // `run` catches the plane's panics; anything else is logged, not an abort.
+        .panic_handler(move |panic| {
+            let message = super::dispatch::panic_message(panic.as_ref());
+            tracing::error!(plane = id, "plane worker failed: {message}");
+        })
+        .spawn_handler(|builder| {
+            let mut named = std::thread::Builder::new();
+            if let Some(name) = builder.name() {
+                named = named.name(name.to_string());
+            }
+            thread = Some(named.spawn(move || builder.run())?);
+            Ok(())
+        })
+        .build()
+        .map_err(std::io::Error::other)?;
+    // The job keeps the pool alive until it returns; the pool's thread ends after it.
+    pool.spawn(move || run(setup, jobs));
+    drop(pool);
+    thread.ok_or_else(|| std::io::Error::other("the pool started no thread"))
+}
+
 /// The worker thread's body.
-pub(super) fn run(setup: Setup, jobs: Receiver<Job>) {
+fn run(setup: Setup, jobs: Receiver<Job>) {
     let Setup {
         id,
         ticket,
@@ -175,7 +309,6 @@ pub(super) fn run(setup: Setup, jobs: Receiver<Job>) {
             return drain(id, jobs, &report);
         }
     };
-    worker.usage.set(worker.plane.usage());
     worker.reschedule(Instant::now());
     loop {
         let job = match worker.next_tick {
@@ -191,13 +324,13 @@ pub(super) fn run(setup: Setup, jobs: Receiver<Job>) {
         };
         match job {
             Some(Job::Stop) => return,
+            Some(Job::Reschedule) => worker.reschedule(Instant::now()),
             Some(Job::Run {
                 ticket,
                 ops,
                 budget,
             }) => {
-                let (results, failed) = worker.run_ops(ops, budget);
-                worker.usage.set(worker.plane.usage());
+                let (results, failed) = worker.run_job(ops, budget);
                 report(Event::Done {
                     ticket,
                     plane: id,
@@ -220,19 +353,23 @@ pub(super) fn run(setup: Setup, jobs: Receiver<Job>) {
 /// After the plane failed: answers what is still queued (the loop forgets the plane once it
 /// reads the failure) until told to stop.
 fn drain(id: PlaneId, jobs: Receiver<Job>, report: &dyn Fn(Event)) {
-    while let Ok(Job::Run { ticket, ops, .. }) = jobs.recv() {
-        report(Event::Done {
-            ticket,
-            plane: id,
-            results: ops.iter().map(|_| Err(unknown_plane(id))).collect(),
-            failed: true,
-        });
+    loop {
+        match jobs.recv() {
+            Ok(Job::Run { ticket, ops, .. }) => report(Event::Done {
+                ticket,
+                plane: id,
+                results: ops.iter().map(|_| Err(unknown_plane(id))).collect(),
+                failed: true,
+            }),
+            Ok(Job::Reschedule) => {}
+            Ok(Job::Stop) | Err(_) => return,
+        }
     }
 }
 
 struct Worker {
     id: PlaneId,
-    plane: Box<dyn Backend>,
+    cell: Arc<PlaneCell>,
     out: PlaneOutput,
     usage: Arc<SharedUsage>,
     panic_on_step_dt: Option<f32>,
@@ -242,6 +379,13 @@ struct Worker {
     next_tick: Option<Instant>,
     // The node goes last: the ports above are dropped before it.
     _node: Node<ipc::Service>,
+}
+
+impl Drop for Worker {
+    fn drop(&mut self) {
+        // The plane goes with its worker (before the worker's ports and node).
+        self.cell.lock().take();
+    }
 }
 
 fn create(setup: &Setup) -> Result<(Worker, Reply), CommandError> {
@@ -262,10 +406,12 @@ fn create(setup: &Setup) -> Result<(Worker, Reply), CommandError> {
     out.publish(plane.as_mut()).map_err(internal)?;
     let info = plane.apply(PlaneOp::Info)?;
     tracing::info!(plane = id, kind = ?setup.kind, ?info, "plane created");
+    setup.usage.set(plane.usage());
+    *setup.cell.lock() = Some(plane);
     Ok((
         Worker {
             id,
-            plane,
+            cell: setup.cell.clone(),
             out,
             usage: setup.usage.clone(),
             panic_on_step_dt: setup.panic_on_step_dt,
@@ -278,21 +424,9 @@ fn create(setup: &Setup) -> Result<(Worker, Reply), CommandError> {
 }
 
 impl Worker {
-    /// The period the plane asks for now: `None` when manual, disabled, or not
-    /// representable (validation keeps rates within bounds; this never panics).
-    fn wanted_period(&self) -> Option<Duration> {
-        let rate = self.plane.tick_rate();
-        if !(rate > 0.0 && self.plane.enabled()) {
-            return None;
-        }
-        Duration::try_from_secs_f64(1.0 / rate as f64)
-            .ok()
-            .filter(|p| !p.is_zero())
-    }
-
     /// Restarts the schedule when the plane's rate or Enabled changed.
     fn reschedule(&mut self, now: Instant) {
-        let period = self.wanted_period();
+        let period = self.cell.lock().as_deref().and_then(wanted_period);
         if period != self.period {
             self.period = period;
             self.next_tick = period.and_then(|p| now.checked_add(p));
@@ -304,7 +438,11 @@ impl Worker {
         let (Some(due), Some(period)) = (self.next_tick.filter(|t| *t <= now), self.period) else {
             return true;
         };
-        let (plane, out) = (&mut self.plane, &self.out);
+        let mut guard = self.cell.lock();
+        let Some(plane) = guard.as_mut() else {
+            return false;
+        };
+        let out = &self.out;
         let stepped = catch_unwind(AssertUnwindSafe(|| {
             plane.step(period.as_secs_f32()).and_then(|stepped| {
                 if stepped {
@@ -320,10 +458,12 @@ impl Worker {
             Err(panic) => {
                 let message = super::dispatch::panic_message(panic.as_ref());
                 tracing::error!(plane = self.id, "plane failed and was removed: {message}");
+                *guard = None;
                 return false;
             }
         }
-        self.usage.set(self.plane.usage());
+        self.usage.set(plane.usage());
+        drop(guard);
         // Keep the cadence; after a stall, restart from now instead of catching up.
         let now = Instant::now();
         let next = due + period;
@@ -335,58 +475,126 @@ impl Worker {
         true
     }
 
-    /// Applies a run of ops in order. A panic fails the plane: that op gets an error naming
-    /// it, the rest of the run find the plane gone.
-    fn run_ops(&mut self, ops: Vec<PlaneOp>, budget: Budget) -> (Vec<CommandResult>, bool) {
-        let mut results = Vec::with_capacity(ops.len());
-        let id = self.id;
-        let mut ops = ops.into_iter();
-        for op in ops.by_ref() {
-            let outcome = catch_unwind(AssertUnwindSafe(|| self.op(op, &budget)));
-            match outcome {
-                Ok(result) => results.push(result),
-                Err(panic) => {
-                    let message = super::dispatch::panic_message(panic.as_ref());
-                    tracing::error!(plane = id, "plane failed and was removed: {message}");
-                    results.push(Err(CommandError::new(
-                        ErrorKind::Internal,
-                        format!("plane {id} failed and was removed: {message}"),
-                    )));
-                    results.extend(ops.map(|_| Err(unknown_plane(id))));
-                    return (results, true);
+    /// Applies a run handed over by the loop, under the plane's lock.
+    fn run_job(&mut self, ops: Vec<PlaneOp>, budget: Budget) -> (Vec<CommandResult>, bool) {
+        let mut guard = self.cell.lock();
+        let outcome = match guard.as_mut() {
+            Some(plane) => {
+                let (results, failed) = run_ops(
+                    self.id,
+                    plane.as_mut(),
+                    ops,
+                    &budget,
+                    Some(&self.out),
+                    self.panic_on_step_dt,
+                );
+                if failed {
+                    *guard = None;
+                } else {
+                    self.usage.set(plane.usage());
                 }
+                (results, failed)
+            }
+            None => (
+                ops.iter().map(|_| Err(unknown_plane(self.id))).collect(),
+                true,
+            ),
+        };
+        // Finished before the lock goes: the loop may apply the next run inline.
+        self.cell.queued.fetch_sub(1, Ordering::SeqCst);
+        drop(guard);
+        if !outcome.1 {
+            self.reschedule(Instant::now());
+        }
+        outcome
+    }
+}
+
+/// The period `plane` asks for now: `None` when manual, disabled, or not representable
+/// (validation keeps rates within bounds; this never panics).
+fn wanted_period(plane: &dyn Backend) -> Option<Duration> {
+    let rate = plane.tick_rate();
+    if !(rate > 0.0 && plane.enabled()) {
+        return None;
+    }
+    Duration::try_from_secs_f64(1.0 / rate as f64)
+        .ok()
+        .filter(|p| !p.is_zero())
+}
+
+/// Applies a run of ops in order. A panic fails the plane: that op gets an error naming it,
+/// the rest of the run find the plane gone. `out` is the plane's output (on its worker;
+/// `None` inline, where runs hold no op that needs it).
+fn run_ops(
+    id: PlaneId,
+    plane: &mut dyn Backend,
+    ops: Vec<PlaneOp>,
+    budget: &Budget,
+    out: Option<&PlaneOutput>,
+    panic_on_step_dt: Option<f32>,
+) -> (Vec<CommandResult>, bool) {
+    let mut results = Vec::with_capacity(ops.len());
+    let mut ops = ops.into_iter();
+    for op in ops.by_ref() {
+        let outcome = catch_unwind(AssertUnwindSafe(|| {
+            apply_op(plane, out, panic_on_step_dt, op, budget)
+        }));
+        match outcome {
+            Ok(result) => results.push(result),
+            Err(panic) => {
+                let message = super::dispatch::panic_message(panic.as_ref());
+                tracing::error!(plane = id, "plane failed and was removed: {message}");
+                results.push(Err(CommandError::new(
+                    ErrorKind::Internal,
+                    format!("plane {id} failed and was removed: {message}"),
+                )));
+                results.extend(ops.map(|_| Err(unknown_plane(id))));
+                return (results, true);
             }
         }
-        self.reschedule(Instant::now());
-        (results, false)
     }
+    (results, false)
+}
 
-    fn op(&mut self, op: PlaneOp, budget: &Budget) -> CommandResult {
-        check_quota(self.plane.as_ref(), &op, budget)?;
-        match op {
-            PlaneOp::Step { dt } => {
-                if self.panic_on_step_dt == Some(dt) {
-                    panic!("injected fault: Step({dt})");
-                }
-                if self.plane.step(dt)? {
-                    self.out
-                        .publish(self.plane.as_mut())
-                        .map_err(super::dispatch::internal)?;
-                }
-                Ok(Reply::Stepped {
-                    tick: self.plane.tick(),
-                })
+fn apply_op(
+    plane: &mut dyn Backend,
+    out: Option<&PlaneOutput>,
+    panic_on_step_dt: Option<f32>,
+    op: PlaneOp,
+    budget: &Budget,
+) -> CommandResult {
+    check_quota(plane, &op, budget)?;
+    let needs_output = matches!(op, PlaneOp::Step { .. } | PlaneOp::Info);
+    let out = match out {
+        Some(out) => Some(out),
+        None if needs_output => {
+            return Err(CommandError::new(
+                ErrorKind::Internal,
+                format!("{op:?} must run on the plane's worker"),
+            ))
+        }
+        None => None,
+    };
+    match op {
+        PlaneOp::Step { dt } => {
+            if panic_on_step_dt == Some(dt) {
+                panic!("injected fault: Step({dt})");
             }
-            op => {
-                if op == PlaneOp::Info {
-                    // A reader that just subscribed gets the newest tick at once.
-                    self.out.connect_readers();
+            if plane.step(dt)? {
+                if let Some(out) = out {
+                    out.publish(plane).map_err(super::dispatch::internal)?;
                 }
-                let result = self.plane.apply(op);
-                // A rate or Enabled change takes effect from now.
-                self.reschedule(Instant::now());
-                result
             }
+            Ok(Reply::Stepped { tick: plane.tick() })
+        }
+        op => {
+            if op == PlaneOp::Info {
+                // A reader that just subscribed gets the newest tick at once.
+                if let Some(out) = out {
+                    out.connect_readers();
+                }
+            }
+            plane.apply(op)
         }
     }
 }
