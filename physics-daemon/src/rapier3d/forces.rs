@@ -20,7 +20,8 @@
 //! body would drift). Angular changes are set directly: "direct rotation" must also turn
 //! bodies whose rotation is locked against contacts.
 //!
-//! A plane with no forces and no driven objects skips the pass entirely.
+//! A plane with no forces and no driven objects skips the pass. The pass runs as part of the
+//! per-body pass before the step (`body_pass`): [`drive`] only reads a body.
 
 use rapier3d::prelude::*;
 use shm_layout::{Pin, RotateTo};
@@ -29,7 +30,7 @@ use super::part::Part;
 use super::Plane;
 
 /// Plane-wide inputs of one pass.
-struct Env {
+pub(super) struct Env {
     dt: f32,
     linear_keep: f32,
     angular_keep: f32,
@@ -40,7 +41,9 @@ struct Env {
 }
 
 impl Plane {
-    pub(super) fn apply_forces(&mut self, dt: f32) {
+    /// The pass's plane-wide inputs, or None when it would change no velocity (no damping,
+    /// drag or plane-wide force, and no object with a drive of its own).
+    pub(super) fn force_env(&self, dt: f32) -> Option<Env> {
         let s = &self.settings;
         let env = Env {
             dt,
@@ -57,56 +60,24 @@ impl Plane {
             && env.acceleration == Vector::ZERO
             && env.force == Vector::ZERO
             && self.driven == 0;
-        // Forces of the previous pass stay in rapier's accumulators until reset.
-        for h in self.forced.drain(..) {
-            if let Some(body) = self.world.bodies.get_mut(h) {
-                body.reset_forces(false);
-            }
-        }
-        if idle {
-            return;
-        }
-        let mut handles = std::mem::take(&mut self.scratch);
-        handles.clear();
-        handles.extend(self.world.islands.active_bodies());
-        // Bodies changed by ops since the last step, awake or not yet listed as awake.
-        let bodies = &self.bodies;
-        handles.extend(
-            self.dirty
-                .since_step()
-                .iter()
-                .filter_map(|s| bodies.at(*s as usize).map(|b| b.handle)),
-        );
-        let stamp = self.tick + 1;
-        for h in &handles {
-            let Some(body) = self.world.bodies.get_mut(*h) else {
-                continue; // removed since it was marked
-            };
-            if !body.is_dynamic() {
-                continue;
-            }
-            let Some(part) = self
-                .bodies
-                .at_mut(body.user_data as usize)
-                .map(|b| &mut b.part)
-            else {
-                continue;
-            };
-            if part.forced_tick == stamp {
-                continue; // both awake and marked
-            }
-            part.forced_tick = stamp;
-            if drive(body, part, &env) {
-                self.forced.push(*h);
-            }
-        }
-        self.scratch = handles;
+        (!idle).then_some(env)
     }
 }
 
-/// Applies one body's forces for the step. Returns whether it left a force in rapier's
-/// accumulator.
-fn drive(body: &mut RigidBody, part: &Part, env: &Env) -> bool {
+/// What the force pass does to one body's linear motion.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) enum Push {
+    /// Nothing: the velocity stays.
+    None,
+    /// A force for the step, for rapier's force accumulator.
+    Force(Vector),
+    /// The velocity, set directly (waking the body): the force would not be finite.
+    Velocity(Vector),
+}
+
+/// One body's forces for the step: its angular velocity after the pass, and its push. Reads
+/// the body only (see `body_pass`, which writes the result).
+pub(super) fn drive(body: &RigidBody, part: &Part, env: &Env) -> (Vector, Push) {
     let dt = env.dt;
     let mass = body.mass();
     let inv_mass = if mass > 0.0 { 1.0 / mass } else { 0.0 };
@@ -141,22 +112,18 @@ fn drive(body: &mut RigidBody, part: &Part, env: &Env) -> bool {
             w[i] = w0[i];
         }
     }
-    if w != w0 {
-        body.set_angvel(w, false);
-    }
     let force = (v - v0) * (mass / dt);
-    if !force.is_finite() {
+    let push = if !force.is_finite() {
         // A dt so small that mass / dt overflows (1e-45 s): a non-finite force would make
         // rapier quarantine (disable) the body for good. Set the velocity the force would
         // have given instead.
-        body.set_linvel(v, true);
-        return false;
-    }
-    if force == Vector::ZERO {
-        return false;
-    }
-    body.add_force(force, false);
-    true
+        Push::Velocity(v)
+    } else if force == Vector::ZERO {
+        Push::None
+    } else {
+        Push::Force(force)
+    };
+    (w, push)
 }
 
 /// Backward Euler on `dv/dt = -c·|v|·v`: the new speed s' solves `s' + c·dt·s'² = s`.

@@ -5,12 +5,15 @@
 //! - `backend`: the [`Backend`](crate::backend::Backend) implementation (op routing).
 //! - `objects`, `properties`, `part`: objects, their properties and their rapier mapping.
 //! - `forces`, `solver`, `contacts`: the per-tick force pass, solver tuning, contacts.
+//! - `body_pass`: the per-body pass before each step (forces, speed caps, contact
+//!   prediction), and when a pass runs on the plane's pool (Threads > 1, large planes).
 //! - `queries`, `collision_groups`: scene queries and the plane's collision-group table.
 //! - `controllers`: kinematic character controllers, ticked before each step.
 //! - `limits`: MaxLinearSpeed and MaxAngularSpeed.
 //! - `joints`: joints, their error figures and breaking; `maps`: triangle-mesh maps.
 
 mod backend;
+mod body_pass;
 mod collision_groups;
 mod contacts;
 mod controllers;
@@ -76,9 +79,8 @@ pub struct Plane {
     /// Slots changed by ops: the publisher rewrites them, and the force pass sees them even
     /// before rapier's island manager lists them as awake.
     dirty: Dirty,
-    /// Bodies the last force pass left a force on (reset at the next pass).
-    forced: Vec<RigidBodyHandle>,
-    scratch: Vec<RigidBodyHandle>,
+    /// Buffers of the per-body passes.
+    pass: body_pass::Scratch,
     /// Objects a step must leave where it found them (see `held`).
     held: Vec<held::HeldBody>,
     tick: u64,
@@ -137,8 +139,7 @@ impl Plane {
             driven: 0,
             mesh_vertices: 0,
             dirty: Dirty::default(),
-            forced: Vec::new(),
-            scratch: Vec::new(),
+            pass: body_pass::Scratch::default(),
             held: Vec::new(),
             tick: 0,
             sim_time: 0.0,
@@ -301,9 +302,7 @@ impl Plane {
         self.world.integration_parameters.dt = dt;
         self.tune_solver(dt);
         self.tick_controllers(dt);
-        self.apply_forces(dt);
-        self.limit_speeds_before_step();
-        self.predict_fast_bodies(dt);
+        self.prepare_bodies(dt);
         self.joints_before_step();
         let hooks = contacts::RestThreshold {
             threshold: self.settings.rest_threshold,
@@ -328,12 +327,14 @@ impl Plane {
         self.tick += 1;
         self.sim_time += dt as f64;
         self.last_dt = dt;
-        (self.max_penetration, self.contact_pairs) = self.contact_figures();
         self.collect_events();
         self.joints_after_step(dt);
         self.removed.clear();
-        if moving || self.awake_count() > 0 {
-            self.state_hash = self.state_hash();
+        let rehash = moving || self.awake_count() > 0;
+        let (figures, hash) = self.figures_and_hash(rehash);
+        (self.max_penetration, self.contact_pairs) = figures;
+        if let Some(hash) = hash {
+            self.state_hash = hash;
         }
         self.last_step_us = started.elapsed().as_secs_f32() * 1e6;
         Ok(true)
@@ -361,6 +362,24 @@ impl Plane {
             contact_pairs: self.contact_pairs,
             event_count: self.event_seq as u32,
             state_hash: self.state_hash,
+        }
+    }
+
+    /// After a step: the contact figures of the tick header and, when `rehash`, the state
+    /// hash. The hash is one sequential chain over every slot; on the plane's pool it runs
+    /// beside the contact figures (themselves split over the pool), not after them.
+    fn figures_and_hash(&self, rehash: bool) -> ((f32, u32), Option<u64>) {
+        let (slots, bodies, narrow_phase) =
+            (&self.bodies, &self.world.bodies, &self.world.narrow_phase);
+        let hash = || rehash.then(|| cpu_state_hash(slots, bodies));
+        let pairs = narrow_phase.contact_graph().raw_graph().raw_edges().len();
+        let work = pairs + if rehash { slots.slot_count() } else { 0 };
+        match self.pool_for(work) {
+            Some(pool) => pool.install(|| {
+                let split = pairs >= body_pass::PARALLEL_FROM;
+                rayon::join(|| contacts::contact_figures(narrow_phase, split), hash)
+            }),
+            None => (contacts::contact_figures(narrow_phase, false), hash()),
         }
     }
 
@@ -431,4 +450,14 @@ impl Plane {
         }
         publish::body_state(&self.bodies, &self.world.bodies, i)
     }
+}
+
+/// [`Plane::state_hash`] of a plane on the CPU, from the parts the hash reads (the plane
+/// itself is not `Sync`: its event channel).
+fn cpu_state_hash(slots: &SlotTable<Body>, bodies: &RigidBodySet) -> u64 {
+    let mut h = StateHasher::new();
+    for i in 0..slots.slot_count() {
+        h.add(&publish::body_state(slots, bodies, i));
+    }
+    h.finish()
 }

@@ -38,8 +38,6 @@ pub(super) struct Part {
     pub size: Vec3,
     pub mesh: Option<Mesh>,
     pub settings: ObjectSettings,
-    /// The tick whose force pass already handled this object (avoids doing it twice).
-    pub forced_tick: u64,
     /// A character controller's capsule (its collider runs the contact hook).
     pub is_controller: bool,
     /// A map object's triangle mesh (see `maps`): static, never reshaped.
@@ -96,7 +94,6 @@ impl Part {
             size,
             mesh,
             settings: ObjectSettings::default(),
-            forced_tick: 0,
             is_controller: false,
             map: None,
         };

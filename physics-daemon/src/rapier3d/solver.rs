@@ -120,42 +120,42 @@ impl Plane {
             s.contact_frequency * base_static.natural_frequency / base.natural_frequency;
     }
 
-    /// Before a step: soft CCD for the bodies the step moves by more than half the
-    /// prediction distance (gravity's share included), none for the others.
-    pub(super) fn predict_fast_bodies(&mut self, dt: f32) {
+    /// What decides each body's contact prediction this step (read after `tune_solver`).
+    pub(super) fn prediction(&self, dt: f32) -> Prediction {
         let p = &self.world.integration_parameters;
-        let threshold = 0.5 * p.prediction_distance();
-        let g_dt = self.world.gravity.length() * dt;
-        let bodies = &mut self.world.bodies;
-        let mut set = |h: RigidBodyHandle| {
-            let Some(body) = bodies.get_mut(h).filter(|b| b.is_dynamic()) else {
-                return;
-            };
-            // Gravity's share of the tick counts, except for a body standing exactly still
-            // (one that just landed): it keeps the plain prediction, whose contact rapier's
-            // soft-CCD pair test would drop (its contact events would stop and start again).
-            let speed = body.linvel().length();
-            let travel = if speed > 0.0 {
-                (speed + g_dt) * dt
-            } else {
-                0.0
-            };
-            let reach = if travel > threshold {
-                SOFT_CCD_REACH
-            } else {
-                0.0
-            };
-            if body.soft_ccd_prediction() != reach {
-                body.set_soft_ccd_prediction(reach);
-            }
-        };
-        for h in self.world.islands.active_bodies() {
-            set(h);
+        Prediction {
+            threshold: 0.5 * p.prediction_distance(),
+            g_dt: self.world.gravity.length() * dt,
+            dt,
         }
-        for slot in self.dirty.since_step() {
-            if let Some(b) = self.bodies.at(*slot as usize) {
-                set(b.handle);
-            }
+    }
+}
+
+/// Soft CCD for the bodies a step moves by more than half the prediction distance
+/// (gravity's share included), none for the others.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Prediction {
+    threshold: f32,
+    g_dt: f32,
+    dt: f32,
+}
+
+impl Prediction {
+    /// The soft-CCD reach a dynamic body moving at `linvel` gets for the step.
+    pub(super) fn reach(&self, linvel: Vector) -> f32 {
+        // Gravity's share of the tick counts, except for a body standing exactly still
+        // (one that just landed): it keeps the plain prediction, whose contact rapier's
+        // soft-CCD pair test would drop (its contact events would stop and start again).
+        let speed = linvel.length();
+        let travel = if speed > 0.0 {
+            (speed + self.g_dt) * self.dt
+        } else {
+            0.0
+        };
+        if travel > self.threshold {
+            SOFT_CCD_REACH
+        } else {
+            0.0
         }
     }
 }
