@@ -57,6 +57,6 @@ pub use shm_layout::{
     FLAG_ON_GROUND,
 };
 pub use spawn::{
-    connect_or_start, daemon_executable, sibling_executable, start_daemon, start_daemon_with,
-    DaemonChild, Session,
+    connect_or_start, daemon_executable, interrupt_child, sibling_executable, start_daemon,
+    start_daemon_with, DaemonChild, Session,
 };

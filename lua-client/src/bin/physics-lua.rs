@@ -331,17 +331,8 @@ mod viewer {
 
     impl Drop for Viewer {
         fn drop(&mut self) {
-            // SAFETY: kill(2) on our own child; SIGINT lets it say goodbye to the daemon.
-            unsafe { libc::kill(self.child.id() as libc::pid_t, libc::SIGINT) };
-            let deadline = Instant::now() + Duration::from_secs(3);
-            while Instant::now() < deadline {
-                if let Ok(Some(_)) = self.child.try_wait() {
-                    return;
-                }
-                std::thread::sleep(Duration::from_millis(10));
-            }
-            let _ = self.child.kill();
-            let _ = self.child.wait();
+            // SIGINT lets it say goodbye to the daemon.
+            client_sdk::interrupt_child(&mut self.child);
         }
     }
 

@@ -272,9 +272,17 @@ fn run(setup: Setup, jobs: Receiver<Job>) {
         let _ = events.send(event);
         waker.wake();
     };
-    let created = catch_unwind(AssertUnwindSafe(|| create(&setup)));
+    let created = catch_unwind(AssertUnwindSafe(|| create(&setup))).unwrap_or_else(|panic| {
+        Err(CommandError::new(
+            ErrorKind::Internal,
+            format!(
+                "creating plane {id} failed: {}",
+                super::dispatch::panic_message(panic.as_ref())
+            ),
+        ))
+    });
     let mut worker = match created {
-        Ok(Ok((worker, info))) => {
+        Ok((worker, info)) => {
             report(Event::Done {
                 ticket,
                 plane: id,
@@ -283,23 +291,7 @@ fn run(setup: Setup, jobs: Receiver<Job>) {
             });
             worker
         }
-        Ok(Err(e)) => {
-            report(Event::Done {
-                ticket,
-                plane: id,
-                results: vec![Err(e)],
-                failed: true,
-            });
-            return drain(id, jobs, &report);
-        }
-        Err(panic) => {
-            let e = CommandError::new(
-                ErrorKind::Internal,
-                format!(
-                    "creating plane {id} failed: {}",
-                    super::dispatch::panic_message(panic.as_ref())
-                ),
-            );
+        Err(e) => {
             report(Event::Done {
                 ticket,
                 plane: id,
