@@ -20,7 +20,7 @@
 use std::collections::BTreeMap;
 
 use rapier3d::control::{CharacterCollision, CharacterLength, KinematicCharacterController};
-use rapier3d::parry::query::ShapeCastOptions;
+use rapier3d::parry::query::{QueryDispatcher, ShapeCastOptions};
 use rapier3d::prelude::*;
 use shm_layout::controller_op::ControllerInfo;
 use shm_layout::{
@@ -483,7 +483,7 @@ impl Plane {
                 co.parent() != Some(h) && co.collision_groups().test(groups) && !co.is_sensor()
             };
             let filter = rapier3d::prelude::QueryFilter::default().predicate(&exclude);
-            let pipeline = self.world.query_pipeline_with_filter(filter);
+            let pipeline = self.query_pipeline(filter);
             kcc.move_shape(dt, &pipeline, &*shape, &pose, desired, |col| {
                 collisions.push(col)
             })
@@ -680,9 +680,8 @@ impl Plane {
         let pred = |_: ColliderHandle, co: &Collider| {
             co.parent() != Some(own) && co.collision_groups().test(groups) && !co.is_sensor()
         };
-        let pipeline = self
-            .world
-            .query_pipeline_with_filter(rapier3d::prelude::QueryFilter::default().predicate(&pred));
+        let pipeline =
+            self.query_pipeline(rapier3d::prelude::QueryFilter::default().predicate(&pred));
         let rotation = yaw_rotation(yaw);
         let cast = |from: Vector, along: Vector, reach: f32| {
             let options = ShapeCastOptions {
@@ -753,12 +752,13 @@ impl Plane {
             let pred = |_: ColliderHandle, co: &Collider| {
                 co.parent() != Some(own) && co.collision_groups().test(groups) && !co.is_sensor()
             };
-            let pipeline = self.world.query_pipeline_with_filter(
-                rapier3d::prelude::QueryFilter::default().predicate(&pred),
-            );
+            let pipeline =
+                self.query_pipeline(rapier3d::prelude::QueryFilter::default().predicate(&pred));
             for (_, co) in pipeline.intersect_shape(pose, &**shape) {
+                // The pose has no rotation: the contact's capsule-local normal is the world's.
+                let pos12 = pose.inv_mul(co.position());
                 if let Ok(Some(contact)) =
-                    rapier3d::parry::query::contact(&pose, &**shape, co.position(), co.shape(), 0.0)
+                    super::clipped::ClippedQueries.contact(&pos12, &**shape, co.shape(), 0.0)
                 {
                     if contact.dist < 0.0 && deepest.is_none_or(|(d, _)| contact.dist < d) {
                         deepest = Some((contact.dist, contact.normal1));
@@ -791,9 +791,8 @@ impl Plane {
         let pred = |_: ColliderHandle, co: &Collider| {
             co.parent() != Some(own) && co.collision_groups().test(groups) && !co.is_sensor()
         };
-        let pipeline = self
-            .world
-            .query_pipeline_with_filter(rapier3d::prelude::QueryFilter::default().predicate(&pred));
+        let pipeline =
+            self.query_pipeline(rapier3d::prelude::QueryFilter::default().predicate(&pred));
         let pose = rapier3d::math::Pose::from_parts(position, yaw_rotation(yaw));
         let options = ShapeCastOptions {
             max_time_of_impact: reach,

@@ -14,6 +14,7 @@
 
 mod backend;
 mod body_pass;
+mod clipped;
 mod collision_groups;
 mod contacts;
 mod controllers;

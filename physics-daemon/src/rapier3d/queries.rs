@@ -139,9 +139,7 @@ impl Plane {
                 let f = self.resolve(&filter, Some(own))?;
                 let co = &self.world.colliders[collider];
                 let predicate = |c: ColliderHandle, co: &Collider| f.accepts(c, co);
-                let pipeline = self
-                    .world
-                    .query_pipeline_with_filter(QueryFilter_::default().predicate(&predicate));
+                let pipeline = self.query_pipeline(QueryFilter_::default().predicate(&predicate));
                 let mut found: Vec<Handle> = pipeline
                     .intersect_shape(*co.position(), co.shape())
                     .filter_map(|(c, _)| self.handle_of_collider(c))
@@ -233,9 +231,7 @@ impl Plane {
         let ray = rapier3d::parry::query::Ray::new(Vector::from(origin), dir / reach);
         f.skipped.borrow_mut().clear();
         let predicate = |c: ColliderHandle, co: &Collider| f.accepts(c, co);
-        let pipeline = self
-            .world
-            .query_pipeline_with_filter(QueryFilter_::default().predicate(&predicate));
+        let pipeline = self.query_pipeline(QueryFilter_::default().predicate(&predicate));
         for _ in 0..MAX_STARTS_INSIDE {
             let (c, hit) = pipeline.cast_ray_and_get_normal(&ray, reach, true)?;
             if hit.time_of_impact <= 0.0 {
@@ -268,9 +264,7 @@ impl Plane {
         }
         f.skipped.borrow_mut().clear();
         let predicate = |c: ColliderHandle, co: &Collider| f.accepts(c, co);
-        let pipeline = self
-            .world
-            .query_pipeline_with_filter(QueryFilter_::default().predicate(&predicate));
+        let pipeline = self.query_pipeline(QueryFilter_::default().predicate(&predicate));
         let options = ShapeCastOptions {
             max_time_of_impact: 1.0,
             target_distance: 0.0,
@@ -302,9 +296,7 @@ impl Plane {
         touches: impl Fn(&Aabb) -> bool,
     ) -> Vec<Handle> {
         let predicate = |c: ColliderHandle, co: &Collider| f.accepts(c, co);
-        let pipeline = self
-            .world
-            .query_pipeline_with_filter(QueryFilter_::default().predicate(&predicate));
+        let pipeline = self.query_pipeline(QueryFilter_::default().predicate(&predicate));
         let mut found: Vec<Handle> = pipeline
             .intersect_aabb_conservative(query)
             .filter(|(_, co)| touches(&co.compute_aabb()))
