@@ -24,10 +24,29 @@ fn scene(tag: &str) -> Scene {
     s
 }
 
+/// Yaw of a controller facing +Z: its LookVector (the CFrame's −Z, as on Roblox) turned
+/// half a turn. The scenes here lie along +Z.
+const FACING_PLUS_Z: f32 = std::f32::consts::PI;
+
+/// A character at `at` facing +Z (so MoveForward walks +Z and +x of the intent is −X).
 fn character(s: &Scene, at: [f32; 3], props: &[ControllerProp]) -> Controller {
     s.plane
-        .new_controller(Pose::at(at), SIZE, false, props)
+        .new_controller(
+            Pose {
+                position: at,
+                rotation: quat([0.0, 1.0, 0.0], FACING_PLUS_Z),
+            },
+            SIZE,
+            false,
+            props,
+        )
         .expect("new controller")
+}
+
+/// The shortest signed angle from `a` to `b`.
+fn angle_diff(a: f32, b: f32) -> f32 {
+    let tau = std::f32::consts::TAU;
+    (b - a + std::f32::consts::PI).rem_euclid(tau) - std::f32::consts::PI
 }
 
 fn speed_h(c: &Controller) -> f32 {
@@ -68,7 +87,7 @@ fn walk_speed_is_reached_with_acceleration_and_standing_is_still() {
     }
     assert!(hi - lo < 1e-3, "jitter {}", hi - lo);
 
-    // Forward (+Z at yaw 0): accelerates over several ticks, then holds WalkSpeed exactly.
+    // Forward (+Z, facing +Z): accelerates over several ticks, then holds WalkSpeed exactly.
     c.set_move_vector(0.0, 1.0).unwrap();
     s.run(DT, 2);
     let early = speed_h(&c);
@@ -201,9 +220,9 @@ fn steps_below_step_height_are_walked_up_and_walls_stop_and_slide() {
     let climber = character(&s, [0.0, HALF + SKIN, 0.0], &[]);
     climber.set_move_vector(0.0, 1.0).unwrap();
     let blocked = character(&s, [24.0, HALF + SKIN, 0.0], &[]);
-    // Diagonally into the wall (+X and +Z at yaw 0): slides along +Z.
+    // Diagonally into the wall (+X and +Z facing +Z, where right is −X): slides along +Z.
     blocked.set(ControllerProp::LookWhereMoving(false)).unwrap();
-    blocked.set_move_vector(0.7, 0.7).unwrap();
+    blocked.set_move_vector(-0.7, 0.7).unwrap();
     let mut grounded_ticks = 0;
     let mut top: f32 = 0.0;
     let mut stair_ticks = 0;
@@ -334,7 +353,10 @@ fn a_rotating_platform_turns_its_rider() {
     assert!((r - 6.0).abs() < 0.05, "radius {r}");
     assert!((angle - 1.0).abs() < 0.03, "turned {angle} rad");
     let yaw = c.info().unwrap().rotation[1];
-    assert!((yaw - 1.0).abs() < 0.03, "facing turned with it: {yaw}");
+    assert!(
+        angle_diff(FACING_PLUS_Z + 1.0, yaw).abs() < 0.03,
+        "facing turned with it: {yaw}"
+    );
 }
 
 #[test]
@@ -443,9 +465,10 @@ fn paths_are_walked_in_order_with_one_event_per_waypoint_and_one_finish() {
     );
     let info = c.info().unwrap();
     assert_eq!((info.path_length, info.path_index), (0, 0));
-    // Facing follows the walk (LookWhereMoving): last leg toward -X, yaw -π/2.
+    // Facing follows the walk (LookWhereMoving): last leg toward -X, so the LookVector
+    // (−sin yaw, 0, −cos yaw) is −X: yaw π/2, read in (−π, π].
     assert!(
-        (info.rotation[1].abs() - std::f32::consts::FRAC_PI_2).abs() < 0.2,
+        (info.rotation[1] - std::f32::consts::FRAC_PI_2).abs() < 0.2,
         "yaw {}",
         info.rotation[1]
     );

@@ -385,10 +385,7 @@ impl QueryDispatcher for ClippedQueries {
         g2: &dyn Shape,
         options: ShapeCastOptions,
     ) -> Result<Option<ShapeCastHit>, Unsupported> {
-        // Boxes (floors, walls, platforms) are where parry's cast was seen to fail; other
-        // pairs keep it.
-        let boxed = g1.as_cuboid().is_some() || g2.as_cuboid().is_some();
-        if boxed && g1.is_convex() && g2.is_convex() {
+        if g1.is_convex() && g2.is_convex() {
             return cast_convex(pos12, local_vel12, g1, g2, options);
         }
         DefaultQueryDispatcher.cast_shapes(pos12, local_vel12, g1, g2, options)

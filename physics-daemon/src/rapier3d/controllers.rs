@@ -56,16 +56,25 @@ pub(super) struct Controller {
     on_ground: bool,
     ground: Option<Ground>,
     move_vector: [f32; 2],
+    /// The facing when the motion intent was last set (see [`Controller::wish`]).
+    intent_yaw: f32,
     path: Vec<Vector>,
     /// 0-based index of the waypoint being walked to.
     path_index: usize,
     jump: bool,
 }
 
+/// The yaw of a rotation: the angle about +Y that turns the controller's forward, the
+/// CFrame's LookVector (its −Z, as on Roblox), to the rotation's LookVector.
 fn yaw_of(rotation: [f32; 4]) -> f32 {
     let q = Rotation::from_array(rotation);
-    let forward = q * Vector::Z;
-    forward.x.atan2(forward.z)
+    let look = q * Vector::NEG_Z;
+    yaw_toward(look)
+}
+
+/// The yaw whose LookVector points along the horizontal part of `direction`.
+fn yaw_toward(direction: Vector) -> f32 {
+    (-direction.x).atan2(-direction.z)
 }
 
 fn yaw_rotation(yaw: f32) -> Rotation {
@@ -91,6 +100,7 @@ impl Controller {
             on_ground: false,
             ground: None,
             move_vector: [0.0; 2],
+            intent_yaw: yaw,
             path: Vec::new(),
             path_index: 0,
             jump: false,
@@ -115,15 +125,24 @@ impl Controller {
     }
 
     /// The wish direction (unit or zero) and its intensity in [0, 1], for a controller at
-    /// `position`: toward the next waypoint, else the motion intent turned by the facing.
+    /// `position`: toward the next waypoint, else the motion intent (+z forward along the
+    /// LookVector, +x right) turned by the facing. A controller that turns toward where it
+    /// moves (LookWhereMoving) takes the intent in the facing it had when the intent was
+    /// given: turning must not turn the intent too, or any intent but straight ahead would
+    /// walk it in circles.
     fn wish(&self, position: Vector) -> (Vector, f32) {
         if let Some(target) = self.path.get(self.path_index) {
             return (horizontal(*target - position).normalize_or_zero(), 1.0);
         }
         let [x, z] = self.move_vector;
-        let local = Vector::new(x, 0.0, z);
+        let local = Vector::new(x, 0.0, -z);
         let amount = local.length().min(1.0);
-        (yaw_rotation(self.yaw) * local.normalize_or_zero(), amount)
+        let yaw = if self.settings.look_where_moving {
+            self.intent_yaw
+        } else {
+            self.yaw
+        };
+        (yaw_rotation(yaw) * local.normalize_or_zero(), amount)
     }
 }
 
@@ -215,6 +234,7 @@ impl Plane {
                 c.path.clear();
                 c.path_index = 0;
                 c.yaw = yaw;
+                c.intent_yaw = yaw;
                 c.ground = None;
                 self.place_controller(handle, Vector::from(pose.position), yaw)?;
                 Ok(Reply::Applied { tick: self.tick })
@@ -340,12 +360,18 @@ impl Plane {
             }
             ControllerProp::Rotation(r) => {
                 c.yaw = r[1];
+                c.intent_yaw = r[1];
                 let yaw = c.yaw;
                 let h = self.body_of(handle)?;
                 let pos = self.world.bodies[h].translation();
                 self.place_controller(handle, pos, yaw)?;
             }
-            ControllerProp::MoveVector(m) => c.move_vector = m,
+            ControllerProp::MoveVector(m) => {
+                if m != c.move_vector {
+                    c.intent_yaw = c.yaw;
+                }
+                c.move_vector = m;
+            }
             _ => {}
         }
         Ok(())
@@ -575,9 +601,11 @@ impl Plane {
         // 8. Facing.
         let vh = horizontal(v);
         if s.look_where_moving && vh.length() > TURN_MIN_SPEED {
-            let target = vh.x.atan2(vh.z);
+            let target = yaw_toward(vh);
             c.yaw += angle_diff(c.yaw, target) * (s.turn_speed * dt).min(1.0);
         }
+        // Kept in (−π, π]: what Rotation.Y reads.
+        c.yaw = angle_diff(0.0, c.yaw);
 
         // 9. Path.
         if let Some(target) = c.path.get(c.path_index) {

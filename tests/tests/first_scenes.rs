@@ -1,0 +1,31 @@
+//! The scenes a user writes first, as Luau scripts under `tests/lua/` run by the real
+//! `physics-lua` against a real daemon: each script asserts its own outcome and prints a
+//! last line that these tests look for.
+
+use integration_tests::{physics_lua, TestDaemon};
+
+/// Runs `script` against a daemon of its own and checks it exits 0 printing `done`.
+fn runs(tag: &str, script: &str, done: &str) {
+    let daemon = TestDaemon::start(tag);
+    let out = physics_lua(&daemon.domain, script, &[])
+        .output()
+        .expect("run physics-lua");
+    let (stdout, stderr) = (
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr),
+    );
+    assert!(
+        out.status.success() && stdout.contains(done),
+        "{script}: {:?}\nstdout:\n{stdout}\nstderr:\n{stderr}",
+        out.status
+    );
+}
+
+#[test]
+fn a_controller_walks_along_its_look_vector() {
+    runs(
+        "first-facing",
+        "tests/lua/controller_facing.luau",
+        "controller facing ok",
+    );
+}
