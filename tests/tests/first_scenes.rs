@@ -29,3 +29,12 @@ fn a_controller_walks_along_its_look_vector() {
         "controller facing ok",
     );
 }
+
+#[test]
+fn joints_swing_and_turn_default_parts() {
+    runs(
+        "first-joints",
+        "tests/lua/joints_default_parts.luau",
+        "joints on default parts ok",
+    );
+}

@@ -259,10 +259,11 @@ fn a_character_controller_walks_across_a_tiled_map() {
         .unwrap();
     s.run(1.0 / 60.0, 10);
     assert!(c.on_ground().unwrap(), "stands on the map");
-    // Facing +X (yaw π/2), walking forward: 2 s at WalkSpeed 16 crosses 30 tile seams.
+    // Facing +X (yaw −π/2: the LookVector (−sin y, 0, −cos y) is +X), walking forward: 2 s
+    // at WalkSpeed 16 crosses 30 tile seams.
     c.set(client_sdk::ControllerProp::Rotation([
         0.0,
-        std::f32::consts::FRAC_PI_2,
+        -std::f32::consts::FRAC_PI_2,
         0.0,
     ]))
     .unwrap();

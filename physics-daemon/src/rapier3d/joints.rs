@@ -259,6 +259,10 @@ impl Plane {
             JointOp::Destroy { joint } => {
                 let j = self.joints.table.remove(joint)?;
                 self.remove_rapier_joint(&j);
+                self.joint_holds(j.a, -1);
+                if let Some(b) = j.b {
+                    self.joint_holds(b, -1);
+                }
                 Ok(Reply::Applied { tick: self.tick })
             }
         }
@@ -321,6 +325,10 @@ impl Plane {
         };
         match self.joints.table.insert(joint) {
             Ok(h) => {
+                self.joint_holds(a, 1);
+                if let Some(b) = b {
+                    self.joint_holds(b, 1);
+                }
                 self.measure_joint(h);
                 Ok(h)
             }
@@ -381,7 +389,26 @@ impl Plane {
         for h in doomed {
             if let Ok(j) = self.joints.table.remove(h) {
                 self.remove_rapier_joint(&j);
+                self.joint_holds(j.a, -1);
+                if let Some(b) = j.b {
+                    self.joint_holds(b, -1);
+                }
             }
+        }
+    }
+
+    /// Counts a joint more (`1`) or less (`-1`) holding `object`, and refreshes its body's
+    /// rotation lock: a part a joint holds is free to rotate (see
+    /// `Part::rotation_locked_by_quality`).
+    fn joint_holds(&mut self, object: Handle, delta: i32) {
+        let Ok(body) = self.bodies.get_mut(object) else {
+            return; // gone with its joint
+        };
+        let h = body.handle;
+        body.part.joints = body.part.joints.saturating_add_signed(delta);
+        let part = &body.part;
+        if let Some(rb) = self.world.bodies.get_mut(h) {
+            rb.set_locked_axes(part.locked_axes(), true);
         }
     }
 

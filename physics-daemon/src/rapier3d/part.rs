@@ -42,6 +42,9 @@ pub(super) struct Part {
     pub is_controller: bool,
     /// A map object's triangle mesh (see `maps`): static, never reshaped.
     pub map: Option<MapShape>,
+    /// Joints that hold this part: a held part rotates whatever its HitBoxQuality (a hinge
+    /// of default cubes swings, a motor turns its wheel).
+    pub joints: u32,
 }
 
 /// A built map's collider shape and what it counts against the mesh quota.
@@ -96,6 +99,7 @@ impl Part {
             settings: ObjectSettings::default(),
             is_controller: false,
             map: None,
+            joints: 0,
         };
         // A wedge's mass sits off its origin: CenterOfMass reads where it is.
         part.settings.center_of_mass = part.natural_center_of_mass();
@@ -215,10 +219,11 @@ impl Part {
 
     /// Low-quality non-spheres (capsules and cylinders included) without a CenterOfMass
     /// offset translate but do not spin from contacts (the documented HitBoxQuality
-    /// behaviour). A wedge's own off-centre centroid is not an offset: only a CenterOfMass
-    /// moved away from it frees its rotation.
+    /// behaviour), unless a joint holds them. A wedge's own off-centre centroid is not an
+    /// offset: only a CenterOfMass moved away from it frees its rotation.
     pub fn rotation_locked_by_quality(&self) -> bool {
         self.hit_box_quality < 2
+            && self.joints == 0
             && self.shape != ShapeKind::Sphere
             && self.center_of_mass == self.natural_center_of_mass()
     }
