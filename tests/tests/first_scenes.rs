@@ -38,3 +38,17 @@ fn joints_swing_and_turn_default_parts() {
         "joints on default parts ok",
     );
 }
+
+#[test]
+fn ground_y_takes_nil_to_clear_it() {
+    runs(
+        "first-groundy",
+        "tests/lua/ground_y_nil.luau",
+        "GroundY nil ok",
+    );
+}
+
+#[test]
+fn values_read_back_as_written() {
+    runs("first-readback", "tests/lua/read_back.luau", "read back ok");
+}

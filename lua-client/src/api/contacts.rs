@@ -195,7 +195,7 @@ impl PlaneState {
         let Some(c) = self.controller_of(r.a()) else {
             return Ok(());
         };
-        let num = |x: f32| Value::Number(x as f64);
+        let num = |x: f32| crate::values::lua_number(x);
         let (name, args): (&str, Vec<Value>) = match r.kind {
             client_sdk::EVENT_CONTROLLER_JUMPED => ("Jumped", vec![]),
             client_sdk::EVENT_CONTROLLER_LANDED => ("Landed", vec![]),
@@ -203,7 +203,7 @@ impl PlaneState {
                 ("Moved", r.normal.iter().map(|v| num(*v)).collect())
             }
             client_sdk::EVENT_WAYPOINT_REACHED => {
-                ("WaypointReached", vec![Value::Number(r.b_slot as f64)])
+                ("WaypointReached", vec![crate::values::lua_number(r.b_slot)])
             }
             client_sdk::EVENT_PATH_FINISHED => ("PathFinished", vec![]),
             _ => return Ok(()),
@@ -218,7 +218,7 @@ impl PlaneState {
             Some(s) if s.listeners() > 0 => s.fire(
                 lua,
                 MultiValue::from_iter([
-                    Value::Number(broke.force as f64),
+                    crate::values::lua_number(broke.force),
                     new_vector(broke.position),
                 ]),
             ),
@@ -230,7 +230,7 @@ impl PlaneState {
         let signal = self.contacts.lost.borrow().clone();
         match signal {
             Some(s) if s.listeners() > 0 => {
-                s.fire(lua, MultiValue::from_iter([Value::Number(n as f64)]))
+                s.fire(lua, MultiValue::from_iter([crate::values::lua_number(n)]))
             }
             _ => {
                 eprintln!(

@@ -157,7 +157,7 @@ impl PrimState {
             )?;
         }
         if r != r0 {
-            self.fire(lua, "Rotation", Value::Number(r as f64))?;
+            self.fire(lua, "Rotation", crate::values::lua_number(r))?;
         }
         Ok(())
     }
@@ -187,7 +187,7 @@ fn get(lua: &Lua, p: &PrimState, key: &Value) -> mlua::Result<Value> {
     Ok(match &*k.to_string_lossy() {
         "Size" => dim(p.size())?,
         "Position" => dim(p.position())?,
-        "Rotation" => Value::Number(p.rotation() as f64),
+        "Rotation" => crate::values::lua_number(p.rotation()),
         "ZIndex" => Value::Integer(p.z_index() as i64),
         "Shape" => Value::String(lua.create_string(p.shape.name())?),
         "Name" => Value::String(lua.create_string(&*p.name.borrow())?),

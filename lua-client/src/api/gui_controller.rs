@@ -70,7 +70,10 @@ impl ControllerState {
             GuiEvent::Moved { dx, dy, .. } => fire(
                 lua,
                 &self.moved,
-                MultiValue::from_iter([Value::Number(dx as f64), Value::Number(dy as f64)]),
+                MultiValue::from_iter([
+                    crate::values::lua_number(dx),
+                    crate::values::lua_number(dy),
+                ]),
             ),
             GuiEvent::GroundChanged { on_ground, .. } => fire(
                 lua,
@@ -235,10 +238,10 @@ impl UserData for GuiControllerUd {
                     c.0.object.check_alive(&what)?;
                     let info = c.0.ctrl.info().map_err(|e| sdk_error(&what, e))?;
                     Ok(match name.as_str() {
-                        "MoveSpeed" => Value::Number(info.move_speed as f64),
-                        "Acceleration" => Value::Number(info.acceleration as f64),
-                        "JumpStrength" => Value::Number(info.jump_strength as f64),
-                        "WaypointRadius" => Value::Number(info.waypoint_radius as f64),
+                        "MoveSpeed" => crate::values::lua_number(info.move_speed),
+                        "Acceleration" => crate::values::lua_number(info.acceleration),
+                        "JumpStrength" => crate::values::lua_number(info.jump_strength),
+                        "WaypointRadius" => crate::values::lua_number(info.waypoint_radius),
                         _ => Value::Boolean(info.on_ground),
                     })
                 }

@@ -126,13 +126,13 @@ fn object_of(what: &str, v: &Value) -> mlua::Result<Object> {
 
 fn info_value(lua: &Lua, info: &JointInfo, key: &str) -> mlua::Result<Value> {
     let s = &info.settings;
-    let opt = |v: Option<f32>| v.map_or(Value::Nil, |x| Value::Number(x as f64));
+    let opt = |v: Option<f32>| v.map_or(Value::Nil, |x| crate::values::lua_number(x));
     Ok(match key {
-        "Error" => Value::Number(info.error as f64),
-        "AngularError" => Value::Number(info.angular_error as f64),
+        "Error" => crate::values::lua_number(info.error),
+        "AngularError" => crate::values::lua_number(info.angular_error),
         "Broken" => Value::Boolean(info.broken),
-        "Force" => Value::Number(info.force as f64),
-        "Position" => Value::Number(info.position as f64),
+        "Force" => crate::values::lua_number(info.force),
+        "Position" => crate::values::lua_number(info.position),
         "Kind" => Value::String(lua.create_string(info.kind.name())?),
         "AnchorA" => new_vector(s.anchor_a),
         "AnchorB" => new_vector(s.anchor_b),
@@ -143,13 +143,13 @@ fn info_value(lua: &Lua, info: &JointInfo, key: &str) -> mlua::Result<Value> {
         "TwistLimit" => opt(s.twist_limit),
         "LowerDistance" => opt(s.lower_distance),
         "UpperDistance" => opt(s.upper_distance),
-        "RestLength" => Value::Number(s.rest_length as f64),
-        "Stiffness" => Value::Number(s.stiffness as f64),
-        "Damping" => Value::Number(s.damping as f64),
+        "RestLength" => crate::values::lua_number(s.rest_length),
+        "Stiffness" => crate::values::lua_number(s.stiffness),
+        "Damping" => crate::values::lua_number(s.damping),
         "MotorSpeed" => opt(s.motor_speed),
         "MotorTarget" => opt(s.motor_target),
-        "MotorMaxForce" => Value::Number(s.motor_max_force as f64),
-        "BreakForce" => Value::Number(s.break_force as f64),
+        "MotorMaxForce" => crate::values::lua_number(s.motor_max_force),
+        "BreakForce" => crate::values::lua_number(s.break_force),
         "CollideConnected" => Value::Boolean(s.collide_connected),
         _ => {
             return Err(mlua::Error::runtime(format!(

@@ -23,7 +23,7 @@ macro_rules! number_row {
         Row {
             name: $name,
             kind: $kind,
-            get: Get::Fn(|_, c| Ok(Value::Number(info(c, $name)?.$field as f64))),
+            get: Get::Fn(|_, c| Ok(crate::values::lua_number(info(c, $name)?.$field))),
             set: Set::Prop(|a| Ok($prop(a.number()? as f32))),
         }
     };
@@ -116,13 +116,18 @@ pub static CONTROLLER: Props<LuaController> = Props {
         ),
         Row {
             name: "GroundY",
-            kind: Kind::ANY_NUMBER,
+            kind: Kind::OptionalNumber,
             get: Get::Fn(|_, c| {
                 Ok(info(c, "GroundY")?
                     .ground_y
-                    .map_or(Value::Nil, |y| Value::Number(y as f64)))
+                    .map_or(Value::Nil, |y| crate::values::lua_number(y)))
             }),
-            set: Set::Prop(|a| Ok(ControllerProp::GroundY(Some(a.number()? as f32)))),
+            // nil clears it (no floor).
+            set: Set::Prop(|a| {
+                Ok(ControllerProp::GroundY(
+                    a.optional_number()?.map(|y| y as f32),
+                ))
+            }),
         },
         number_row!(
             "CapsuleRadius",
@@ -214,13 +219,17 @@ pub static CONTROLLER: Props<LuaController> = Props {
         Row {
             name: "PathLength",
             kind: Kind::ANY_INTEGER,
-            get: Get::Fn(|_, c| Ok(Value::Number(info(c, "PathLength")?.path_length as f64))),
+            get: Get::Fn(|_, c| {
+                Ok(crate::values::lua_number(
+                    info(c, "PathLength")?.path_length,
+                ))
+            }),
             set: Set::ReadOnly,
         },
         Row {
             name: "PathIndex",
             kind: Kind::ANY_INTEGER,
-            get: Get::Fn(|_, c| Ok(Value::Number(info(c, "PathIndex")?.path_index as f64))),
+            get: Get::Fn(|_, c| Ok(crate::values::lua_number(info(c, "PathIndex")?.path_index))),
             set: Set::ReadOnly,
         },
         Row {

@@ -79,7 +79,7 @@ macro_rules! gui_row {
 }
 
 fn out_num(_: &Lua, x: f32) -> mlua::Result<Value> {
-    Ok(Value::Number(x as f64))
+    Ok(crate::values::lua_number(x))
 }
 fn out_int(_: &Lua, x: u32) -> mlua::Result<Value> {
     Ok(Value::Integer(x as i64))
@@ -158,7 +158,7 @@ pub(crate) static GUI_PLANE_ROWS: &[PlaneRow] = &[
         name: "TickRate",
         takes: Takes::Number(0.0, MAX_TICK_RATE as f64),
         prop: |v| PlaneProp::TickRate(num(v)),
-        get: |_, i| Ok(Value::Number(i.tick_rate as f64)),
+        get: |_, i| Ok(crate::values::lua_number(i.tick_rate)),
     },
 ];
 
@@ -353,17 +353,17 @@ pub fn object_get(lua: &Lua, o: &PhysicsGuiObject, key: &Value) -> mlua::Result<
     Ok(match name.as_str() {
         "Position" => out_dim(lua, b.position().map_err(sdk)?)?,
         "Velocity" => out_dim(lua, b.velocity().map_err(sdk)?)?,
-        "Rotation" => Value::Number(b.rotation().map_err(sdk)? as f64),
-        "AngularVelocity" => Value::Number(b.angular_velocity().map_err(sdk)? as f64),
+        "Rotation" => crate::values::lua_number(b.rotation().map_err(sdk)?),
+        "AngularVelocity" => crate::values::lua_number(b.angular_velocity().map_err(sdk)?),
         "Anchored" => Value::Boolean(b.is_anchored().map_err(sdk)?),
         "Sleeping" => Value::Boolean(b.is_sleeping().map_err(sdk)?),
         "ImpulseDirection" => out_dim(lua, info()?.impulse_direction)?,
         "ConstantForce" => out_dim(lua, info()?.constant_force)?,
-        "Mass" => Value::Number(info()?.mass as f64),
-        "Bounciness" => Value::Number(info()?.bounciness as f64),
-        "Friction" => Value::Number(info()?.friction as f64),
+        "Mass" => crate::values::lua_number(info()?.mass),
+        "Bounciness" => crate::values::lua_number(info()?.bounciness),
+        "Friction" => crate::values::lua_number(info()?.friction),
         "CanCollide" => Value::Boolean(info()?.can_collide),
-        "GravityScale" => Value::Number(info()?.gravity_scale as f64),
+        "GravityScale" => crate::values::lua_number(info()?.gravity_scale),
         "LockedX" => Value::Boolean(info()?.locked_x),
         "LockedY" => Value::Boolean(info()?.locked_y),
         "LockedRotation" => Value::Boolean(info()?.locked_rotation),

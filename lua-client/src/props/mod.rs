@@ -60,6 +60,8 @@ pub enum Kind {
     CFrame,
     /// A Lua string.
     String,
+    /// A finite number, or nil for none (an optional setting such as `GroundY`).
+    OptionalNumber,
 }
 
 impl Kind {
@@ -102,6 +104,7 @@ impl Kind {
             Kind::PositiveVector => "a Vector with finite components > 0".into(),
             Kind::CFrame => "a CFrame".into(),
             Kind::String => "a string".into(),
+            Kind::OptionalNumber => "a finite number or nil".into(),
         }
     }
 
@@ -117,6 +120,11 @@ impl Kind {
         match *self {
             Kind::Number { min, max } => match number(value) {
                 Some(n) if n.is_finite() && n >= min && n <= max => Ok(Arg::Number(n)),
+                _ => Err(bad()),
+            },
+            Kind::OptionalNumber => match (value, number(value)) {
+                (Value::Nil, _) => Ok(Arg::Nil),
+                (_, Some(n)) if n.is_finite() => Ok(Arg::Number(n)),
                 _ => Err(bad()),
             },
             Kind::Positive => match number(value) {
@@ -171,6 +179,8 @@ pub enum Arg {
     CFrame(CFrame),
     /// From [`Kind::String`].
     String(String),
+    /// Nil, from [`Kind::OptionalNumber`].
+    Nil,
 }
 
 fn mismatch(arg: &Arg, want: &str) -> LuaError {
@@ -187,6 +197,13 @@ impl Arg {
             Arg::Number(n) => Ok(n),
             Arg::Integer(i) => Ok(i as f64),
             _ => Err(mismatch(self, "a number")),
+        }
+    }
+    /// The number, or `None` for nil.
+    pub fn optional_number(&self) -> Result<Option<f64>, LuaError> {
+        match *self {
+            Arg::Nil => Ok(None),
+            _ => self.number().map(Some),
         }
     }
     /// The integer.

@@ -153,26 +153,26 @@ pub static OBJECT: Props<PhysicsObject> = Props {
                 min: 1e-4,
                 max: f64::INFINITY,
             },
-            |i| Value::Number(i.weight as f64),
+            |i| crate::values::lua_number(i.weight),
             |a| ObjectProp::Weight(a.number()? as f32)
         ),
         info_row!(
             "Density",
             Kind::NON_NEGATIVE,
-            |i| Value::Number(i.density as f64),
+            |i| crate::values::lua_number(i.density),
             |a| ObjectProp::Density(a.number()? as f32)
         ),
         // Documented as clamped to [0, 1]: any finite number is accepted.
         info_row!(
             "Bounciness",
             Kind::ANY_NUMBER,
-            |i| Value::Number(i.bounciness as f64),
+            |i| crate::values::lua_number(i.bounciness),
             |a| ObjectProp::Bounciness(a.number()? as f32)
         ),
         info_row!(
             "Friction",
             Kind::UNIT,
-            |i| Value::Number(i.friction as f64),
+            |i| crate::values::lua_number(i.friction),
             |a| ObjectProp::Friction(a.number()? as f32)
         ),
         info_row!(
@@ -185,7 +185,7 @@ pub static OBJECT: Props<PhysicsObject> = Props {
         info_row!(
             "HitBoxQuality",
             Kind::ANY_INTEGER,
-            |i| Value::Number(i.hit_box_quality as f64),
+            |i| crate::values::lua_number(i.hit_box_quality),
             |a| ObjectProp::HitBoxQuality(a.integer()?.clamp(1, MAX_HIT_BOX_QUALITY as i64) as u32)
         ),
         info_row!(

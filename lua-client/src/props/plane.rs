@@ -18,7 +18,7 @@ macro_rules! number_row {
         Row {
             name: $name,
             kind: $kind,
-            get: Get::Fn(|_, p| Ok(Value::Number(p.info($name)?.$field as f64))),
+            get: Get::Fn(|_, p| Ok(crate::values::lua_number(p.info($name)?.$field))),
             set: Set::Prop(|a| Ok($prop(a.number()? as f32))),
         }
     };
@@ -80,7 +80,7 @@ pub static PLANE: Props<PlaneState> = Props {
                 min: 1,
                 max: MAX_THREADS as i64,
             },
-            get: Get::Fn(|_, p| Ok(Value::Number(p.info("Threads")?.threads as f64))),
+            get: Get::Fn(|_, p| Ok(crate::values::lua_number(p.info("Threads")?.threads))),
             set: Set::CreationOnly(|a| Ok(PlaneProp::Threads(a.integer()? as u32))),
         },
         Row {
@@ -106,7 +106,7 @@ pub static PLANE: Props<PlaneState> = Props {
                 let n = p
                     .object_count()
                     .map_err(|e| sdk_error("PhysicsPlane.ObjectCount", e))?;
-                Ok(Value::Number(n as f64))
+                Ok(crate::values::lua_number(n))
             }),
             set: Set::ReadOnly,
         },

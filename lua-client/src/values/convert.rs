@@ -106,3 +106,65 @@ pub fn sdk_error(what: &str, e: client_sdk::Error) -> LuaError {
 pub fn new_vector(v: [f32; 3]) -> Value {
     Value::Vector(mlua::Vector::new(v[0], v[1], v[2]))
 }
+
+/// A number the daemon keeps as `f32` or as an integer, as a Lua number that reads back
+/// what a script wrote: an `f32` becomes the double nearest its shortest decimal form
+/// (`0.7f32` reads `0.7`, not `0.699999988`), so `obj.Bounciness = 0.7` then
+/// `obj.Bounciness == 0.7` holds, and documented defaults read as written.
+pub fn lua_number<T: LuaNumber>(x: T) -> mlua::Value {
+    mlua::Value::Number(x.to_lua_f64())
+}
+
+/// Numbers [`lua_number`] takes.
+pub trait LuaNumber {
+    /// The Lua number for `self`.
+    fn to_lua_f64(self) -> f64;
+}
+
+impl LuaNumber for f32 {
+    fn to_lua_f64(self) -> f64 {
+        let wide = self as f64;
+        if !self.is_finite() || wide.fract() == 0.0 {
+            return wide;
+        }
+        // Rust prints the shortest decimal that reads back as this f32.
+        self.to_string().parse().unwrap_or(wide)
+    }
+}
+
+impl LuaNumber for f64 {
+    fn to_lua_f64(self) -> f64 {
+        self
+    }
+}
+
+macro_rules! lua_integer {
+    ($($t:ty),*) => {$(
+        impl LuaNumber for $t {
+            fn to_lua_f64(self) -> f64 {
+                self as f64
+            }
+        }
+    )*};
+}
+lua_integer!(u8, u16, u32, u64, i32, i64, usize);
+
+#[cfg(test)]
+mod lua_number_tests {
+    use super::*;
+
+    #[test]
+    fn f32_values_read_back_as_written() {
+        for (x, want) in [
+            (0.7f32, 0.7f64),
+            (1.1, 1.1),
+            (0.1, 0.1),
+            (16.0, 16.0),
+            (1e-4, 1e-4),
+        ] {
+            assert_eq!(x.to_lua_f64(), want, "{x}");
+        }
+        assert_eq!(u32::MAX.to_lua_f64(), u32::MAX as f64);
+        assert!(f32::NAN.to_lua_f64().is_nan());
+    }
+}

@@ -13,8 +13,8 @@ mod vector;
 
 pub use cframe::{CFrame, CFrameCache};
 pub use convert::{
-    describe, expected, finite_number, finite_vector, new_vector, number, sdk_error, vector,
-    DESCRIBE,
+    describe, expected, finite_number, finite_vector, lua_number, new_vector, number, sdk_error,
+    vector, DESCRIBE,
 };
 pub use dim::Dim;
 

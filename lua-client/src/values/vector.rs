@@ -48,7 +48,7 @@ fn install_metatable(lua: &Lua) -> mlua::Result<()> {
         let v = vec_arg("Vector", &v)?;
         let len = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
         match &*key.as_bytes() {
-            b"Magnitude" => Ok(Value::Number(len as f64)),
+            b"Magnitude" => Ok(crate::values::lua_number(len)),
             b"Unit" if len > 0.0 => Ok(new_vector(v.map(|c| c / len))),
             b"Unit" => Ok(new_vector([0.0; 3])),
             b"Dot" => Ok(Value::Function(dot.clone())),
