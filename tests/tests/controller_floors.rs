@@ -25,9 +25,9 @@ fn gravity_50() -> PlaneOptions {
 
 /// One case: a floor `width` × `thickness` × `width` whose top centre is `top`, a controller
 /// of `radius` and total `height` dropped from `drop` above it at `offset` (x, z) from the
-/// floor's centre. Returns the controller's rest height error, or why it failed.
-fn stands(
-    s: &Scene,
+/// floor's centre.
+#[derive(Debug, Clone, Copy)]
+struct Case {
     width: f32,
     thickness: f32,
     top: [f32; 3],
@@ -35,7 +35,20 @@ fn stands(
     radius: f32,
     height: f32,
     drop: f32,
-) -> Result<(), TestCaseError> {
+}
+
+/// Runs `case` on `s`'s plane (removing what it added): the controller must stand on the
+/// floor, `SKIN` above it, with OnGround.
+fn stands(s: &Scene, case: Case) -> Result<(), TestCaseError> {
+    let Case {
+        width,
+        thickness,
+        top,
+        offset,
+        radius,
+        height,
+        drop,
+    } = case;
     let floor = s
         .plane
         .add(
@@ -89,8 +102,16 @@ fn the_reported_floors_hold_a_controller() {
         (10_000.0, 0.05, [0.0, 0.0]),
         (1.0, 20.0, [0.0, 0.0]),
     ] {
-        stands(&s, width, thickness, [0.0; 3], offset, 1.0, 5.0, 3.5)
-            .unwrap_or_else(|e| panic!("{e}"));
+        let case = Case {
+            width,
+            thickness,
+            top: [0.0; 3],
+            offset,
+            radius: 1.0,
+            height: 5.0,
+            drop: 3.5,
+        };
+        stands(&s, case).unwrap_or_else(|e| panic!("{e}"));
     }
 }
 
@@ -123,16 +144,16 @@ fn any_floor_holds_any_controller() {
             |(width, thickness, top, fraction, radius, height_ratio, drop)| {
                 let half = width / 2.0;
                 let offset = [fraction[0] * half, fraction[1] * half];
-                stands(
-                    &s,
+                let case = Case {
                     width,
                     thickness,
                     top,
                     offset,
                     radius,
-                    2.0 * radius * height_ratio,
+                    height: 2.0 * radius * height_ratio,
                     drop,
-                )
+                };
+                stands(&s, case)
             },
         )
         .unwrap();

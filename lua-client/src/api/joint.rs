@@ -126,7 +126,7 @@ fn object_of(what: &str, v: &Value) -> mlua::Result<Object> {
 
 fn info_value(lua: &Lua, info: &JointInfo, key: &str) -> mlua::Result<Value> {
     let s = &info.settings;
-    let opt = |v: Option<f32>| v.map_or(Value::Nil, |x| crate::values::lua_number(x));
+    let opt = |v: Option<f32>| v.map_or(Value::Nil, crate::values::lua_number);
     Ok(match key {
         "Error" => crate::values::lua_number(info.error),
         "AngularError" => crate::values::lua_number(info.angular_error),

@@ -120,7 +120,7 @@ pub static CONTROLLER: Props<LuaController> = Props {
             get: Get::Fn(|_, c| {
                 Ok(info(c, "GroundY")?
                     .ground_y
-                    .map_or(Value::Nil, |y| crate::values::lua_number(y)))
+                    .map_or(Value::Nil, crate::values::lua_number))
             }),
             // nil clears it (no floor).
             set: Set::Prop(|a| {

@@ -252,7 +252,7 @@ fn cast_convex(
     options: ShapeCastOptions,
 ) -> Result<Option<ShapeCastHit>, Unsupported> {
     let speed = vel12.length();
-    if !(g1.is_convex() && g2.is_convex()) || !speed.is_finite() || speed == 0.0 {
+    if !(g1.is_convex() && g2.is_convex() && speed.is_finite()) || speed == 0.0 {
         return DefaultQueryDispatcher.cast_shapes(pos12, vel12, g1, g2, options);
     }
     let target = options.target_distance.max(0.0);
