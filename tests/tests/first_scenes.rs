@@ -52,3 +52,12 @@ fn ground_y_takes_nil_to_clear_it() {
 fn values_read_back_as_written() {
     runs("first-readback", "tests/lua/read_back.luau", "read back ok");
 }
+
+#[test]
+fn joints_have_a_lifecycle_like_objects() {
+    runs(
+        "first-joint-life",
+        "tests/lua/joint_lifecycle.luau",
+        "joint lifecycle ok",
+    );
+}

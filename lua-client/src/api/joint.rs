@@ -159,22 +159,60 @@ fn info_value(lua: &Lua, info: &JointInfo, key: &str) -> mlua::Result<Value> {
     })
 }
 
-/// The Lua handle of a joint, with its plane (for its Broke signal).
-pub struct LuaJoint(pub Joint, pub Rc<PlaneState>);
+/// The Lua handle of a joint, with its plane (for its Broke signal) and whether this
+/// script destroyed it.
+pub struct LuaJoint(pub Joint, pub Rc<PlaneState>, std::cell::Cell<bool>);
 
 impl LuaJoint {
+    /// The handle of `joint`, a joint of `plane`.
+    pub fn new(joint: Joint, plane: Rc<PlaneState>) -> LuaJoint {
+        LuaJoint(joint, plane, std::cell::Cell::new(false))
+    }
+
+    /// What `tostring` and messages call it: its kind, and "(destroyed)" once it is.
     fn name(&self) -> String {
-        format!("Joint {} ({:?})", self.0.kind().name(), self.0.handle())
+        let gone = if self.2.get() { " (destroyed)" } else { "" };
+        format!("Joint {}{gone}", self.0.kind().name())
+    }
+
+    /// Whether the joint still exists: not destroyed by this script, nor removed by the
+    /// daemon with one of its objects.
+    fn alive(&self) -> bool {
+        !self.2.get() && self.0.info().is_ok()
     }
 }
 
 impl UserData for LuaJoint {
     fn add_methods<M: UserDataMethods<Self>>(methods: &mut M) {
+        // Destroying a destroyed joint (or one removed with its object) does nothing, as
+        // for objects and controllers.
         methods.add_method("Destroy", |_, j, ()| {
+            if j.2.get() {
+                return Ok(());
+            }
             forget_joint(&j.1, j.0.handle());
-            j.0.destroy().map_err(|e| sdk_error("Joint:Destroy", e))
+            match j.0.destroy() {
+                Ok(()) => {
+                    j.2.set(true);
+                    Ok(())
+                }
+                Err(_) if j.0.info().is_err() => {
+                    j.2.set(true);
+                    Ok(())
+                }
+                Err(e) => Err(sdk_error("Joint:Destroy", e)),
+            }
         });
         methods.add_meta_method(MetaMethod::Index, |lua, j, key: String| {
+            if key == "Alive" {
+                return Ok(Value::Boolean(j.alive()));
+            }
+            if j.2.get() {
+                return Err(mlua::Error::runtime(format!(
+                    "Joint.{key}: {} (read Alive to check)",
+                    j.name()
+                )));
+            }
             if key == "Broke" {
                 let signal = joint_broke_signal(&j.1, j.0.handle(), &j.name());
                 return Ok(Value::UserData(lua.create_userdata(signal)?));
@@ -242,7 +280,7 @@ fn new_joint(
         .0
         .plane
         .joint(kind, &a, b.as_ref(), &props)
-        .map(|j| LuaJoint(j, plane.0.clone()))
+        .map(|j| LuaJoint::new(j, plane.0.clone()))
         .map_err(|e| sdk_error(what, e))
 }
 
