@@ -61,3 +61,12 @@ fn joints_have_a_lifecycle_like_objects() {
         "joint lifecycle ok",
     );
 }
+
+#[test]
+fn gui_values_name_themselves_without_rust_internals() {
+    runs(
+        "first-gui-names",
+        "tests/lua/gui_names.luau",
+        "gui names ok",
+    );
+}

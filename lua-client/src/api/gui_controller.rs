@@ -104,6 +104,12 @@ fn prop(what: &str, key: &Value, value: &Value) -> mlua::Result<GuiControllerPro
         Value::String(s) => s.to_string_lossy(),
         other => describe(other),
     };
+    // "GUIController." + "MoveSpeed", "NewController option" + " MoveSpeed".
+    let full = if what.ends_with('.') {
+        format!("{what}{name}")
+    } else {
+        format!("{what} {name}")
+    };
     let make: fn(f32) -> GuiControllerProp = match name.as_str() {
         "MoveSpeed" => GuiControllerProp::MoveSpeed,
         "Acceleration" => GuiControllerProp::Acceleration,
@@ -121,13 +127,9 @@ fn prop(what: &str, key: &Value, value: &Value) -> mlua::Result<GuiControllerPro
         Some(n) if n.is_finite() && n >= 0.0 => {
             let p = make(n as f32);
             p.checked()
-                .map_err(|e| mlua::Error::runtime(format!("{what} {name}: {}", e.message)))
+                .map_err(|e| mlua::Error::runtime(format!("{full}: {}", e.message)))
         }
-        _ => Err(expected(
-            &format!("{what} {name}"),
-            "a finite number >= 0",
-            value,
-        )),
+        _ => Err(expected(&full, "a finite number >= 0", value)),
     }
 }
 
@@ -156,6 +158,7 @@ fn dims(lua: &Lua, ps: &[[f32; 2]]) -> mlua::Result<Table> {
 
 impl UserData for GuiControllerUd {
     fn add_methods<M: UserDataMethods<Self>>(methods: &mut M) {
+        methods.add_meta_method(MetaMethod::ToString, |_, _, ()| Ok("GUIController"));
         let sdk = |what: &'static str| move |e| sdk_error(what, e);
         methods.add_method("Move", move |_, c, d: Value| {
             const WHAT: &str = "GUIController:Move";

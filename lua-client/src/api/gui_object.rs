@@ -80,7 +80,11 @@ impl UserData for PhysicsGuiObject {
             |_, o, (key, value): (Value, Value)| crate::props::gui::object_set(o, &key, &value),
         );
         methods.add_meta_method(MetaMethod::ToString, |_, o, ()| {
-            Ok(format!("PhysicsGuiObject {:?}", o.object.handle()))
+            Ok(if o.alive() {
+                "PhysicsGuiObject"
+            } else {
+                "PhysicsGuiObject (destroyed)"
+            })
         });
     }
 }
