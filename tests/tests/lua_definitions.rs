@@ -12,7 +12,7 @@
 //! - every member the example and test scripts use (`x.Name`, `x:Name(`) is declared.
 //!
 //! A real Luau type checker (Luau's Analysis library) is not part of this check: see the
-//! README's "Luau tooling" section.
+//! docs/lua.md, "Luau tooling".
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
