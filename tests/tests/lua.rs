@@ -451,3 +451,61 @@ fn defer_gpu_from_lua_falls_flips_and_refuses() {
     r.assert_ok();
     assert!(r.stdout().contains("gpu ok\t60"), "{}", r.stdout());
 }
+
+// The scenes a user writes first (defects a new user met), each script asserting its outcome.
+
+#[test]
+fn a_controller_walks_along_its_look_vector() {
+    let daemon = TestDaemon::start("first-facing");
+    let r = run(&daemon, "tests/lua/controller_facing.luau");
+    r.assert_ok();
+    assert!(
+        r.stdout().contains("controller facing ok"),
+        "{}",
+        r.stdout()
+    );
+}
+
+#[test]
+fn joints_swing_and_turn_default_parts() {
+    let daemon = TestDaemon::start("first-joints");
+    let r = run(&daemon, "tests/lua/joints_default_parts.luau");
+    r.assert_ok();
+    assert!(
+        r.stdout().contains("joints on default parts ok"),
+        "{}",
+        r.stdout()
+    );
+}
+
+#[test]
+fn ground_y_takes_nil_to_clear_it() {
+    let daemon = TestDaemon::start("first-groundy");
+    let r = run(&daemon, "tests/lua/ground_y_nil.luau");
+    r.assert_ok();
+    assert!(r.stdout().contains("GroundY nil ok"), "{}", r.stdout());
+}
+
+#[test]
+fn values_read_back_as_written() {
+    let daemon = TestDaemon::start("first-readback");
+    let r = run(&daemon, "tests/lua/read_back.luau");
+    r.assert_ok();
+    assert!(r.stdout().contains("read back ok"), "{}", r.stdout());
+}
+
+#[test]
+fn joints_have_a_lifecycle_like_objects() {
+    let daemon = TestDaemon::start("first-joint-life");
+    let r = run(&daemon, "tests/lua/joint_lifecycle.luau");
+    r.assert_ok();
+    assert!(r.stdout().contains("joint lifecycle ok"), "{}", r.stdout());
+}
+
+#[test]
+fn gui_values_name_themselves_without_rust_internals() {
+    let daemon = TestDaemon::start("first-gui-names");
+    let r = run(&daemon, "tests/lua/gui_names.luau");
+    r.assert_ok();
+    assert!(r.stdout().contains("gui names ok"), "{}", r.stdout());
+}

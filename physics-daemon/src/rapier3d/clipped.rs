@@ -10,15 +10,22 @@
 //! casts 0.5 too long (the controller stood 0.49 too low). Floors of 50, 100 and 2048 happened
 //! to be fine, and so did the 400 floor a few units off its centre.
 //!
-//! [`ClippedQueries`] answers every query of a shape against a box from the part of the box
-//! near the shape: the box intersected with the shape's bounding box (swept along a cast,
-//! widened by a margin several times the shape's size). Near the shape the two boxes have the
-//! same surface, so distances, contacts and casts are the same; the clipped box is a few
-//! shape-sizes wide, where GJK is exact to f32 rounding. Witness points come back in the
-//! original box's frame. Everything else goes to parry's default dispatcher unchanged.
+//! GJK also goes wrong, at any size, when a shape sits exactly over the middle of a box
+//! (ties between the box's corners): a capsule sunk 0.05 into a 10 × 1 × 10 box cast down
+//! finds no hit; two capsules meeting exactly head-on pass through each other.
+//!
+//! [`ClippedQueries`], the dispatcher every query of a 3D plane uses, answers:
+//! - a contact of a convex shape with a box from the box's face when the shape's deepest
+//!   point lies over it (exact at any size, see [`face_contact`]);
+//! - otherwise any query against a much larger box on that box clipped to the region near
+//!   the other shape (off its centre, widened several shape-sizes: the same surface there,
+//!   where GJK is exact to f32 rounding), witness points given back in the box's own frame;
+//! - a cast of two convex shapes by conservative advancement on that contact
+//!   ([`cast_convex`]);
+//! - everything else through parry's default dispatcher unchanged.
 
 use rapier3d::math::{Pose, Vector};
-use rapier3d::parry::bounding_volume::{Aabb, BoundingVolume};
+use rapier3d::parry::bounding_volume::Aabb;
 use rapier3d::parry::query::{
     ClosestPoints, Contact, DefaultQueryDispatcher, NonlinearRigidMotion, QueryDispatcher,
     ShapeCastHit, ShapeCastOptions, ShapeCastStatus, ShapeDistance, ShapeIntersection, Unsupported,
@@ -54,8 +61,7 @@ impl super::Plane {
     }
 }
 
-/// A query dispatcher that clips very large boxes to the part near the other shape (see the
-/// module docs) and hands everything to parry's default dispatcher.
+/// The dispatcher of the module docs: exact contacts and casts next to boxes of any size.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct ClippedQueries;
 
@@ -97,29 +103,34 @@ enum Clipped {
     First(Cuboid, Vector),
 }
 
-/// The clipping for a query of `g1` against `g2` placed at `pos12`, `sweep` being how far
-/// `g2` travels relative to `g1` (in `g1`'s frame) during a cast.
-fn clipping(pos12: &Pose, g1: &dyn Shape, g2: &dyn Shape, sweep: Vector) -> Option<Clipped> {
+/// The clipping for a query of `g1` against `g2` placed at `pos12`, if either is a box much
+/// larger than the other shape.
+fn clipping(pos12: &Pose, g1: &dyn Shape, g2: &dyn Shape) -> Option<Clipped> {
     if let Some(c2) = g2.as_cuboid() {
-        // g1 in g2's frame, moving by -sweep relative to it.
-        let inv = pos12.inverse();
-        let a = g1.compute_aabb(&inv);
-        let swept = a.merged(&Aabb::new(
-            a.mins - inv.rotation * sweep,
-            a.maxs - inv.rotation * sweep,
-        ));
-        if let Some((c, centre)) = clip(c2, swept) {
+        if let Some((c, centre)) = clip(c2, g1.compute_aabb(&pos12.inverse())) {
             return Some(Clipped::Second(c, centre));
         }
     }
-    if let Some(c1) = g1.as_cuboid() {
-        let a = g2.compute_aabb(pos12);
-        let swept = a.merged(&Aabb::new(a.mins + sweep, a.maxs + sweep));
-        if let Some((c, centre)) = clip(c1, swept) {
-            return Some(Clipped::First(c, centre));
+    let c1 = g1.as_cuboid()?;
+    let (c, centre) = clip(c1, g2.compute_aabb(pos12))?;
+    Some(Clipped::First(c, centre))
+}
+
+/// Runs `query` on the clipped pair (or the pair itself when nothing is clipped), with the
+/// offsets that bring points of each shape back to its own frame.
+fn with_clipping<R>(
+    pos12: &Pose,
+    g1: &dyn Shape,
+    g2: &dyn Shape,
+    query: impl FnOnce(&Pose, &dyn Shape, &dyn Shape, (Vector, Vector)) -> R,
+) -> R {
+    match clipping(pos12, g1, g2) {
+        Some(c) => {
+            let (s1, s2) = c.shapes(g1, g2);
+            query(&c.pos12(pos12), s1, s2, c.offsets())
         }
+        None => query(pos12, g1, g2, (Vector::ZERO, Vector::ZERO)),
     }
-    None
 }
 
 impl Clipped {
@@ -199,7 +210,7 @@ fn face_contact(
 
 /// The contact query every path here uses: a box's face when that decides it (exact at any
 /// size), else GJK on the box clipped near the other shape, else parry's default.
-fn contact(
+pub(super) fn contact(
     pos12: &Pose,
     g1: &dyn Shape,
     g2: &dyn Shape,
@@ -214,18 +225,15 @@ fn contact(
             return Ok(found.map(Contact::flipped));
         }
     }
-    let Some(c) = clipping(pos12, g1, g2, Vector::ZERO) else {
-        return DefaultQueryDispatcher.contact(pos12, g1, g2, prediction);
-    };
-    let (s1, s2) = c.shapes(g1, g2);
-    let (o1, o2) = c.offsets();
-    Ok(DefaultQueryDispatcher
-        .contact(&c.pos12(pos12), s1, s2, prediction)?
-        .map(|mut contact| {
-            contact.point1 += o1;
-            contact.point2 += o2;
-            contact
-        }))
+    with_clipping(pos12, g1, g2, |pos12, s1, s2, (o1, o2)| {
+        Ok(DefaultQueryDispatcher
+            .contact(pos12, s1, s2, prediction)?
+            .map(|mut contact| {
+                contact.point1 += o1;
+                contact.point2 += o2;
+                contact
+            }))
+    })
 }
 
 /// Newton steps of [`cast_convex`] before it hands the cast to parry.
@@ -252,7 +260,7 @@ fn cast_convex(
     options: ShapeCastOptions,
 ) -> Result<Option<ShapeCastHit>, Unsupported> {
     let speed = vel12.length();
-    if !(g1.is_convex() && g2.is_convex() && speed.is_finite()) || speed == 0.0 {
+    if !speed.is_finite() || speed == 0.0 {
         return DefaultQueryDispatcher.cast_shapes(pos12, vel12, g1, g2, options);
     }
     let target = options.target_distance.max(0.0);
@@ -321,13 +329,9 @@ impl QueryDispatcher for ClippedQueries {
         g1: &dyn Shape,
         g2: &dyn Shape,
     ) -> Result<ShapeIntersection, Unsupported> {
-        match clipping(pos12, g1, g2, Vector::ZERO) {
-            Some(c) => {
-                let (s1, s2) = c.shapes(g1, g2);
-                DefaultQueryDispatcher.intersection_test(&c.pos12(pos12), s1, s2)
-            }
-            None => DefaultQueryDispatcher.intersection_test(pos12, g1, g2),
-        }
+        with_clipping(pos12, g1, g2, |pos12, s1, s2, _| {
+            DefaultQueryDispatcher.intersection_test(pos12, s1, s2)
+        })
     }
 
     fn distance(
@@ -336,13 +340,9 @@ impl QueryDispatcher for ClippedQueries {
         g1: &dyn Shape,
         g2: &dyn Shape,
     ) -> Result<ShapeDistance, Unsupported> {
-        match clipping(pos12, g1, g2, Vector::ZERO) {
-            Some(c) => {
-                let (s1, s2) = c.shapes(g1, g2);
-                DefaultQueryDispatcher.distance(&c.pos12(pos12), s1, s2)
-            }
-            None => DefaultQueryDispatcher.distance(pos12, g1, g2),
-        }
+        with_clipping(pos12, g1, g2, |pos12, s1, s2, _| {
+            DefaultQueryDispatcher.distance(pos12, s1, s2)
+        })
     }
 
     fn contact(
@@ -362,19 +362,16 @@ impl QueryDispatcher for ClippedQueries {
         g2: &dyn Shape,
         max_dist: f32,
     ) -> Result<ClosestPoints, Unsupported> {
-        let Some(c) = clipping(pos12, g1, g2, Vector::ZERO) else {
-            return DefaultQueryDispatcher.closest_points(pos12, g1, g2, max_dist);
-        };
-        let (s1, s2) = c.shapes(g1, g2);
-        let (o1, o2) = c.offsets();
-        Ok(
-            match DefaultQueryDispatcher.closest_points(&c.pos12(pos12), s1, s2, max_dist)? {
-                ClosestPoints::WithinMargin(p1, p2) => {
-                    ClosestPoints::WithinMargin(p1 + o1, p2 + o2)
-                }
-                other => other,
-            },
-        )
+        with_clipping(pos12, g1, g2, |pos12, s1, s2, (o1, o2)| {
+            Ok(
+                match DefaultQueryDispatcher.closest_points(pos12, s1, s2, max_dist)? {
+                    ClosestPoints::WithinMargin(p1, p2) => {
+                        ClosestPoints::WithinMargin(p1 + o1, p2 + o2)
+                    }
+                    other => other,
+                },
+            )
+        })
     }
 
     fn cast_shapes(
@@ -385,6 +382,7 @@ impl QueryDispatcher for ClippedQueries {
         g2: &dyn Shape,
         options: ShapeCastOptions,
     ) -> Result<Option<ShapeCastHit>, Unsupported> {
+        // Composite shapes (maps, compounds) go to parry, which casts their parts itself.
         if g1.is_convex() && g2.is_convex() {
             return cast_convex(pos12, local_vel12, g1, g2, options);
         }

@@ -20,7 +20,7 @@
 use std::collections::BTreeMap;
 
 use rapier3d::control::{CharacterCollision, CharacterLength, KinematicCharacterController};
-use rapier3d::parry::query::{QueryDispatcher, ShapeCastOptions};
+use rapier3d::parry::query::ShapeCastOptions;
 use rapier3d::prelude::*;
 use shm_layout::controller_op::ControllerInfo;
 use shm_layout::{
@@ -786,7 +786,7 @@ impl Plane {
                 // The pose has no rotation: the contact's capsule-local normal is the world's.
                 let pos12 = pose.inv_mul(co.position());
                 if let Ok(Some(contact)) =
-                    super::clipped::ClippedQueries.contact(&pos12, &**shape, co.shape(), 0.0)
+                    super::clipped::contact(&pos12, &**shape, co.shape(), 0.0)
                 {
                     if contact.dist < 0.0 && deepest.is_none_or(|(d, _)| contact.dist < d) {
                         deepest = Some((contact.dist, contact.normal1));
