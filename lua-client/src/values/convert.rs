@@ -124,10 +124,24 @@ pub trait LuaNumber {
 impl LuaNumber for f32 {
     fn to_lua_f64(self) -> f64 {
         let wide = self as f64;
-        if !self.is_finite() || wide.fract() == 0.0 {
+        if !self.is_finite() {
             return wide;
         }
-        // Rust prints the shortest decimal that reads back as this f32.
+        if wide.abs() >= 16_777_216.0 {
+            // Past 2^24 an f32 is an integer that need not be the one written.
+            return self.to_string().parse().unwrap_or(wide);
+        }
+        // The fewest decimal places that still read back as this f32 (a multiply and a
+        // division per place, no formatting), nearest to it; Rust's shortest printing for
+        // what needs more.
+        let mut scale = 1.0f64;
+        for _ in 0..=12 {
+            let r = (wide * scale).round() / scale;
+            if r as f32 == self {
+                return r;
+            }
+            scale *= 10.0;
+        }
         self.to_string().parse().unwrap_or(wide)
     }
 }
@@ -166,5 +180,13 @@ mod lua_number_tests {
         }
         assert_eq!(u32::MAX.to_lua_f64(), u32::MAX as f64);
         assert!(f32::NAN.to_lua_f64().is_nan());
+        // Every f32 reads as the value Rust's shortest printing gives.
+        for bits in (0..u32::MAX).step_by(65_537) {
+            let x = f32::from_bits(bits);
+            if x.is_finite() {
+                let shortest: f64 = x.to_string().parse().unwrap();
+                assert_eq!(x.to_lua_f64(), shortest, "{x:e}");
+            }
+        }
     }
 }
