@@ -45,6 +45,14 @@ pub struct ConnectOptions {
     /// Lua host does); a client that never flushes leaves new objects held for
     /// `MAX_HELD_TICKS` ticks. Default off.
     pub hold_adds_until_flush: bool,
+    /// Writes the daemon refuses after the call that queued them returned (a refusal that
+    /// depends on the plane's state, such as an object write the GPU path cannot do) are
+    /// kept by plane and reported by the next call into that plane
+    /// ([`Error::Refused`]), instead of by the next [`Client::flush`]: a host whose frame
+    /// loop flushes (the Lua host) then never ends a frame on another call's refusal, and a
+    /// script can catch it where it works with the plane. [`Client::take_refused`] collects
+    /// what no call reported. Default off (`flush` reports every refusal).
+    pub refusals_at_next_call: bool,
 }
 
 impl ConnectOptions {
@@ -56,6 +64,7 @@ impl ConnectOptions {
             crate_version: CRATE_VERSION.to_string(),
             layout_version: LAYOUT_VERSION,
             hold_adds_until_flush: false,
+            refusals_at_next_call: false,
         }
     }
 }
@@ -64,13 +73,25 @@ impl ConnectOptions {
 struct Queued {
     command: Command,
     confirms: Option<(PlaneId, Handle)>,
+    /// The host's line that made the write ([`Client::set_origin`]; 0: unknown).
+    origin: u32,
+}
+
+/// The host's answer to "which line of the script is running?" (0: none).
+type Origin = Box<dyn Fn() -> u32>;
+
+/// A queued write the daemon refused, kept for the next call into its plane.
+struct Refusal {
+    plane: Option<PlaneId>,
+    error: CommandError,
 }
 
 #[derive(Default)]
 struct State {
     queue: Vec<Queued>,
-    /// Failures of queued commands sent along with another call, reported by `flush`.
-    deferred: Vec<CommandError>,
+    /// Failures of queued commands sent along with another call, reported by `flush` (or
+    /// by the next call into their plane: [`ConnectOptions::refusals_at_next_call`]).
+    deferred: Vec<Refusal>,
     planes: HashMap<PlaneId, Rc<PlaneShared>>,
     /// Planes this client created (they take its collision-group table).
     owned: Vec<PlaneId>,
@@ -88,6 +109,8 @@ struct Inner {
     /// The frame number of [`Client::begin_frame`] (0: no frames, every read looks for the
     /// newest sample).
     frame: std::cell::Cell<u64>,
+    /// Where the host's script queues a write ([`Client::set_origin`]).
+    origin: RefCell<Option<Origin>>,
 }
 
 /// A connection to the physics daemon of one domain. Cheap to clone; not `Send` (shared
@@ -113,6 +136,7 @@ impl Client {
             daemon_pid: 0,
             state: RefCell::default(),
             frame: std::cell::Cell::new(0),
+            origin: RefCell::new(None),
         };
         let hello = Command::Hello {
             crate_version: inner.options.crate_version.clone(),
@@ -212,16 +236,44 @@ impl Client {
 
     /// Sends every queued write as one request. Errors of individual commands (including
     /// ones sent along with earlier calls) come back together; the others were applied.
+    ///
+    /// With [`ConnectOptions::refusals_at_next_call`] the refusals stay with their planes
+    /// for the next call into each (or [`Client::take_refused`]) and `flush` reports only
+    /// a failure to send.
     pub fn flush(&self) -> Result<(), Error> {
         if !self.inner.state.borrow().queue.is_empty() {
             self.send(Vec::new())?;
         }
-        let deferred = std::mem::take(&mut self.inner.state.borrow_mut().deferred);
+        if self.inner.options.refusals_at_next_call {
+            return Ok(());
+        }
+        let deferred = self.take_refused(None);
         if deferred.is_empty() {
             Ok(())
         } else {
             Err(Error::Batch(deferred))
         }
+    }
+
+    /// Takes the refused writes not reported yet: of plane `plane`, or of every plane
+    /// (`None`, which also takes refusals of commands that name no plane).
+    pub fn take_refused(&self, plane: Option<PlaneId>) -> Vec<CommandError> {
+        let mut state = self.inner.state.borrow_mut();
+        if state.deferred.is_empty() {
+            return Vec::new();
+        }
+        let (taken, kept) = std::mem::take(&mut state.deferred)
+            .into_iter()
+            .partition(|r| plane.is_none() || r.plane == plane);
+        state.deferred = kept;
+        taken.into_iter().map(|r| r.error).collect()
+    }
+
+    /// Gives the client a way to ask the host which line of its script queues a write
+    /// (0: none), so that a write refused later names it ("written at line 12"). Asked
+    /// once per queued write.
+    pub fn set_origin(&self, origin: impl Fn() -> u32 + 'static) {
+        *self.inner.origin.borrow_mut() = Some(Box::new(origin));
     }
 
     /// Starts a frame of a host's frame loop: from now until the next call, object reads
@@ -244,9 +296,35 @@ impl Client {
     }
 
     /// Sends the queue plus `command` and returns the reply to `command`.
+    ///
+    /// With [`ConnectOptions::refusals_at_next_call`], a call into a plane first reports the
+    /// plane's refused writes ([`Error::Refused`]) instead of running, and a call that
+    /// creates nothing (a step, a write) also reports the refusals its own request brought
+    /// back, after it ran; a creating call keeps them for the next call, so its handle is
+    /// never lost.
     pub(crate) fn call(&self, command: Command) -> Result<Reply, Error> {
+        let plane = match (&command, self.inner.options.refusals_at_next_call) {
+            (Command::Plane { plane, op }, true) => {
+                let refused = self.take_refused(Some(*plane));
+                // A plane that goes away takes its refusals with it.
+                if !refused.is_empty() && !matches!(op, PlaneOp::Destroy) {
+                    return Err(Error::Refused(refused));
+                }
+                Some(*plane)
+            }
+            _ => None,
+        };
         let mut results = self.send(vec![command])?;
         match results.pop() {
+            Some(Ok(reply @ (Reply::Stepped { .. } | Reply::Applied { .. } | Reply::Done)))
+                if plane.is_some() =>
+            {
+                let refused = self.take_refused(plane);
+                match refused.is_empty() {
+                    true => Ok(reply),
+                    false => Err(Error::Refused(refused)),
+                }
+            }
             Some(Ok(reply)) => Ok(reply),
             Some(Err(e)) => Err(Error::Command(e)),
             None => Err(Error::Protocol("empty reply".into())),
@@ -254,11 +332,11 @@ impl Client {
     }
 
     pub(crate) fn queue(&self, command: Command, confirms: Option<(PlaneId, Handle)>) {
-        self.inner
-            .state
-            .borrow_mut()
-            .queue
-            .push(Queued { command, confirms });
+        self.inner.state.borrow_mut().queue.push(Queued {
+            command,
+            confirms,
+            origin: self.inner.origin.borrow().as_ref().map_or(0, |f| f()),
+        });
     }
 
     /// One request: the queued commands first, then `extra`. Returns the results of `extra`.
@@ -269,7 +347,9 @@ impl Client {
         let mut targets = Vec::with_capacity(n_queued);
         let mut commands = Vec::with_capacity(n_queued + extra.len());
         let mut releases = Vec::with_capacity(n_queued);
+        let mut origins = Vec::with_capacity(n_queued);
         for q in queued {
+            origins.push(q.origin);
             confirms.push(q.confirms);
             releases.push(is_release(&q.command));
             targets.push(match &q.command {
@@ -295,7 +375,7 @@ impl Client {
         let extra_results = results.split_off(n_queued.min(results.len()));
         let mut state = self.inner.state.borrow_mut();
         let each = results.into_iter().zip(confirms).zip(targets).zip(releases);
-        for (((result, confirm), target), release) in each {
+        for ((((result, confirm), target), release), origin) in each.zip(origins) {
             if release {
                 // The SDK's own release of a held add: nothing the caller asked for, and an
                 // object already gone has nothing left to release.
@@ -328,14 +408,18 @@ impl Client {
                     }
                 }
                 (Ok(_), _) => {}
-                (Err(e), confirm) => {
+                (Err(mut error), confirm) => {
                     // A rejected write must not linger as if it had happened.
                     if let Some((plane, handle)) = confirm {
                         if let Some(p) = state.planes.get(&plane) {
                             p.discard(handle);
                         }
                     }
-                    state.deferred.push(e);
+                    if origin > 0 {
+                        error.message = format!("{} (written at line {origin})", error.message);
+                    }
+                    let plane = target.map(|(plane, _, _)| plane);
+                    state.deferred.push(Refusal { plane, error });
                 }
             }
         }

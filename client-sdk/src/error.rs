@@ -32,6 +32,12 @@ pub enum Error {
     /// Some commands of a flushed batch failed; the others were applied.
     #[error("{} command(s) of the batch failed; first: {}", .0.len(), .0[0])]
     Batch(Vec<CommandError>),
+    /// Writes queued earlier were refused by the daemon after the call that queued them
+    /// returned ([`ConnectOptions::refusals_at_next_call`](crate::ConnectOptions)): reported
+    /// by the next call into their plane instead of being lost or ending a frame. Each
+    /// message names the write and, when the host recorded it, the line that made it.
+    #[error("{}", refused_text(.0))]
+    Refused(Vec<CommandError>),
     /// A value was refused before anything was sent.
     #[error("invalid {field}: {message}")]
     Invalid {
@@ -63,6 +69,14 @@ pub enum Error {
     /// The daemon's reply could not be decoded or was not the one expected.
     #[error("protocol: {0}")]
     Protocol(String),
+}
+
+fn refused_text(errors: &[CommandError]) -> String {
+    let first = errors.first().map(|e| e.message.as_str()).unwrap_or("");
+    match errors.len() {
+        1 => format!("an earlier write was refused: {first}"),
+        n => format!("{n} earlier writes were refused; first: {first}"),
+    }
 }
 
 impl Error {

@@ -325,6 +325,22 @@ impl Plane {
         Ok(())
     }
 
+    /// [`Plane::set`] applied at once: sends the queued writes and this one as one request
+    /// and returns the daemon's verdict on it, for a write whose refusal depends on the
+    /// plane's state (`DeferGpu = true` with a joint present or no adapter).
+    pub fn set_now(&self, prop: PlaneProp) -> Result<(), Error> {
+        let prop = prop.checked().map_err(Error::invalid_value)?;
+        self.shared.mirror.borrow_mut().plane_written(&prop);
+        let result = self
+            .client
+            .call(Command::plane(self.id(), PlaneOp::Set(prop)));
+        if result.is_err() {
+            // A refused write must not linger in the mirror.
+            self.shared.mirror.borrow_mut().forget_plane();
+        }
+        result.map(|_| ())
+    }
+
     /// False once this process destroyed the plane or the daemon no longer knows it.
     pub fn is_alive(&self) -> bool {
         if !self.shared.alive.get() {

@@ -42,6 +42,13 @@ pub fn install(lua: &Lua, client: Client) -> mlua::Result<Host> {
     lua.set_app_data(scheduler.clone());
     scheduler.watchdog.install(lua);
     host::errors::install(lua)?;
+    // A write the daemon refuses after its call returned names the line that made it.
+    let weak = lua.weak();
+    client.set_origin(move || {
+        weak.try_upgrade()
+            .and_then(|lua| lua.inspect_stack(1, |d| d.current_line()).flatten())
+            .map_or(0, |line| line as u32)
+    });
     let modules = api::modules(lua, client.clone())?;
     let import = lua.create_function(move |_, name: Value| {
         let found = match &name {

@@ -359,6 +359,11 @@ fn without_an_adapter_defer_gpu_fails_and_the_plane_stays_on_the_cpu() {
         text.contains("DeferGpu") && text.contains("no GPU adapter"),
         "{text}"
     );
+    // No plane came of it, and the message does not claim one did.
+    assert!(
+        text.contains("no plane was created") && !text.contains("stays on the CPU"),
+        "{text}"
+    );
     let plane = client.create_plane(&PlaneOptions::manual()).unwrap();
     let b = plane
         .add(

@@ -509,3 +509,19 @@ fn gui_values_name_themselves_without_rust_internals() {
     r.assert_ok();
     assert!(r.stdout().contains("gui names ok"), "{}", r.stdout());
 }
+
+#[test]
+fn refused_writes_raise_catchably_and_never_end_the_run() {
+    let daemon = TestDaemon::start("first-refused");
+    let r = run(&daemon, "tests/lua/refused_writes.luau");
+    r.assert_ok();
+    assert!(r.stdout().contains("refused writes ok"), "{}", r.stdout());
+}
+
+#[test]
+fn defer_gpu_without_an_adapter_is_refused_where_it_is_written() {
+    let daemon = TestDaemon::start_with("first-gpu-off", &[], &[("PHYSICS_GPU", "off")]);
+    let r = run(&daemon, "tests/lua/defer_gpu_off.luau");
+    r.assert_ok();
+    assert!(r.stdout().contains("defer gpu off ok"), "{}", r.stdout());
+}

@@ -141,7 +141,9 @@ impl PlaneState {
 impl Target for PlaneState {
     type Prop = PlaneProp;
 
-    /// Queues an option change for the frame's batch.
+    /// Applies an option change at once (with the writes queued before it): a plane
+    /// option can be refused for the plane's state (`DeferGpu = true` with a joint
+    /// present or no adapter), and the script learns it at the assignment, catchably.
     fn write(&self, name: &str, prop: PlaneProp) -> mlua::Result<()> {
         if !self.alive() {
             return Err(mlua::Error::runtime(format!(
@@ -149,7 +151,7 @@ impl Target for PlaneState {
             )));
         }
         self.plane
-            .set(prop)
+            .set_now(prop)
             .map_err(|e| sdk_error(&format!("PhysicsPlane.{name}"), e))
     }
 }

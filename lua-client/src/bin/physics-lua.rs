@@ -206,6 +206,9 @@ fn connect(domain: &str, timeout: Duration) -> Result<Session, client_sdk::Error
     let mut options = ConnectOptions::new(domain);
     // The host flushes every frame: writes right after an Add apply before its first step.
     options.hold_adds_until_flush = true;
+    // A write refused after its frame was flushed is the next plane call's error (which the
+    // script can catch), never the end of the run.
+    options.refusals_at_next_call = true;
     options.request_timeout = timeout;
     match Client::connect_with(options.clone()) {
         Ok(client) => Ok(Session {
@@ -444,6 +447,12 @@ fn frames(
         let dt = (now - last).as_secs_f64();
         last = now;
         host.frame(dt)?;
+    }
+    for refused in host.client().take_refused(None) {
+        eprintln!(
+            "physics-lua: warning: the daemon refused a write that no later call reported: {}",
+            refused.message
+        );
     }
     Ok(Ended::Finished)
 }

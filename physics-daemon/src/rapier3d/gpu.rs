@@ -45,13 +45,7 @@ impl Plane {
             (true, false) => {
                 self.check_gpu_ready()?;
                 let ctx = gpu::context().map_err(|e| {
-                    CommandError::invalid_field(
-                        "DeferGpu",
-                        format!(
-                            "DeferGpu = true failed: {e}; plane {} stays on the CPU",
-                            self.id
-                        ),
-                    )
+                    CommandError::invalid_field("DeferGpu", format!("DeferGpu = true failed: {e}"))
                 })?;
                 let mut world = GpuWorld::new(ctx);
                 for slot in 0..self.bodies.slot_count() {

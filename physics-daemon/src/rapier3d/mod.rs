@@ -181,8 +181,12 @@ impl Plane {
         let before = self.settings;
         let prop = self.settings.apply(prop, creating)?;
         if let PlaneProp::DeferGpu(on) = prop {
-            if let Err(e) = self.set_defer_gpu(on) {
+            if let Err(mut e) = self.set_defer_gpu(on) {
                 self.settings = before;
+                e.message = match creating {
+                    true => format!("{}; no plane was created", e.message),
+                    false => format!("{}; plane {} stays on the CPU", e.message, self.id),
+                };
                 return Err(e);
             }
         }
@@ -207,7 +211,7 @@ impl Plane {
             return Err(CommandError::invalid_field(
                 "DeferGpu",
                 "DeferGpu = true failed: this daemon was built without the GPU path (cargo \
-                 feature \"gpu\"); the plane stays on the CPU",
+                 feature \"gpu\")",
             ));
         }
         Ok(())
