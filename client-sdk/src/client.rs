@@ -75,6 +75,8 @@ struct Queued {
     confirms: Option<(PlaneId, Handle)>,
     /// The host's line that made the write ([`Client::set_origin`]; 0: unknown).
     origin: u32,
+    /// An impulse's overlay ticket (`overlay::Entry::impulse`).
+    impulse: Option<u32>,
 }
 
 /// The host's answer to "which line of the script is running?" (0: none).
@@ -332,11 +334,41 @@ impl Client {
     }
 
     pub(crate) fn queue(&self, command: Command, confirms: Option<(PlaneId, Handle)>) {
+        self.queue_with(command, confirms, None);
+    }
+
+    /// Queues an impulse on `handle` of `plane` whose reply carries the velocity after it,
+    /// recorded under overlay ticket `ticket`.
+    pub(crate) fn queue_impulse(
+        &self,
+        command: Command,
+        plane: PlaneId,
+        handle: Handle,
+        ticket: u32,
+    ) {
+        self.queue_with(command, Some((plane, handle)), Some(ticket));
+    }
+
+    fn queue_with(
+        &self,
+        command: Command,
+        confirms: Option<(PlaneId, Handle)>,
+        impulse: Option<u32>,
+    ) {
         self.inner.state.borrow_mut().queue.push(Queued {
             command,
             confirms,
             origin: self.inner.origin.borrow().as_ref().map_or(0, |f| f()),
+            impulse,
         });
+    }
+
+    /// Sends the queued writes now, if any (their refusals are kept as for any send).
+    pub(crate) fn send_queue(&self) -> Result<(), Error> {
+        if !self.inner.state.borrow().queue.is_empty() {
+            self.send(Vec::new())?;
+        }
+        Ok(())
     }
 
     /// One request: the queued commands first, then `extra`. Returns the results of `extra`.
@@ -349,7 +381,7 @@ impl Client {
         let mut releases = Vec::with_capacity(n_queued);
         let mut origins = Vec::with_capacity(n_queued);
         for q in queued {
-            origins.push(q.origin);
+            origins.push((q.origin, q.impulse));
             confirms.push(q.confirms);
             releases.push(is_release(&q.command));
             targets.push(match &q.command {
@@ -375,7 +407,7 @@ impl Client {
         let extra_results = results.split_off(n_queued.min(results.len()));
         let mut state = self.inner.state.borrow_mut();
         let each = results.into_iter().zip(confirms).zip(targets).zip(releases);
-        for ((((result, confirm), target), release), origin) in each.zip(origins) {
+        for ((((result, confirm), target), release), (origin, impulse)) in each.zip(origins) {
             if release {
                 // The SDK's own release of a held add: nothing the caller asked for, and an
                 // object already gone has nothing left to release.
@@ -402,6 +434,11 @@ impl Client {
                 }
             }
             match (result, confirm) {
+                (Ok(Reply::Velocity { tick, linear }), Some((plane, handle))) => {
+                    if let (Some(p), Some(ticket)) = (state.planes.get(&plane), impulse) {
+                        p.impulse_applied(handle, ticket, linear, tick);
+                    }
+                }
                 (Ok(Reply::Applied { tick }), Some((plane, handle))) => {
                     if let Some(p) = state.planes.get(&plane) {
                         p.confirm(handle, tick);

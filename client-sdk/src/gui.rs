@@ -404,7 +404,9 @@ impl GuiObject {
                         rotation: rotation_z(deg),
                     })
                 }
-                GuiObjectProp::Velocity(v) => e.velocity = Some([v[0], v[1], 0.0]),
+                GuiObjectProp::Velocity(v) => {
+                    e.record(&shm_layout::ObjectProp::Velocity([v[0], v[1], 0.0]))
+                }
                 GuiObjectProp::AngularVelocity(w) => {
                     e.angular_velocity = Some([0.0, 0.0, w.to_radians()])
                 }
@@ -422,8 +424,17 @@ impl GuiObject {
     /// `Δv = impulse / Mass`, sent with the next flush.
     pub fn apply_impulse(&self, impulse: Vec2) -> Result<(), Error> {
         let j = finite2("impulse", impulse).map_err(Error::invalid_value)?;
-        self.plane
-            .queue(self.op(GuiObjectOp::ApplyImpulse(j)), None);
+        let plane = &self.plane.plane;
+        let ticket = plane.impulse_queued(self.handle);
+        plane.client().queue_impulse(
+            Command::plane(
+                plane.id(),
+                PlaneOp::Gui(self.op(GuiObjectOp::ApplyImpulse(j))),
+            ),
+            plane.id(),
+            self.handle,
+            ticket,
+        );
         Ok(())
     }
 

@@ -43,6 +43,8 @@ pub use object::Object;
 pub use plane::{Plane, PlaneOptions, Snapshot};
 pub use query::QueryParams;
 pub use ragdoll::{Bone, Ragdoll, RagdollDesc};
+/// The collision group every object starts in ("Default").
+pub use shm_layout::collision_groups::DEFAULT_GROUP;
 pub use shm_layout::gui_op::{GuiControllerInfo, GuiObjectInfo, GuiPlaneInfo};
 /// The limits and checks the daemon applies, for callers that want to check early.
 pub use shm_layout::validate;

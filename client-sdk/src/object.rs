@@ -266,9 +266,13 @@ impl Object {
     pub fn apply_impulse(&self, impulse: Vec3) -> Result<(), Error> {
         let impulse =
             shm_layout::validate::finite3("impulse", impulse).map_err(Error::invalid_value)?;
-        self.plane
-            .client()
-            .queue(self.op(ObjectOp::ApplyImpulse(impulse)), None);
+        let ticket = self.plane.impulse_queued(self.handle);
+        self.plane.client().queue_impulse(
+            self.op(ObjectOp::ApplyImpulse(impulse)),
+            self.plane.id(),
+            self.handle,
+            ticket,
+        );
         Ok(())
     }
 

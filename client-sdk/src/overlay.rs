@@ -13,6 +13,12 @@ pub struct Entry {
     pub angular_velocity: Option<Vec3>,
     pub anchored: Option<bool>,
     pub destroyed: bool,
+    /// Counts this entry's velocity writes and impulses: an impulse's reply (the velocity
+    /// right after it) counts only if nothing changed the velocity after it was queued.
+    pub velocity_ticket: u32,
+    /// An impulse is queued or in flight: only the daemon knows the velocity after it
+    /// (mass, locks, anchoring), so a read of this object flushes the queue first.
+    pub impulse_pending: bool,
     /// Set once the daemon confirmed every write of this entry: samples with a tick greater
     /// than this show them. `None` while a write is still queued or in flight.
     pub applied_at: Option<u64>,
@@ -24,15 +30,28 @@ impl Entry {
     pub fn record(&mut self, prop: &ObjectProp) {
         match *prop {
             ObjectProp::Pose(p) => self.pose = Some(p),
-            ObjectProp::Velocity(v) => self.velocity = Some(v),
+            ObjectProp::Velocity(v) => {
+                self.velocity = Some(v);
+                self.velocity_ticket += 1;
+                self.impulse_pending = false;
+            }
             ObjectProp::AngularVelocity(w) => self.angular_velocity = Some(w),
             ObjectProp::Anchored(a) => {
                 self.anchored = Some(a);
                 self.velocity = Some([0.0; 3]);
                 self.angular_velocity = Some([0.0; 3]);
+                self.velocity_ticket += 1;
+                self.impulse_pending = false;
             }
             _ => {}
         }
+    }
+
+    /// Records a queued impulse; returns its ticket for [`Overlay::impulse_applied`].
+    pub fn impulse(&mut self) -> u32 {
+        self.velocity_ticket += 1;
+        self.impulse_pending = true;
+        self.velocity_ticket
     }
 
     /// `base` with this entry's writes on top.
@@ -80,9 +99,28 @@ impl Overlay {
         e.applied_at = None;
     }
 
+    /// Records an impulse on `handle` (unconfirmed); returns its ticket.
+    pub fn write_ticketed(&mut self, handle: Handle) -> u32 {
+        let e = self.entries.entry(handle).or_default();
+        e.applied_at = None;
+        e.impulse()
+    }
+
     /// The daemon applied the writes of `handle` after tick `tick`.
     pub fn confirm(&mut self, handle: Handle, tick: u64) {
         if let Some(e) = self.entries.get_mut(&handle) {
+            e.applied_at = Some(tick);
+        }
+    }
+
+    /// The daemon applied the impulse of `ticket` after tick `tick`, leaving the linear
+    /// velocity `linear`: the read-back value unless a later write changed the velocity.
+    pub fn impulse_applied(&mut self, handle: Handle, ticket: u32, linear: Vec3, tick: u64) {
+        if let Some(e) = self.entries.get_mut(&handle) {
+            if e.velocity_ticket == ticket {
+                e.velocity = Some(linear);
+                e.impulse_pending = false;
+            }
             e.applied_at = Some(tick);
         }
     }

@@ -137,6 +137,13 @@ impl PlaneShared {
         self.overlay.borrow_mut().confirm(handle, tick);
     }
 
+    /// The daemon applied an impulse ([`Overlay::impulse_applied`]).
+    pub(crate) fn impulse_applied(&self, handle: Handle, ticket: u32, linear: [f32; 3], tick: u64) {
+        self.overlay
+            .borrow_mut()
+            .impulse_applied(handle, ticket, linear, tick);
+    }
+
     /// The daemon refused a write to `handle`: it must not linger as if it had happened.
     pub(crate) fn discard(&self, handle: Handle) {
         self.overlay.borrow_mut().discard(handle);
@@ -253,9 +260,30 @@ impl Plane {
         };
         let mut overlay = self.shared.overlay.borrow_mut();
         Ok(match overlay.get(handle, tick) {
+            Some(entry) if entry.impulse_pending => {
+                // Only the daemon knows the velocity an impulse leaves (mass, locks,
+                // anchoring): send the queue, whose reply carries it, then read again.
+                drop(overlay);
+                self.client.send_queue()?;
+                let mut overlay = self.shared.overlay.borrow_mut();
+                match overlay.get(handle, tick) {
+                    Some(entry) if !entry.impulse_pending => entry.apply(handle, base),
+                    Some(_) => {
+                        // Not settled by that send (it failed before a reply): show the
+                        // sample rather than loop.
+                        base
+                    }
+                    None => base,
+                }
+            }
             Some(entry) => entry.apply(handle, base),
             None => base,
         })
+    }
+
+    /// Records an impulse queued on `handle` (read-your-writes: see [`Plane::body`]).
+    pub(crate) fn impulse_queued(&self, handle: Handle) -> u32 {
+        self.shared.overlay.borrow_mut().write_ticketed(handle)
     }
 
     /// [`Plane::object_count`] from the newest header and this process's pending changes;

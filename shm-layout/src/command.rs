@@ -220,6 +220,14 @@ pub enum Reply {
     Map(Box<MapInfo>),
     /// The ids of every plane of the daemon, ascending ([`Command::ListPlanes`]).
     PlaneIds(Vec<PlaneId>),
+    /// An impulse was applied after `tick`: the object's linear velocity right after it
+    /// (what the script reads back until a newer sample shows the stepped value).
+    Velocity {
+        /// Samples newer than this tick reflect the change.
+        tick: u64,
+        /// The linear velocity after the impulse (a GUI plane's has z = 0).
+        linear: Vec3,
+    },
 }
 
 /// The result of one command.

@@ -525,3 +525,23 @@ fn defer_gpu_without_an_adapter_is_refused_where_it_is_written() {
     r.assert_ok();
     assert!(r.stdout().contains("defer gpu off ok"), "{}", r.stdout());
 }
+
+#[test]
+fn impulses_read_back_at_once_and_divide_by_the_mass_just_written() {
+    let daemon = TestDaemon::start("first-impulse");
+    let r = run(&daemon, "tests/lua/impulse_read_back.luau");
+    r.assert_ok();
+    assert!(
+        r.stdout().contains("impulse read back ok"),
+        "{}",
+        r.stdout()
+    );
+}
+
+#[test]
+fn parts_follow_their_collision_groups_renaming_and_removal() {
+    let daemon = TestDaemon::start("first-group-rename");
+    let r = run(&daemon, "tests/lua/group_rename.luau");
+    r.assert_ok();
+    assert!(r.stdout().contains("group rename ok"), "{}", r.stdout());
+}

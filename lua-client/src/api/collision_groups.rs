@@ -61,10 +61,12 @@ pub fn install(lua: &Lua, m: &Table) -> mlua::Result<()> {
             const W: &str = "PhysicsService:UnregisterCollisionGroup";
             let v = args(all);
             let name = string_arg(W, &v, 0, "name")?;
-            context(lua)
-                .client
+            let ctx = context(lua);
+            ctx.client
                 .unregister_collision_group(&name)
-                .map_err(|e| sdk_error(W, e))
+                .map_err(|e| sdk_error(W, e))?;
+            ctx.group_renamed(&name, client_sdk::DEFAULT_GROUP);
+            Ok(())
         })?,
     )?;
     m.set(
@@ -74,10 +76,12 @@ pub fn install(lua: &Lua, m: &Table) -> mlua::Result<()> {
             let v = args(all);
             let from = string_arg(W, &v, 0, "from")?;
             let to = string_arg(W, &v, 1, "to")?;
-            context(lua)
-                .client
+            let ctx = context(lua);
+            ctx.client
                 .rename_collision_group(&from, &to)
-                .map_err(|e| sdk_error(W, e))
+                .map_err(|e| sdk_error(W, e))?;
+            ctx.group_renamed(&from, &to);
+            Ok(())
         })?,
     )?;
     m.set(

@@ -1,6 +1,7 @@
 //! `Renderable.BasePart`: the host stand-in for a visual part. Once a plane simulates it,
 //! reading `part.CFrame` returns the pose of the newest tick, read from shared memory.
 
+use client_sdk::DEFAULT_GROUP;
 use std::cell::{Cell, RefCell};
 use std::rc::{Rc, Weak};
 
@@ -314,22 +315,36 @@ impl PartState {
     }
 
     /// Sets the collision group (checked against the connection's table; its body follows
-    /// while simulated).
+    /// while simulated). `what` names the property written, for errors. The part follows
+    /// its group's renaming and removal ([`super::plane::Context::group_renamed`]).
     pub fn set_collision_group(
-        &self,
-        client: &client_sdk::Client,
+        this: &Rc<PartState>,
+        ctx: &super::plane::Context,
+        what: &str,
         name: String,
     ) -> mlua::Result<()> {
-        client
+        ctx.client
             .collision_group_id(&name)
-            .map_err(|e| sdk_error("BasePart.CollisionGroup", e))?;
-        if let Some(object) = self.object() {
+            .map_err(|e| sdk_error(what, e))?;
+        if let Some(object) = this.object() {
             object
                 .set_collision_group(&name)
-                .map_err(|e| sdk_error("BasePart.CollisionGroup", e))?;
+                .map_err(|e| sdk_error(what, e))?;
         }
-        *self.collision_group.borrow_mut() = name;
+        if name != DEFAULT_GROUP {
+            ctx.note_group_member(this);
+        }
+        *this.collision_group.borrow_mut() = name;
         Ok(())
+    }
+
+    /// The part's group was renamed (or removed: `to` is [`DEFAULT_GROUP`]); its body, if any,
+    /// follows by itself (the daemon keeps the group's index).
+    pub(crate) fn group_renamed(&self, from: &str, to: &str) {
+        let mut group = self.collision_group.borrow_mut();
+        if *group == from {
+            *group = to.to_string();
+        }
     }
 
     /// The part's size.

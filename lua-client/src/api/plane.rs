@@ -161,6 +161,9 @@ pub struct Context {
     /// The connection to the daemon.
     pub client: Client,
     planes: RefCell<Vec<Rc<PlaneState>>>,
+    /// Parts ever put in a group other than "Default": they follow its renaming and
+    /// removal (parts outside any plane too).
+    group_members: RefCell<Vec<std::rc::Weak<PartState>>>,
 }
 
 impl Context {
@@ -169,7 +172,35 @@ impl Context {
         Context {
             client,
             planes: RefCell::default(),
+            group_members: RefCell::default(),
         }
+    }
+
+    /// Remembers `part`, just put in a group other than "Default".
+    pub(crate) fn note_group_member(&self, part: &Rc<PartState>) {
+        let mut members = self.group_members.borrow_mut();
+        if !members
+            .iter()
+            .any(|w| std::ptr::eq(w.as_ptr(), Rc::as_ptr(part)))
+        {
+            // Forget collected parts before growing.
+            members.retain(|w| w.strong_count() > 0);
+            members.push(Rc::downgrade(part));
+        }
+    }
+
+    /// Group `from` is now called `to` (removed: `to` is "Default"): every part in it
+    /// reads the new name, as its body does.
+    pub(crate) fn group_renamed(&self, from: &str, to: &str) {
+        self.group_members
+            .borrow_mut()
+            .retain(|w| match w.upgrade() {
+                Some(part) => {
+                    part.group_renamed(from, to);
+                    true
+                }
+                None => false,
+            });
     }
 }
 

@@ -10,6 +10,7 @@ use mlua::{Error as LuaError, Value};
 
 use super::{Get, Kind, Props, Row, Set};
 use crate::api::object::PhysicsObject;
+use crate::api::part::PartState;
 use crate::values::{new_vector, sdk_error, CFrame};
 
 /// The object's properties (the SDK's mirror; one round trip the first time).
@@ -130,8 +131,13 @@ pub static OBJECT: Props<PhysicsObject> = Props {
             }),
             set: Set::Fn(|lua, o, a| {
                 o.live("PhysicsObject.CollisionGroup")?;
-                let client = crate::api::plane::context(lua).client.clone();
-                o.part.set_collision_group(&client, a.string()?)
+                let ctx = crate::api::plane::context(lua);
+                PartState::set_collision_group(
+                    &o.part,
+                    &ctx,
+                    "PhysicsObject.CollisionGroup",
+                    a.string()?,
+                )
             }),
         },
         info_row!(

@@ -5,7 +5,7 @@
 use mlua::Value;
 
 use super::{Get, Kind, Props, Row, Set};
-use crate::api::part::BasePart;
+use crate::api::part::{BasePart, PartState};
 use crate::values::{new_vector, sdk_error};
 
 /// The rows of `BasePart`.
@@ -77,8 +77,8 @@ pub static PART: Props<BasePart> = Props {
             kind: Kind::String,
             get: Get::Fn(|lua, p| Ok(Value::String(lua.create_string(p.0.collision_group())?))),
             set: Set::Fn(|lua, p, a| {
-                let client = crate::api::plane::context(lua).client.clone();
-                p.0.set_collision_group(&client, a.string()?)
+                let ctx = crate::api::plane::context(lua);
+                PartState::set_collision_group(&p.0, &ctx, "BasePart.CollisionGroup", a.string()?)
             }),
         },
         Row {

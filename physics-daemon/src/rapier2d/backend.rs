@@ -28,7 +28,10 @@ impl Plane {
             GuiOp::Object { handle, op } => match op {
                 GuiObjectOp::Set(prop) => self.set_object(handle, prop).map(|_| applied(self)),
                 GuiObjectOp::ApplyImpulse(j) => {
-                    self.apply_impulse(handle, j).map(|_| applied(self))
+                    self.apply_impulse(handle, j).map(|v| Reply::Velocity {
+                        tick: self.tick,
+                        linear: [v[0], v[1], 0.0],
+                    })
                 }
                 GuiObjectOp::Wake => self.wake(handle).map(|_| applied(self)),
                 GuiObjectOp::Info => Ok(Reply::Gui(GuiReply::Object(Box::new(

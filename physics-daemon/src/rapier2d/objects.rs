@@ -159,7 +159,7 @@ impl Plane {
             Held(on) => self.hold(h, on),
             Mass(m) => {
                 self.world.colliders[c].set_mass(m);
-                self.world.bodies[h].wake_up(true);
+                self.refresh_mass(h);
             }
             Bounciness(e) => self.world.colliders[c].set_restitution(e),
             Friction(mu) => self.world.colliders[c].set_friction(mu),
@@ -181,7 +181,7 @@ impl Plane {
                 let co = &mut self.world.colliders[c];
                 co.set_shape(collider_shape(shape, s));
                 co.set_mass(settings.mass);
-                self.world.bodies[h].wake_up(true);
+                self.refresh_mass(h);
                 self.query_stale.push(h);
             }
         }
@@ -195,8 +195,17 @@ impl Plane {
         Ok(())
     }
 
+    /// Gives body `h` the mass of its collider now (rapier would at the next step), so an
+    /// impulse, a jump or drag in the same batch divides by the new Mass; and wakes it.
+    fn refresh_mass(&mut self, h: RigidBodyHandle) {
+        let rb = &mut self.world.bodies[h];
+        rb.recompute_mass_properties_from_colliders(&self.world.colliders);
+        rb.wake_up(true);
+    }
+
     /// `Δv = impulse / Mass` now (anchored bodies absorb it; locked axes are skipped).
-    pub fn apply_impulse(&mut self, handle: Handle, impulse: Vec2) -> Result<(), CommandError> {
+    /// Returns the linear velocity right after it.
+    pub fn apply_impulse(&mut self, handle: Handle, impulse: Vec2) -> Result<Vec2, CommandError> {
         let impulse = finite2("impulse", impulse)?;
         let b = self.body(handle)?;
         let (h, settings) = (b.handle, b.settings);
@@ -205,8 +214,9 @@ impl Plane {
             let v = rb.linvel() + Vector::from(impulse) / rb.mass();
             rb.set_linvel(unlocked(&settings, v), true);
         }
+        let v = rb.linvel();
         self.dirty.mark(handle.slot);
-        Ok(())
+        Ok([v.x, v.y])
     }
 
     /// Wakes the body.

@@ -24,7 +24,12 @@ impl Plane {
             }
             PlaneOp::Object { handle, op } => match op {
                 ObjectOp::Set(prop) => self.set_object(handle, prop).map(|_| applied(self)),
-                ObjectOp::ApplyImpulse(j) => self.apply_impulse(handle, j).map(|_| applied(self)),
+                ObjectOp::ApplyImpulse(j) => {
+                    self.apply_impulse(handle, j).map(|linear| Reply::Velocity {
+                        tick: self.tick,
+                        linear,
+                    })
+                }
                 ObjectOp::Info => Ok(Reply::ObjectInfo(Box::new(self.object_info(handle)?))),
                 ObjectOp::RecalculateCenterOfMass => self
                     .recalculate_center_of_mass(handle)

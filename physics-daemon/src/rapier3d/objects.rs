@@ -90,14 +90,17 @@ impl Plane {
         self.bodies.handle_at(slot)
     }
 
-    /// Velocity-space impulse: `Δv = impulse / mass`; anchored bodies absorb it.
-    pub fn apply_impulse(&mut self, handle: Handle, impulse: Vec3) -> Result<(), CommandError> {
+    /// Velocity-space impulse: `Δv = impulse / mass`; anchored bodies absorb it. Returns
+    /// the linear velocity right after it.
+    pub fn apply_impulse(&mut self, handle: Handle, impulse: Vec3) -> Result<Vec3, CommandError> {
         let impulse = shm_layout::validate::finite3("impulse", impulse)?;
         let h = self.body_of(handle)?;
         // Rapier divides by the mass in effect and skips locked axes; fixed bodies absorb it.
-        self.world.bodies[h].apply_impulse(Vector::from(impulse), true);
+        let body = &mut self.world.bodies[h];
+        body.apply_impulse(Vector::from(impulse), true);
+        let v = body.linvel();
         self.dirty.mark(handle.slot);
-        Ok(())
+        Ok([v.x, v.y, v.z])
     }
 
     /// Wakes the object up (rapier wakes what rests on it at the next step).

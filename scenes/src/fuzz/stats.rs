@@ -363,6 +363,7 @@ pub fn reply_name(reply: &Reply) -> &'static str {
         Reply::JointInfo(_) => "JointInfo",
         Reply::Map(_) => "Map",
         Reply::PlaneIds(_) => "PlaneIds",
+        Reply::Velocity { .. } => "Velocity",
     }
 }
 
