@@ -7,7 +7,8 @@ use std::time::{Duration, Instant};
 
 use shm_layout::codec;
 use shm_layout::{
-    CollisionGroups, Command, CommandError, CommandResult, ErrorKind, GuiObjectOp, GuiOp, Handle,
+    CollisionGroups, Command, CommandError, CommandResult, ErrorKind, GuiControllerOp, GuiObjectOp,
+    GuiOp, Handle,
     ObjectOp, PlaneId, PlaneOp, Reply, Request, Response, CRATE_VERSION, LAYOUT_VERSION,
 };
 
@@ -392,10 +393,16 @@ impl Client {
                 Command::Plane {
                     plane,
                     op:
-                        PlaneOp::Gui(GuiOp::Object {
-                            handle,
-                            op: GuiObjectOp::Destroy,
-                        }),
+                        PlaneOp::Gui(
+                            GuiOp::Object {
+                                handle,
+                                op: GuiObjectOp::Destroy,
+                            }
+                            | GuiOp::Controller {
+                                handle,
+                                op: GuiControllerOp::Destroy,
+                            },
+                        ),
                 } => Some((*plane, Some(*handle), true)),
                 Command::Plane { plane, .. } => Some((*plane, None, false)),
                 _ => None,

@@ -542,6 +542,14 @@ impl GuiController {
             .plane
             .plane
             .overlay_write(self.object.handle, |e| e.destroyed = true);
+        // Like an object's removal: the plane's object count drops at once.
+        self.object
+            .plane
+            .plane
+            .shared
+            .members
+            .borrow_mut()
+            .removal_queued(self.object.handle);
         self.op(GuiControllerOp::Destroy)
     }
 }

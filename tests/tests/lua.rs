@@ -545,3 +545,11 @@ fn parts_follow_their_collision_groups_renaming_and_removal() {
     r.assert_ok();
     assert!(r.stdout().contains("group rename ok"), "{}", r.stdout());
 }
+
+#[test]
+fn gui_object_count_drops_at_once_when_a_controller_is_destroyed() {
+    let daemon = TestDaemon::start("first-gui-count");
+    let r = run(&daemon, "tests/lua/gui_count.luau");
+    r.assert_ok();
+    assert!(r.stdout().contains("gui count ok"), "{}", r.stdout());
+}
