@@ -8,8 +8,8 @@ use std::time::{Duration, Instant};
 use shm_layout::codec;
 use shm_layout::{
     CollisionGroups, Command, CommandError, CommandResult, ErrorKind, GuiControllerOp, GuiObjectOp,
-    GuiOp, Handle,
-    ObjectOp, PlaneId, PlaneOp, Reply, Request, Response, CRATE_VERSION, LAYOUT_VERSION,
+    GuiOp, Handle, ObjectOp, PlaneId, PlaneOp, Reply, Request, Response, CRATE_VERSION,
+    LAYOUT_VERSION,
 };
 
 use crate::plane::{PlaneOptions, PlaneShared};

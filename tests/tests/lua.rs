@@ -553,3 +553,11 @@ fn gui_object_count_drops_at_once_when_a_controller_is_destroyed() {
     r.assert_ok();
     assert!(r.stdout().contains("gui count ok"), "{}", r.stdout());
 }
+
+#[test]
+fn apis_hand_back_the_values_the_script_holds() {
+    let daemon = TestDaemon::start("first-identity");
+    let r = run(&daemon, "tests/lua/identity.luau");
+    r.assert_ok();
+    assert!(r.stdout().contains("identity ok"), "{}", r.stdout());
+}

@@ -12,7 +12,6 @@ use std::rc::{Rc, Weak};
 use client_sdk::{Contact, Handle, JointBroke};
 use mlua::{Lua, MultiValue, Value};
 
-use super::part::BasePart;
 use super::plane::PlaneState;
 use crate::host::signal::Signal;
 use crate::host::Watched;
@@ -173,7 +172,7 @@ impl PlaneState {
             return Ok(());
         }
         let other = match self.part_of(other) {
-            Some(p) => Value::UserData(lua.create_userdata(BasePart(p))?),
+            Some(p) => Value::UserData(super::part::part_ud(lua, &p)?),
             None => Value::Nil,
         };
         let contact = match contact {

@@ -216,7 +216,10 @@ impl UserData for GuiControllerUd {
             };
             let signal = |s: &Signal| Ok(Value::UserData(lua.create_userdata(s.clone())?));
             match name.as_str() {
-                "Object" => Ok(Value::UserData(lua.create_userdata(c.0.object.clone())?)),
+                "Object" => Ok(Value::UserData(super::gui_object::gui_object_ud(
+                    lua,
+                    c.0.object.clone(),
+                )?)),
                 "MoveDirection" => Ok(Value::UserData(
                     lua.create_userdata(new_dim(c.0.move_direction.get()))?,
                 )),

@@ -88,3 +88,18 @@ impl UserData for PhysicsGuiObject {
         });
     }
 }
+
+/// The script's `PhysicsGuiObject` value of `o` (one per body: see `identity.rs`).
+pub(crate) fn gui_object_ud(
+    lua: &mlua::Lua,
+    o: PhysicsGuiObject,
+) -> mlua::Result<mlua::AnyUserData> {
+    let handle = o.object.handle();
+    super::identity::userdata_if(
+        lua,
+        Rc::as_ptr(&o.prim).cast(),
+        super::identity::tag::GUI_OBJECT,
+        |held: &PhysicsGuiObject| held.object.handle() == handle,
+        || o,
+    )
+}

@@ -177,8 +177,8 @@ pub struct GuiPhysicsPlane(pub Rc<GuiPlaneState>);
 
 impl UserData for GuiPhysicsPlane {
     fn add_methods<M: UserDataMethods<Self>>(methods: &mut M) {
-        methods.add_method("Add", |_, p, prim: Value| {
-            p.0.add("GuiPhysicsPlane:Add", &prim)
+        methods.add_method("Add", |lua, p, prim: Value| {
+            super::gui_object::gui_object_ud(lua, p.0.add("GuiPhysicsPlane:Add", &prim)?)
         });
         methods.add_method("NewController", |_, p, (prim, opts): (Value, Value)| {
             p.0.new_controller("GuiPhysicsPlane:NewController", &prim, opts, false)
@@ -223,7 +223,7 @@ impl UserData for GuiPhysicsPlane {
                         prim,
                         plane: Rc::downgrade(&p.0),
                     };
-                    t.set("Object", object)?;
+                    t.set("Object", super::gui_object::gui_object_ud(lua, object)?)?;
                 }
                 Ok(Value::Table(t))
             },

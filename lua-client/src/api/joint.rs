@@ -10,7 +10,7 @@ use mlua::{Lua, MetaMethod, Table, UserData, UserDataMethods, Value};
 
 use super::contacts::{forget_joint, joint_broke_signal};
 use super::object::PhysicsObject;
-use super::part::{BasePart, PartState};
+use super::part::PartState;
 use super::plane::{add, PhysicsPlane, PlaneState};
 use crate::values::CFrame;
 use crate::values::{describe, expected, finite_number, finite_vector, new_vector, sdk_error};
@@ -342,7 +342,7 @@ fn load_prop(
     lua: &Lua,
     plane: &PhysicsPlane,
     (path, cframe, opts): (String, Value, Value),
-) -> mlua::Result<(PhysicsObject, Table)> {
+) -> mlua::Result<(mlua::AnyUserData, Table)> {
     let what = "PhysicsPlane:LoadProp";
     let cf = match &cframe {
         Value::UserData(ud) => ud.borrow::<CFrame>().map(|c| *c).ok(),
@@ -413,7 +413,7 @@ fn load_prop(
             )));
         }
         let part = Rc::new(PartState::mesh(vertices, triangles, cf));
-        let ud = lua.create_userdata(BasePart(part))?;
+        let ud = super::part::part_ud(lua, &part)?;
         let obj = add(&plane.0, Value::UserData(ud))?;
         if let Some(first) = objects.first() {
             // Same rotation for every part: A's local anchor is the centres' difference.
@@ -437,15 +437,10 @@ fn load_prop(
         objects.push(obj);
     }
     let all = lua.create_table()?;
-    for o in &objects {
-        all.push(PhysicsObject {
-            body: o.body.clone(),
-            part: o.part.clone(),
-            part_ud: o.part_ud.clone(),
-        })?;
+    for o in objects {
+        all.push(super::object::object_ud(lua, o)?)?;
     }
-    let first = objects.swap_remove(0);
-    Ok((first, all))
+    Ok((all.get(1)?, all))
 }
 
 /// Registers `NewJoint`, `LoadMap` and `LoadProp` on PhysicsPlane.

@@ -647,21 +647,31 @@ pub fn module(lua: &Lua) -> mlua::Result<Table> {
     let renderable = lua.create_table()?;
     renderable.set(
         "BasePart",
-        lua.create_function(|_, shape: Value| {
+        lua.create_function(|lua, shape: Value| {
             let shape = match &shape {
                 Value::Nil => Some(PartShape::Cube),
                 Value::String(s) => PartShape::from_name(&s.as_bytes()),
                 _ => None,
             }
             .ok_or_else(|| expected("Renderable.BasePart", PartShape::NAMES, &shape))?;
-            Ok(BasePart(Rc::new(PartState::new(shape))))
+            part_ud(lua, &Rc::new(PartState::new(shape)))
         })?,
     )?;
     renderable.set(
         "MeshPart",
-        lua.create_function(|_, (vertices, triangles): (Value, Value)| {
-            Ok(BasePart(Rc::new(mesh_part(vertices, triangles)?)))
+        lua.create_function(|lua, (vertices, triangles): (Value, Value)| {
+            part_ud(lua, &Rc::new(mesh_part(vertices, triangles)?))
         })?,
     )?;
     Ok(renderable)
+}
+
+/// The script's `BasePart` value of `part` (one per part: see `identity.rs`).
+pub(crate) fn part_ud(lua: &Lua, part: &Rc<PartState>) -> mlua::Result<mlua::AnyUserData> {
+    super::identity::userdata(
+        lua,
+        Rc::as_ptr(part).cast(),
+        super::identity::tag::PART,
+        || BasePart(part.clone()),
+    )
 }

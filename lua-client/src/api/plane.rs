@@ -216,7 +216,9 @@ pub struct PhysicsPlane(pub Rc<PlaneState>);
 
 impl UserData for PhysicsPlane {
     fn add_methods<M: UserDataMethods<Self>>(methods: &mut M) {
-        methods.add_method("Add", |_, p, part: Value| add(&p.0, part));
+        methods.add_method("Add", |lua, p, part: Value| {
+            super::object::object_ud(lua, add(&p.0, part)?)
+        });
         methods.add_method("SetEnabled", |lua, p, on: Value| {
             PLANE.set(
                 lua,

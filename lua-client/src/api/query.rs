@@ -125,13 +125,16 @@ fn part_and_object(lua: &Lua, plane: &PlaneState, h: Handle) -> mlua::Result<(Va
     let Some(part) = plane.part_of(h) else {
         return Ok((Value::Nil, Value::Nil));
     };
-    let part_ud = lua.create_userdata(BasePart(part.clone()))?;
+    let part_ud = super::part::part_ud(lua, &part)?;
     let object = match part.body() {
-        Some(body) => Value::UserData(lua.create_userdata(PhysicsObject {
-            body,
-            part: part.clone(),
-            part_ud: part_ud.clone(),
-        })?),
+        Some(body) => Value::UserData(super::object::object_ud(
+            lua,
+            PhysicsObject {
+                body,
+                part: part.clone(),
+                part_ud: part_ud.clone(),
+            },
+        )?),
         None => Value::Nil,
     };
     Ok((Value::UserData(part_ud), object))

@@ -14,7 +14,7 @@ use client_sdk::{Bone, JointKind, Pose, RagdollDesc};
 use mlua::{AnyUserData, Lua, ObjectLike, Table, UserDataMethods, Value};
 
 use super::joint::LuaJoint;
-use super::part::{BasePart, PartShape, PartState};
+use super::part::{PartShape, PartState};
 use super::plane::{add, PhysicsPlane};
 use crate::values::{describe, expected, finite_number, finite_vector, sdk_error, CFrame};
 
@@ -134,13 +134,13 @@ fn new_ragdoll(lua: &Lua, plane: &PhysicsPlane, desc: Value) -> mlua::Result<Tab
         part.set_name(b.name.clone());
         part.resize(lua, WHAT, [2.0 * b.radius, b.length, 2.0 * b.radius])?;
         part.store_cframe(CFrame::from_pose(b.pose));
-        let ud = lua.create_userdata(BasePart(part))?;
+        let ud = super::part::part_ud(lua, &part)?;
         let obj = add(&plane.0, Value::UserData(ud))?;
         for p in BONE_PROPS {
             obj.body.object.set(p).map_err(|e| sdk_error(WHAT, e))?;
         }
         objects.push(obj.body.object.clone());
-        bones.set(b.name.as_str(), obj)?;
+        bones.set(b.name.as_str(), super::object::object_ud(lua, obj)?)?;
     }
     let joints = lua.create_table()?;
     for (i, b) in d.bones.iter().enumerate() {
