@@ -27,6 +27,25 @@ pub const STALL_AFTER: Duration = Duration::from_secs(1);
 /// thread for a moment does not fail requests).
 pub const HUNG_AFTER: Duration = Duration::from_secs(3);
 
+/// A silent heartbeat this long, with the daemon's process stopped, is a stall for
+/// [`Client::watch_daemon`] (three missed beats: a reader learns of a SIGSTOP within a
+/// second).
+pub const WATCH_STALL_AFTER: Duration = Duration::from_millis(600);
+
+/// What [`Client::watch_daemon`] finds.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum DaemonHealth {
+    /// Beating (or answering).
+    Live,
+    /// Stopped (SIGSTOP) or hung: no heartbeat for `silent`.
+    Stalled {
+        /// How long the heartbeat has been silent.
+        silent: Duration,
+    },
+    /// The daemon process is gone.
+    Gone,
+}
+
 /// How to connect.
 #[derive(Debug, Clone)]
 pub struct ConnectOptions {
@@ -114,6 +133,10 @@ struct Inner {
     frame: std::cell::Cell<u64>,
     /// Where the host's script queues a write ([`Client::set_origin`]).
     origin: RefCell<Option<Origin>>,
+    /// When the daemon last showed life (a heartbeat or a reply).
+    last_beat: std::cell::Cell<Instant>,
+    /// When [`Client::watch_daemon`] last read the node list.
+    last_node_check: std::cell::Cell<Instant>,
 }
 
 /// A connection to the physics daemon of one domain. Cheap to clone; not `Send` (shared
@@ -140,6 +163,8 @@ impl Client {
             state: RefCell::default(),
             frame: std::cell::Cell::new(0),
             origin: RefCell::new(None),
+            last_beat: std::cell::Cell::new(Instant::now()),
+            last_node_check: std::cell::Cell::new(Instant::now()),
         };
         let hello = Command::Hello {
             crate_version: inner.options.crate_version.clone(),
@@ -411,6 +436,8 @@ impl Client {
         }
         commands.extend(extra);
         let mut results = self.inner.round_trip(commands)?;
+        // A reply is a sign of life as good as a beat.
+        self.inner.last_beat.set(Instant::now());
         let extra_results = results.split_off(n_queued.min(results.len()));
         let mut state = self.inner.state.borrow_mut();
         let each = results.into_iter().zip(confirms).zip(targets).zip(releases);
@@ -487,6 +514,38 @@ impl Client {
     #[doc(hidden)]
     pub fn node_id(&self) -> u128 {
         self.inner.transport.id()
+    }
+
+    /// Whether the daemon is live, stalled or gone, without a request: for a host that only
+    /// reads shared memory (which would otherwise run on against frozen poses). Cheap
+    /// enough for every frame: one check of the heartbeat's queue; `/proc` and the node list
+    /// are read only once the heartbeat has been silent for [`WATCH_STALL_AFTER`].
+    pub fn watch_daemon(&self) -> DaemonHealth {
+        let inner = &self.inner;
+        if inner.state.borrow().gone {
+            return DaemonHealth::Gone;
+        }
+        let now = Instant::now();
+        match inner.transport.heartbeat_arrived() {
+            Some(true) => inner.last_beat.set(now),
+            None => return DaemonHealth::Live,
+            Some(false) => {}
+        }
+        let silent = now.duration_since(inner.last_beat.get());
+        if silent < WATCH_STALL_AFTER {
+            return DaemonHealth::Live;
+        }
+        if now.duration_since(inner.last_node_check.get()) >= LIVENESS_PERIOD {
+            inner.last_node_check.set(now);
+            if inner.check_daemon().is_err() {
+                return DaemonHealth::Gone;
+            }
+        }
+        if silent > HUNG_AFTER || process_stopped(inner.daemon_pid) {
+            DaemonHealth::Stalled { silent }
+        } else {
+            DaemonHealth::Live
+        }
     }
 
     /// Fails with [`Error::DaemonGone`] when the daemon process no longer exists.
@@ -590,6 +649,7 @@ impl Inner {
                     last_check = now;
                     if self.transport.heartbeat_arrived() != Some(false) {
                         last_beat = now;
+                        self.last_beat.set(now);
                     }
                 }
                 let silent = now.duration_since(last_beat);

@@ -31,7 +31,9 @@ pub mod ragdoll;
 mod spawn;
 mod transport;
 
-pub use client::{Client, ConnectOptions, HUNG_AFTER, STALL_AFTER};
+pub use client::{
+    Client, ConnectOptions, DaemonHealth, HUNG_AFTER, STALL_AFTER, WATCH_STALL_AFTER,
+};
 pub use collision_groups::CollisionGroup;
 pub use controller::Controller;
 pub use error::Error;

@@ -29,7 +29,7 @@ use client_sdk::Client;
 use mlua::{Lua, Table, Value};
 
 use host::scheduler::{self, Scheduler};
-pub use host::{Host, Stop};
+pub use host::{Host, Stop, WATCH_PERIOD};
 #[doc(hidden)]
 pub use members::property_rows;
 

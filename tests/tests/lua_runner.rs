@@ -288,3 +288,24 @@ fn a_killed_daemon_is_reported() {
     assert!(r.took < Duration::from_secs(10), "took {:?}", r.took);
     assert!(r.stdout.starts_with("ready"), "{}", r.stdout);
 }
+
+#[test]
+fn a_script_that_only_reads_learns_of_a_stall_within_a_second() {
+    let daemon = TestDaemon::start("lua-read-stall");
+    let mut runner = Runner::start(&daemon.domain, "tests/lua/read_only_stall.luau", &[]);
+    runner.wait_for("ready", Duration::from_secs(30));
+    stop_process(daemon.pid(), libc::SIGSTOP);
+    let stopped = Instant::now();
+    // Three missed beats (0.6 s) plus at most one beat period and one watch period; the
+    // required bound is 1 s; 1.5 s leaves room for a loaded machine's scheduling.
+    runner.wait_for("stalled", Duration::from_secs(5));
+    let noticed = stopped.elapsed();
+    stop_process(daemon.pid(), libc::SIGCONT);
+    runner.wait_for("resumed", Duration::from_secs(5));
+    let r = runner.wait(Duration::from_secs(10));
+    assert_eq!(r.status.code(), Some(0), "stderr:\n{}", r.stderr);
+    assert!(
+        noticed < Duration::from_millis(1500),
+        "Stalled fired {noticed:?} after the stop"
+    );
+}

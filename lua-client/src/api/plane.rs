@@ -164,6 +164,12 @@ pub struct Context {
     /// Parts ever put in a group other than "Default": they follow its renaming and
     /// removal (parts outside any plane too).
     group_members: RefCell<Vec<std::rc::Weak<PartState>>>,
+    /// `PhysicsService.Stalled(silentSeconds)`: the daemon stopped beating (SIGSTOP, hung).
+    pub stalled: crate::host::signal::Signal,
+    /// `PhysicsService.Resumed()`: it beats again.
+    pub resumed: crate::host::signal::Signal,
+    /// Whether the last watch found it stalled.
+    is_stalled: Cell<bool>,
 }
 
 impl Context {
@@ -173,7 +179,43 @@ impl Context {
             client,
             planes: RefCell::default(),
             group_members: RefCell::default(),
+            stalled: crate::host::signal::Signal::new("PhysicsService.Stalled"),
+            resumed: crate::host::signal::Signal::new("PhysicsService.Resumed"),
+            is_stalled: Cell::new(false),
         }
+    }
+
+    /// Once per frame: fires `Stalled` when the daemon stops beating and `Resumed` when it
+    /// beats again (a stall nobody listens to is printed once).
+    pub(crate) fn watch_daemon(&self, lua: &Lua) -> mlua::Result<()> {
+        let health = self.client.watch_daemon();
+        let stalled = matches!(health, client_sdk::DaemonHealth::Stalled { .. });
+        if stalled == self.is_stalled.replace(stalled) {
+            return Ok(());
+        }
+        match health {
+            client_sdk::DaemonHealth::Stalled { silent } => {
+                if self.stalled.listeners() == 0 {
+                    eprintln!(
+                        "the physics daemon (process {}) is stalled: no heartbeat for {:.1} s \
+                         (stopped or hung); poses read now are frozen",
+                        self.client.daemon_pid(),
+                        silent.as_secs_f64()
+                    );
+                }
+                self.stalled.fire(
+                    lua,
+                    mlua::MultiValue::from_iter([Value::Number(silent.as_secs_f64())]),
+                )
+            }
+            _ => self.resumed.fire(lua, mlua::MultiValue::new()),
+        }
+    }
+
+    /// Whether `Stalled` or `Resumed` has handlers (the host then keeps watching while
+    /// the script only waits).
+    pub(crate) fn watching_daemon(&self) -> bool {
+        self.stalled.listeners() > 0 || self.resumed.listeners() > 0
     }
 
     /// Remembers `part`, just put in a group other than "Default".
@@ -411,6 +453,9 @@ fn option(o: &mut PlaneOptions, prop: PlaneProp) {
 pub fn module(lua: &Lua) -> mlua::Result<Table> {
     let m = lua.create_table()?;
     m.set("New", lua.create_function(new_plane)?)?;
+    let ctx = context(lua);
+    m.set("Stalled", ctx.stalled.clone())?;
+    m.set("Resumed", ctx.resumed.clone())?;
     m.set(
         "HumanoidRagdoll",
         lua.create_function(super::ragdoll::humanoid)?,

@@ -435,6 +435,10 @@ fn frames(
         // With only waits pending, sleep until the earliest is due rather than spinning frames.
         if let (Some(wake_in), false) = (host.next_wake_in(), host.busy_every_frame()) {
             next = next.max(Instant::now() + Duration::from_secs_f64(wake_in));
+            if host.watching_daemon() {
+                // Stalled / Resumed must fire within a second of the daemon stopping.
+                next = next.min(Instant::now() + lua_client::WATCH_PERIOD);
+            }
         }
         if deadline.is_some_and(|d| next > d) {
             break;

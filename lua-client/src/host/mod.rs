@@ -20,6 +20,9 @@ use crate::values::sdk_error;
 use scheduler::Scheduler;
 pub use watchdog::Stop;
 
+/// The longest a host should sleep between frames while [`Host::watching_daemon`].
+pub const WATCH_PERIOD: Duration = Duration::from_millis(100);
+
 /// Something with a per-frame change signal: probed each frame, fired when it changed.
 pub trait Watched {
     /// How many handlers listen; at zero the frame skips it.
@@ -54,8 +57,15 @@ impl Host {
     pub fn frame(&self, dt: f64) -> mlua::Result<()> {
         // Reads in this frame take each plane's newest sample once.
         self.client.begin_frame();
+        crate::api::plane::context(&self.lua).watch_daemon(&self.lua)?;
         self.scheduler.frame(&self.lua, dt)?;
         self.flush()
+    }
+
+    /// Whether the script listens to `PhysicsService.Stalled` / `Resumed`: the host then
+    /// runs a frame at least every [`WATCH_PERIOD`] while the script only waits.
+    pub fn watching_daemon(&self) -> bool {
+        crate::api::plane::context(&self.lua).watching_daemon()
     }
 
     /// Sends the queued writes as one request.

@@ -24,6 +24,16 @@ struct Waiting {
     wake_at: f64,
     since: f64,
     thread: Thread,
+    /// The signal handler this thread runs (`None`: a script thread).
+    handler: Option<Rc<Handler>>,
+}
+
+/// A signal handler's thread: its error is reported and contained, as on Roblox.
+pub(crate) struct Handler {
+    /// What fired it ("Heart", "Touched").
+    signal: String,
+    /// The handler function (for the line that defines it).
+    function: Function,
 }
 
 /// The frame loop's state: pending waits, `Heart`, and what is watched each frame.
@@ -109,7 +119,14 @@ impl Scheduler {
             due
         };
         for w in due {
-            resume(self, w.thread, (now - w.since).into_lua_multi_value())?;
+            let handler = w.handler.clone();
+            let resumed = resume(
+                self,
+                w.thread.clone(),
+                (now - w.since).into_lua_multi_value(),
+                handler.clone(),
+            );
+            contain(lua, self, resumed, &w.thread, handler.as_deref())?;
         }
         self.heart
             .fire(lua, Value::Number(dt).into_lua_multi_value())
@@ -142,10 +159,72 @@ pub fn scheduler(lua: &Lua) -> Rc<Scheduler> {
 /// Runs `f(args)` as a new coroutine; if it waits, the scheduler resumes it later.
 pub fn spawn(lua: &Lua, f: Function, args: MultiValue) -> mlua::Result<()> {
     let thread = lua.create_thread(f)?;
-    resume(&scheduler(lua), thread, args)
+    resume(&scheduler(lua), thread, args, None)
 }
 
-fn resume(sched: &Scheduler, thread: Thread, args: MultiValue) -> mlua::Result<()> {
+/// Runs handler `f(args)` of `signal` as a new coroutine, isolated: an error in it (now or
+/// after it waits) is printed with its traceback and the line that defines the handler,
+/// and the caller, the other handlers and the script go on. Only a stop of the whole
+/// script (the watchdog, memory) goes through.
+pub fn spawn_handler(lua: &Lua, signal: &str, f: Function, args: MultiValue) -> mlua::Result<()> {
+    let thread = lua.create_thread(f.clone())?;
+    let handler = Rc::new(Handler {
+        signal: signal.to_string(),
+        function: f,
+    });
+    let sched = scheduler(lua);
+    let resumed = resume(&sched, thread.clone(), args, Some(handler.clone()));
+    contain(lua, &sched, resumed, &thread, Some(&handler))
+}
+
+/// Reports and swallows the error of a handler's thread; passes anything else on.
+fn contain(
+    lua: &Lua,
+    sched: &Scheduler,
+    resumed: mlua::Result<()>,
+    thread: &Thread,
+    handler: Option<&Handler>,
+) -> mlua::Result<()> {
+    let (Err(e), Some(handler)) = (&resumed, handler) else {
+        return resumed;
+    };
+    if sched.watchdog.stopped().is_some() || matches!(e, mlua::Error::MemoryError(_)) {
+        return resumed;
+    }
+    let defined = handler
+        .function
+        .info()
+        .short_src
+        .map(|src| {
+            format!(
+                "{src}:{}",
+                handler.function.info().line_defined.unwrap_or(0)
+            )
+        })
+        .unwrap_or_else(|| "?".to_string());
+    let message = e.to_string();
+    let traceback = if message.contains("stack traceback") {
+        message
+    } else {
+        lua.globals()
+            .get::<mlua::Table>("debug")
+            .and_then(|d| d.get::<Function>("traceback"))
+            .and_then(|tb| tb.call::<String>((thread.clone(), message.clone())))
+            .unwrap_or(message)
+    };
+    eprintln!(
+        "error in a {} handler (the function at {defined}); the script goes on:\n{traceback}",
+        handler.signal
+    );
+    Ok(())
+}
+
+fn resume(
+    sched: &Scheduler,
+    thread: Thread,
+    args: MultiValue,
+    handler: Option<Rc<Handler>>,
+) -> mlua::Result<()> {
     let out: MultiValue = {
         let _running = sched.watchdog.running();
         thread.resume(args)?
@@ -163,6 +242,7 @@ fn resume(sched: &Scheduler, thread: Thread, args: MultiValue) -> mlua::Result<(
         wake_at: now + delay,
         since: now,
         thread,
+        handler,
     });
     Ok(())
 }

@@ -97,7 +97,7 @@ impl Signal {
             self.0.listeners_changed();
         }
         for handler in handlers {
-            scheduler::spawn(lua, handler, args.clone())?;
+            scheduler::spawn_handler(lua, &self.0.name, handler, args.clone())?;
         }
         Ok(())
     }
