@@ -220,6 +220,8 @@ pub enum Reply {
     Map(Box<MapInfo>),
     /// The ids of every plane of the daemon, ascending ([`Command::ListPlanes`]).
     PlaneIds(Vec<PlaneId>),
+    /// What a proximity query found (`None`: nothing within its reach).
+    Probe(Option<crate::probe::ProbeHit>),
 }
 
 /// The result of one command.
