@@ -3,10 +3,7 @@
 //! against closed forms (plane geometry for probes, Δv = J / m for explosions).
 
 use client_sdk::map::MapOptions;
-use client_sdk::{
-    Controller, ControllerProp, Falloff, Object, ObjectProp, PlaneOptions, Pose, ProbeHit,
-    QueryParams, Shape,
-};
+use client_sdk::{Controller, Falloff, Object, PlaneOptions, Pose, ProbeHit, QueryParams, Shape};
 use integration_tests::{assets, quat, zero_gravity, Scene};
 
 /// Point projections and face contacts are exact to f32 rounding on shapes of size ~1 at
@@ -357,4 +354,287 @@ fn clearance_gives_the_gap_and_both_closest_points() {
         )
         .unwrap_err();
     assert!(e.to_string().contains("radius"), "{e}");
+}
+
+#[test]
+fn probe_wall_finds_walls_not_floors_including_a_maps() {
+    let s = Scene::new("pr-wall", zero_gravity());
+    // Floor top y = 0; wall face x = 4 (an anchored 2 × 10 × 40 box at x = 5).
+    s.anchored_box([40.0, 2.0, 40.0], Pose::at([0.0, -1.0, 0.0]));
+    let wall = s.anchored_box([2.0, 10.0, 40.0], Pose::at([5.0, 5.0, 0.0]));
+    // A capsule of radius 0.5, height 3 standing 0.02 above the floor, 0.1 from the wall.
+    let (r, height) = (0.5f32, 3.0f32);
+    let at = Pose::at([4.0 - r - 0.1, 1.5 + 0.02, 0.0]);
+    let h = hit(
+        s.plane.probe_wall(at, r, height, 0.5, None, None).unwrap(),
+        "wall",
+    );
+    assert_eq!(h.object, wall.handle());
+    assert!((h.distance - 0.1).abs() < EPS, "{h:?}");
+    assert!(close(h.normal, [-1.0, 0.0, 0.0], EPS), "{h:?}");
+    assert!((h.position[0] - 4.0).abs() < EPS, "{h:?}");
+    assert!((h.point_on_shape[0] - (4.0 - 0.1)).abs() < EPS, "{h:?}");
+    // The floor is nearer (0.02) but is no wall; beyond the reach, no wall.
+    assert!(s
+        .plane
+        .probe_wall(at, r, height, 0.09, None, None)
+        .unwrap()
+        .is_none());
+    // A 60° slope is a wall under the default 45° limit and ground under 70°: its face
+    // n = (−sin 60°, cos 60°, 0) through the slab's top.
+    let theta = 60f32.to_radians();
+    let centre = [-50.0, 0.0, 0.0];
+    let slope = incline(&s, centre, theta);
+    let n = [-theta.sin(), theta.cos(), 0.0];
+    // The capsule's centre 0.3 + r + 1 along n from the slab's centre (its sphere caps are
+    // what meet a slope: gap 0.3 from the nearer cap, which sits 1 along the capsule's axis).
+    let axis_gap = |k: f32| [centre[0] + n[0] * k, centre[1] + n[1] * k, 0.0];
+    let c = axis_gap(1.0 + r + 0.3);
+    let h = hit(
+        s.plane
+            .probe_wall(Pose::at(c), r, height, 2.0, None, None)
+            .unwrap(),
+        "slope as wall",
+    );
+    assert_eq!(h.object, slope.handle());
+    assert!(close(h.normal, n, EPS), "{h:?}");
+    // The lower cap's centre (axis offset −1 along Y) is nearer the slope by cos θ · 1.
+    let expected = 0.3 - theta.cos() * (height / 2.0 - r);
+    assert!((h.distance - expected).abs() < EPS, "{h:?} vs {expected}");
+    assert!(s
+        .plane
+        .probe_wall(Pose::at(c), r, height, 2.0, Some(70.0), None)
+        .unwrap()
+        .is_none());
+
+    // A map's floor and wall in one triangle mesh: the floor's triangles do not hide the
+    // wall's (floor top y = 0 over x in [80, 100], wall face x = 96).
+    s.plane
+        .load_map_meshes(
+            &[
+                assets::box_mesh([90.0, -1.0, 0.0], [20.0, 2.0, 20.0]),
+                assets::box_mesh([98.0, 5.0, 0.0], [4.0, 10.0, 20.0]),
+            ],
+            &MapOptions::default(),
+        )
+        .expect("map");
+    let at = Pose::at([96.0 - r - 0.1, 1.5 + 0.02, 0.0]);
+    let h = hit(
+        s.plane.probe_wall(at, r, height, 0.5, None, None).unwrap(),
+        "map wall",
+    );
+    assert!((h.distance - 0.1).abs() < EPS, "{h:?}");
+    assert!(close(h.normal, [-1.0, 0.0, 0.0], EPS), "{h:?}");
+    let e = s
+        .plane
+        .probe_wall(at, r, f32::NAN, 0.5, None, None)
+        .unwrap_err();
+    assert!(e.to_string().contains("height"), "{e}");
+}
+
+/// A controller of the default character size (radius 1, height 5) facing +Z.
+fn character(s: &Scene, at: [f32; 3]) -> Controller {
+    s.plane
+        .new_controller(
+            Pose {
+                position: at,
+                rotation: quat([0.0, 1.0, 0.0], std::f32::consts::PI),
+            },
+            [2.0, 5.0, 2.0],
+            false,
+            &[],
+        )
+        .expect("new controller")
+}
+
+#[test]
+fn controllers_report_the_wall_beside_them() {
+    let s = Scene::new("pr-onwall", PlaneOptions::default());
+    s.floor();
+    // Wall face x = −4.
+    s.anchored_box([2.0, 20.0, 40.0], Pose::at([-5.0, 10.0, 0.0]));
+    let c = character(&s, [-2.5, 2.51, 0.0]);
+    s.run(1.0 / 60.0, 5);
+    let info = c.info().unwrap();
+    assert!(info.on_ground, "standing");
+    assert_eq!(info.wall_normal, [0.0; 3], "0.5 from the wall: not on it");
+    // Facing +Z, the intent's +x is −X: walk into the wall.
+    c.set_move_vector(1.0, 0.0).unwrap();
+    s.run(1.0 / 60.0, 60);
+    let x = c.object().position().unwrap()[0];
+    assert!(
+        (x - (-4.0 + 1.0 + 0.01)).abs() < 0.01,
+        "against the wall at {x}"
+    );
+    let info = c.info().unwrap();
+    assert!(close(info.wall_normal, [1.0, 0.0, 0.0], EPS), "{info:?}");
+    // In the air beside it (0.03 off, within the 0.05 skin): still on the wall, not on
+    // the ground; 0.1 off: not.
+    c.set_move_vector(0.0, 0.0).unwrap();
+    c.teleport(Pose::at([-4.0 + 1.0 + 0.03, 10.0, 0.0]))
+        .unwrap();
+    s.run(1.0 / 60.0, 1);
+    let info = c.info().unwrap();
+    assert!(!info.on_ground);
+    let p = c.object().position().unwrap();
+    assert!(
+        close(info.wall_normal, [1.0, 0.0, 0.0], EPS),
+        "{info:?} at {p:?}"
+    );
+    c.teleport(Pose::at([-4.0 + 1.0 + 0.1, 10.0, 0.0])).unwrap();
+    s.run(1.0 / 60.0, 1);
+    assert_eq!(c.info().unwrap().wall_normal, [0.0; 3]);
+}
+
+#[test]
+fn explosions_push_by_falloff_skip_anchored_and_kick_controllers() {
+    let s = Scene::new("pr-explode", zero_gravity());
+    let (radius, impulse) = (10.0f32, 100.0f32);
+    let near = ball(&s, 0.5, [2.0, 0.0, 0.0]);
+    let side = ball(&s, 0.5, [0.0, 0.0, 5.0]);
+    let far = ball(&s, 0.5, [30.0, 0.0, 0.0]);
+    let wall = s.anchored_box([1.0; 3], Pose::at([0.0, -3.0, 0.0]));
+    let mass = near.info().unwrap().mass;
+    let hit_list = s
+        .plane
+        .explode([0.0; 3], radius, impulse, Falloff::Linear, None)
+        .unwrap();
+    assert_eq!(hit_list, vec![near.handle(), side.handle()]);
+    // Linear: Δv = J (1 − d/R) / m along the centre → object direction (read after a step:
+    // no gravity, no damping, nothing touches).
+    s.run(1.0 / 60.0, 1);
+    let v = near.velocity().unwrap();
+    let expected = impulse * (1.0 - 2.0 / radius) / mass;
+    assert!(
+        close(v, [expected, 0.0, 0.0], expected * 1e-4),
+        "{v:?} vs {expected}"
+    );
+    let v = side.velocity().unwrap();
+    let expected = impulse * (1.0 - 5.0 / radius) / mass;
+    assert!(
+        close(v, [0.0, 0.0, expected], expected * 1e-4),
+        "{v:?} vs {expected}"
+    );
+    assert_eq!(far.velocity().unwrap(), [0.0; 3]);
+    assert_eq!(wall.velocity().unwrap(), [0.0; 3], "anchored: unmoved");
+
+    // None and InverseSquare, on fresh balls at rest (d = 2: full, then J / 4).
+    for (falloff, share) in [(Falloff::None, 1.0f32), (Falloff::InverseSquare, 0.25)] {
+        let b = ball(&s, 0.5, [100.0, 2.0, 0.0]);
+        let found = s
+            .plane
+            .explode([100.0, 0.0, 0.0], radius, impulse, falloff, None)
+            .unwrap();
+        assert_eq!(found, vec![b.handle()]);
+        s.run(1.0 / 60.0, 1);
+        let v = b.velocity().unwrap();
+        let expected = impulse * share / mass;
+        assert!(
+            close(v, [0.0, expected, 0.0], expected * 1e-4),
+            "{falloff:?}: {v:?}"
+        );
+        b.destroy();
+    }
+
+    // Filters: excluded or in a group that does not collide with the blast's, untouched.
+    let a = ball(&s, 0.5, [200.0, 1.0, 0.0]);
+    let b = ball(&s, 0.5, [200.0, -1.0, 0.0]);
+    s.client.register_collision_group("Blast").unwrap();
+    s.client.register_collision_group("Shielded").unwrap();
+    s.client
+        .collision_group_set_collidable("Blast", "Shielded", false)
+        .unwrap();
+    b.set_collision_group("Shielded").unwrap();
+    let found = s
+        .plane
+        .explode(
+            [200.0, 0.0, 0.0],
+            radius,
+            impulse,
+            Falloff::Linear,
+            Some(&QueryParams {
+                collision_group: Some("Blast".into()),
+                ..QueryParams::default()
+            }),
+        )
+        .unwrap();
+    assert_eq!(found, vec![a.handle()]);
+    let found = s
+        .plane
+        .explode(
+            [200.0, 0.0, 0.0],
+            radius,
+            impulse,
+            Falloff::Linear,
+            Some(&QueryParams::excluding(&[&a, &b])),
+        )
+        .unwrap();
+    assert!(found.is_empty(), "{found:?}");
+
+    // Bad input names the field; a sleeping body is woken (it moves after the step).
+    let e = s
+        .plane
+        .explode([0.0; 3], radius, f32::NAN, Falloff::Linear, None)
+        .unwrap_err();
+    assert!(e.to_string().contains("impulse"), "{e}");
+    let e = s
+        .plane
+        .explode([0.0; 3], -1.0, impulse, Falloff::Linear, None)
+        .unwrap_err();
+    assert!(e.to_string().contains("radius"), "{e}");
+}
+
+#[test]
+fn explosions_wake_sleepers_and_kick_controllers() {
+    let s = Scene::new("pr-explode-kcc", PlaneOptions::default());
+    s.floor();
+    let c = character(&s, [0.0, 2.51, 0.0]);
+    let crate_ = s
+        .plane
+        .add(
+            Shape::Cube { size: [1.0; 3] },
+            Pose::at([20.0, 0.5, 0.0]),
+            &[],
+        )
+        .unwrap();
+    // Let everything settle and the crate fall asleep.
+    s.run(1.0 / 60.0, 240);
+    assert!(c.on_ground().unwrap());
+    assert!(crate_.is_sleeping().unwrap(), "the crate sleeps");
+    // A blast 4 units behind the controller (−Z side), level with its centre: a kick of
+    // J (1 − 4/10) / m along +Z, read straight from its velocity before any step.
+    let mass = c.object().info().unwrap().mass;
+    let centre = c.object().position().unwrap();
+    let found = s
+        .plane
+        .explode(
+            [centre[0], centre[1], centre[2] - 4.0],
+            10.0,
+            300.0,
+            Falloff::Linear,
+            None,
+        )
+        .unwrap();
+    assert!(found.contains(&c.handle()), "{found:?}");
+    let v = c.info().unwrap().velocity;
+    let expected = 300.0 * 0.6 / mass;
+    assert!(
+        close(v, [0.0, 0.0, expected], expected * 1e-4),
+        "{v:?} vs {expected}"
+    );
+    // The sleeping crate, 3 from a blast beside it, wakes and moves.
+    let found = s
+        .plane
+        .explode(
+            [17.0, 0.5, 0.0],
+            10.0,
+            50.0,
+            Falloff::Linear,
+            Some(&QueryParams::including(&[&crate_])),
+        )
+        .unwrap();
+    assert_eq!(found, vec![crate_.handle()]);
+    s.run(1.0 / 60.0, 1);
+    assert!(!crate_.is_sleeping().unwrap());
+    assert!(crate_.velocity().unwrap()[0] > 0.0);
 }
