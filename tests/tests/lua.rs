@@ -509,3 +509,11 @@ fn gui_values_name_themselves_without_rust_internals() {
     r.assert_ok();
     assert!(r.stdout().contains("gui names ok"), "{}", r.stdout());
 }
+
+#[test]
+fn probes_and_explosions_from_luau() {
+    let daemon = TestDaemon::start("lua-probes");
+    let r = run(&daemon, "tests/lua/probes.luau");
+    r.assert_ok();
+    assert!(r.stdout().contains("probes ok"), "{}", r.stdout());
+}
