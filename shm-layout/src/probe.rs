@@ -172,6 +172,12 @@ mod tests {
     use super::*;
 
     #[test]
+    fn the_default_slope_limit_is_the_controllers() {
+        let c = crate::ControllerSettings::defaults([2.0, 5.0, 2.0], false);
+        assert_eq!(DEFAULT_MAX_SLOPE, c.max_slope);
+    }
+
+    #[test]
     fn probe_fields_are_named_in_errors() {
         let op = QueryOp::ProbeGround {
             position: [0.0; 3],
