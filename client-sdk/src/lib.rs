@@ -26,6 +26,7 @@ mod mirror;
 mod object;
 mod overlay;
 mod plane;
+mod probe;
 mod query;
 pub mod ragdoll;
 mod spawn;
@@ -43,6 +44,7 @@ pub use joint::{Joint, JointBroke};
 pub use map::{Map, MapMesh, MapOptions};
 pub use object::Object;
 pub use plane::{Plane, PlaneOptions, Snapshot};
+pub use probe::{Explosion, Falloff, ProbeHit, DEFAULT_MAX_SLOPE};
 pub use query::QueryParams;
 pub use ragdoll::{Bone, Ragdoll, RagdollDesc};
 /// The collision group every object starts in ("Default").

@@ -38,7 +38,7 @@ impl QueryParams {
 }
 
 impl Plane {
-    fn wire_filter(&self, params: Option<&QueryParams>) -> Result<QueryFilter, Error> {
+    pub(crate) fn wire_filter(&self, params: Option<&QueryParams>) -> Result<QueryFilter, Error> {
         let Some(p) = params else {
             return Ok(QueryFilter::default());
         };
@@ -54,7 +54,7 @@ impl Plane {
         })
     }
 
-    fn query(&self, op: QueryOp) -> Result<Reply, Error> {
+    pub(crate) fn query(&self, op: QueryOp) -> Result<Reply, Error> {
         let op = op.checked().map_err(Error::invalid_value)?;
         self.client()
             .call(shm_layout::Command::plane(self.id(), PlaneOp::Query(op)))

@@ -228,6 +228,8 @@ pub enum Reply {
         /// The linear velocity after the impulse (a GUI plane's has z = 0).
         linear: Vec3,
     },
+    /// What a proximity query found (`None`: nothing within its reach).
+    Probe(Option<crate::probe::ProbeHit>),
 }
 
 /// The result of one command.

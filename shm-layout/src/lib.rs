@@ -5,7 +5,8 @@
 //!   [`Command`] → [`PlaneOp`] ([`plane_op`]) → [`ObjectOp`] ([`object_op`]).
 //! - [`settings`]: every plane option and object property with its default and its check,
 //!   defined once for the SDK and the daemon.
-//! - [`query`]: scene queries (rays, sweeps, overlaps); [`collision_groups`]: named groups
+//! - [`query`]: scene queries (rays, sweeps, overlaps); [`probe`]: proximity queries and
+//!   explosions; [`collision_groups`]: named groups
 //!   and which pairs collide.
 //! - [`shape`]: collision shapes; [`error`]: command errors that name their field.
 //! - [`codec`]: framing of those enums into bytes (version header + postcard body).
@@ -27,6 +28,7 @@ pub mod map_op;
 pub mod names;
 pub mod object_op;
 pub mod plane_op;
+pub mod probe;
 pub mod query;
 pub mod records;
 pub mod settings;
@@ -43,6 +45,7 @@ pub use joint_op::{AxisMode, JointInfo, JointKind, JointOp, JointProp, JointSett
 pub use map_op::{MapInfo, MapOp, MapReport};
 pub use object_op::ObjectOp;
 pub use plane_op::{OpCost, PlaneKind, PlaneOp};
+pub use probe::{Explosion, Falloff, ProbeHit};
 pub use query::{FilterType, Hit, QueryFilter, QueryOp, Ray};
 pub use records::*;
 pub use settings::{

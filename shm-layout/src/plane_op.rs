@@ -69,6 +69,9 @@ pub enum PlaneOp {
     Joint(JointOp),
     /// An op on the plane's triangle-mesh map upload.
     Map(MapOp),
+    /// Pushes dynamic objects and controllers away from a point; replies
+    /// [`crate::Reply::Objects`] (what it affected).
+    Explode(crate::probe::Explosion),
 }
 
 /// What an op may add to a plane, for the daemon's per-client quotas.

@@ -133,6 +133,60 @@ pub enum QueryOp {
         /// Which objects may be listed.
         filter: QueryFilter,
     },
+    /// Casts a sphere of `radius` straight down from `position` by at most `max_distance`;
+    /// replies [`crate::Reply::Probe`] (see [`crate::probe`]).
+    ProbeGround {
+        /// The sphere's centre at the start.
+        position: Vec3,
+        /// The sphere's radius.
+        radius: f32,
+        /// How far down to look.
+        max_distance: f32,
+        /// Steepest walkable slope (degrees) for the hit's `walkable`.
+        max_slope: f32,
+        /// Which objects may be hit.
+        filter: QueryFilter,
+    },
+    /// The closest point of any object's surface to `position`, within `max_distance`;
+    /// replies [`crate::Reply::Probe`].
+    ClosestPoint {
+        /// The point.
+        position: Vec3,
+        /// Farthest surface considered.
+        max_distance: f32,
+        /// Which objects may be found.
+        filter: QueryFilter,
+    },
+    /// The nearest object to `shape` placed at `pose` and the two closest points, within
+    /// `max_distance`; replies [`crate::Reply::Probe`] (negative distance: overlapping).
+    Clearance {
+        /// The shape (a mesh counts as the convex hull of its vertices).
+        shape: crate::Shape,
+        /// Where the shape is.
+        pose: Pose,
+        /// Farthest object considered.
+        max_distance: f32,
+        /// An object never found (the part whose shape this is).
+        own: Option<Handle>,
+        /// Which objects may be found.
+        filter: QueryFilter,
+    },
+    /// The nearest wall (a surface steeper than `max_slope` and not a ceiling) within
+    /// `max_distance` of an upright capsule; replies [`crate::Reply::Probe`].
+    ProbeWall {
+        /// The capsule's pose (its axis along the pose's Y).
+        pose: Pose,
+        /// The capsule's radius.
+        radius: f32,
+        /// The capsule's full height, caps included (at least `2 × radius` counts as a ball).
+        height: f32,
+        /// How far from the capsule to look.
+        max_distance: f32,
+        /// Steepest walkable slope (degrees): steeper surfaces are walls.
+        max_slope: f32,
+        /// Which objects may be found.
+        filter: QueryFilter,
+    },
 }
 
 /// A direction whose length is a reach: finite and at most [`MAX_QUERY_DISTANCE`].
@@ -214,6 +268,7 @@ impl QueryOp {
                 object,
                 filter: filter.checked()?,
             },
+            op => crate::probe::checked(op)?,
         })
     }
 }

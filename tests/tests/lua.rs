@@ -576,4 +576,9 @@ fn apis_hand_back_the_values_the_script_holds() {
     let r = run(&daemon, "tests/lua/identity.luau");
     r.assert_ok();
     assert!(r.stdout().contains("identity ok"), "{}", r.stdout());
+fn probes_and_explosions_from_luau() {
+    let daemon = TestDaemon::start("lua-probes");
+    let r = run(&daemon, "tests/lua/probes.luau");
+    r.assert_ok();
+    assert!(r.stdout().contains("probes ok"), "{}", r.stdout());
 }

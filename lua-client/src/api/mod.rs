@@ -14,6 +14,7 @@ pub mod joint;
 pub mod object;
 pub mod part;
 pub mod plane;
+pub mod probe;
 pub mod query;
 pub mod ragdoll;
 

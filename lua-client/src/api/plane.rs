@@ -315,6 +315,7 @@ impl UserData for PhysicsPlane {
         );
         super::joint::add_methods(methods);
         super::ragdoll::add_methods(methods);
+        super::probe::add_methods(methods);
         methods.add_meta_method(MetaMethod::Index, |lua, p, key: Value| {
             PLANE.get(lua, &p.0, &key)
         });

@@ -15,10 +15,10 @@ use super::part::BasePart;
 use super::plane::{PhysicsPlane, PlaneState};
 use crate::values::{describe, expected, finite_number, new_vector, sdk_error, vector, CFrame};
 
-const PARAM_KEYS: &str = "FilterType, Filter, CollisionGroup, RespectCanCollide";
+pub(super) const PARAM_KEYS: &str = "FilterType, Filter, CollisionGroup, RespectCanCollide";
 
 /// The handle of a PhysicsObject or of a simulated BasePart, or an error for `what`.
-fn object_handle(what: &str, v: &Value) -> mlua::Result<Handle> {
+pub(super) fn object_handle(what: &str, v: &Value) -> mlua::Result<Handle> {
     let not = || expected(what, "a PhysicsObject or a BasePart in a plane", v);
     let Value::UserData(ud) = v else {
         return Err(not());
@@ -32,14 +32,14 @@ fn object_handle(what: &str, v: &Value) -> mlua::Result<Handle> {
     Err(not())
 }
 
-fn vector_arg(what: &str, v: &Value) -> mlua::Result<[f32; 3]> {
+pub(super) fn vector_arg(what: &str, v: &Value) -> mlua::Result<[f32; 3]> {
     match vector(v) {
         Some(x) if x.iter().all(|c| c.is_finite()) => Ok(x),
         _ => Err(expected(what, "a Vector with finite components", v)),
     }
 }
 
-fn cframe_arg(what: &str, v: &Value) -> mlua::Result<CFrame> {
+pub(super) fn cframe_arg(what: &str, v: &Value) -> mlua::Result<CFrame> {
     match v {
         Value::UserData(ud) => ud.borrow::<CFrame>().map(|c| *c).ok(),
         _ => None,
@@ -47,7 +47,7 @@ fn cframe_arg(what: &str, v: &Value) -> mlua::Result<CFrame> {
     .ok_or_else(|| expected(what, "a CFrame", v))
 }
 
-fn positive_arg(what: &str, v: &Value) -> mlua::Result<f32> {
+pub(super) fn positive_arg(what: &str, v: &Value) -> mlua::Result<f32> {
     match finite_number(what, v) {
         Ok(n) if n > 0.0 => Ok(n as f32),
         _ => Err(expected(what, "a number > 0", v)),
@@ -55,7 +55,7 @@ fn positive_arg(what: &str, v: &Value) -> mlua::Result<f32> {
 }
 
 /// `params`: nil or a table of the documented keys; unknown keys are errors naming them.
-fn params(what: &str, v: &Value) -> mlua::Result<Option<QueryParams>> {
+pub(super) fn params(what: &str, v: &Value) -> mlua::Result<Option<QueryParams>> {
     let t = match v {
         Value::Nil => return Ok(None),
         Value::Table(t) => t,
@@ -121,7 +121,11 @@ fn is_part_or_object(v: &Value) -> bool {
 }
 
 /// The part and PhysicsObject of a handle this host added.
-fn part_and_object(lua: &Lua, plane: &PlaneState, h: Handle) -> mlua::Result<(Value, Value)> {
+pub(super) fn part_and_object(
+    lua: &Lua,
+    plane: &PlaneState,
+    h: Handle,
+) -> mlua::Result<(Value, Value)> {
     let Some(part) = plane.part_of(h) else {
         return Ok((Value::Nil, Value::Nil));
     };
@@ -168,7 +172,7 @@ fn parts(lua: &Lua, plane: &PlaneState, found: Vec<Handle>) -> mlua::Result<Tabl
     Ok(list)
 }
 
-fn live(plane: &Rc<PlaneState>, what: &str) -> mlua::Result<()> {
+pub(super) fn live(plane: &Rc<PlaneState>, what: &str) -> mlua::Result<()> {
     match plane.alive() {
         true => Ok(()),
         false => Err(mlua::Error::runtime(format!(

@@ -243,5 +243,17 @@ pub static CONTROLLER: Props<LuaController> = Props {
         signal_row!("Moved"),
         signal_row!("WaypointReached"),
         signal_row!("PathFinished"),
+        Row {
+            name: "WallNormal",
+            kind: Kind::Vector,
+            get: Get::Fn(|_, c| Ok(new_vector(info(c, "WallNormal")?.wall_normal))),
+            set: Set::ReadOnly,
+        },
+        Row {
+            name: "OnWall",
+            kind: Kind::Boolean,
+            get: Get::Fn(|_, c| Ok(Value::Boolean(info(c, "OnWall")?.wall_normal != [0.0; 3]))),
+            set: Set::ReadOnly,
+        },
     ],
 };

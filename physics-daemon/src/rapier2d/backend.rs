@@ -97,6 +97,7 @@ impl Backend for Plane {
                 ErrorKind::Internal,
                 format!("{op:?} is handled by the server, not the plane"),
             )),
+            PlaneOp::Explode(_) => Err(not_for_gui("Explode")),
         }
     }
 

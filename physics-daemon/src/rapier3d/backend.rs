@@ -52,6 +52,7 @@ impl Plane {
                 ErrorKind::Internal,
                 format!("{op:?} is handled by the server, not the plane"),
             )),
+            PlaneOp::Explode(explosion) => self.explode(explosion),
         }
     }
 }

@@ -236,6 +236,11 @@ pub(super) fn contact(
     })
 }
 
+/// How far before the touch (units) [`cast_convex`] reads a hit's witness points and
+/// normals: near enough to be the touch's geometry within the tolerance of a hit, far
+/// enough that the contact query does not pick a thin box's far face.
+const WITNESS_BACKOFF: f32 = 1.0e-3;
+
 /// Newton steps of [`cast_convex`] before it hands the cast to parry.
 const ADVANCE_STEPS: usize = 24;
 /// A cast has hit once the gap left is within this of the target distance (units).
@@ -294,7 +299,19 @@ fn cast_convex(
             if step == 0 && !options.stop_at_penetration && closing <= 0.0 {
                 return Ok(None);
             }
-            let contact = before.unwrap_or(contact);
+            // The geometry just before the touch: a step back of [`WITNESS_BACKOFF`] from
+            // it, not the previous iterate (Newton's first step from far away lands on a
+            // plane at once, and the contact seen from the start lies elsewhere on a slope).
+            let contact = match before {
+                Some(_) => {
+                    let back = (t - WITNESS_BACKOFF / speed).max(0.0);
+                    let near = Pose::from_translation(vel12 * back) * *pos12;
+                    self::contact(&near, g1, g2, reach)?
+                        .or(before)
+                        .unwrap_or(contact)
+                }
+                None => contact,
+            };
             return Ok(Some(ShapeCastHit {
                 time_of_impact: t,
                 witness1: contact.point1,

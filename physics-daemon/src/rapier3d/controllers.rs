@@ -62,6 +62,8 @@ pub(super) struct Controller {
     /// 0-based index of the waypoint being walked to.
     path_index: usize,
     jump: bool,
+    /// The wall beside the capsule after the last tick (zero: none).
+    wall_normal: Vector,
 }
 
 /// The yaw of a rotation: the angle about +Y that turns the controller's forward, the
@@ -104,6 +106,7 @@ impl Controller {
             path: Vec::new(),
             path_index: 0,
             jump: false,
+            wall_normal: Vector::ZERO,
         }
     }
 
@@ -398,6 +401,7 @@ impl Plane {
             } else {
                 0
             },
+            wall_normal: c.wall_normal.into(),
         })
     }
 
@@ -578,6 +582,9 @@ impl Plane {
                 events.push((EVENT_CONTROLLER_LANDED, 0, Vector::ZERO));
             }
         }
+
+        // The wall beside the capsule where it ends up (wall running, wall jumps).
+        c.wall_normal = self.wall_beside(h, &shape, next, c.yaw, s.max_slope, groups);
 
         // 7. Push dynamic bodies; clip the velocity against what stopped it (slide along
         // walls, stop at ceilings); a body pushed with less than the cap gave way.
@@ -883,6 +890,62 @@ impl Plane {
         gave_way
     }
 }
+
+impl Plane {
+    /// The unit normal of the nearest wall (steeper than `max_slope`, not a ceiling) within
+    /// [`WALL_SKIN`] of the capsule at `position`, or zero.
+    #[allow(clippy::too_many_arguments)]
+    fn wall_beside(
+        &self,
+        own: RigidBodyHandle,
+        shape: &SharedShape,
+        position: Vector,
+        yaw: f32,
+        max_slope: f32,
+        groups: InteractionGroups,
+    ) -> Vector {
+        let pred = |_: ColliderHandle, co: &Collider| {
+            co.parent() != Some(own) && co.collision_groups().test(groups) && !co.is_sensor()
+        };
+        let pipeline =
+            self.query_pipeline(rapier3d::prelude::QueryFilter::default().predicate(&pred));
+        let pose = rapier3d::math::Pose::from_parts(position, yaw_rotation(yaw));
+        let mut best: Option<(f32, Vector)> = None;
+        let region = shape.compute_aabb(&pose).loosened(WALL_SKIN);
+        for (_, co) in pipeline.intersect_aabb_conservative(region) {
+            self.each_piece(co, &**shape, &pose, WALL_SKIN, |piece, piece_pose| {
+                let pos12 = pose.inv_mul(&piece_pose);
+                let Ok(Some(contact)) = super::clipped::contact(&pos12, &**shape, piece, WALL_SKIN)
+                else {
+                    return;
+                };
+                let normal = (piece_pose.rotation * contact.normal2).normalize_or_zero();
+                if contact.dist <= WALL_SKIN
+                    && super::probes::is_wall(normal, max_slope)
+                    && best.is_none_or(|(d, _)| contact.dist < d)
+                {
+                    best = Some((contact.dist, normal));
+                }
+            });
+        }
+        best.map_or(Vector::ZERO, |(_, n)| n)
+    }
+
+    /// Adds `dv` to a controller's velocity (an explosion's kick); a kick upward lifts it
+    /// off the ground.
+    pub(super) fn kick_controller(&mut self, slot: u32, dv: Vector) {
+        if let Some(c) = self.controllers.get_mut(&slot) {
+            c.velocity += dv;
+            if dv.y > 0.0 {
+                c.on_ground = false;
+            }
+        }
+    }
+}
+
+/// How far from the capsule's side a wall still counts for `OnWall` (units): a few times
+/// the gap the mover keeps from what it touches.
+const WALL_SKIN: f32 = 5.0 * SKIN;
 
 /// The controllers of a plane, by slot.
 pub(super) type Controllers = BTreeMap<u32, Controller>;

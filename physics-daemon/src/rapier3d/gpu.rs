@@ -202,6 +202,12 @@ impl Plane {
                 self.push_all();
                 reply
             }
+            PlaneOp::Explode(_) => {
+                self.pull_all();
+                let reply = self.apply_on_cpu(op);
+                self.push_all();
+                reply
+            }
             PlaneOp::AddObject { ref props, .. } => {
                 for p in props {
                     check_gpu_prop(p)?;

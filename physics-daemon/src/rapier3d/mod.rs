@@ -18,6 +18,7 @@ mod clipped;
 mod collision_groups;
 mod contacts;
 mod controllers;
+mod explode;
 mod forces;
 mod held {
     //! Held objects: see `crate::backend::held`.
@@ -30,6 +31,7 @@ mod limits;
 mod maps;
 mod objects;
 mod part;
+mod probes;
 mod properties;
 mod publish;
 mod queries;

@@ -17,7 +17,7 @@ use super::Plane;
 const MAX_STARTS_INSIDE: usize = 16;
 
 /// A query's filter, resolved against the plane once per query.
-struct Resolved<'a> {
+pub(super) struct Resolved<'a> {
     plane: &'a Plane,
     filter_type: FilterType,
     list: HashSet<Handle>,
@@ -31,7 +31,8 @@ struct Resolved<'a> {
 }
 
 impl Resolved<'_> {
-    fn accepts(&self, collider: ColliderHandle, co: &Collider) -> bool {
+    /// Whether the query may see `collider`.
+    pub(super) fn accepts(&self, collider: ColliderHandle, co: &Collider) -> bool {
         let Some(body) = co.parent() else {
             return false;
         };
@@ -148,6 +149,8 @@ impl Plane {
                 found.dedup();
                 Reply::Objects(found)
             }
+            // The proximity queries (probes.rs).
+            op => Reply::Probe(self.probe(op)?),
         })
     }
 
@@ -179,7 +182,7 @@ impl Plane {
         }
     }
 
-    fn resolve(
+    pub(super) fn resolve(
         &self,
         filter: &QueryFilter,
         own_body: Option<RigidBodyHandle>,

@@ -364,6 +364,7 @@ pub fn reply_name(reply: &Reply) -> &'static str {
         Reply::Map(_) => "Map",
         Reply::PlaneIds(_) => "PlaneIds",
         Reply::Velocity { .. } => "Velocity",
+        Reply::Probe(_) => "Probe",
     }
 }
 
@@ -413,6 +414,7 @@ pub fn op_name(command: &Command) -> String {
                 MapOp::Build { .. } => "Plane.Map.Build".into(),
                 MapOp::Discard => "Plane.Map.Discard".into(),
             },
+            PlaneOp::Explode(_) => "Plane.Explode".into(),
         },
     }
 }
@@ -497,6 +499,10 @@ pub fn query_name(query: &QueryOp) -> &'static str {
         QueryOp::BoundsInRadius { .. } => "BoundsInRadius",
         QueryOp::BoundsInBox { .. } => "BoundsInBox",
         QueryOp::InPart { .. } => "InPart",
+        QueryOp::ProbeGround { .. } => "ProbeGround",
+        QueryOp::ClosestPoint { .. } => "ClosestPoint",
+        QueryOp::Clearance { .. } => "Clearance",
+        QueryOp::ProbeWall { .. } => "ProbeWall",
     }
 }
 
