@@ -220,6 +220,8 @@ pub enum Reply {
     Map(Box<MapInfo>),
     /// The ids of every plane of the daemon, ascending ([`Command::ListPlanes`]).
     PlaneIds(Vec<PlaneId>),
+    /// The objects an object touches now, with their contact points ([`ObjectOp::Contacts`]).
+    Contacts(Vec<crate::contact_points::ContactInfo>),
 }
 
 /// The result of one command.

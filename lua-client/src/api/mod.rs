@@ -3,6 +3,7 @@
 //! ([`part`]). Their properties are the rows in `props`; values come from `values`.
 
 pub mod collision_groups;
+pub mod contact_points;
 pub mod contacts;
 pub mod controller;
 pub mod gui_basic;

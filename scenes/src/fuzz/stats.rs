@@ -363,6 +363,7 @@ pub fn reply_name(reply: &Reply) -> &'static str {
         Reply::JointInfo(_) => "JointInfo",
         Reply::Map(_) => "Map",
         Reply::PlaneIds(_) => "PlaneIds",
+        Reply::Contacts(_) => "Contacts",
     }
 }
 
@@ -396,6 +397,7 @@ pub fn op_name(command: &Command) -> String {
                 ObjectOp::RecalculateCenterOfMass => "Object.RecalculateCenterOfMass".into(),
                 ObjectOp::Wake => "Object.Wake".into(),
                 ObjectOp::Destroy => "Object.Destroy".into(),
+                ObjectOp::Contacts => "Object.Contacts".into(),
             },
             PlaneOp::Query(q) => format!("Plane.Query.{}", query_name(q)),
             PlaneOp::CollisionGroups(_) => "Plane.CollisionGroups".into(),
