@@ -16,6 +16,7 @@
 
 #![warn(missing_docs)]
 
+pub mod axis_motor;
 pub mod codec;
 pub mod collision_groups;
 pub mod command;
@@ -34,6 +35,7 @@ pub mod settings;
 pub mod shape;
 pub mod validate;
 
+pub use axis_motor::AxisMotor;
 pub use codec::{DecodeError, Frame};
 pub use collision_groups::CollisionGroups;
 pub use command::*;

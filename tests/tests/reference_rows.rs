@@ -42,3 +42,13 @@ fn a_resting_box_reports_four_corner_points_whose_impulses_carry_its_weight() {
     );
     print!("{out}");
 }
+
+#[test]
+fn sixdof_axis_springs_oscillate_at_their_period_and_motors_reach_their_velocity() {
+    let out = run_script(
+        "rows-motors",
+        "tests/lua/axis_motors.luau",
+        "axis motors ok",
+    );
+    print!("{out}");
+}
