@@ -52,3 +52,13 @@ fn sixdof_axis_springs_oscillate_at_their_period_and_motors_reach_their_velocity
     );
     print!("{out}");
 }
+
+#[test]
+fn planes_and_brushes_meet_rays_contacts_and_controllers_where_their_equations_say() {
+    let out = run_script(
+        "rows-static",
+        "tests/lua/static_shapes.luau",
+        "static shapes ok",
+    );
+    print!("{out}");
+}

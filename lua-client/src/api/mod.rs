@@ -17,6 +17,7 @@ pub mod part;
 pub mod plane;
 pub mod query;
 pub mod ragdoll;
+pub mod static_shapes;
 
 use std::rc::Rc;
 
