@@ -12,8 +12,10 @@
 
 #![warn(missing_docs)]
 
+pub mod axis_motor;
 mod client;
 mod collision_groups;
+mod contact_points;
 mod controller;
 mod error;
 mod events;
@@ -62,6 +64,7 @@ pub use shm_layout::{
     EVENT_CONTROLLER_LANDED, EVENT_CONTROLLER_MOVED, EVENT_PATH_FINISHED, EVENT_WAYPOINT_REACHED,
     FLAG_ON_GROUND,
 };
+pub use shm_layout::{AxisMotor, ContactInfo, ContactPoint, MAX_CONTACT_POINTS};
 pub use spawn::{
     connect_or_start, daemon_executable, interrupt_child, sibling_executable, start_daemon,
     start_daemon_with, DaemonChild, Session,

@@ -230,6 +230,8 @@ pub enum Reply {
     },
     /// What a proximity query found (`None`: nothing within its reach).
     Probe(Option<crate::probe::ProbeHit>),
+    /// The objects an object touches now, with their contact points ([`ObjectOp::Contacts`]).
+    Contacts(Vec<crate::contact_points::ContactInfo>),
 }
 
 /// The result of one command.

@@ -4,6 +4,7 @@
 
 use serde::{Deserialize, Serialize};
 
+pub use crate::axis_motor::AxisMotor;
 use crate::records::Handle;
 use crate::validate::{finite, finite3, non_negative, MAX_COORDINATE};
 use crate::{CommandError, Vec3};
@@ -144,6 +145,14 @@ pub enum JointProp {
     BreakForce(f32),
     /// Whether the two objects still collide with each other.
     CollideConnected(bool),
+    /// A SixDof joint's motor (or spring) on one axis (0..6: X, Y, Z, RotX, RotY, RotZ);
+    /// None removes it.
+    AxisMotor {
+        /// The axis, an index into [`AXIS_NAMES`].
+        axis: u8,
+        /// The motor, or None for none.
+        motor: Option<AxisMotor>,
+    },
 }
 
 impl JointProp {
@@ -168,6 +177,7 @@ impl JointProp {
             JointProp::Axes(_) => "Axes",
             JointProp::BreakForce(_) => "BreakForce",
             JointProp::CollideConnected(_) => "CollideConnected",
+            JointProp::AxisMotor { .. } => "AxisMotor",
         }
     }
 
@@ -266,6 +276,14 @@ impl JointProp {
             JointProp::MotorMaxForce(v) => JointProp::MotorMaxForce(amount(v)?),
             JointProp::BreakForce(v) => JointProp::BreakForce(amount(v)?),
             p @ (JointProp::Axes(_) | JointProp::CollideConnected(_)) => p,
+            JointProp::AxisMotor { axis, motor } => JointProp::AxisMotor {
+                axis,
+                motor: match motor {
+                    Some(m) => Some(m.checked(axis)?),
+                    // The axis is still checked: a bad index is an error, not a no-op.
+                    None => AxisMotor::default().checked(axis).map(|_| None)?,
+                },
+            },
         })
     }
 }
@@ -309,6 +327,8 @@ pub struct JointSettings {
     pub break_force: f32,
     /// `CollideConnected`.
     pub collide_connected: bool,
+    /// SixDof per-axis motors (`AxisMotor`), X, Y, Z, RotX, RotY, RotZ.
+    pub axis_motors: [Option<AxisMotor>; 6],
 }
 
 impl Default for JointSettings {
@@ -332,6 +352,7 @@ impl Default for JointSettings {
             axes: [AxisMode::Locked; 6],
             break_force: 0.0,
             collide_connected: false,
+            axis_motors: [None; 6],
         }
     }
 }
@@ -358,6 +379,11 @@ impl JointSettings {
             JointProp::Axes(v) => self.axes = v,
             JointProp::BreakForce(v) => self.break_force = v,
             JointProp::CollideConnected(v) => self.collide_connected = v,
+            JointProp::AxisMotor { axis, motor } => {
+                if let Some(slot) = self.axis_motors.get_mut(axis as usize) {
+                    *slot = motor;
+                }
+            }
         }
     }
 
@@ -415,6 +441,30 @@ impl JointSettings {
                     format!(
                         "{field} applies to Hinge and Prismatic joints, not {}",
                         kind.name()
+                    ),
+                ));
+            }
+        }
+        for (i, motor) in self.axis_motors.iter().enumerate() {
+            if motor.is_none() {
+                continue;
+            }
+            let axis = AXIS_NAMES[i];
+            if kind != JointKind::SixDof {
+                return Err(CommandError::invalid_field(
+                    "AxisMotor",
+                    format!(
+                        "axis motors apply to SixDof joints, not {} (axis {axis})",
+                        kind.name()
+                    ),
+                ));
+            }
+            if self.axes[i] == AxisMode::Locked {
+                return Err(CommandError::invalid_field(
+                    "AxisMotor",
+                    format!(
+                        "axis {axis} is Locked: a motor there cannot move it (set Axes.{axis} \
+                         to \"Free\" or \"Limited\" first)"
                     ),
                 ));
             }

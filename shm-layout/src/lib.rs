@@ -17,9 +17,11 @@
 
 #![warn(missing_docs)]
 
+pub mod axis_motor;
 pub mod codec;
 pub mod collision_groups;
 pub mod command;
+pub mod contact_points;
 pub mod controller_op;
 pub mod error;
 pub mod gui_op;
@@ -35,9 +37,11 @@ pub mod settings;
 pub mod shape;
 pub mod validate;
 
+pub use axis_motor::AxisMotor;
 pub use codec::{DecodeError, Frame};
 pub use collision_groups::CollisionGroups;
 pub use command::*;
+pub use contact_points::{ContactInfo, ContactPoint, MAX_CONTACT_POINTS};
 pub use controller_op::{ControllerInfo, ControllerOp};
 pub use error::{CommandError, ErrorKind};
 pub use gui_op::{GuiControllerOp, GuiControllerProp, GuiHit, GuiObjectOp, GuiOp, GuiReply};
@@ -56,7 +60,7 @@ pub use shape::{Shape, ShapeKind};
 
 /// Bumped whenever a record layout or the command encoding changes. Client and daemon must
 /// agree on it; the handshake reports both values when they differ.
-pub const LAYOUT_VERSION: u32 = 6;
+pub const LAYOUT_VERSION: u32 = 7;
 
 /// The crate version both sides were built from; also checked by the handshake.
 pub const CRATE_VERSION: &str = env!("CARGO_PKG_VERSION");

@@ -21,4 +21,7 @@ pub enum ObjectOp {
     Wake,
     /// Removes the object.
     Destroy,
+    /// Every object it touches now, with the contact points of each pair
+    /// ([`crate::Reply::Contacts`]).
+    Contacts,
 }

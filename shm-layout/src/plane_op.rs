@@ -96,6 +96,10 @@ impl PlaneOp {
                     op: ObjectOp::Info,
                     ..
                 }
+                | PlaneOp::Object {
+                    op: ObjectOp::Contacts,
+                    ..
+                }
         ) || matches!(self, PlaneOp::Gui(op) if op.is_read_only())
     }
 

@@ -2,6 +2,8 @@
 
 use iceoryx2::prelude::ZeroCopySend;
 
+use crate::contact_points::{ContactPoint, MAX_CONTACT_POINTS};
+
 /// Body flag: the slot holds a live body.
 pub const FLAG_ALIVE: u32 = 1 << 0;
 /// Body flag: rapier put the body to sleep.
@@ -207,11 +209,12 @@ pub const EVENT_GUI_GROUND_CHANGED: u32 = 0x23;
 pub const EVENT_JOINT_BROKE: u32 = 3;
 
 /// One per-tick event (published in the plane's event service, one sample per tick that
-/// has events). 64 bytes.
+/// has events). 200 bytes.
 ///
 /// For contact events `a` and `b` are the two objects, `normal` points from `a` toward `b`,
 /// `position` is the world-space contact point and `impulse` the total normal impulse the
-/// solver applied in the tick the contact started (all zero for `EVENT_CONTACT_STOPPED`).
+/// solver applied in the tick the contact started (all zero for `EVENT_CONTACT_STOPPED`);
+/// `points` holds the pair's contact manifold then (its first `point_count` entries).
 #[derive(Debug, Clone, Copy, PartialEq, Default, ZeroCopySend)]
 #[type_name("physics::EventRecord")]
 #[repr(C)]
@@ -237,6 +240,13 @@ pub struct EventRecord {
     /// The plane's running event number (0 for its first event): a reader that sees a gap
     /// knows exactly how many events it lost.
     pub seq: u64,
+    /// Contact started: the manifold's points (normals from `a` toward `b`); the first
+    /// `point_count` are set.
+    pub points: [ContactPoint; MAX_CONTACT_POINTS],
+    /// How many of `points` are set (0 to 4).
+    pub point_count: u32,
+    /// Zero; keeps the record a multiple of 8 bytes.
+    pub _reserved: u32,
 }
 
 impl EventRecord {
@@ -253,6 +263,10 @@ impl EventRecord {
             slot: self.b_slot,
             generation: self.b_generation,
         }
+    }
+    /// The contact points the record carries (none but for a contact start).
+    pub fn contact_points(&self) -> &[ContactPoint] {
+        &self.points[..(self.point_count as usize).min(MAX_CONTACT_POINTS)]
     }
 }
 
@@ -274,7 +288,8 @@ mod tests {
     #[test]
     fn record_sizes_are_fixed() {
         assert_eq!(core::mem::size_of::<BodyState>(), 64);
-        assert_eq!(core::mem::size_of::<EventRecord>(), 64);
+        assert_eq!(core::mem::size_of::<EventRecord>(), 200);
+        assert_eq!(core::mem::size_of::<ContactPoint>(), 32);
         assert_eq!(core::mem::size_of::<TickHeader>(), 72);
     }
 

@@ -17,6 +17,17 @@ use crate::host::signal::Signal;
 use crate::host::Watched;
 use crate::values::{new_vector, sdk_error};
 
+/// What `Touched` reports of a contact start: point, normal (toward the part told), impulse,
+/// the manifold's points and whether their normals (from the record's first object toward
+/// the second) must be turned around.
+type TouchContact<'a> = (
+    [f32; 3],
+    [f32; 3],
+    f32,
+    &'a [client_sdk::ContactPoint],
+    bool,
+);
+
 /// Per plane: whether events are being read, and the `EventsLost` signal.
 pub struct ContactPump {
     /// True while some part of the plane has touch handlers (events are drained each frame).
@@ -143,10 +154,11 @@ impl PlaneState {
                     ..
                 }) => {
                     let flipped = normal.map(|c| -c);
+                    let points = record.contact_points();
                     // Each side gets the other part, and the normal of the other's surface
                     // pointing toward itself.
-                    self.touch(lua, a, b, Some((position, flipped, impulse)))?;
-                    self.touch(lua, b, a, Some((position, normal, impulse)))?;
+                    self.touch(lua, a, b, Some((position, flipped, impulse, points, true)))?;
+                    self.touch(lua, b, a, Some((position, normal, impulse, points, false)))?;
                 }
                 Some(Contact::Ended { a, b, .. }) => {
                     self.touch(lua, a, b, None)?;
@@ -163,7 +175,7 @@ impl PlaneState {
         lua: &Lua,
         this: Handle,
         other: Handle,
-        contact: Option<([f32; 3], [f32; 3], f32)>,
+        contact: Option<TouchContact<'_>>,
     ) -> mlua::Result<()> {
         let Some(part) = self.part_of(this) else {
             return Ok(());
@@ -176,11 +188,15 @@ impl PlaneState {
             None => Value::Nil,
         };
         let contact = match contact {
-            Some((position, normal, impulse)) => {
+            Some((position, normal, impulse, points, flip)) => {
                 let t = lua.create_table()?;
                 t.set("Position", new_vector(position))?;
                 t.set("Normal", new_vector(normal))?;
                 t.set("Impulse", impulse)?;
+                t.set(
+                    "Points",
+                    super::contact_points::points_table(lua, points, flip)?,
+                )?;
                 Some(Value::Table(t))
             }
             None => None,

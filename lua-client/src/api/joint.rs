@@ -180,6 +180,17 @@ impl LuaJoint {
     fn alive(&self) -> bool {
         !self.2.get() && self.0.info().is_ok()
     }
+
+    /// The joint, unless this script destroyed it (then an error for `what`, the method).
+    pub(crate) fn live(&self, what: &str) -> mlua::Result<&Joint> {
+        if self.2.get() {
+            return Err(mlua::Error::runtime(format!(
+                "{what}: {} (read Alive to check)",
+                self.name()
+            )));
+        }
+        Ok(&self.0)
+    }
 }
 
 impl UserData for LuaJoint {
@@ -231,6 +242,7 @@ impl UserData for LuaJoint {
             },
         );
         methods.add_meta_method(MetaMethod::ToString, |_, j, ()| Ok(j.name()));
+        super::axis_motor::add_methods(methods);
     }
 }
 

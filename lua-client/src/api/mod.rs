@@ -2,7 +2,9 @@
 //! `PhysicsObject` a plane's `:Add` returns ([`object`]), and `Renderable.BasePart`
 //! ([`part`]). Their properties are the rows in `props`; values come from `values`.
 
+pub mod axis_motor;
 pub mod collision_groups;
+pub mod contact_points;
 pub mod contacts;
 pub mod controller;
 pub mod gui_basic;
@@ -17,6 +19,7 @@ pub mod plane;
 pub mod probe;
 pub mod query;
 pub mod ragdoll;
+pub mod static_shapes;
 
 use std::rc::Rc;
 

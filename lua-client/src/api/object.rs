@@ -240,6 +240,10 @@ pub fn methods(lua: &Lua) -> mlua::Result<Table> {
             Ok(new_vector(com))
         })?,
     )?;
+    t.set(
+        "GetContacts",
+        lua.create_function(super::contact_points::get_contacts)?,
+    )?;
     Ok(t)
 }
 

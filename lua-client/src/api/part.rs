@@ -239,6 +239,8 @@ pub struct PartState {
     mesh: RefCell<Option<Rc<MeshData>>>,
     /// The CFrame value last handed to scripts (reads of an unmoved pose reuse it).
     cframe_value: CFrameCache,
+    /// Added anchored (`Renderable.Plane`, `Renderable.Brush`: static shapes).
+    anchor_on_add: Cell<bool>,
 }
 
 impl PartState {
@@ -257,7 +259,18 @@ impl PartState {
             reporting: Cell::new(false),
             mesh: RefCell::new(None),
             cframe_value: CFrameCache::default(),
+            anchor_on_add: Cell::new(false),
         }
+    }
+
+    /// Whether `plane:Add` anchors its body from the start.
+    pub fn anchor_on_add(&self) -> bool {
+        self.anchor_on_add.get()
+    }
+
+    /// Makes `plane:Add` anchor its body from the start (static shapes).
+    pub fn set_anchor_on_add(&self, on: bool) {
+        self.anchor_on_add.set(on);
     }
 
     /// A mesh part of `vertices` and 0-based `triangles` (indices checked by the caller):
@@ -663,6 +676,7 @@ pub fn module(lua: &Lua) -> mlua::Result<Table> {
             part_ud(lua, &Rc::new(mesh_part(vertices, triangles)?))
         })?,
     )?;
+    super::static_shapes::add_constructors(lua, &renderable)?;
     Ok(renderable)
 }
 

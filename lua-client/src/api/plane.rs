@@ -366,6 +366,9 @@ pub(crate) fn add(plane: &Rc<PlaneState>, part: Value) -> mlua::Result<PhysicsOb
     if reporting {
         props.push(ObjectProp::ReportContacts(true));
     }
+    if state.anchor_on_add() {
+        props.push(ObjectProp::Anchored(true));
+    }
     let group = state.collision_group();
     if group != "Default" {
         let id = plane

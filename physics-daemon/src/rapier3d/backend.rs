@@ -36,6 +36,7 @@ impl Plane {
                     .map(Reply::CenterOfMass),
                 ObjectOp::Wake => self.wake(handle).map(|_| applied(self)),
                 ObjectOp::Destroy => self.destroy_object(handle).map(|_| applied(self)),
+                ObjectOp::Contacts => self.object_contacts(handle).map(Reply::Contacts),
             },
             PlaneOp::Query(query) => self.query(query),
             PlaneOp::Controller(op) => self.controller_op(op),

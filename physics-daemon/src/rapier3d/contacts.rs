@@ -127,6 +127,9 @@ impl Plane {
                     record.normal = normal.into();
                     record.impulse = impulse;
                 }
+                let points = self.pair_points(c1, c2);
+                record.point_count = points.len() as u32;
+                record.points[..points.len()].copy_from_slice(&points);
             }
             self.event_seq += 1;
             self.events.push(record);

@@ -20,10 +20,10 @@ use super::Plane;
 
 /// Damping of a velocity motor when `Damping` is 0: stiff enough to hold the speed within
 /// a few ticks (acceleration-based: the gain per second).
-const VELOCITY_MOTOR_GAIN: f32 = 1.0e4;
+pub(super) const VELOCITY_MOTOR_GAIN: f32 = 1.0e4;
 /// Position motor spring when `Stiffness` is 0 (acceleration-based, 1/s²) and its damping.
-const POSITION_MOTOR_STIFFNESS: f32 = 400.0;
-const POSITION_MOTOR_DAMPING: f32 = 40.0;
+pub(super) const POSITION_MOTOR_STIFFNESS: f32 = 400.0;
+pub(super) const POSITION_MOTOR_DAMPING: f32 = 40.0;
 
 /// One joint of the plane.
 #[derive(Debug)]
@@ -211,6 +211,7 @@ fn build(kind: JointKind, s: &JointSettings, rel: Rotation) -> GenericJoint {
                 }
             }
             j.lock_axes(locked);
+            super::axis_motors::apply(&mut j, s);
         }
         JointKind::Rope => {
             j.coupled_axes = JointAxesMask::LIN_AXES;

@@ -24,6 +24,8 @@ mod held {
     //! Held objects: see `crate::backend::held`.
     crate::backend::held::held_bodies!(rapier3d);
 }
+mod axis_motors;
+mod contact_points;
 #[cfg(feature = "gpu")]
 mod gpu;
 mod joints;

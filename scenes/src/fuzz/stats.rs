@@ -365,6 +365,7 @@ pub fn reply_name(reply: &Reply) -> &'static str {
         Reply::PlaneIds(_) => "PlaneIds",
         Reply::Velocity { .. } => "Velocity",
         Reply::Probe(_) => "Probe",
+        Reply::Contacts(_) => "Contacts",
     }
 }
 
@@ -398,6 +399,7 @@ pub fn op_name(command: &Command) -> String {
                 ObjectOp::RecalculateCenterOfMass => "Object.RecalculateCenterOfMass".into(),
                 ObjectOp::Wake => "Object.Wake".into(),
                 ObjectOp::Destroy => "Object.Destroy".into(),
+                ObjectOp::Contacts => "Object.Contacts".into(),
             },
             PlaneOp::Query(q) => format!("Plane.Query.{}", query_name(q)),
             PlaneOp::CollisionGroups(_) => "Plane.CollisionGroups".into(),

@@ -1,0 +1,66 @@
+//! Contact manifolds in Luau: `contact.Points` (up to four, each `{Position, Normal, Depth,
+//! Impulse}`) in the contact table `Touched` hands its handlers, and
+//! `PhysicsObject:GetContacts()`, every part the object touches now with the same table.
+//! Normals point from the other part's surface toward the part they are reported to, as
+//! `Touched`'s `contact.Normal` does.
+
+use client_sdk::{ContactPoint, Vec3};
+use mlua::{Lua, Table, Value};
+
+use super::object::PhysicsObject;
+use super::part::BasePart;
+use crate::values::{expected, lua_number, new_vector, sdk_error};
+
+fn neg(v: Vec3) -> Vec3 {
+    v.map(|c| -c)
+}
+
+/// `contact.Points`: the points as an array of `{Position, Normal, Depth, Impulse}`;
+/// `flip` turns the normals around (the wire's point from the first object toward the
+/// second).
+pub fn points_table(lua: &Lua, points: &[ContactPoint], flip: bool) -> mlua::Result<Table> {
+    let list = lua.create_table_with_capacity(points.len(), 0)?;
+    for p in points {
+        let t = lua.create_table_with_capacity(0, 4)?;
+        t.set("Position", new_vector(p.position))?;
+        t.set(
+            "Normal",
+            new_vector(if flip { neg(p.normal) } else { p.normal }),
+        )?;
+        t.set("Depth", lua_number(p.depth))?;
+        t.set("Impulse", lua_number(p.impulse))?;
+        list.push(t)?;
+    }
+    Ok(list)
+}
+
+/// `PhysicsObject:GetContacts()`: an array with one table per object it touches now,
+/// `{Part, Position, Normal, Impulse, Points}` (`Part` nil for a body that is no part of
+/// this script, e.g. a map piece).
+pub fn get_contacts(lua: &Lua, this: Value) -> mlua::Result<Table> {
+    let what = "PhysicsObject:GetContacts";
+    let o = match &this {
+        Value::UserData(ud) => ud.borrow::<PhysicsObject>().ok(),
+        _ => None,
+    }
+    .ok_or_else(|| expected(what, "a PhysicsObject as self (call it with ':')", &this))?;
+    let list = o.live(what)?.contacts().map_err(|e| sdk_error(what, e))?;
+    let plane = o.body.plane.upgrade();
+    let out = lua.create_table_with_capacity(list.len(), 0)?;
+    for c in &list {
+        let t = lua.create_table_with_capacity(0, 5)?;
+        let part = plane.as_ref().and_then(|p| p.part_of(c.other));
+        let part = match part {
+            Some(p) => Value::UserData(lua.create_userdata(BasePart(p))?),
+            None => Value::Nil,
+        };
+        t.set("Part", part)?;
+        t.set("Position", new_vector(c.position))?;
+        // The wire's normal points from this object toward the other.
+        t.set("Normal", new_vector(neg(c.normal)))?;
+        t.set("Impulse", lua_number(c.impulse))?;
+        t.set("Points", points_table(lua, &c.points, true)?)?;
+        out.push(t)?;
+    }
+    Ok(out)
+}
