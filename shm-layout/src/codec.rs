@@ -233,3 +233,9 @@ mod tests {
         }
     }
 }
+
+/// How many bytes `result` takes in an encoded response (what the daemon counts against a
+/// request's reply budget). Never fails: a value postcard cannot size counts as huge.
+pub fn result_size(result: &crate::CommandResult) -> usize {
+    postcard::experimental::serialized_size(result).unwrap_or(usize::MAX)
+}

@@ -220,6 +220,15 @@ pub enum Reply {
     Map(Box<MapInfo>),
     /// The ids of every plane of the daemon, ascending ([`Command::ListPlanes`]).
     PlaneIds(Vec<PlaneId>),
+    /// A page of an overlap query's objects, ascending slots: the answer of a
+    /// [`crate::QueryOp::Page`], and of an overlap query that found more than
+    /// [`crate::query::MAX_QUERY_RESULTS`].
+    ObjectPage {
+        /// The objects of this page.
+        objects: Vec<Handle>,
+        /// More objects match after the last one (ask for the page after its slot).
+        truncated: bool,
+    },
 }
 
 /// The result of one command.

@@ -35,6 +35,10 @@ pub struct Limits {
         default_value_t = Limits::DEFAULT.commands_per_request
     )]
     pub commands_per_request: usize,
+    /// Bytes of the reply to one request: results past it are refused with `Quota` (the
+    /// overlap queries' own cap is `MAX_QUERY_RESULTS` objects a query).
+    #[arg(long = "max-reply-bytes", default_value_t = Limits::DEFAULT.reply_bytes)]
+    pub reply_bytes: usize,
 }
 
 impl Limits {
@@ -48,6 +52,7 @@ impl Limits {
         mesh_vertices_per_client: 1_000_000,
         request_bytes: 16 << 20,
         commands_per_request: 262_144,
+        reply_bytes: 8 << 20,
     };
 }
 

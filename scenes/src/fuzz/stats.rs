@@ -363,6 +363,7 @@ pub fn reply_name(reply: &Reply) -> &'static str {
         Reply::JointInfo(_) => "JointInfo",
         Reply::Map(_) => "Map",
         Reply::PlaneIds(_) => "PlaneIds",
+        Reply::ObjectPage { .. } => "ObjectPage",
     }
 }
 
@@ -496,6 +497,7 @@ pub fn query_name(query: &QueryOp) -> &'static str {
         QueryOp::BoundsInRadius { .. } => "BoundsInRadius",
         QueryOp::BoundsInBox { .. } => "BoundsInBox",
         QueryOp::InPart { .. } => "InPart",
+        QueryOp::Page { .. } => "Page",
     }
 }
 
