@@ -41,7 +41,7 @@ pub use joint::{Joint, JointBroke};
 pub use map::{Map, MapMesh, MapOptions};
 pub use object::Object;
 pub use plane::{Plane, PlaneOptions, Snapshot};
-pub use query::QueryParams;
+pub use query::{Found, QueryParams};
 pub use ragdoll::{Bone, Ragdoll, RagdollDesc};
 pub use shm_layout::gui_op::{GuiControllerInfo, GuiObjectInfo, GuiPlaneInfo};
 /// The limits and checks the daemon applies, for callers that want to check early.

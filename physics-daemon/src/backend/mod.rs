@@ -7,6 +7,7 @@
 
 mod dirty;
 pub(crate) mod held;
+pub mod pools;
 mod slot_table;
 
 use std::mem::MaybeUninit;

@@ -119,53 +119,53 @@ impl Plane {
     /// Every object an overlap query finds, ascending slots (the caller pages it).
     fn overlap(&self, op: QueryOp) -> Result<Vec<Handle>, CommandError> {
         Ok(match op {
-                QueryOp::BoundsInRadius {
-                    position,
-                    radius,
-                    filter,
-                } => {
-                    let f = self.resolve(&filter, None)?;
-                    let centre = Vector::from(position);
-                    let query = Aabb::new(
-                        centre - Vector::splat(radius),
-                        centre + Vector::splat(radius),
-                    );
-                    self.bounds_overlapping(&f, query, |aabb| {
-                        // Distance from the centre to the box, squared.
-                        let d = (centre.clamp(aabb.mins, aabb.maxs) - centre).length_squared();
-                        d <= radius * radius
-                    })
-                }
-                QueryOp::BoundsInBox { pose, size, filter } => {
-                    let f = self.resolve(&filter, None)?;
-                    let pose = super::objects::rapier_pose(pose);
-                    let cuboid = Cuboid::new(Vector::from(size) / 2.0);
-                    let query = cuboid.compute_aabb(&pose);
-                    self.bounds_overlapping(&f, query, |aabb| {
-                        let other = rapier3d::math::Pose::from_translation(aabb.center());
-                        rapier3d::parry::query::intersection_test(
-                            &pose,
-                            &cuboid,
-                            &other,
-                            &Cuboid::new(aabb.half_extents()),
-                        )
-                        .map_or(true, |hit| hit.intersecting)
-                    })
-                }
-                QueryOp::InPart { object, filter } => {
-                    let (own, collider) = self.collider_of(object)?;
-                    let f = self.resolve(&filter, Some(own))?;
-                    let co = &self.world.colliders[collider];
-                    let predicate = |c: ColliderHandle, co: &Collider| f.accepts(c, co);
-                    let pipeline = self.query_pipeline(QueryFilter_::default().predicate(&predicate));
-                    let mut found: Vec<Handle> = pipeline
-                        .intersect_shape(*co.position(), co.shape())
-                        .filter_map(|(c, _)| self.handle_of_collider(c))
-                        .collect();
-                    found.sort_by_key(|h| h.slot);
-                    found.dedup();
-                    found
-                }
+            QueryOp::BoundsInRadius {
+                position,
+                radius,
+                filter,
+            } => {
+                let f = self.resolve(&filter, None)?;
+                let centre = Vector::from(position);
+                let query = Aabb::new(
+                    centre - Vector::splat(radius),
+                    centre + Vector::splat(radius),
+                );
+                self.bounds_overlapping(&f, query, |aabb| {
+                    // Distance from the centre to the box, squared.
+                    let d = (centre.clamp(aabb.mins, aabb.maxs) - centre).length_squared();
+                    d <= radius * radius
+                })
+            }
+            QueryOp::BoundsInBox { pose, size, filter } => {
+                let f = self.resolve(&filter, None)?;
+                let pose = super::objects::rapier_pose(pose);
+                let cuboid = Cuboid::new(Vector::from(size) / 2.0);
+                let query = cuboid.compute_aabb(&pose);
+                self.bounds_overlapping(&f, query, |aabb| {
+                    let other = rapier3d::math::Pose::from_translation(aabb.center());
+                    rapier3d::parry::query::intersection_test(
+                        &pose,
+                        &cuboid,
+                        &other,
+                        &Cuboid::new(aabb.half_extents()),
+                    )
+                    .map_or(true, |hit| hit.intersecting)
+                })
+            }
+            QueryOp::InPart { object, filter } => {
+                let (own, collider) = self.collider_of(object)?;
+                let f = self.resolve(&filter, Some(own))?;
+                let co = &self.world.colliders[collider];
+                let predicate = |c: ColliderHandle, co: &Collider| f.accepts(c, co);
+                let pipeline = self.query_pipeline(QueryFilter_::default().predicate(&predicate));
+                let mut found: Vec<Handle> = pipeline
+                    .intersect_shape(*co.position(), co.shape())
+                    .filter_map(|(c, _)| self.handle_of_collider(c))
+                    .collect();
+                found.sort_by_key(|h| h.slot);
+                found.dedup();
+                found
+            }
             _ => {
                 return Err(CommandError::invalid(
                     "only BoundsInRadius, BoundsInBox and InPart list objects",

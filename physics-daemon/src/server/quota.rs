@@ -32,9 +32,7 @@ pub struct Reserved<'a> {
 
 impl Drop for Reserved<'_> {
     fn drop(&mut self) {
-        self.owner
-            .objects
-            .fetch_sub(self.objects, Ordering::SeqCst);
+        self.owner.objects.fetch_sub(self.objects, Ordering::SeqCst);
         self.owner
             .mesh_vertices
             .fetch_sub(self.mesh_vertices, Ordering::SeqCst);
@@ -82,7 +80,11 @@ impl OwnerUsage {
                 sum,
             )
         })?;
-        if let Err(sum) = take(&self.mesh_vertices, vertices, limits.mesh_vertices_per_client) {
+        if let Err(sum) = take(
+            &self.mesh_vertices,
+            vertices,
+            limits.mesh_vertices_per_client,
+        ) {
             self.objects.fetch_sub(objects, Ordering::SeqCst);
             return Err(exceeded(
                 "mesh vertices per client",
@@ -195,7 +197,13 @@ mod tests {
                     for _ in 0..500 {
                         if let Ok(r) = owner.reserve(&limits, cost(1)) {
                             // The op "adds" its object: the plane's count takes it over.
-                            owner.change(Usage::default(), Usage { objects: 1, ..Usage::default() });
+                            owner.change(
+                                Usage::default(),
+                                Usage {
+                                    objects: 1,
+                                    ..Usage::default()
+                                },
+                            );
                             drop(r);
                             accepted.fetch_add(1, Ordering::SeqCst);
                         }
@@ -227,8 +235,15 @@ mod tests {
             ..Limits::DEFAULT
         };
         let owner = OwnerUsage::default();
-        let e = owner.reserve(&limits, cost(11)).err().expect("over the quota");
-        assert!(e.message.contains("--max-objects-per-client"), "{}", e.message);
+        let e = owner
+            .reserve(&limits, cost(11))
+            .err()
+            .expect("over the quota");
+        assert!(
+            e.message.contains("--max-objects-per-client"),
+            "{}",
+            e.message
+        );
         assert!(e.message.contains("11"), "{}", e.message);
         assert_eq!(owner.get(), Usage::default());
     }

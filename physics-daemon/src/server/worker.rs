@@ -421,14 +421,19 @@ impl Worker {
             return false;
         };
         let out = &self.out;
+        // A plane slower than 1 Hz steps its period in equal pieces of at most MAX_DT (the
+        // longest step the engines take) and publishes once.
+        let (pieces, dt) = pieces_of(period);
         let stepped = catch_unwind(AssertUnwindSafe(|| {
-            plane.step(period.as_secs_f32()).and_then(|stepped| {
-                if stepped {
-                    out.publish(plane.as_mut())
-                        .map_err(super::dispatch::internal)?;
-                }
-                Ok(())
-            })
+            let mut stepped = false;
+            for _ in 0..pieces {
+                stepped |= plane.step(dt)?;
+            }
+            if stepped {
+                out.publish(plane.as_mut())
+                    .map_err(super::dispatch::internal)?;
+            }
+            Ok::<(), CommandError>(())
         }));
         match stepped {
             Ok(Ok(())) => {}
@@ -489,6 +494,15 @@ impl Worker {
         }
         outcome
     }
+}
+
+/// How an automatic tick of `period` steps: the number of steps and the dt of each (equal
+/// pieces of at most [`shm_layout::validate::MAX_DT`]).
+fn pieces_of(period: Duration) -> (u32, f32) {
+    let max = shm_layout::validate::MAX_DT as f64;
+    let secs = period.as_secs_f64();
+    let pieces = (secs / max).ceil().max(1.0) as u32;
+    (pieces, (secs / pieces as f64) as f32)
 }
 
 /// The period `plane` asks for now: `None` when manual, disabled, or not representable
@@ -625,4 +639,23 @@ fn count_reply(result: CommandResult, left: &mut usize, limits: &Limits) -> Comm
     }
     *left = left.saturating_sub(size);
     result
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn slow_ticks_step_in_pieces_of_at_most_max_dt() {
+        let max = shm_layout::validate::MAX_DT;
+        assert_eq!(pieces_of(Duration::from_secs_f64(1.0 / 60.0)).0, 1);
+        for rate in [0.9f64, 0.5, 0.01] {
+            let (n, dt) = pieces_of(Duration::from_secs_f64(1.0 / rate));
+            assert!(dt <= max && dt > 0.0, "rate {rate}: dt {dt}");
+            assert!(
+                (n as f64 * dt as f64 - 1.0 / rate).abs() < 1e-4,
+                "rate {rate}"
+            );
+        }
+    }
 }
