@@ -509,3 +509,9 @@ fn gui_values_name_themselves_without_rust_internals() {
     r.assert_ok();
     assert!(r.stdout().contains("gui names ok"), "{}", r.stdout());
 }
+
+#[test]
+fn overlap_queries_page_and_max_parts_from_luau() {
+    let daemon = TestDaemon::start("lua-overlap-pages");
+    run_ok(&daemon, "tests/lua/overlap_pages.luau", "overlap pages ok");
+}
