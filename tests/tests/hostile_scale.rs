@@ -2,7 +2,8 @@
 //! used to exhaust the daemon or starve other clients, at a size that runs in seconds in a
 //! debug build yet fails the old code. Reply amplification (overlap queries capped, paged
 //! and counted), queries off the request loop and bounded per request, the quota race of
-//! many connections, planes slower than 1 Hz, and `Threads` capped by cores.
+//! many connections, controller paths counted against a quota, planes slower than 1 Hz,
+//! and `Threads` capped by cores.
 
 use std::sync::{Arc, Barrier};
 use std::time::{Duration, Instant};
@@ -14,8 +15,7 @@ use integration_tests::TestDaemon;
 use shm_layout::codec::{decode_response, encode_request};
 use shm_layout::query::{MAX_QUERY_RESULTS, MAX_RAY_WORK};
 use shm_layout::{
-    Command as Cmd, CommandResult, PlaneId, PlaneOp, QueryFilter, QueryOp, Reply, Request,
-    Response,
+    Command as Cmd, CommandResult, PlaneId, PlaneOp, QueryFilter, QueryOp, Reply, Request, Response,
 };
 
 fn send(client: &Client, commands: Vec<Cmd>) -> (Vec<CommandResult>, usize) {
@@ -76,9 +76,15 @@ fn overlap_replies_are_capped_paged_and_counted() {
     add_grid(&client, plane.id(), N);
 
     // One query: the first MAX_QUERY_RESULTS by slot, flagged as truncated.
-    let (r, _) = send(&client, vec![Cmd::plane(plane.id(), PlaneOp::Query(everything()))]);
+    let (r, _) = send(
+        &client,
+        vec![Cmd::plane(plane.id(), PlaneOp::Query(everything()))],
+    );
     let Ok(Reply::ObjectPage { objects, truncated }) = &r[0] else {
-        panic!("expected a truncated page, got {:?}", r[0].as_ref().map(|_| ()));
+        panic!(
+            "expected a truncated page, got {:?}",
+            r[0].as_ref().map(|_| ())
+        );
     };
     assert!(*truncated);
     assert_eq!(objects.len(), MAX_QUERY_RESULTS);
@@ -280,7 +286,10 @@ fn a_heavy_query_does_not_stall_another_clients_step() {
     stop.store(true, std::sync::atomic::Ordering::Relaxed);
     let took = attacker.join().unwrap();
     let query = took.iter().min().copied().unwrap();
-    let (alone99, during99) = (percentile(alone.clone(), 0.99), percentile(during.clone(), 0.99));
+    let (alone99, during99) = (
+        percentile(alone.clone(), 0.99),
+        percentile(during.clone(), 0.99),
+    );
     eprintln!(
         "step alone p50 {:?} p99 {alone99:?}; during the attack p50 {:?} p99 {during99:?}; \
          one query request {query:?}",
@@ -391,7 +400,11 @@ fn planes_slower_than_one_hertz_tick() {
                 })
                 .unwrap();
             let ball = plane
-                .add(Shape::Sphere { radius: 0.5 }, Pose::at([0.0, 100.0, 0.0]), &[])
+                .add(
+                    Shape::Sphere { radius: 0.5 },
+                    Pose::at([0.0, 100.0, 0.0]),
+                    &[],
+                )
                 .unwrap();
             (rate, plane, ball)
         })
@@ -461,3 +474,64 @@ fn threads_are_capped_by_cores() {
     one.set(PlaneProp::TickRate(0.0)).unwrap();
 }
 
+/// Controller paths used to be counted nowhere (9,000 controllers × 65,536 waypoints took
+/// the daemon down). Their bytes now count against `--max-state-bytes-per-client`, and a
+/// cleared path gives them back.
+#[test]
+fn controller_paths_count_against_the_state_quota() {
+    const POINTS: usize = shm_layout::controller_op::MAX_WAYPOINTS;
+    // Room for one full path (12 bytes a point), not two.
+    let quota = (12 * POINTS * 3 / 2).to_string();
+    let daemon = TestDaemon::start_with(
+        "hostile-paths",
+        &["--max-state-bytes-per-client", &quota],
+        &[],
+    );
+    let client = daemon.client();
+    let plane = client.create_plane(&PlaneOptions::manual()).unwrap();
+    let new = |x: f32| {
+        plane
+            .new_controller(Pose::at([x, 0.0, 0.0]), [2.0, 5.0, 2.0], false, &[])
+            .unwrap()
+    };
+    let (a, b) = (new(0.0), new(10.0));
+    let path: Vec<[f32; 3]> = (0..POINTS).map(|i| [i as f32 * 0.01, 0.0, 100.0]).collect();
+    let set_path = |c: &client_sdk::Controller| {
+        let op = shm_layout::ControllerOp::SetPath {
+            handle: c.handle(),
+            waypoints: path.clone(),
+        };
+        let (r, _) = send(
+            &client,
+            vec![Cmd::plane(plane.id(), PlaneOp::Controller(op))],
+        );
+        r.into_iter().next().unwrap()
+    };
+    set_path(&a).expect("the first path fits");
+    let e = set_path(&b).expect_err("a second full path passes the quota");
+    assert_eq!(e.kind, ErrorKind::Quota, "{e}");
+    assert!(e.message.contains("--max-state-bytes-per-client"), "{e}");
+    // A stopped controller frees its path; the other one's path then fits.
+    a.stop_walking().unwrap();
+    client.flush().unwrap();
+    set_path(&b).expect("the freed bytes are counted back");
+    // Appending one point at a time counts too (the buffer grows by doubling, so the count
+    // may pass the quota by what one growth adds; the next append is then refused).
+    let appends = (0..POINTS)
+        .map(|i| {
+            let op = shm_layout::ControllerOp::AppendWaypoint {
+                handle: a.handle(),
+                point: [i as f32, 0.0, 0.0],
+            };
+            Cmd::plane(plane.id(), PlaneOp::Controller(op))
+        })
+        .collect();
+    let (r, _) = send(&client, appends);
+    let refused = r
+        .iter()
+        .position(|r| r.is_err())
+        .expect("appends pass the quota");
+    assert!(refused < POINTS / 2 + 1, "{refused} points appended");
+    let e = r[refused].as_ref().unwrap_err();
+    assert!(e.message.contains("--max-state-bytes-per-client"), "{e}");
+}

@@ -120,6 +120,8 @@ pub struct Plane {
     gpu: Option<crate::gpu::GpuWorld>,
     /// [`StateHasher`] over every slot as the last step left it (the tick header's).
     state_hash: u64,
+    /// Bytes of controller paths (counted against the owner's quota).
+    state_bytes: crate::backend::counted::Counter,
 }
 
 impl Plane {
@@ -165,6 +167,7 @@ impl Plane {
             #[cfg(feature = "gpu")]
             gpu: None,
             state_hash: 0,
+            state_bytes: Default::default(),
         };
         for prop in props {
             plane.apply_prop(*prop, true)?;

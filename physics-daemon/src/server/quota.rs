@@ -20,6 +20,7 @@ use crate::backend::Usage;
 pub struct OwnerUsage {
     objects: AtomicU64,
     mesh_vertices: AtomicU64,
+    state_bytes: AtomicU64,
 }
 
 /// A reservation: released when dropped (by then the plane's own count holds what the op
@@ -28,10 +29,14 @@ pub struct Reserved<'a> {
     owner: &'a OwnerUsage,
     objects: u64,
     mesh_vertices: u64,
+    state_bytes: u64,
 }
 
 impl Drop for Reserved<'_> {
     fn drop(&mut self) {
+        self.owner
+            .state_bytes
+            .fetch_sub(self.state_bytes, Ordering::SeqCst);
         self.owner.objects.fetch_sub(self.objects, Ordering::SeqCst);
         self.owner
             .mesh_vertices
@@ -56,6 +61,7 @@ impl OwnerUsage {
         Usage {
             objects: self.objects.load(Ordering::SeqCst),
             mesh_vertices: self.mesh_vertices.load(Ordering::SeqCst),
+            state_bytes: self.state_bytes.load(Ordering::SeqCst),
         }
     }
 
@@ -93,10 +99,22 @@ impl OwnerUsage {
                 sum,
             ));
         }
+        let bytes = cost.state_bytes;
+        if let Err(sum) = take(&self.state_bytes, bytes, limits.state_bytes_per_client) {
+            self.objects.fetch_sub(objects, Ordering::SeqCst);
+            self.mesh_vertices.fetch_sub(vertices, Ordering::SeqCst);
+            return Err(exceeded(
+                "state bytes per client (controller paths)",
+                limits.state_bytes_per_client,
+                "max-state-bytes-per-client",
+                sum,
+            ));
+        }
         Ok(Reserved {
             owner: self,
             objects,
             mesh_vertices: vertices,
+            state_bytes: bytes,
         })
     }
 
@@ -109,6 +127,10 @@ impl OwnerUsage {
             .fetch_add(new.mesh_vertices, Ordering::SeqCst);
         self.mesh_vertices
             .fetch_sub(old.mesh_vertices, Ordering::SeqCst);
+        self.state_bytes
+            .fetch_add(new.state_bytes, Ordering::SeqCst);
+        self.state_bytes
+            .fetch_sub(old.state_bytes, Ordering::SeqCst);
     }
 }
 
@@ -222,6 +244,7 @@ mod tests {
         plane.set(Usage {
             objects: 7,
             mesh_vertices: 30,
+            state_bytes: 1_000,
         });
         assert_eq!(owner.get().objects, 7);
         drop(plane);
