@@ -47,7 +47,7 @@ pub use map::{Map, MapMesh, MapOptions};
 pub use object::Object;
 pub use plane::{Plane, PlaneOptions, Snapshot};
 pub use probe::{Explosion, Falloff, ProbeHit, DEFAULT_MAX_SLOPE};
-pub use query::QueryParams;
+pub use query::{Found, QueryParams};
 pub use ragdoll::{Bone, Ragdoll, RagdollDesc};
 /// The collision group every object starts in ("Default").
 pub use shm_layout::collision_groups::DEFAULT_GROUP;

@@ -1,6 +1,11 @@
 //! Scene queries on a plane (Roblox's `Raycast`, `Spherecast`, `Blockcast`, `Shapecast`,
 //! `GetPartBoundsInRadius`, `GetPartBoundsInBox`, `GetPartsInPart`), each one round trip that
 //! also carries the queued writes, so a query sees what this client just did.
+//!
+//! The daemon answers an overlap query with at most `MAX_QUERY_RESULTS` objects per reply
+//! and says when it cut the list; the SDK asks for the pages after it, so a query returns
+//! every object it found (or the first `max_parts`, Roblox's `OverlapParams.MaxParts`) while
+//! no single reply grows with the plane.
 
 use shm_layout::{FilterType, Handle, Hit, PlaneOp, Pose, QueryFilter, QueryOp, Ray, Reply, Vec3};
 
@@ -17,6 +22,18 @@ pub struct QueryParams {
     pub collision_group: Option<String>,
     /// Skip objects with CanCollide = false (default false: queries see every object).
     pub respect_can_collide: bool,
+    /// Overlap queries return at most this many objects, the lowest slots first (Roblox's
+    /// `OverlapParams.MaxParts`); 0 (the default): all of them.
+    pub max_parts: usize,
+}
+
+/// What an overlap query found.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct Found {
+    /// The objects, ascending slots.
+    pub objects: Vec<Handle>,
+    /// More objects matched than `max_parts` allowed: `objects` is the first `max_parts`.
+    pub truncated: bool,
 }
 
 impl QueryParams {
@@ -71,10 +88,41 @@ impl Plane {
         Ok(self.hits(op)?.into_iter().next().flatten())
     }
 
-    fn objects(&self, op: QueryOp) -> Result<Vec<Handle>, Error> {
-        match self.query(op)? {
-            Reply::Objects(found) => Ok(found),
-            other => Err(Error::Protocol(format!("expected objects, got {other:?}"))),
+    /// Runs the overlap query `op`, following the daemon's pages until every object (or
+    /// `max_parts`, when not 0) is in.
+    fn objects(&self, op: QueryOp, max_parts: usize) -> Result<Found, Error> {
+        let mut objects = Vec::new();
+        let mut reply = self.query(op.clone())?;
+        loop {
+            let more = match reply {
+                Reply::Objects(found) => {
+                    objects.extend(found);
+                    false
+                }
+                Reply::ObjectPage {
+                    objects: found,
+                    truncated,
+                } => {
+                    objects.extend(found);
+                    truncated
+                }
+                other => return Err(Error::Protocol(format!("expected objects, got {other:?}"))),
+            };
+            if max_parts > 0 && objects.len() >= max_parts {
+                let truncated = more || objects.len() > max_parts;
+                objects.truncate(max_parts);
+                return Ok(Found { objects, truncated });
+            }
+            let Some(last) = objects.last().filter(|_| more) else {
+                return Ok(Found {
+                    objects,
+                    truncated: false,
+                });
+            };
+            reply = self.query(QueryOp::Page {
+                query: Box::new(op.clone()),
+                after_slot: last.slot,
+            })?;
         }
     }
 
@@ -165,11 +213,24 @@ impl Plane {
         radius: f32,
         params: Option<&QueryParams>,
     ) -> Result<Vec<Handle>, Error> {
-        self.objects(QueryOp::BoundsInRadius {
+        Ok(self
+            .bounds_in_radius_found(position, radius, params)?
+            .objects)
+    }
+
+    /// [`Plane::bounds_in_radius`], saying whether `max_parts` cut the list.
+    pub fn bounds_in_radius_found(
+        &self,
+        position: Vec3,
+        radius: f32,
+        params: Option<&QueryParams>,
+    ) -> Result<Found, Error> {
+        let op = QueryOp::BoundsInRadius {
             position,
             radius,
             filter: self.wire_filter(params)?,
-        })
+        };
+        self.objects(op, params.map_or(0, |p| p.max_parts))
     }
 
     /// Objects whose world bounding box touches the oriented box.
@@ -179,11 +240,22 @@ impl Plane {
         size: Vec3,
         params: Option<&QueryParams>,
     ) -> Result<Vec<Handle>, Error> {
-        self.objects(QueryOp::BoundsInBox {
+        Ok(self.bounds_in_box_found(pose, size, params)?.objects)
+    }
+
+    /// [`Plane::bounds_in_box`], saying whether `max_parts` cut the list.
+    pub fn bounds_in_box_found(
+        &self,
+        pose: Pose,
+        size: Vec3,
+        params: Option<&QueryParams>,
+    ) -> Result<Found, Error> {
+        let op = QueryOp::BoundsInBox {
             pose,
             size,
             filter: self.wire_filter(params)?,
-        })
+        };
+        self.objects(op, params.map_or(0, |p| p.max_parts))
     }
 
     /// Objects whose shape overlaps `object`'s shape (exact test).
@@ -192,9 +264,19 @@ impl Plane {
         object: &Object,
         params: Option<&QueryParams>,
     ) -> Result<Vec<Handle>, Error> {
-        self.objects(QueryOp::InPart {
+        Ok(self.parts_in_part_found(object, params)?.objects)
+    }
+
+    /// [`Plane::parts_in_part`], saying whether `max_parts` cut the list.
+    pub fn parts_in_part_found(
+        &self,
+        object: &Object,
+        params: Option<&QueryParams>,
+    ) -> Result<Found, Error> {
+        let op = QueryOp::InPart {
             object: object.handle(),
             filter: self.wire_filter(params)?,
-        })
+        };
+        self.objects(op, params.map_or(0, |p| p.max_parts))
     }
 }

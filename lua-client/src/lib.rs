@@ -28,6 +28,7 @@ use std::rc::Rc;
 use client_sdk::Client;
 use mlua::{Lua, Table, Value};
 
+pub use host::assets::AssetRoots;
 use host::scheduler::{self, Scheduler};
 pub use host::{Host, Stop, WATCH_PERIOD};
 #[doc(hidden)]

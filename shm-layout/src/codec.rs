@@ -133,6 +133,12 @@ pub fn encode_request_with_version(request: &Request, version: u32) -> Vec<u8> {
     out
 }
 
+/// How many bytes `result` takes in an encoded response (what the daemon counts against a
+/// request's reply budget). Never fails: a value postcard cannot size counts as huge.
+pub fn result_size(result: &crate::CommandResult) -> usize {
+    postcard::experimental::serialized_size(result).unwrap_or(usize::MAX)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

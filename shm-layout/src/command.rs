@@ -232,6 +232,15 @@ pub enum Reply {
     Probe(Option<crate::probe::ProbeHit>),
     /// The objects an object touches now, with their contact points ([`ObjectOp::Contacts`]).
     Contacts(Vec<crate::contact_points::ContactInfo>),
+    /// A page of an overlap query's objects, ascending slots: the answer of a
+    /// [`crate::QueryOp::Page`], and of an overlap query that found more than
+    /// [`crate::query::MAX_QUERY_RESULTS`].
+    ObjectPage {
+        /// The objects of this page.
+        objects: Vec<Handle>,
+        /// More objects match after the last one (ask for the page after its slot).
+        truncated: bool,
+    },
 }
 
 /// The result of one command.

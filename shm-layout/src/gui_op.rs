@@ -349,6 +349,17 @@ pub enum GuiReply {
 }
 
 impl GuiOp {
+    /// Bytes of path the op may add (8 a waypoint), for the per-client quotas.
+    pub fn path_bytes(&self) -> u64 {
+        match self {
+            GuiOp::Controller {
+                op: GuiControllerOp::SetWaypoints(points),
+                ..
+            } => 8 * points.len() as u64,
+            _ => 0,
+        }
+    }
+
     /// Whether the op only reads.
     pub fn is_read_only(&self) -> bool {
         matches!(

@@ -81,6 +81,9 @@ pub struct OpCost {
     pub objects: u32,
     /// Mesh vertices the op adds.
     pub mesh_vertices: u64,
+    /// Bytes of other state the op may add (controller paths: 12 bytes a 3D waypoint, 8 a
+    /// GUI one).
+    pub state_bytes: u64,
 }
 
 impl PlaneOp {
@@ -109,21 +112,34 @@ impl PlaneOp {
             PlaneOp::AddObject { shape, .. } => OpCost {
                 objects: 1,
                 mesh_vertices: shape.mesh_vertices() as u64,
+                ..OpCost::default()
             },
             PlaneOp::Controller(ControllerOp::Create { .. }) | PlaneOp::Gui(GuiOp::Add { .. }) => {
                 OpCost {
                     objects: 1,
-                    mesh_vertices: 0,
+                    ..OpCost::default()
                 }
             }
             // A joint counts as an object; map pieces count vertices + triangles.
             PlaneOp::Joint(JointOp::Create { .. }) => OpCost {
                 objects: 1,
-                mesh_vertices: 0,
+                ..OpCost::default()
             },
             PlaneOp::Map(op) => OpCost {
-                objects: 0,
                 mesh_vertices: op.cost(),
+                ..OpCost::default()
+            },
+            PlaneOp::Controller(ControllerOp::SetPath { waypoints, .. }) => OpCost {
+                state_bytes: 12 * waypoints.len() as u64,
+                ..OpCost::default()
+            },
+            PlaneOp::Controller(ControllerOp::AppendWaypoint { .. }) => OpCost {
+                state_bytes: 12,
+                ..OpCost::default()
+            },
+            PlaneOp::Gui(op) => OpCost {
+                state_bytes: op.path_bytes(),
+                ..OpCost::default()
             },
             _ => OpCost::default(),
         }

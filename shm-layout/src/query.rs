@@ -12,6 +12,15 @@ use crate::{CommandError, Pose, Vec3};
 pub const MAX_RAYS: usize = 65_536;
 /// Most objects one filter may list.
 pub const MAX_FILTER: usize = 65_536;
+/// Most work one [`QueryOp::Raycast`] may ask for, counted as rays × (1 + objects in the
+/// filter): a ray may meet every listed object before its hit, so this bounds the time one
+/// query holds its plane (65,536 rays with a 63-object filter, or 4,096 rays with 1,023).
+pub const MAX_RAY_WORK: usize = 1 << 22;
+/// Most objects one overlap query (`BoundsInRadius`, `BoundsInBox`, `InPart`) returns: a
+/// query that finds more returns the first ones by slot and says it was truncated
+/// ([`crate::Reply::ObjectPage`]); [`QueryOp::Page`] asks for the ones after. This bounds the
+/// reply of one query (8 bytes per object) whatever the plane holds.
+pub const MAX_QUERY_RESULTS: usize = 4096;
 /// Longest ray or sweep (units): a direction longer than this is almost certainly a bug.
 pub const MAX_QUERY_DISTANCE: f32 = 2.0 * MAX_COORDINATE;
 
@@ -187,6 +196,15 @@ pub enum QueryOp {
         /// Which objects may be found.
         filter: QueryFilter,
     },
+    /// The objects of the overlap query `query` whose slot is above `after_slot`, at most
+    /// [`MAX_QUERY_RESULTS`] (ascending slots): the next page after a truncated answer.
+    /// Replies [`crate::Reply::ObjectPage`].
+    Page {
+        /// An overlap query (`BoundsInRadius`, `BoundsInBox` or `InPart`).
+        query: Box<QueryOp>,
+        /// Only objects with a greater slot are listed (the last slot of the previous page).
+        after_slot: u32,
+    },
 }
 
 /// A direction whose length is a reach: finite and at most [`MAX_QUERY_DISTANCE`].
@@ -204,6 +222,19 @@ impl QueryOp {
                     return Err(CommandError::invalid_field(
                         "rays",
                         format!("rays must hold at most {MAX_RAYS} rays, got {}", rays.len()),
+                    ));
+                }
+                let work = rays.len().saturating_mul(1 + filter.list.len());
+                if work > MAX_RAY_WORK {
+                    return Err(CommandError::invalid_field(
+                        "rays",
+                        format!(
+                            "rays × (1 + Filter objects) must be at most {MAX_RAY_WORK}, got {} \
+                             rays × (1 + {}) = {work}: cast fewer rays per request or filter \
+                             fewer objects",
+                            rays.len(),
+                            filter.list.len()
+                        ),
                     ));
                 }
                 for (i, r) in rays.iter().enumerate() {
@@ -268,9 +299,59 @@ impl QueryOp {
                 object,
                 filter: filter.checked()?,
             },
+            QueryOp::Page { query, after_slot } => {
+                if !query.is_overlap() {
+                    return Err(CommandError::invalid_field(
+                        "query",
+                        "a Page holds an overlap query (BoundsInRadius, BoundsInBox or InPart)",
+                    ));
+                }
+                QueryOp::Page {
+                    query: Box::new(query.checked()?),
+                    after_slot,
+                }
+            }
             op => crate::probe::checked(op)?,
         })
     }
+
+    /// Whether the op lists objects (`BoundsInRadius`, `BoundsInBox`, `InPart`).
+    pub fn is_overlap(&self) -> bool {
+        matches!(
+            self,
+            QueryOp::BoundsInRadius { .. } | QueryOp::BoundsInBox { .. } | QueryOp::InPart { .. }
+        )
+    }
+
+    /// The filter of the op (for a page, its query's).
+    pub fn filter(&self) -> &QueryFilter {
+        match self {
+            QueryOp::Raycast { filter, .. }
+            | QueryOp::Spherecast { filter, .. }
+            | QueryOp::Blockcast { filter, .. }
+            | QueryOp::Shapecast { filter, .. }
+            | QueryOp::BoundsInRadius { filter, .. }
+            | QueryOp::BoundsInBox { filter, .. }
+            | QueryOp::InPart { filter, .. }
+            | QueryOp::ProbeGround { filter, .. }
+            | QueryOp::ClosestPoint { filter, .. }
+            | QueryOp::Clearance { filter, .. }
+            | QueryOp::ProbeWall { filter, .. } => filter,
+            QueryOp::Page { query, .. } => query.filter(),
+        }
+    }
+}
+
+/// The page of an overlap query's answer that a reply carries: `found` (ascending slots)
+/// reduced to the objects above `after_slot`, then to the first [`MAX_QUERY_RESULTS`];
+/// `true` when some were cut off.
+pub fn page_of(mut found: Vec<Handle>, after_slot: Option<u32>) -> (Vec<Handle>, bool) {
+    if let Some(after) = after_slot {
+        found.retain(|h| h.slot > after);
+    }
+    let truncated = found.len() > MAX_QUERY_RESULTS;
+    found.truncate(MAX_QUERY_RESULTS);
+    (found, truncated)
 }
 
 impl QueryFilter {

@@ -576,9 +576,31 @@ fn apis_hand_back_the_values_the_script_holds() {
     let r = run(&daemon, "tests/lua/identity.luau");
     r.assert_ok();
     assert!(r.stdout().contains("identity ok"), "{}", r.stdout());
+}
+
+#[test]
 fn probes_and_explosions_from_luau() {
     let daemon = TestDaemon::start("lua-probes");
     let r = run(&daemon, "tests/lua/probes.luau");
     r.assert_ok();
     assert!(r.stdout().contains("probes ok"), "{}", r.stdout());
+}
+
+#[test]
+fn overlap_queries_page_and_max_parts_from_luau() {
+    let daemon = TestDaemon::start("lua-overlap-pages");
+    run_ok(&daemon, "tests/lua/overlap_pages.luau", "overlap pages ok");
+}
+
+#[test]
+fn modules_are_frozen_and_maps_load_only_under_the_asset_roots() {
+    let daemon = TestDaemon::start("lua-assets");
+    let r = run_in(
+        &daemon.domain,
+        "tests/lua/sandbox_assets.luau",
+        &["--asset-root", "examples/assets"],
+        Duration::from_secs(60),
+    );
+    r.assert_ok();
+    assert!(r.stdout().contains("sandbox assets ok"), "{}", r.stdout());
 }

@@ -2,7 +2,6 @@
 //! Options are the SDK's `JointProp`s by name; reads (`Error`, `Broken`, `Force`, options)
 //! ask the daemon (one round trip).
 
-use std::path::Path;
 use std::rc::Rc;
 
 use client_sdk::{AxisMode, Joint, JointInfo, JointKind, JointProp, MapOptions, Object};
@@ -326,10 +325,11 @@ fn map_options(what: &str, opts: &Value) -> mlua::Result<MapOptions> {
 fn load_map(lua: &Lua, plane: &PhysicsPlane, (path, opts): (String, Value)) -> mlua::Result<Table> {
     let what = "PhysicsPlane:LoadMap";
     let o = map_options(what, &opts)?;
+    let path = crate::host::assets::resolve(lua, what, &path)?;
     let map = plane
         .0
         .plane
-        .load_map(Path::new(&path), &o)
+        .load_map(&path, &o)
         .map_err(|e| sdk_error(what, e))?;
     let r = &map.report;
     let t = lua.create_table()?;
@@ -389,7 +389,8 @@ fn load_prop(
             }
         }
     }
-    let meshes = client_sdk::map::read_meshes(Path::new(&path)).map_err(|e| sdk_error(what, e))?;
+    let meshes = client_sdk::map::read_meshes(&crate::host::assets::resolve(lua, what, &path)?)
+        .map_err(|e| sdk_error(what, e))?;
     let scaled = |m: &client_sdk::MapMesh| -> Vec<[f32; 3]> {
         m.vertices
             .iter()

@@ -59,7 +59,30 @@ pub fn modules(lua: &Lua, client: Client) -> mlua::Result<Table> {
     modules.set("Renderable", part::module(lua)?)?;
     modules.set("Primitives", crate::values::module(lua)?)?;
     modules.set("GUI", gui_basic::module(lua)?)?;
+    freeze(&modules)?;
     Ok(modules)
+}
+
+/// Makes `table` and every table reachable from it read-only, so a script cannot change a
+/// module for the scripts it shares a state with (`import("Primitives").Vector = nil`).
+fn freeze(table: &Table) -> mlua::Result<()> {
+    let mut seen = std::collections::HashSet::new();
+    let mut stack = vec![table.clone()];
+    while let Some(t) = stack.pop() {
+        if !seen.insert(t.to_pointer()) {
+            continue;
+        }
+        for pair in t.pairs::<Value, Value>() {
+            if let (_, Value::Table(inner)) = pair? {
+                stack.push(inner);
+            }
+        }
+        if let Some(meta) = t.metatable() {
+            stack.push(meta);
+        }
+        t.set_readonly(true);
+    }
+    Ok(())
 }
 
 /// `__index` of a type whose methods live in a table consulted after its properties: with

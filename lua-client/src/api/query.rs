@@ -3,11 +3,12 @@
 //! `GetPartBoundsInRadius`, `GetPartBoundsInBox`, `GetPartsInPart` return arrays of
 //! BaseParts; `RaycastMany` casts many rays in one round trip. `params` is an optional table
 //! of `FilterType` ("Exclude" / "Include"), `Filter` (PhysicsObjects or BaseParts),
-//! `CollisionGroup` (a registered name) and `RespectCanCollide`.
+//! `CollisionGroup` (a registered name), `RespectCanCollide` and `MaxParts` (overlap
+//! queries list at most that many; their second return value says whether it cut the list).
 
 use std::rc::Rc;
 
-use client_sdk::{FilterType, Handle, Hit, QueryParams, Ray};
+use client_sdk::{FilterType, Found, Handle, Hit, QueryParams, Ray};
 use mlua::{Lua, Table, UserDataMethods, Value};
 
 use super::object::PhysicsObject;
@@ -15,7 +16,8 @@ use super::part::BasePart;
 use super::plane::{PhysicsPlane, PlaneState};
 use crate::values::{describe, expected, finite_number, new_vector, sdk_error, vector, CFrame};
 
-pub(super) const PARAM_KEYS: &str = "FilterType, Filter, CollisionGroup, RespectCanCollide";
+pub(super) const PARAM_KEYS: &str =
+    "FilterType, Filter, CollisionGroup, RespectCanCollide, MaxParts";
 
 /// The handle of a PhysicsObject or of a simulated BasePart, or an error for `what`.
 pub(super) fn object_handle(what: &str, v: &Value) -> mlua::Result<Handle> {
@@ -106,6 +108,12 @@ pub(super) fn params(what: &str, v: &Value) -> mlua::Result<Option<QueryParams>>
                 Value::Boolean(b) => p.respect_can_collide = b,
                 other => return Err(expected(&field, "a boolean", &other)),
             },
+            "MaxParts" => {
+                p.max_parts = match finite_number(&field, &value) {
+                    Ok(n) if n >= 0.0 && n.fract() == 0.0 && n <= u32::MAX as f64 => n as usize,
+                    _ => return Err(expected(&field, "a whole number >= 0", &value)),
+                }
+            }
             _ => {
                 return Err(mlua::Error::runtime(format!(
                     "{what}: unknown params key \"{key}\" (expected one of {PARAM_KEYS})"
@@ -160,16 +168,17 @@ fn result(lua: &Lua, plane: &PlaneState, hit: Option<Hit>) -> mlua::Result<Value
     Ok(Value::Table(t))
 }
 
-fn parts(lua: &Lua, plane: &PlaneState, found: Vec<Handle>) -> mlua::Result<Table> {
+/// The parts an overlap query found, and whether `MaxParts` cut the list.
+fn parts(lua: &Lua, plane: &PlaneState, found: Found) -> mlua::Result<(Table, bool)> {
     let list = lua.create_table()?;
     let mut n = 0;
-    for h in found {
+    for h in found.objects {
         if let (part @ Value::UserData(_), _) = part_and_object(lua, plane, h)? {
             n += 1;
             list.raw_set(n, part)?;
         }
     }
-    Ok(list)
+    Ok((list, found.truncated))
 }
 
 pub(super) fn live(plane: &Rc<PlaneState>, what: &str) -> mlua::Result<()> {
@@ -300,7 +309,7 @@ pub fn add_methods<M: UserDataMethods<PhysicsPlane>>(methods: &mut M) {
             let params = params(W, &opts)?;
             let found =
                 p.0.plane
-                    .bounds_in_radius(position, radius, params.as_ref())
+                    .bounds_in_radius_found(position, radius, params.as_ref())
                     .map_err(|e| sdk_error(W, e))?;
             parts(lua, &p.0, found)
         },
@@ -315,7 +324,7 @@ pub fn add_methods<M: UserDataMethods<PhysicsPlane>>(methods: &mut M) {
             let params = params(W, &opts)?;
             let found =
                 p.0.plane
-                    .bounds_in_box(cframe.pose(), size, params.as_ref())
+                    .bounds_in_box_found(cframe.pose(), size, params.as_ref())
                     .map_err(|e| sdk_error(W, e))?;
             parts(lua, &p.0, found)
         },
@@ -328,7 +337,7 @@ pub fn add_methods<M: UserDataMethods<PhysicsPlane>>(methods: &mut M) {
         let object = client_sdk::Object::from_handle(&p.0.plane, handle);
         let found =
             p.0.plane
-                .parts_in_part(&object, params.as_ref())
+                .parts_in_part_found(&object, params.as_ref())
                 .map_err(|e| sdk_error(W, e))?;
         parts(lua, &p.0, found)
     });

@@ -55,6 +55,26 @@ struct Args {
     /// Let the viewer's page pause, step and resume planes (its `--allow-control`).
     #[arg(long, requires = "view")]
     view_allow_control: bool,
+    /// A directory `LoadMap` / `LoadProp` may read files under (repeatable). Other paths
+    /// are refused with one message that does not tell whether they exist. Default: the
+    /// script's directory and the current directory.
+    #[arg(long = "asset-root")]
+    asset_roots: Vec<PathBuf>,
+}
+
+/// The asset roots of a run: `--asset-root`, or the script's directory and the current one.
+fn asset_roots(args: &Args) -> lua_client::AssetRoots {
+    if !args.asset_roots.is_empty() {
+        return lua_client::AssetRoots::new(args.asset_roots.iter().cloned());
+    }
+    let script_dir = args
+        .script
+        .parent()
+        .map(|p| match p.as_os_str().is_empty() {
+            true => PathBuf::from("."),
+            false => p.to_path_buf(),
+        });
+    lua_client::AssetRoots::new(script_dir.into_iter().chain(std::env::current_dir().ok()))
 }
 
 /// How long the first signal lets a running script's run end before the runner stops the
@@ -287,6 +307,7 @@ fn run(args: &Args, signals: &Signals) -> Result<Ended, String> {
     let lua_err = |e: mlua::Error| e.to_string();
     install_print(&lua).map_err(lua_err)?;
     let host = lua_client::install(&lua, session.client.clone()).map_err(lua_err)?;
+    asset_roots(args).install(&lua);
     // Every global is in place: from here on scripts cannot change builtins or the API.
     lua.sandbox(true).map_err(lua_err)?;
     host.set_stop_flag(signals.shared.stop.clone());

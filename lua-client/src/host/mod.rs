@@ -3,6 +3,7 @@
 //! them. Nothing here knows an API type: what changes per frame (a simulated part's CFrame)
 //! is [`Watched`] through a trait object.
 
+pub mod assets;
 pub mod errors;
 pub mod scheduler;
 pub mod signal;

@@ -5,8 +5,10 @@
 //! Adding a plane kind: a folder of its own (like `rapier3d/`) with a type implementing
 //! [`Backend`], a [`PlaneKind`] variant in shm-layout, and one line in [`create`].
 
+pub mod counted;
 mod dirty;
 pub(crate) mod held;
+pub mod pools;
 mod slot_table;
 
 use std::mem::MaybeUninit;
@@ -55,6 +57,8 @@ pub struct Usage {
     pub objects: u64,
     /// Mesh vertices of all its parts.
     pub mesh_vertices: u64,
+    /// Bytes of state clients grew beyond objects and meshes (controller paths).
+    pub state_bytes: u64,
 }
 
 /// A plane as the server and the publisher see it.

@@ -151,6 +151,7 @@ impl Backend for Plane {
         Usage {
             objects: self.bodies.live() as u64,
             mesh_vertices: 0,
+            state_bytes: self.state_bytes.get(),
         }
     }
 }

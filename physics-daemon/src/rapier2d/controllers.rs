@@ -22,6 +22,7 @@ use shm_layout::{CommandError, EventRecord, Handle, Reply};
 
 use super::hooks::{on_layer, CONTROLLED};
 use super::Plane;
+use crate::backend::counted::CountedVec;
 
 /// Movement below this (px) in a tick is not a `Moved`.
 const MOVED_EPSILON: f32 = 1e-3;
@@ -33,7 +34,8 @@ pub struct Controller {
     uncontrolled: bool,
     move_direction: Vec2,
     jump: bool,
-    waypoints: Vec<Vec2>,
+    /// Counted in the plane's state bytes (a client's quota).
+    waypoints: CountedVec<Vec2>,
     next: usize,
     on_ground: bool,
     last_position: Vec2,
@@ -70,7 +72,7 @@ impl Plane {
                 uncontrolled,
                 move_direction: [0.0; 2],
                 jump: false,
-                waypoints: Vec::new(),
+                waypoints: CountedVec::new(&self.state_bytes),
                 next: 0,
                 on_ground,
                 last_position: [p.x, p.y],
@@ -106,7 +108,7 @@ impl Plane {
                     uncontrolled: c.uncontrolled,
                     move_direction: c.move_direction,
                     on_ground: c.on_ground,
-                    waypoints: c.waypoints.clone(),
+                    waypoints: c.waypoints.to_vec(),
                     next_waypoint: c.next as u32,
                 },
             ))));
@@ -125,7 +127,7 @@ impl Plane {
             GuiControllerOp::Move(d) => c.move_direction = d,
             GuiControllerOp::Jump => c.jump = true,
             GuiControllerOp::SetWaypoints(points) => {
-                c.waypoints = points;
+                c.waypoints.replace(points);
                 c.next = 0;
             }
             GuiControllerOp::ClearWaypoints => {

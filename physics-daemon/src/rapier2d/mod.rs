@@ -80,6 +80,8 @@ pub struct Plane {
     contact_pairs: u32,
     events: Vec<EventRecord>,
     event_seq: u64,
+    /// Bytes of controller paths (counted against the owner's quota).
+    state_bytes: crate::backend::counted::Counter,
 }
 
 impl Plane {
@@ -109,6 +111,7 @@ impl Plane {
             contact_pairs: 0,
             events: Vec::new(),
             event_seq: 0,
+            state_bytes: Default::default(),
         };
         for prop in props {
             plane.apply_prop(*prop, true)?;

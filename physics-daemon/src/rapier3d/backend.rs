@@ -135,6 +135,7 @@ impl Backend for Plane {
         Usage {
             objects: self.bodies.live() as u64 + self.joints.live() as u64,
             mesh_vertices: self.mesh_vertices + self.map_pending.cost(),
+            state_bytes: self.state_bytes.get(),
         }
     }
 }

@@ -31,6 +31,7 @@ use shm_layout::{
 
 use super::part::Part;
 use super::{Body, Plane};
+use crate::backend::counted::{CountedVec, Counter};
 
 /// Gap kept between the capsule and what it touches (units).
 const SKIN: f32 = 0.01;
@@ -58,7 +59,8 @@ pub(super) struct Controller {
     move_vector: [f32; 2],
     /// The facing when the motion intent was last set (see [`Controller::wish`]).
     intent_yaw: f32,
-    path: Vec<Vector>,
+    /// Counted in the plane's state bytes (a client's quota).
+    path: CountedVec<Vector>,
     /// 0-based index of the waypoint being walked to.
     path_index: usize,
     jump: bool,
@@ -94,7 +96,7 @@ fn horizontal(v: Vector) -> Vector {
 }
 
 impl Controller {
-    fn new(settings: ControllerSettings, yaw: f32) -> Controller {
+    fn new(settings: ControllerSettings, yaw: f32, state_bytes: &Counter) -> Controller {
         Controller {
             settings,
             velocity: Vector::ZERO,
@@ -103,7 +105,7 @@ impl Controller {
             ground: None,
             move_vector: [0.0; 2],
             intent_yaw: yaw,
-            path: Vec::new(),
+            path: CountedVec::new(state_bytes),
             path_index: 0,
             jump: false,
             wall_normal: Vector::ZERO,
@@ -198,7 +200,8 @@ impl Plane {
             }
             ControllerOp::SetPath { handle, waypoints } => {
                 let c = self.controller_mut(handle)?;
-                c.path = waypoints.into_iter().map(Vector::from).collect();
+                c.path
+                    .replace(waypoints.into_iter().map(Vector::from).collect());
                 c.path_index = 0;
                 Ok(Reply::Applied { tick: self.tick })
             }
@@ -259,7 +262,7 @@ impl Plane {
     ) -> Result<Handle, CommandError> {
         let mut settings = ControllerSettings::defaults(size, controlled);
         let yaw = yaw_of(pose.rotation);
-        let mut controller = Controller::new(settings, yaw);
+        let mut controller = Controller::new(settings, yaw, &self.state_bytes);
         let mut state = Vec::new();
         for prop in props {
             if !settings.apply(*prop)? {

@@ -40,7 +40,7 @@ mod queries;
 mod solver;
 
 use std::sync::mpsc;
-use std::sync::Arc;
+
 use std::time::Instant;
 
 use rapier3d::prelude::*;
@@ -124,6 +124,8 @@ pub struct Plane {
     gpu: Option<crate::gpu::GpuWorld>,
     /// [`StateHasher`] over every slot as the last step left it (the tick header's).
     state_hash: u64,
+    /// Bytes of controller paths (counted against the owner's quota).
+    state_bytes: crate::backend::counted::Counter,
 }
 
 impl Plane {
@@ -169,6 +171,7 @@ impl Plane {
             #[cfg(feature = "gpu")]
             gpu: None,
             state_hash: 0,
+            state_bytes: Default::default(),
         };
         for prop in props {
             plane.apply_prop(*prop, true)?;
@@ -236,17 +239,18 @@ impl Plane {
     }
 
     fn set_threads(&mut self, n: u32) -> Result<(), CommandError> {
-        // Only a plane that asks for parallelism pays for a pool of its own.
-        let pool = if n > 1 {
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(n as usize)
-                .thread_name(move |i| format!("plane-worker-{i}"))
-                .build()
-                .map_err(|e| CommandError::new(shm_layout::ErrorKind::Internal, e.to_string()))?;
-            Some(Arc::new(pool))
-        } else {
-            None
-        };
+        // Capped by the machine's cores; the plane reads back what it uses. Only a plane
+        // that asks for parallelism pays for a pool, shared with the planes of its size.
+        let used = crate::backend::pools::capped(n);
+        self.settings.threads = used;
+        let pool =
+            if used > 1 {
+                Some(crate::backend::pools::shared(used).map_err(|e| {
+                    CommandError::new(shm_layout::ErrorKind::Internal, e.to_string())
+                })?)
+            } else {
+                None
+            };
         self.world.physics_pipeline.set_thread_pool(pool);
         Ok(())
     }

@@ -8,6 +8,7 @@ use std::collections::HashSet;
 
 use rapier3d::parry::query::ShapeCastOptions;
 use rapier3d::prelude::*;
+use shm_layout::query::page_of;
 use shm_layout::{CommandError, FilterType, Handle, Hit, QueryFilter, QueryOp, Reply, Vec3};
 
 use super::Plane;
@@ -102,6 +103,28 @@ impl Plane {
                 let hit = self.sweep(&f, co.position(), co.shape(), direction);
                 Reply::Hits(vec![hit])
             }
+            QueryOp::Page { query, after_slot } => {
+                let (objects, truncated) = page_of(self.overlap(*query)?, Some(after_slot));
+                Reply::ObjectPage { objects, truncated }
+            }
+            // The proximity queries (probes.rs).
+            op @ (QueryOp::ProbeGround { .. }
+            | QueryOp::ClosestPoint { .. }
+            | QueryOp::Clearance { .. }
+            | QueryOp::ProbeWall { .. }) => Reply::Probe(self.probe(op)?),
+            overlap => match page_of(self.overlap(overlap)?, None) {
+                (objects, false) => Reply::Objects(objects),
+                (objects, true) => Reply::ObjectPage {
+                    objects,
+                    truncated: true,
+                },
+            },
+        })
+    }
+
+    /// Every object an overlap query finds, ascending slots (the caller pages it).
+    fn overlap(&self, op: QueryOp) -> Result<Vec<Handle>, CommandError> {
+        Ok(match op {
             QueryOp::BoundsInRadius {
                 position,
                 radius,
@@ -113,18 +136,18 @@ impl Plane {
                     centre - Vector::splat(radius),
                     centre + Vector::splat(radius),
                 );
-                Reply::Objects(self.bounds_overlapping(&f, query, |aabb| {
+                self.bounds_overlapping(&f, query, |aabb| {
                     // Distance from the centre to the box, squared.
                     let d = (centre.clamp(aabb.mins, aabb.maxs) - centre).length_squared();
                     d <= radius * radius
-                }))
+                })
             }
             QueryOp::BoundsInBox { pose, size, filter } => {
                 let f = self.resolve(&filter, None)?;
                 let pose = super::objects::rapier_pose(pose);
                 let cuboid = Cuboid::new(Vector::from(size) / 2.0);
                 let query = cuboid.compute_aabb(&pose);
-                Reply::Objects(self.bounds_overlapping(&f, query, |aabb| {
+                self.bounds_overlapping(&f, query, |aabb| {
                     let other = rapier3d::math::Pose::from_translation(aabb.center());
                     rapier3d::parry::query::intersection_test(
                         &pose,
@@ -133,7 +156,7 @@ impl Plane {
                         &Cuboid::new(aabb.half_extents()),
                     )
                     .map_or(true, |hit| hit.intersecting)
-                }))
+                })
             }
             QueryOp::InPart { object, filter } => {
                 let (own, collider) = self.collider_of(object)?;
@@ -147,10 +170,13 @@ impl Plane {
                     .collect();
                 found.sort_by_key(|h| h.slot);
                 found.dedup();
-                Reply::Objects(found)
+                found
             }
-            // The proximity queries (probes.rs).
-            op => Reply::Probe(self.probe(op)?),
+            _ => {
+                return Err(CommandError::invalid(
+                    "only BoundsInRadius, BoundsInBox and InPart list objects",
+                ))
+            }
         })
     }
 

@@ -15,7 +15,6 @@ use shm_layout::{
 use super::limits::exceeded;
 use super::worker::{self, Budget, PlaneCell, SharedUsage};
 use super::{Daemon, Origin, PlaneEntry, Routed, MAX_PLANES};
-use crate::backend::Usage;
 use crate::DaemonError;
 
 impl Daemon {
@@ -137,25 +136,12 @@ impl Daemon {
         }
     }
 
-    /// The quotas a run for plane `id` is checked against: what the other planes of its
-    /// owner's process hold.
-    pub(super) fn budget(&self, id: PlaneId) -> Budget {
-        let mut other = Usage::default();
-        if let Some(owner) = self.planes.get(&id).map(|p| p.owner) {
-            for p in self.clients.planes_of_process(owner) {
-                if p == id {
-                    continue;
-                }
-                if let Some(entry) = self.planes.get(&p) {
-                    let usage = entry.usage.get();
-                    other.objects += usage.objects;
-                    other.mesh_vertices += usage.mesh_vertices;
-                }
-            }
-        }
+    /// The quotas a run is checked against: the limits (the owner's totals are reserved
+    /// atomically as ops run, see `quota`), and the reply bytes the request has left.
+    pub(super) fn budget(&self) -> Budget {
         Budget {
             limits: self.options.limits,
-            other,
+            reply_left: self.reply_left,
         }
     }
 
@@ -210,7 +196,8 @@ impl Daemon {
         }
         let id = self.next_plane_id;
         let ticket = self.next_ticket;
-        let usage = Arc::new(SharedUsage::default());
+        let owner_pid = self.clients.get(owner).map_or(0, |c| c.pid);
+        let usage = Arc::new(SharedUsage::new(self.owners.of(owner_pid)));
         let cell = Arc::new(PlaneCell::default());
         let (jobs, receiver) = mpsc::channel();
         let shared = PlaneProp::shared_in(&props);

@@ -35,6 +35,17 @@ pub struct Limits {
         default_value_t = Limits::DEFAULT.commands_per_request
     )]
     pub commands_per_request: usize,
+    /// Bytes of other state in the planes one client process owns (controller paths: 12
+    /// bytes a 3D waypoint, 8 a GUI one).
+    #[arg(
+        long = "max-state-bytes-per-client",
+        default_value_t = Limits::DEFAULT.state_bytes_per_client
+    )]
+    pub state_bytes_per_client: u64,
+    /// Bytes of the reply to one request: results past it are refused with `Quota` (the
+    /// overlap queries' own cap is `MAX_QUERY_RESULTS` objects a query).
+    #[arg(long = "max-reply-bytes", default_value_t = Limits::DEFAULT.reply_bytes)]
+    pub reply_bytes: usize,
 }
 
 impl Limits {
@@ -48,6 +59,8 @@ impl Limits {
         mesh_vertices_per_client: 1_000_000,
         request_bytes: 16 << 20,
         commands_per_request: 262_144,
+        reply_bytes: 8 << 20,
+        state_bytes_per_client: 64 << 20,
     };
 }
 

@@ -26,6 +26,7 @@ mod dispatch;
 pub mod files;
 pub mod heartbeat;
 pub mod limits;
+mod quota;
 mod worker;
 
 use std::collections::{BTreeMap, HashMap, VecDeque};
@@ -97,6 +98,8 @@ struct Pending {
     waiting: Option<u64>,
     /// A reply decided without running commands (malformed, over a limit).
     early: Option<Vec<u8>>,
+    /// Encoded bytes of `results` (counted against `--max-reply-bytes`).
+    reply_bytes: usize,
 }
 
 /// Everything the daemon owns except the WaitSet, the request listener and the workers'
@@ -119,6 +122,10 @@ pub struct Daemon {
     events_tx: Sender<Event>,
     waker: Arc<Waker>,
     workers: Vec<JoinHandle<()>>,
+    /// Per client process, what its planes hold (quotas reserve against it atomically).
+    owners: quota::Owners,
+    /// Reply bytes the request being routed may still fill.
+    reply_left: usize,
 }
 
 /// Wakes the loop of the daemon of `domain` (e.g. from a signal handler thread after setting
@@ -272,6 +279,8 @@ fn serve(
         events_tx,
         waker: Arc::new(Waker::new(wake_end)),
         workers: Vec::new(),
+        owners: quota::Owners::default(),
+        reply_left: 0,
     };
     // iceoryx2 creates its node-counter segment world-writable: narrow it to this user.
     files::restrict(domain);
@@ -314,6 +323,7 @@ fn serve(
         } else if Instant::now() >= next_housekeeping {
             daemon.release_gone_clients();
             daemon.workers.retain(|w| !w.is_finished());
+            daemon.owners.prune();
             next_housekeeping = Instant::now() + HOUSEKEEPING;
         }
     }
@@ -373,6 +383,7 @@ impl Daemon {
                     commands: commands.into(),
                     waiting: None,
                     early: None,
+                    reply_bytes: 0,
                 },
                 Err(reply) => Pending {
                     request,
@@ -381,6 +392,7 @@ impl Daemon {
                     results: Vec::new(),
                     waiting: None,
                     early: Some(reply),
+                    reply_bytes: 0,
                 },
             };
             let queue = self.queues.entry(client).or_default();
@@ -404,8 +416,13 @@ impl Daemon {
                 return;
             }
             while let Some(command) = pending.commands.pop_front() {
+                self.reply_left = self
+                    .options
+                    .limits
+                    .reply_bytes
+                    .saturating_sub(pending.reply_bytes);
                 match self.route(pending.origin, command, &mut pending.commands) {
-                    Routed::Now(results) => pending.results.extend(results),
+                    Routed::Now(results) => pending.count(results),
                     Routed::Wait(ticket) => {
                         pending.waiting = Some(ticket);
                         self.tickets.insert(ticket, client);
@@ -466,7 +483,7 @@ impl Daemon {
                     else {
                         continue;
                     };
-                    pending.results.extend(results);
+                    pending.count(results);
                     pending.waiting = None;
                     self.advance(client);
                 }
@@ -479,7 +496,7 @@ impl Daemon {
     /// queued for it (see [`PlaneCell::try_apply`]); otherwise hands it to the worker, and
     /// the ticket names its answer.
     fn send_job(&mut self, id: PlaneId, ops: Vec<shm_layout::PlaneOp>) -> Routed {
-        let budget = self.budget(id);
+        let budget = self.budget();
         let n = ops.len();
         let Some(entry) = self.planes.get(&id) else {
             return Routed::Now((0..n).map(|_| Err(dispatch::unknown_plane(id))).collect());
@@ -574,6 +591,17 @@ impl Daemon {
             self.queues.remove(&client);
             self.release_client(client);
         }
+    }
+}
+
+impl Pending {
+    /// Adds `results`, counting their encoded bytes.
+    fn count(&mut self, results: Vec<CommandResult>) {
+        self.reply_bytes = results
+            .iter()
+            .map(shm_layout::codec::result_size)
+            .fold(self.reply_bytes, usize::saturating_add);
+        self.results.extend(results);
     }
 }
 

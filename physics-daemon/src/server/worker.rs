@@ -16,7 +16,7 @@
 //! The worker has an iceoryx2 node of its own (ports stay on the thread that made them).
 
 use std::panic::{catch_unwind, AssertUnwindSafe};
-use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::mpsc::{Receiver, RecvTimeoutError, Sender};
 use std::sync::{Arc, Mutex, MutexGuard, TryLockError};
 use std::thread::JoinHandle;
@@ -31,7 +31,7 @@ use shm_layout::{
 
 use super::dispatch::unknown_plane;
 use super::limits::{exceeded, Limits};
-use crate::backend::{self, Backend, Usage};
+use crate::backend::{self, Backend};
 use crate::publish::PlaneOutput;
 use crate::DaemonError;
 
@@ -64,35 +64,16 @@ pub(super) enum Event {
     Failed { plane: PlaneId },
 }
 
-/// The quotas a run is checked against: the limits, and what the other planes of the
-/// plane owner's process held when the run was handed out.
+/// The quotas a run is checked against: the limits, and how many reply bytes the request
+/// it belongs to may still fill.
 #[derive(Debug, Clone, Copy)]
 pub(super) struct Budget {
     pub limits: Limits,
-    pub other: Usage,
+    pub reply_left: usize,
 }
 
-/// A plane's [`Usage`] as the worker last saw it, for the quotas of the owner's other planes.
-#[derive(Debug, Default)]
-pub(super) struct SharedUsage {
-    objects: AtomicU64,
-    mesh_vertices: AtomicU64,
-}
-
-impl SharedUsage {
-    pub fn get(&self) -> Usage {
-        Usage {
-            objects: self.objects.load(Ordering::Relaxed),
-            mesh_vertices: self.mesh_vertices.load(Ordering::Relaxed),
-        }
-    }
-
-    fn set(&self, usage: Usage) {
-        self.objects.store(usage.objects, Ordering::Relaxed);
-        self.mesh_vertices
-            .store(usage.mesh_vertices, Ordering::Relaxed);
-    }
-}
+/// A plane's usage, counted in its owner's total.
+pub(super) type SharedUsage = super::quota::PlaneUsage;
 
 /// The plane, shared by its worker and the request loop.
 #[derive(Default)]
@@ -120,10 +101,13 @@ pub(super) enum Inline {
 impl PlaneCell {
     /// Whether the loop may apply `op` itself: a short op that neither steps nor touches the
     /// plane's shared-memory output (which lives on the worker's thread), and that is cheap
-    /// enough not to hold up the other clients (no meshes, no maps).
+    /// enough not to hold up the other clients (no meshes, no maps, no scene queries: a
+    /// query's time grows with its rays and filter, so it runs on the plane's worker).
     pub fn inline_op(op: &PlaneOp) -> bool {
-        !matches!(op, PlaneOp::Step { .. } | PlaneOp::Info | PlaneOp::Map(_))
-            && op.cost().mesh_vertices == 0
+        !matches!(
+            op,
+            PlaneOp::Step { .. } | PlaneOp::Info | PlaneOp::Map(_) | PlaneOp::Query(_)
+        ) && op.cost().mesh_vertices == 0
     }
 
     /// Notes a run handed to the worker (before sending it).
@@ -158,9 +142,10 @@ impl PlaneCell {
             return Inline::HandOver(ops);
         };
         let before = schedule_of(plane.as_ref());
-        let (results, failed) = run_ops(id, plane.as_mut(), ops, &budget, None, None);
+        let (results, failed) = run_ops(id, plane.as_mut(), ops, &budget, usage, None, None);
         if failed {
             *guard = None;
+            usage.release();
             return Inline::Applied {
                 results,
                 failed,
@@ -377,6 +362,7 @@ impl Drop for Worker {
     fn drop(&mut self) {
         // The plane goes with its worker (before the worker's ports and node).
         self.cell.lock().take();
+        self.usage.release();
     }
 }
 
@@ -435,14 +421,19 @@ impl Worker {
             return false;
         };
         let out = &self.out;
+        // A plane slower than 1 Hz steps its period in equal pieces of at most MAX_DT (the
+        // longest step the engines take) and publishes once.
+        let (pieces, dt) = pieces_of(period);
         let stepped = catch_unwind(AssertUnwindSafe(|| {
-            plane.step(period.as_secs_f32()).and_then(|stepped| {
-                if stepped {
-                    out.publish(plane.as_mut())
-                        .map_err(super::dispatch::internal)?;
-                }
-                Ok(())
-            })
+            let mut stepped = false;
+            for _ in 0..pieces {
+                stepped |= plane.step(dt)?;
+            }
+            if stepped {
+                out.publish(plane.as_mut())
+                    .map_err(super::dispatch::internal)?;
+            }
+            Ok::<(), CommandError>(())
         }));
         match stepped {
             Ok(Ok(())) => {}
@@ -451,6 +442,7 @@ impl Worker {
                 let message = super::dispatch::panic_message(panic.as_ref());
                 tracing::error!(plane = self.id, "plane failed and was removed: {message}");
                 *guard = None;
+                self.usage.release();
                 return false;
             }
         }
@@ -477,11 +469,13 @@ impl Worker {
                     plane.as_mut(),
                     ops,
                     &budget,
+                    &self.usage,
                     Some(&self.out),
                     self.panic_on_step_dt,
                 );
                 if failed {
                     *guard = None;
+                    self.usage.release();
                 } else {
                     self.usage.set(plane.usage());
                 }
@@ -500,6 +494,15 @@ impl Worker {
         }
         outcome
     }
+}
+
+/// How an automatic tick of `period` steps: the number of steps and the dt of each (equal
+/// pieces of at most [`shm_layout::validate::MAX_DT`]).
+fn pieces_of(period: Duration) -> (u32, f32) {
+    let max = shm_layout::validate::MAX_DT as f64;
+    let secs = period.as_secs_f64();
+    let pieces = (secs / max).ceil().max(1.0) as u32;
+    (pieces, (secs / pieces as f64) as f32)
 }
 
 /// The period `plane` asks for now: `None` when manual, disabled, or not representable
@@ -522,17 +525,22 @@ fn run_ops(
     plane: &mut dyn Backend,
     ops: Vec<PlaneOp>,
     budget: &Budget,
+    usage: &SharedUsage,
     out: Option<&PlaneOutput>,
     panic_on_step_dt: Option<f32>,
 ) -> (Vec<CommandResult>, bool) {
     let mut results = Vec::with_capacity(ops.len());
+    let mut reply_left = budget.reply_left;
     let mut ops = ops.into_iter();
     for op in ops.by_ref() {
         let outcome = catch_unwind(AssertUnwindSafe(|| {
-            apply_op(plane, out, panic_on_step_dt, op, budget)
+            apply_op(plane, out, panic_on_step_dt, op, budget, usage)
         }));
         match outcome {
-            Ok(result) => results.push(result),
+            Ok(result) => {
+                let result = count_reply(result, &mut reply_left, &budget.limits);
+                results.push(result)
+            }
             Err(panic) => {
                 let message = super::dispatch::panic_message(panic.as_ref());
                 tracing::error!(plane = id, "plane failed and was removed: {message}");
@@ -554,8 +562,29 @@ fn apply_op(
     panic_on_step_dt: Option<f32>,
     op: PlaneOp,
     budget: &Budget,
+    usage: &SharedUsage,
 ) -> CommandResult {
-    check_quota(plane, &op, budget)?;
+    let cost = op.cost();
+    // Reserved before the op runs, released after the plane's count holds what it added:
+    // runs of the same process on other planes cannot overtake it.
+    let _reserved = if cost == Default::default() {
+        None
+    } else {
+        Some(usage.owner().reserve(&budget.limits, cost)?)
+    };
+    let result = apply_inner(plane, out, panic_on_step_dt, op);
+    if _reserved.is_some() {
+        usage.set(plane.usage());
+    }
+    result
+}
+
+fn apply_inner(
+    plane: &mut dyn Backend,
+    out: Option<&PlaneOutput>,
+    panic_on_step_dt: Option<f32>,
+    op: PlaneOp,
+) -> CommandResult {
     let needs_output = matches!(op, PlaneOp::Step { .. } | PlaneOp::Info);
     let out = match out {
         Some(out) => Some(out),
@@ -591,39 +620,42 @@ fn apply_op(
     }
 }
 
-/// What `op` adds must fit the quotas of the plane's owner.
-fn check_quota(plane: &dyn Backend, op: &PlaneOp, budget: &Budget) -> Result<(), CommandError> {
-    let cost = op.cost();
-    if cost == Default::default() {
-        return Ok(());
-    }
-    let limits = &budget.limits;
-    if cost.mesh_vertices > limits.mesh_vertices_per_object {
+/// Results up to this size always go out (an acknowledgement, a step's tick): they are
+/// about as big as the commands that asked for them, so they amplify nothing.
+const SMALL_RESULT: usize = 64;
+
+/// `result`, or a `Quota` error when it would pass what the request's reply may still
+/// hold; takes its size from `left`.
+fn count_reply(result: CommandResult, left: &mut usize, limits: &Limits) -> CommandResult {
+    let size = shm_layout::codec::result_size(&result);
+    if size > *left && size > SMALL_RESULT {
+        let used = limits.reply_bytes.saturating_sub(*left);
         return Err(exceeded(
-            "mesh vertices per object",
-            limits.mesh_vertices_per_object,
-            "max-mesh-vertices",
-            cost.mesh_vertices,
+            "reply bytes per request",
+            limits.reply_bytes,
+            "max-reply-bytes",
+            used.saturating_add(size),
         ));
     }
-    let own = plane.usage();
-    let objects = budget.other.objects + own.objects + cost.objects as u64;
-    let vertices = budget.other.mesh_vertices + own.mesh_vertices + cost.mesh_vertices;
-    if objects > limits.objects_per_client {
-        return Err(exceeded(
-            "objects per client",
-            limits.objects_per_client,
-            "max-objects-per-client",
-            objects,
-        ));
+    *left = left.saturating_sub(size);
+    result
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn slow_ticks_step_in_pieces_of_at_most_max_dt() {
+        let max = shm_layout::validate::MAX_DT;
+        assert_eq!(pieces_of(Duration::from_secs_f64(1.0 / 60.0)).0, 1);
+        for rate in [0.9f64, 0.5, 0.01] {
+            let (n, dt) = pieces_of(Duration::from_secs_f64(1.0 / rate));
+            assert!(dt <= max && dt > 0.0, "rate {rate}: dt {dt}");
+            assert!(
+                (n as f64 * dt as f64 - 1.0 / rate).abs() < 1e-4,
+                "rate {rate}"
+            );
+        }
     }
-    if vertices > limits.mesh_vertices_per_client {
-        return Err(exceeded(
-            "mesh vertices per client",
-            limits.mesh_vertices_per_client,
-            "max-mesh-vertices-per-client",
-            vertices,
-        ));
-    }
-    Ok(())
 }

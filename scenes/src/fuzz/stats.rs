@@ -366,6 +366,7 @@ pub fn reply_name(reply: &Reply) -> &'static str {
         Reply::Velocity { .. } => "Velocity",
         Reply::Probe(_) => "Probe",
         Reply::Contacts(_) => "Contacts",
+        Reply::ObjectPage { .. } => "ObjectPage",
     }
 }
 
@@ -505,6 +506,7 @@ pub fn query_name(query: &QueryOp) -> &'static str {
         QueryOp::ClosestPoint { .. } => "ClosestPoint",
         QueryOp::Clearance { .. } => "Clearance",
         QueryOp::ProbeWall { .. } => "ProbeWall",
+        QueryOp::Page { .. } => "Page",
     }
 }
 
