@@ -27,6 +27,8 @@ pub mod files;
 pub mod heartbeat;
 pub mod limits;
 mod worker;
+mod origin;
+mod request_bytes;
 
 use std::collections::{BTreeMap, HashMap, VecDeque};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -119,6 +121,10 @@ pub struct Daemon {
     events_tx: Sender<Event>,
     waker: Arc<Waker>,
     workers: Vec<JoinHandle<()>>,
+    /// The control service (its port list tells which node sent a request).
+    control: origin::ControlService,
+    /// Client port → node and process, for identifying senders.
+    origins: origin::Origins,
 }
 
 /// Wakes the loop of the daemon of `domain` (e.g. from a signal handler thread after setting
@@ -222,7 +228,7 @@ fn serve(
         .listener_builder()
         .create()
         .map_err(|e| DaemonError::Ipc(format!("cannot create the request listener: {e:?}")))?;
-    let server = node
+    let control = node
         .service_builder(&names::control())
         .request_response::<[u8], [u8]>()
         .request_user_header::<u128>()
@@ -233,7 +239,8 @@ fn serve(
         .max_nodes(MAX_NODES)
         .max_active_requests_per_client(4)
         .open_or_create()
-        .map_err(|e| DaemonError::Ipc(format!("cannot create the control service: {e:?}")))?
+        .map_err(|e| DaemonError::Ipc(format!("cannot create the control service: {e:?}")))?;
+    let server = control
         .server_builder()
         .initial_max_slice_len(4096)
         .allocation_strategy(AllocationStrategy::PowerOfTwo)
@@ -272,6 +279,8 @@ fn serve(
         events_tx,
         waker: Arc::new(Waker::new(wake_end)),
         workers: Vec::new(),
+        control,
+        origins: origin::Origins::default(),
     };
     // iceoryx2 creates its node-counter segment world-writable: narrow it to this user.
     files::restrict(domain);
@@ -359,13 +368,19 @@ impl Daemon {
                     break;
                 }
             };
-            // Who sent it comes from the transport (the request's origin node), never from
-            // the payload: a client cannot speak for another.
-            let node = request.header().node_id();
-            let client = node.value();
-            let pid = node.pid::<ipc::Service>().map_or(0, |p| p.value() as u32);
-            let origin = Origin { id: client, pid };
-            let pending = match self.decode(request.payload()) {
+            // Who sent it comes from the connection it arrived on (see `origin`), never from
+            // the request header or the payload, which the sender writes: a client cannot
+            // speak for another.
+            let port = request.origin_client_id();
+            let Some(origin) = self.origins.of(&self.control, port) else {
+                tracing::warn!(
+                    port = format!("{port:032x}"),
+                    "request from a client port the service no longer lists: dropped"
+                );
+                continue;
+            };
+            let client = origin.id;
+            let pending = match self.take_bytes(&request).and_then(|b| self.decode(&b)) {
                 Ok(commands) => Pending {
                     request,
                     origin,
