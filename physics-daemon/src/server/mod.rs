@@ -26,9 +26,9 @@ mod dispatch;
 pub mod files;
 pub mod heartbeat;
 pub mod limits;
-mod worker;
 mod origin;
 mod request_bytes;
+mod worker;
 
 use std::collections::{BTreeMap, HashMap, VecDeque};
 use std::sync::atomic::{AtomicBool, Ordering};
