@@ -601,13 +601,73 @@ impl Inner {
         }
         let request = Request { commands };
         let n = request.commands.len();
-        let bytes = if self.options.layout_version == LAYOUT_VERSION {
-            codec::encode_request(&request)
-        } else {
-            codec::encode_request_with_version(&request, self.options.layout_version)
-        };
+        let bytes = self.encode(&request);
         let reply = self.exchange(&bytes, self.transport.id())?;
-        let frame = codec::Frame::parse(&reply).map_err(|e| Error::Protocol(e.to_string()))?;
+        let results = self.results_of(&reply, n)?;
+        self.rejoin_if_forgotten(request.commands, results)
+    }
+
+    /// A daemon that forgot this client (it said Goodbye, or was released) answers
+    /// `NotConnected` to every command from the first one it refused: say Hello again and
+    /// send those commands once more. The commands before it were applied and are not sent
+    /// twice. Planes released with the old connection stay gone (their commands then fail
+    /// with `UnknownPlane`).
+    fn rejoin_if_forgotten(
+        &self,
+        commands: Vec<Command>,
+        mut results: Vec<CommandResult>,
+    ) -> Result<Vec<CommandResult>, Error> {
+        let refused = results
+            .iter()
+            .position(|r| matches!(r, Err(e) if e.kind == ErrorKind::NotConnected));
+        let Some(first) = refused else {
+            return Ok(results);
+        };
+        if self.daemon_node == 0 || matches!(commands[first], Command::Hello { .. }) {
+            return Ok(results);
+        }
+        tracing::debug!("the daemon forgot this client: saying Hello again");
+        let hello = Command::Hello {
+            crate_version: self.options.crate_version.clone(),
+            pid: std::process::id(),
+        };
+        match self.round_trip_once(vec![hello])?.pop() {
+            Some(Ok(Reply::Welcome { .. })) => {}
+            Some(Err(e)) => return Err(e.into()),
+            other => {
+                return Err(Error::Protocol(format!(
+                    "unexpected handshake reply {other:?}"
+                )))
+            }
+        }
+        let again = commands[first..].to_vec();
+        let retried = self.round_trip_once(again)?;
+        results.truncate(first);
+        results.extend(retried);
+        Ok(results)
+    }
+
+    /// One request and its results, without the re-handshake of [`Inner::round_trip`].
+    fn round_trip_once(&self, commands: Vec<Command>) -> Result<Vec<CommandResult>, Error> {
+        let n = commands.len();
+        let request = Request { commands };
+        let bytes = self.encode(&request);
+        let reply = self.exchange(&bytes, self.transport.id())?;
+        self.results_of(&reply, n)
+    }
+
+    /// The bytes of `request` in this client's layout version.
+    fn encode(&self, request: &Request) -> Vec<u8> {
+        if self.options.layout_version == LAYOUT_VERSION {
+            codec::encode_request(request)
+        } else {
+            codec::encode_request_with_version(request, self.options.layout_version)
+        }
+    }
+
+    /// The results of a reply to `n` commands.
+    fn results_of(&self, reply: &[u8], n: usize) -> Result<Vec<CommandResult>, Error> {
+        let frame = codec::Frame::parse(reply).map_err(|e| Error::Protocol(e.to_string()))?;
         if frame.version != self.options.layout_version {
             // The daemon answered in the version-neutral form: its crate version as text.
             return Err(Error::VersionMismatch(format!(
@@ -619,7 +679,7 @@ impl Inner {
                 String::from_utf8_lossy(frame.body),
             )));
         }
-        match codec::decode_response(&reply) {
+        match codec::decode_response(reply) {
             Ok(Response::Results(results)) if results.len() == n => Ok(results),
             Ok(Response::Results(results)) => Err(Error::Protocol(format!(
                 "{n} commands sent, {} results received",

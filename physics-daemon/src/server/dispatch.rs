@@ -18,6 +18,28 @@ use super::{Daemon, Origin, PlaneEntry, Routed, MAX_PLANES};
 use crate::DaemonError;
 
 impl Daemon {
+    /// Copies a request's bytes out of the sender's memory (see `request_bytes`), or the
+    /// reply that rejects it: over `--max-request-bytes` (checked before anything is read),
+    /// or a length past the sender's readable memory.
+    pub(super) fn take_bytes(&self, request: &super::Request) -> Result<Vec<u8>, Vec<u8>> {
+        let payload = request.payload();
+        let limit = self.options.limits.request_bytes;
+        if payload.len() > limit {
+            return Err(codec::encode_response(&Response::Rejected(exceeded(
+                "request bytes",
+                limit,
+                "max-request-bytes",
+                payload.len(),
+            ))));
+        }
+        super::request_bytes::copy(payload.as_ptr(), payload.len()).map_err(|e| {
+            codec::encode_response(&Response::Rejected(CommandError::new(
+                ErrorKind::Malformed,
+                e.to_string(),
+            )))
+        })
+    }
+
     /// Decodes one request into its commands, or the reply that rejects it. Never panics on
     /// any input.
     pub(super) fn decode(&self, bytes: &[u8]) -> Result<Vec<Command>, Vec<u8>> {

@@ -26,7 +26,9 @@ mod dispatch;
 pub mod files;
 pub mod heartbeat;
 pub mod limits;
+mod origin;
 mod quota;
+mod request_bytes;
 mod worker;
 
 use std::collections::{BTreeMap, HashMap, VecDeque};
@@ -126,6 +128,10 @@ pub struct Daemon {
     owners: quota::Owners,
     /// Reply bytes the request being routed may still fill.
     reply_left: usize,
+    /// The control service (its port list tells which node sent a request).
+    control: origin::ControlService,
+    /// Client port → node and process, for identifying senders.
+    origins: origin::Origins,
 }
 
 /// Wakes the loop of the daemon of `domain` (e.g. from a signal handler thread after setting
@@ -229,7 +235,7 @@ fn serve(
         .listener_builder()
         .create()
         .map_err(|e| DaemonError::Ipc(format!("cannot create the request listener: {e:?}")))?;
-    let server = node
+    let control = node
         .service_builder(&names::control())
         .request_response::<[u8], [u8]>()
         .request_user_header::<u128>()
@@ -240,7 +246,8 @@ fn serve(
         .max_nodes(MAX_NODES)
         .max_active_requests_per_client(4)
         .open_or_create()
-        .map_err(|e| DaemonError::Ipc(format!("cannot create the control service: {e:?}")))?
+        .map_err(|e| DaemonError::Ipc(format!("cannot create the control service: {e:?}")))?;
+    let server = control
         .server_builder()
         .initial_max_slice_len(4096)
         .allocation_strategy(AllocationStrategy::PowerOfTwo)
@@ -281,6 +288,8 @@ fn serve(
         workers: Vec::new(),
         owners: quota::Owners::default(),
         reply_left: 0,
+        control,
+        origins: origin::Origins::default(),
     };
     // iceoryx2 creates its node-counter segment world-writable: narrow it to this user.
     files::restrict(domain);
@@ -369,13 +378,19 @@ impl Daemon {
                     break;
                 }
             };
-            // Who sent it comes from the transport (the request's origin node), never from
-            // the payload: a client cannot speak for another.
-            let node = request.header().node_id();
-            let client = node.value();
-            let pid = node.pid::<ipc::Service>().map_or(0, |p| p.value() as u32);
-            let origin = Origin { id: client, pid };
-            let pending = match self.decode(request.payload()) {
+            // Who sent it comes from the connection it arrived on (see `origin`), never from
+            // the request header or the payload, which the sender writes: a client cannot
+            // speak for another.
+            let port = request.origin_client_id();
+            let Some(origin) = self.origins.of(&self.control, port) else {
+                tracing::warn!(
+                    port = format!("{port:032x}"),
+                    "request from a client port the service no longer lists: dropped"
+                );
+                continue;
+            };
+            let client = origin.id;
+            let pending = match self.take_bytes(&request).and_then(|b| self.decode(&b)) {
                 Ok(commands) => Pending {
                     request,
                     origin,

@@ -1,0 +1,322 @@
+//! Hostile clients below the payload: a client owns the shared memory its requests live in,
+//! so it can write any value into the iceoryx2 request header before (or after) sending.
+//! Each test here is such a client, built on raw iceoryx2 ports in this process, tampering
+//! with one header field; each asserts that the daemon survives, is not misled, and serves
+//! an honest client afterwards. The fuzzer (`fuzz.rs`) covers the payload above the header.
+
+use std::time::{Duration, Instant};
+
+use client_sdk::{ErrorKind, PlaneOptions, Pose, Shape};
+use iceoryx2::pending_response::PendingResponse;
+use iceoryx2::port::client::Client as RequestPort;
+use iceoryx2::port::listener::Listener;
+use iceoryx2::port::notifier::Notifier;
+use iceoryx2::prelude::*;
+use integration_tests::TestDaemon;
+use shm_layout::codec::{decode_response, encode_request};
+use shm_layout::{names, Command, CommandResult, PlaneOp, PlaneProp, Request, Response};
+
+/// Where each field sits in iceoryx2 0.10's `#[repr(C)]` request header (node id, client id,
+/// channel id, request id, element count, payload offset); the tests read the fields back
+/// through iceoryx2's accessors where it has them, so a moved field fails loudly.
+const NODE_ID: usize = 0;
+const CLIENT_ID: usize = 16;
+const CHANNEL_ID: usize = 32;
+const NUMBER_OF_ELEMENTS: usize = 48;
+
+type Header = iceoryx2::service::header::request_response::RequestHeader;
+
+/// A client process that speaks the wire protocol through its own raw ports.
+struct Hostile {
+    _node: Node<ipc::Service>,
+    port: RequestPort<ipc::Service, [u8], u128, [u8], ()>,
+    wake: Notifier<ipc::Service>,
+    replies: Listener<ipc::Service>,
+}
+
+impl Hostile {
+    fn open(domain: &str) -> Hostile {
+        let config = names::config(domain).unwrap();
+        let node = NodeBuilder::new()
+            .config(&config)
+            .signal_handling_mode(SignalHandlingMode::Disabled)
+            .create::<ipc::Service>()
+            .unwrap();
+        let port = node
+            .service_builder(&names::control())
+            .request_response::<[u8], [u8]>()
+            .request_user_header::<u128>()
+            .open()
+            .unwrap()
+            .client_builder()
+            .initial_max_slice_len(4096)
+            .allocation_strategy(AllocationStrategy::PowerOfTwo)
+            .create()
+            .unwrap();
+        let wake = node
+            .service_builder(&names::control_wake())
+            .event()
+            .open()
+            .unwrap()
+            .notifier_builder()
+            .create()
+            .unwrap();
+        let replies = node
+            .service_builder(&names::client_wake(node.id().value()))
+            .event()
+            .create()
+            .unwrap()
+            .listener_builder()
+            .create()
+            .unwrap();
+        Hostile {
+            _node: node,
+            port,
+            wake,
+            replies,
+        }
+    }
+
+    /// Sends `commands`, letting `tamper` write into the header (in this process's own
+    /// shared memory) first.
+    fn send(
+        &self,
+        commands: Vec<Command>,
+        tamper: impl FnOnce(*mut u8),
+    ) -> PendingResponse<ipc::Service, [u8], u128, [u8], ()> {
+        let bytes = encode_request(&Request { commands });
+        let request = self
+            .port
+            .loan_slice_uninit(bytes.len())
+            .unwrap()
+            .write_from_slice(&bytes);
+        assert_eq!(
+            std::mem::size_of::<Header>(),
+            64,
+            "iceoryx2's header changed"
+        );
+        let header = request.header() as *const Header as *mut u8;
+        tamper(header);
+        let pending = request.send().unwrap();
+        self.wake.notify().unwrap();
+        pending
+    }
+
+    /// The results of `pending`, or `None` when no reply came within `timeout`.
+    fn reply(
+        &self,
+        pending: &PendingResponse<ipc::Service, [u8], u128, [u8], ()>,
+        timeout: Duration,
+    ) -> Option<Vec<CommandResult>> {
+        let deadline = Instant::now() + timeout;
+        while Instant::now() < deadline {
+            if let Some(response) = pending.receive().unwrap() {
+                return match decode_response(response.payload()).unwrap() {
+                    Response::Results(r) => Some(r),
+                    Response::Rejected(e) => Some(vec![Err(e)]),
+                };
+            }
+            let _ = self.replies.timed_wait(|_| {}, Duration::from_millis(20));
+        }
+        None
+    }
+
+    fn call(&self, commands: Vec<Command>, tamper: impl FnOnce(*mut u8)) -> Vec<CommandResult> {
+        let pending = self.send(commands, tamper);
+        self.reply(&pending, Duration::from_secs(5))
+            .expect("the daemon answers")
+    }
+
+    fn hello(&self) {
+        let r = self.call(
+            vec![Command::Hello {
+                crate_version: shm_layout::CRATE_VERSION.to_string(),
+                pid: std::process::id(),
+            }],
+            |_| {},
+        );
+        assert!(r[0].is_ok(), "{r:?}");
+    }
+}
+
+/// Writes `value` at byte `offset` of the header.
+fn poke<T: Copy>(header: *mut u8, offset: usize, value: T) {
+    // SAFETY: the header is 64 bytes of our own, writable shared memory (asserted in `send`);
+    // writing it is exactly what a hostile process can do to its mapping.
+    unsafe { std::ptr::write_unaligned(header.add(offset).cast::<T>(), value) };
+}
+
+fn peek<T: Copy>(header: *mut u8, offset: usize) -> T {
+    // SAFETY: as in `poke`.
+    unsafe { std::ptr::read_unaligned(header.add(offset).cast::<T>()) }
+}
+
+/// The daemon still runs, an honest new client gets a plane and a body falls in it, and
+/// `survivor` (connected before the attack) still owns and steps its plane.
+fn serves_on(daemon: &mut TestDaemon, survivor: &client_sdk::Plane) {
+    assert!(daemon.is_running(), "the daemon died");
+    falls_one_step(&daemon.client());
+    survivor.step(0.1).unwrap();
+}
+
+/// A ball dropped in a new plane of `client` falls as the integrator says.
+fn falls_one_step(client: &client_sdk::Client) {
+    let plane = client
+        .create_plane(&PlaneOptions {
+            gravity: Some([0.0, -9.81, 0.0]),
+            linear_damping: Some(0.0),
+            ..PlaneOptions::manual()
+        })
+        .unwrap();
+    let ball = plane
+        .add(
+            Shape::Sphere { radius: 0.5 },
+            Pose::at([0.0, 10.0, 0.0]),
+            &[],
+        )
+        .unwrap();
+    plane.step(0.1).unwrap();
+    // Semi-implicit Euler from rest in k equal sub-steps of h/k drops g h^2 (k+1)/(2k):
+    // between g h^2 / 2 (k -> inf) and g h^2 (k = 1), whatever the plane's sub-stepping;
+    // f32 rounding of a 10-unit coordinate is ~1e-6.
+    let (g, h) = (9.81f32, 0.1f32);
+    let drop = 10.0 - ball.position().unwrap()[1];
+    assert!(
+        drop >= 0.5 * g * h * h - 1e-4 && drop <= g * h * h + 1e-4,
+        "drop = {drop}"
+    );
+}
+
+fn step_request(plane: u32) -> Vec<Command> {
+    vec![Command::plane(plane, PlaneOp::Step { dt: 0.1 })]
+}
+
+#[test]
+fn channel_ids_out_of_range_are_dropped() {
+    let mut daemon = TestDaemon::start("hostile-chan");
+    let victim = daemon.client();
+    let survivor = victim.create_plane(&PlaneOptions::manual()).unwrap();
+    let hostile = Hostile::open(&daemon.domain);
+    hostile.hello();
+    for channel in [4usize, 1_000_000, usize::MAX] {
+        let pending = hostile.send(step_request(survivor.id()), |h| {
+            poke(h, CHANNEL_ID, channel);
+            assert_eq!(peek::<usize>(h, CHANNEL_ID), channel);
+        });
+        // Refused without an answer: the reply would need the forged channel.
+        assert!(hostile
+            .reply(&pending, Duration::from_millis(300))
+            .is_none());
+        serves_on(&mut daemon, &survivor);
+    }
+    // The hostile client's own untampered requests are still served.
+    assert!(hostile.call(vec![Command::ListPlanes], |_| {})[0].is_ok());
+}
+
+#[test]
+fn element_counts_past_the_chunk_are_refused() {
+    let mut daemon = TestDaemon::start("hostile-len");
+    let victim = daemon.client();
+    let survivor = victim.create_plane(&PlaneOptions::manual()).unwrap();
+    let hostile = Hostile::open(&daemon.domain);
+    hostile.hello();
+    // 1e6 and 16e6 bytes (under the 16 MiB request limit) point far past a 30-byte request;
+    // the larger ones are over the limit or overflow `count * size`.
+    for count in [1_000_000u64, 16_000_000, 1 << 40, u64::MAX / 2, u64::MAX] {
+        let pending = hostile.send(step_request(survivor.id()), |h| {
+            poke(h, NUMBER_OF_ELEMENTS, count);
+            // SAFETY: `h` is the header `send` holds.
+            let read = unsafe { &*(h as *const Header) }.number_of_elements();
+            assert_eq!(read, count);
+        });
+        match hostile.reply(&pending, Duration::from_millis(500)) {
+            // Dropped by the transport (the count overflows a slice).
+            None => assert!(count > isize::MAX as u64, "count {count} got no reply"),
+            Some(r) => {
+                let e = r[0].as_ref().unwrap_err();
+                assert!(
+                    matches!(e.kind, ErrorKind::Quota | ErrorKind::Malformed),
+                    "count {count}: {e}"
+                );
+                assert!(e.message.contains(&count.to_string()), "count {count}: {e}");
+            }
+        }
+        serves_on(&mut daemon, &survivor);
+    }
+}
+
+#[test]
+fn a_forged_client_id_gets_no_reply_and_misroutes_none() {
+    let mut daemon = TestDaemon::start("hostile-port");
+    let victim = daemon.client();
+    let survivor = victim.create_plane(&PlaneOptions::manual()).unwrap();
+    let hostile = Hostile::open(&daemon.domain);
+    hostile.hello();
+    let other = Hostile::open(&daemon.domain);
+    other.hello();
+    let other_port = other.port.id().value();
+    let pending = hostile.send(vec![Command::ListPlanes], |h| {
+        poke(h, CLIENT_ID, other_port);
+        // SAFETY: `h` is the header `send` holds.
+        assert_eq!(
+            unsafe { &*(h as *const Header) }.client_id().value(),
+            other_port
+        );
+    });
+    assert!(hostile
+        .reply(&pending, Duration::from_millis(300))
+        .is_none());
+    // The port named in the forgery got nothing it did not ask for: its next reply is the
+    // answer to its own request.
+    let r = other.call(vec![Command::plane(survivor.id(), PlaneOp::Info)], |_| {});
+    assert!(r[0].is_ok(), "{r:?}");
+    serves_on(&mut daemon, &survivor);
+}
+
+#[test]
+fn a_forged_node_id_acts_as_the_sender_itself() {
+    let mut daemon = TestDaemon::start("hostile-node");
+    let victim = daemon.client();
+    let plane = victim.create_plane(&PlaneOptions::manual()).unwrap();
+    let hostile = Hostile::open(&daemon.domain);
+    hostile.hello();
+    let victim_node = victim.node_id();
+    let as_victim = |h: *mut u8| {
+        poke(h, NODE_ID, victim_node);
+        // SAFETY: `h` is the header `send` holds.
+        assert_eq!(
+            unsafe { &*(h as *const Header) }.node_id().value(),
+            victim_node
+        );
+    };
+    // Changing and destroying the victim's plane: refused as the hostile client's own.
+    for op in [PlaneOp::Set(PlaneProp::TickRate(30.0)), PlaneOp::Destroy] {
+        let r = hostile.call(vec![Command::plane(plane.id(), op.clone())], as_victim);
+        let e = r[0].as_ref().unwrap_err();
+        assert_eq!(e.kind, ErrorKind::NotOwner, "{op:?}: {e}");
+    }
+    // A forged Goodbye ends the sender's own connection, not the victim's.
+    let r = hostile.call(vec![Command::Goodbye], as_victim);
+    assert!(r[0].is_ok(), "{r:?}");
+    let r = hostile.call(vec![Command::ListPlanes], |_| {});
+    assert_eq!(r[0].as_ref().unwrap_err().kind, ErrorKind::NotConnected);
+    // A node id the daemon never saw, on an unconnected sender: still that sender.
+    let r = hostile.call(vec![Command::ListPlanes], |h| poke(h, NODE_ID, 0x1234u128));
+    assert_eq!(r[0].as_ref().unwrap_err().kind, ErrorKind::NotConnected);
+    // The victim's plane is untouched and still its own.
+    assert_eq!(plane.info().unwrap().tick_rate, 0.0);
+    serves_on(&mut daemon, &plane);
+}
+
+#[test]
+fn a_forgotten_client_says_hello_again() {
+    let daemon = TestDaemon::start("hostile-rejoin");
+    let client = daemon.client();
+    // The client's own Goodbye, sent behind the SDK's back: the daemon forgets it.
+    let bye = encode_request(&Request {
+        commands: vec![Command::Goodbye],
+    });
+    client.raw_request(&bye).unwrap();
+    // The SDK gets NotConnected, says Hello again and repeats the command.
+    falls_one_step(&client);
+}
