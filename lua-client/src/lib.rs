@@ -29,6 +29,7 @@ use client_sdk::Client;
 use mlua::{Lua, Table, Value};
 
 pub use host::assets::AssetRoots;
+pub use host::errors::colon_hint;
 use host::scheduler::{self, Scheduler};
 pub use host::{Host, Stop, WATCH_PERIOD};
 #[doc(hidden)]
@@ -57,9 +58,12 @@ pub fn install(lua: &Lua, client: Client) -> mlua::Result<Host> {
             _ => None,
         };
         found.ok_or_else(|| {
+            let asked = match &name {
+                Value::String(s) => format!("\"{}\"", s.to_string_lossy()),
+                other => values::describe(other),
+            };
             mlua::Error::runtime(format!(
-                "import: no module {} in this host (available: {})",
-                values::describe(&name),
+                "import: no module {asked} in this host (available: {})",
                 api::MODULES.join(", ")
             ))
         })

@@ -604,3 +604,11 @@ fn modules_are_frozen_and_maps_load_only_under_the_asset_roots() {
     r.assert_ok();
     assert!(r.stdout().contains("sandbox assets ok"), "{}", r.stdout());
 }
+
+#[test]
+fn small_messages_say_what_to_do() {
+    let daemon = TestDaemon::start("first-messages");
+    let r = run(&daemon, "tests/lua/small_messages.luau");
+    r.assert_ok();
+    assert!(r.stdout().contains("small messages ok"), "{}", r.stdout());
+}

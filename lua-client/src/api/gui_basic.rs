@@ -203,7 +203,7 @@ fn get(lua: &Lua, p: &PrimState, key: &Value) -> mlua::Result<Value> {
                 .ok_or_else(|| {
                     expected(
                         "GuiPrimitive:GetPropertyChangedSignal",
-                        "a property name (Position, Rotation, Size, ZIndex, Name)",
+                        &format!("a property name ({})", PROPS.join(", ")),
                         &name,
                     )
                 })?;

@@ -270,7 +270,10 @@ impl UserData for GuiPhysicsPlane {
             |_, p, (key, value): (Value, Value)| crate::props::gui::plane_set(&p.0, &key, &value),
         );
         methods.add_meta_method(MetaMethod::ToString, |_, p, ()| {
-            Ok(format!("GuiPhysicsPlane {}", p.0.plane.plane().id()))
+            Ok(match p.0.alive() {
+                true => format!("GuiPhysicsPlane {}", p.0.plane.plane().id()),
+                false => format!("GuiPhysicsPlane {} (destroyed)", p.0.plane.plane().id()),
+            })
         });
     }
 }

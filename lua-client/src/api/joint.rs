@@ -461,10 +461,25 @@ pub fn add_methods<M: UserDataMethods<PhysicsPlane>>(methods: &mut M) {
     methods.add_method("NewJoint", |_, p, args: (Value, Value, Value, Value)| {
         new_joint(p, args)
     });
-    methods.add_method("LoadMap", |lua, p, args: (String, Value)| {
-        load_map(lua, p, args)
+    methods.add_method("LoadMap", |lua, p, (path, opts): (Value, Value)| {
+        load_map(lua, p, (path_arg("PhysicsPlane:LoadMap", &path)?, opts))
     });
-    methods.add_method("LoadProp", |lua, p, args: (String, Value, Value)| {
-        load_prop(lua, p, args)
-    });
+    methods.add_method(
+        "LoadProp",
+        |lua, p, (path, cframe, opts): (Value, Value, Value)| {
+            load_prop(
+                lua,
+                p,
+                (path_arg("PhysicsPlane:LoadProp", &path)?, cframe, opts),
+            )
+        },
+    );
+}
+
+/// A file path argument, or an error naming the call and what was given.
+fn path_arg(what: &str, v: &Value) -> mlua::Result<String> {
+    match v {
+        Value::String(s) => Ok(s.to_str()?.to_string()),
+        other => Err(expected(what, "a file path (a string)", other)),
+    }
 }

@@ -595,8 +595,10 @@ pub fn methods(lua: &Lua) -> mlua::Result<Table> {
         move |lua: &Lua, (this, name): (Value, Value)| {
             let part = this_part(what, &this)?;
             let row = PART.row(&name).ok_or_else(|| {
+                let names: Vec<&str> = PART.rows.iter().map(|r| r.name).collect();
                 mlua::Error::runtime(format!(
-                    "{what} expects a property name (CFrame, Size, Name, Shape), got {}",
+                    "{what} expects a property name ({}), got {}",
+                    names.join(", "),
                     describe(&name)
                 ))
             })?;

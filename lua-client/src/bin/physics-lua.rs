@@ -501,7 +501,10 @@ fn failed(args: &Args, host: &Host, signals: &Signals, e: mlua::Error) -> Result
             "script ran out of memory (limit --max-memory-mb {}; 0 turns it off)\n{e}",
             args.max_memory_mb
         )),
-        None => Err(e.to_string()),
+        None => match lua_client::colon_hint(&e) {
+            Some(hint) => Err(format!("{hint}\n{e}")),
+            None => Err(e.to_string()),
+        },
     }
 }
 

@@ -58,9 +58,10 @@ pub fn script_message(e: &Error) -> String {
         }
         cause = inner;
     }
-    let text = match cause {
-        Error::RuntimeError(m) | Error::MemoryError(m) => m.clone(),
-        other => other.to_string(),
+    let text = match (cause, colon_hint(cause)) {
+        (_, Some(hint)) => hint,
+        (Error::RuntimeError(m) | Error::MemoryError(m), None) => m.clone(),
+        (other, None) => other.to_string(),
     };
     // A Lua error that went through Rust carries its own traceback: the position says where.
     let text = match text.find("\nstack traceback:") {
@@ -68,6 +69,30 @@ pub fn script_message(e: &Error) -> String {
         None => text,
     };
     format!("{}{text}", position.unwrap_or_default())
+}
+
+/// What to say instead of mlua's "bad argument `self`" when a method was called with `.`
+/// (`obj.Method()`, so `self` is missing or another value).
+pub fn colon_hint(e: &Error) -> Option<String> {
+    let mut cause = e;
+    while let Error::CallbackError { cause: inner, .. } = cause {
+        cause = inner;
+    }
+    match cause {
+        Error::BadArgument {
+            to: Some(to),
+            pos: 1,
+            name: Some(name),
+            ..
+        } if name == "self" => {
+            let (owner, method) = to.rsplit_once('.').unwrap_or(("value", to.as_str()));
+            Some(format!(
+                "{owner}.{method} is a method: call it with a colon, x:{method}(...), not \
+                 x.{method}(...)"
+            ))
+        }
+        _ => None,
+    }
 }
 
 /// `"chunk:line: "` of the first script frame in a traceback mlua recorded where a Rust
