@@ -620,7 +620,9 @@ mod tests {
         assert!(s.check(JointKind::SixDof).is_ok());
         // A forged axis index is refused, with or without a motor.
         for motor in [None, Some(AxisMotor::default())] {
-            let e = JointProp::AxisMotor { axis: 9, motor }.checked().unwrap_err();
+            let e = JointProp::AxisMotor { axis: 9, motor }
+                .checked()
+                .unwrap_err();
             assert!(e.message.contains("got 9"), "{}", e.message);
         }
     }
