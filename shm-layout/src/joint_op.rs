@@ -597,4 +597,33 @@ mod tests {
             assert_eq!(JointKind::from_name(k.name()), Some(k));
         }
     }
+
+    #[test]
+    fn axis_motors_need_a_sixdof_joint_and_an_axis_that_moves() {
+        let mut s = JointSettings::default();
+        s.store(JointProp::AxisMotor {
+            axis: 4,
+            motor: Some(AxisMotor::spring(10.0, 1.0, 0.0)),
+        });
+        let e = s.check(JointKind::SixDof).unwrap_err();
+        assert!(e.message.contains("RotY is Locked"), "{}", e.message);
+        let e = s.check(JointKind::Hinge).unwrap_err();
+        assert!(e.message.contains("SixDof"), "{}", e.message);
+        s.store(JointProp::Axes([
+            AxisMode::Locked,
+            AxisMode::Locked,
+            AxisMode::Locked,
+            AxisMode::Locked,
+            AxisMode::Free,
+            AxisMode::Locked,
+        ]));
+        assert!(s.check(JointKind::SixDof).is_ok());
+        // A forged axis index is refused, with or without a motor.
+        for motor in [None, Some(AxisMotor::default())] {
+            let e = JointProp::AxisMotor { axis: 9, motor }
+                .checked()
+                .unwrap_err();
+            assert!(e.message.contains("got 9"), "{}", e.message);
+        }
+    }
 }

@@ -62,3 +62,13 @@ fn planes_and_brushes_meet_rays_contacts_and_controllers_where_their_equations_s
     );
     print!("{out}");
 }
+
+#[test]
+fn animated_ragdoll_bones_follow_their_cframes_and_hits_name_the_bone() {
+    let out = run_script(
+        "rows-ragdoll",
+        "tests/lua/animated_ragdoll.luau",
+        "animated ragdoll ok",
+    );
+    print!("{out}");
+}

@@ -2,6 +2,7 @@
 //! `PhysicsObject` a plane's `:Add` returns ([`object`]), and `Renderable.BasePart`
 //! ([`part`]). Their properties are the rows in `props`; values come from `values`.
 
+pub mod animated_ragdoll;
 pub mod axis_motor;
 pub mod collision_groups;
 pub mod contact_points;

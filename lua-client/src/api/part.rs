@@ -241,6 +241,8 @@ pub struct PartState {
     cframe_value: CFrameCache,
     /// Added anchored (`Renderable.Plane`, `Renderable.Brush`: static shapes).
     anchor_on_add: Cell<bool>,
+    /// The ragdoll bone the part is (hits on it name the bone).
+    bone: RefCell<Option<String>>,
 }
 
 impl PartState {
@@ -260,7 +262,18 @@ impl PartState {
             mesh: RefCell::new(None),
             cframe_value: CFrameCache::default(),
             anchor_on_add: Cell::new(false),
+            bone: RefCell::new(None),
         }
+    }
+
+    /// The ragdoll bone the part is, if any.
+    pub fn bone(&self) -> Option<String> {
+        self.bone.borrow().clone()
+    }
+
+    /// Marks the part as the ragdoll bone `name`.
+    pub fn set_bone(&self, name: &str) {
+        *self.bone.borrow_mut() = Some(name.to_string());
     }
 
     /// Whether `plane:Add` anchors its body from the start.

@@ -165,6 +165,7 @@ fn result(lua: &Lua, plane: &PlaneState, hit: Option<Hit>) -> mlua::Result<Value
     t.set("Object", object)?;
     t.set("Part", part.clone())?;
     t.set("Instance", part)?;
+    t.set("Bone", plane.part_of(hit.object).and_then(|p| p.bone()))?;
     Ok(Value::Table(t))
 }
 

@@ -132,6 +132,7 @@ fn new_ragdoll(lua: &Lua, plane: &PhysicsPlane, desc: Value) -> mlua::Result<Tab
     for b in &d.bones {
         let part = Rc::new(PartState::new(PartShape::Capsule));
         part.set_name(b.name.clone());
+        part.set_bone(&b.name);
         part.resize(lua, WHAT, [2.0 * b.radius, b.length, 2.0 * b.radius])?;
         part.store_cframe(CFrame::from_pose(b.pose));
         let ud = super::part::part_ud(lua, &part)?;
@@ -167,6 +168,7 @@ fn new_ragdoll(lua: &Lua, plane: &PhysicsPlane, desc: Value) -> mlua::Result<Tab
             Ok(())
         })?,
     )?;
+    super::animated_ragdoll::install(lua, &doll)?;
     Ok(doll)
 }
 

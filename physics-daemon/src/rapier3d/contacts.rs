@@ -94,7 +94,8 @@ impl PhysicsHooks for RestThreshold {
 
 impl Plane {
     /// Turns the step's collision events into records: both objects, and for a start the
-    /// contact point, the normal (from `a` toward `b`) and the normal impulse of the step.
+    /// contact point, the normal (from `a` toward `b`), the normal impulse of the step and
+    /// the pair's manifold points (`contact_points.rs`).
     pub(super) fn collect_events(&mut self) {
         self.events.clear();
         // Events the controllers produced before the step come first, in their order.
