@@ -97,9 +97,9 @@ pub struct ControllerInfo {
     pub path_length: u32,
     /// Index (1-based) of the waypoint being walked to; 0 without a path.
     pub path_index: u32,
-    /// Unit normal of the wall beside the capsule after the last tick (a surface steeper
-    /// than MaxSlope, not a ceiling, touching or within a small skin of its side); zero
-    /// when there is none (`OnWall` is false).
+    /// Unit normal of the wall beside the capsule where the last tick's move left it (a
+    /// surface steeper than MaxSlope, not a ceiling, touching or within a small skin of its
+    /// side), probed when this info is asked for; zero when there is none (`OnWall` false).
     pub wall_normal: Vec3,
 }
 

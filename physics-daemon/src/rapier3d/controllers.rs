@@ -64,8 +64,6 @@ pub(super) struct Controller {
     /// 0-based index of the waypoint being walked to.
     path_index: usize,
     jump: bool,
-    /// The wall beside the capsule after the last tick (zero: none).
-    wall_normal: Vector,
 }
 
 /// The yaw of a rotation: the angle about +Y that turns the controller's forward, the
@@ -108,7 +106,6 @@ impl Controller {
             path: CountedVec::new(state_bytes),
             path_index: 0,
             jump: false,
-            wall_normal: Vector::ZERO,
         }
     }
 
@@ -196,6 +193,8 @@ impl Plane {
                 Ok(Reply::Applied { tick: self.tick })
             }
             ControllerOp::Info { handle } => {
+                // The wall probe of the info reads the scene as ops left it.
+                self.refresh_scene();
                 Ok(Reply::Controller(Box::new(self.controller_info(handle)?)))
             }
             ControllerOp::SetPath { handle, waypoints } => {
@@ -404,7 +403,9 @@ impl Plane {
             } else {
                 0
             },
-            wall_normal: c.wall_normal.into(),
+            // Probed on request, where the last tick's move left the capsule: a tick pays
+            // nothing for it.
+            wall_normal: self.controller_wall(handle, c).into(),
         })
     }
 
@@ -585,9 +586,6 @@ impl Plane {
                 events.push((EVENT_CONTROLLER_LANDED, 0, Vector::ZERO));
             }
         }
-
-        // The wall beside the capsule where it ends up (wall running, wall jumps).
-        c.wall_normal = self.wall_beside(h, &shape, next, c.yaw, s.max_slope, groups);
 
         // 7. Push dynamic bodies; clip the velocity against what stopped it (slide along
         // walls, stop at ceilings); a body pushed with less than the cap gave way.
@@ -895,6 +893,27 @@ impl Plane {
 }
 
 impl Plane {
+    /// The wall beside controller `c` (object `handle`) where it stands now, or zero.
+    fn controller_wall(&self, handle: Handle, c: &Controller) -> Vector {
+        let Ok(h) = self.body_of(handle) else {
+            return Vector::ZERO;
+        };
+        let body = &self.world.bodies[h];
+        let groups = body
+            .colliders()
+            .first()
+            .map(|col| self.world.colliders[*col].collision_groups())
+            .unwrap_or_default();
+        self.wall_beside(
+            h,
+            &c.shape(),
+            body.translation(),
+            c.yaw,
+            c.settings.max_slope,
+            groups,
+        )
+    }
+
     /// The unit normal of the nearest wall (steeper than `max_slope`, not a ceiling) within
     /// [`WALL_SKIN`] of the capsule at `position`, or zero.
     #[allow(clippy::too_many_arguments)]
