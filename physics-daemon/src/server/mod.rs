@@ -126,6 +126,8 @@ pub struct Daemon {
     owners: quota::Owners,
     /// Reply bytes the request being routed may still fill.
     reply_left: usize,
+    /// Who pays for what the command being routed adds, when not the plane's owner.
+    guest: Option<Arc<quota::OwnerUsage>>,
 }
 
 /// Wakes the loop of the daemon of `domain` (e.g. from a signal handler thread after setting
@@ -281,6 +283,7 @@ fn serve(
         workers: Vec::new(),
         owners: quota::Owners::default(),
         reply_left: 0,
+        guest: None,
     };
     // iceoryx2 creates its node-counter segment world-writable: narrow it to this user.
     files::restrict(domain);
@@ -501,7 +504,7 @@ impl Daemon {
         let Some(entry) = self.planes.get(&id) else {
             return Routed::Now((0..n).map(|_| Err(dispatch::unknown_plane(id))).collect());
         };
-        let ops = match entry.cell.try_apply(id, ops, budget, &entry.usage) {
+        let ops = match entry.cell.try_apply(id, ops, &budget, &entry.usage) {
             Inline::Applied {
                 results,
                 failed,
