@@ -59,6 +59,9 @@ pub struct PlaneOptions {
     /// `DeferGpu`: run the plane on the GPU (wgpu compute) instead of rapier on the CPU.
     /// Refused, naming the reason, when the daemon has no GPU adapter.
     pub defer_gpu: Option<bool>,
+    /// `SharedObjectLimit`: most objects other clients may have added to this `Shared`
+    /// plane at once (what they add counts against their own quotas). Default: no cap.
+    pub shared_object_limit: Option<u32>,
 }
 
 impl PlaneOptions {
@@ -90,6 +93,7 @@ impl PlaneOptions {
             o.max_linear_speed.map(PlaneProp::MaxLinearSpeed),
             o.max_angular_speed.map(PlaneProp::MaxAngularSpeed),
             o.defer_gpu.map(PlaneProp::DeferGpu),
+            o.shared_object_limit.map(PlaneProp::SharedObjectLimit),
         ]
         .into_iter()
         .flatten()

@@ -2,8 +2,9 @@
 //! used to exhaust the daemon or starve other clients, at a size that runs in seconds in a
 //! debug build yet fails the old code. Reply amplification (overlap queries capped, paged
 //! and counted), queries off the request loop and bounded per request, the quota race of
-//! many connections, controller paths counted against a quota, planes slower than 1 Hz,
-//! and `Threads` capped by cores.
+//! many connections, controller paths counted against a quota, objects added to another's
+//! shared plane counted against the adder, planes slower than 1 Hz, and `Threads` capped by
+//! cores.
 
 use std::sync::{Arc, Barrier};
 use std::time::{Duration, Instant};
@@ -534,4 +535,109 @@ fn controller_paths_count_against_the_state_quota() {
     assert!(refused < POINTS / 2 + 1, "{refused} points appended");
     let e = r[refused].as_ref().unwrap_err();
     assert!(e.message.contains("--max-state-bytes-per-client"), "{e}");
+}
+
+/// A non-owner used to fill a `Shared` plane with objects that counted against the owner, so
+/// the owner's next add to its own plane was refused. Now they count against the adder, the
+/// owner's SharedObjectLimit caps them, and they stop counting once destroyed.
+#[test]
+fn objects_added_to_a_shared_plane_count_against_the_adder() {
+    use std::io::{BufRead, BufReader, Write};
+    const QUOTA: u32 = 100;
+    const LIMIT: u32 = 60;
+    let daemon = TestDaemon::start_with(
+        "hostile-shared",
+        &["--max-objects-per-client", &QUOTA.to_string()],
+        &[],
+    );
+    let mut owner = std::process::Command::new(env!("CARGO_BIN_EXE_test-client"))
+        .args([
+            "share",
+            &daemon.domain,
+            &LIMIT.to_string(),
+            &QUOTA.to_string(),
+        ])
+        .stdin(std::process::Stdio::piped())
+        .stdout(std::process::Stdio::piped())
+        .spawn()
+        .expect("spawn test-client");
+    let mut lines = BufReader::new(owner.stdout.take().unwrap()).lines();
+    let mut line = || lines.next().expect("a line").expect("readable");
+    let plane_id: PlaneId = line().strip_prefix("plane=").unwrap().parse().unwrap();
+
+    let guest = daemon.client();
+    let shared = guest.attach_plane(plane_id).unwrap();
+    assert_eq!(shared.info().unwrap().settings.shared_object_limit, LIMIT);
+    let e = shared
+        .set(PlaneProp::SharedObjectLimit(1_000))
+        .and_then(|_| guest.flush())
+        .unwrap_err();
+    assert!(e.to_string().contains("SharedObjectLimit"), "{e}");
+    // The guest adds past the owner's limit: LIMIT are accepted.
+    let adds = (0..LIMIT + 10)
+        .map(|i| {
+            Cmd::plane(
+                plane_id,
+                PlaneOp::AddObject {
+                    shape: cube(),
+                    pose: Pose::at([i as f32, 0.0, 0.0]),
+                    props: vec![],
+                },
+            )
+        })
+        .collect();
+    let (r, _) = send(&guest, adds);
+    let added: Vec<Handle> = r
+        .iter()
+        .filter_map(|r| match r {
+            Ok(Reply::Object { handle, .. }) => Some(*handle),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(added.len(), LIMIT as usize);
+    let e = r[LIMIT as usize].as_ref().unwrap_err();
+    assert_eq!(e.kind, ErrorKind::Quota, "{e}");
+    assert!(e.message.contains("SharedObjectLimit"), "{e}");
+
+    // The owner still has its whole quota for its own plane.
+    owner.stdin.as_mut().unwrap().write_all(b"go\n").unwrap();
+    assert_eq!(line(), format!("added={QUOTA}"));
+
+    // The guest paid for them: its own plane takes only the rest of its quota.
+    let own = guest.create_plane(&PlaneOptions::manual()).unwrap();
+    let fill = |n: u32| {
+        let adds = (0..n)
+            .map(|i| {
+                Cmd::plane(
+                    own.id(),
+                    PlaneOp::AddObject {
+                        shape: cube(),
+                        pose: Pose::at([i as f32, 0.0, 0.0]),
+                        props: vec![],
+                    },
+                )
+            })
+            .collect();
+        let (r, _) = send(&guest, adds);
+        r.iter().filter(|r| r.is_ok()).count() as u32
+    };
+    assert_eq!(fill(QUOTA), QUOTA - LIMIT);
+    // Destroyed, they stop counting for it.
+    let destroys = added
+        .iter()
+        .map(|h| {
+            Cmd::plane(
+                plane_id,
+                PlaneOp::Object {
+                    handle: *h,
+                    op: shm_layout::ObjectOp::Destroy,
+                },
+            )
+        })
+        .collect();
+    let (r, _) = send(&guest, destroys);
+    assert!(r.iter().all(|r| r.is_ok()));
+    assert_eq!(fill(QUOTA), LIMIT);
+    let _ = owner.kill();
+    let _ = owner.wait();
 }

@@ -448,6 +448,7 @@ fn option(o: &mut PlaneOptions, prop: PlaneProp) {
         PlaneProp::MaxLinearSpeed(v) => o.max_linear_speed = Some(v),
         PlaneProp::MaxAngularSpeed(v) => o.max_angular_speed = Some(v),
         PlaneProp::DeferGpu(v) => o.defer_gpu = Some(v),
+        PlaneProp::SharedObjectLimit(v) => o.shared_object_limit = Some(v),
         // No row of PhysicsPlane makes a GUI option (NewGUI has its own rows).
         PlaneProp::Gui(_) => {}
     }

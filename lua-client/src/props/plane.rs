@@ -161,5 +161,19 @@ pub static PLANE: Props<PlaneState> = Props {
             PlaneProp::MaxAngularSpeed
         ),
         bool_row!("DeferGpu", defer_gpu, PlaneProp::DeferGpu),
+        Row {
+            // Most objects other clients may have added to a Shared plane; owner only.
+            name: "SharedObjectLimit",
+            kind: Kind::Integer {
+                min: 0,
+                max: u32::MAX as i64,
+            },
+            get: Get::Fn(|_, p| {
+                Ok(crate::values::lua_number(
+                    p.info("SharedObjectLimit")?.shared_object_limit,
+                ))
+            }),
+            set: Set::Prop(|a| Ok(PlaneProp::SharedObjectLimit(a.integer()? as u32))),
+        },
     ],
 };

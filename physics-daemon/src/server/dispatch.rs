@@ -130,6 +130,7 @@ impl Daemon {
                     };
                     ops.push(op);
                 }
+                self.guest = self.guest_of(origin, plane);
                 self.send_job(plane, ops)
             }
         }
@@ -150,6 +151,9 @@ impl Daemon {
         };
         match op {
             PlaneOp::Destroy => refused("only its owner may destroy it"),
+            PlaneOp::Set(PlaneProp::SharedObjectLimit(_)) => {
+                refused("only its owner may set SharedObjectLimit")
+            }
             _ if entry.shared => Ok(()),
             _ => refused(
                 "it is not shared, so other clients may only read it (its owner can create it \
@@ -158,12 +162,21 @@ impl Daemon {
         }
     }
 
+    /// The total of the requesting process when it does not own plane `id` (it adds to a
+    /// shared plane: what it adds counts against it).
+    fn guest_of(&mut self, origin: Origin, id: PlaneId) -> Option<Arc<super::quota::OwnerUsage>> {
+        let owner = self.planes.get(&id)?.owner;
+        let owner_pid = self.clients.get(owner).map(|c| c.pid)?;
+        (owner_pid != origin.pid).then(|| self.owners.of(origin.pid))
+    }
+
     /// The quotas a run is checked against: the limits (the owner's totals are reserved
     /// atomically as ops run, see `quota`), and the reply bytes the request has left.
     pub(super) fn budget(&self) -> Budget {
         Budget {
             limits: self.options.limits,
             reply_left: self.reply_left,
+            guest: self.guest.clone(),
         }
     }
 

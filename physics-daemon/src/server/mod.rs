@@ -132,6 +132,8 @@ pub struct Daemon {
     control: origin::ControlService,
     /// Client port → node and process, for identifying senders.
     origins: origin::Origins,
+    /// Who pays for what the command being routed adds, when not the plane's owner.
+    guest: Option<Arc<quota::OwnerUsage>>,
 }
 
 /// Wakes the loop of the daemon of `domain` (e.g. from a signal handler thread after setting
@@ -290,6 +292,7 @@ fn serve(
         reply_left: 0,
         control,
         origins: origin::Origins::default(),
+        guest: None,
     };
     // iceoryx2 creates its node-counter segment world-writable: narrow it to this user.
     files::restrict(domain);
@@ -516,7 +519,7 @@ impl Daemon {
         let Some(entry) = self.planes.get(&id) else {
             return Routed::Now((0..n).map(|_| Err(dispatch::unknown_plane(id))).collect());
         };
-        let ops = match entry.cell.try_apply(id, ops, budget, &entry.usage) {
+        let ops = match entry.cell.try_apply(id, ops, &budget, &entry.usage) {
             Inline::Applied {
                 results,
                 failed,

@@ -6,13 +6,14 @@
 //! one process each add a full quota at once; a reservation cannot be overtaken.
 
 use std::collections::HashMap;
-use std::sync::atomic::{AtomicU64, Ordering};
-use std::sync::Arc;
+use std::sync::atomic::{AtomicU32, AtomicU64, Ordering};
+use std::sync::{Arc, Mutex};
 
-use shm_layout::{CommandError, OpCost};
+use shm_layout::settings::plane::NO_SHARED_OBJECT_LIMIT;
+use shm_layout::{CommandError, ErrorKind, Handle, OpCost, PlaneId};
 
 use super::limits::{exceeded, Limits};
-use crate::backend::Usage;
+use crate::backend::{Backend, Usage};
 
 /// What the planes of one client process hold, all together, plus what ops in flight have
 /// reserved.
@@ -30,6 +31,14 @@ pub struct Reserved<'a> {
     objects: u64,
     mesh_vertices: u64,
     state_bytes: u64,
+}
+
+impl Reserved<'_> {
+    /// Keeps the reservation as a lasting charge (an object another process added to a
+    /// shared plane stays counted for it; [`PlaneUsage`] gives it back).
+    pub fn keep(self) {
+        std::mem::forget(self);
+    }
 }
 
 impl Drop for Reserved<'_> {
@@ -134,20 +143,41 @@ impl OwnerUsage {
     }
 }
 
-/// A plane's [`Usage`] as it last was, kept in its owner's [`OwnerUsage`] total.
+/// A plane's [`Usage`]: the owner's share kept in its owner's [`OwnerUsage`] total, and the
+/// objects other processes added to it (a `Shared` plane), each kept in its adder's total
+/// until it is destroyed or the plane goes.
 #[derive(Debug)]
 pub struct PlaneUsage {
-    now: std::sync::Mutex<Usage>,
+    state: Mutex<PlaneState>,
     owner: Arc<OwnerUsage>,
+    /// `SharedObjectLimit`: most objects other processes may have added at once.
+    guest_limit: AtomicU32,
+}
+
+#[derive(Debug, Default)]
+struct PlaneState {
+    /// The owner's share as counted in its total.
+    share: Usage,
+    /// Objects other processes added, by handle: who pays, and what.
+    guests: HashMap<Handle, (Arc<OwnerUsage>, Usage)>,
+    /// The sum of `guests`.
+    guest_total: Usage,
+    /// The plane's objects at the last update (fewer now: some were destroyed).
+    objects: u64,
 }
 
 impl PlaneUsage {
     /// A plane that holds nothing yet, counted for `owner`.
     pub fn new(owner: Arc<OwnerUsage>) -> PlaneUsage {
         PlaneUsage {
-            now: std::sync::Mutex::new(Usage::default()),
+            state: Mutex::default(),
             owner,
+            guest_limit: AtomicU32::new(NO_SHARED_OBJECT_LIMIT),
         }
+    }
+
+    fn lock(&self) -> std::sync::MutexGuard<'_, PlaneState> {
+        self.state.lock().unwrap_or_else(|p| p.into_inner())
     }
 
     /// The owner's total.
@@ -155,18 +185,91 @@ impl PlaneUsage {
         &self.owner
     }
 
-    /// The plane now holds `usage`.
-    pub fn set(&self, usage: Usage) {
-        let mut now = self.now.lock().unwrap_or_else(|p| p.into_inner());
-        if *now != usage {
-            self.owner.change(*now, usage);
-            *now = usage;
+    /// Sets `SharedObjectLimit`.
+    pub fn set_guest_limit(&self, limit: u32) {
+        self.guest_limit.store(limit, Ordering::SeqCst);
+    }
+
+    /// Whether other processes may add `objects` more objects (`SharedObjectLimit`).
+    pub fn check_guest_room(&self, plane: PlaneId, objects: u64) -> Result<(), CommandError> {
+        let limit = self.guest_limit.load(Ordering::SeqCst);
+        let now = self.lock().guest_total.objects;
+        if now + objects > limit as u64 {
+            return Err(CommandError::new(
+                ErrorKind::Quota,
+                format!(
+                    "quota exceeded: objects other clients may add to plane {plane} are limited \
+                     to {limit} (its owner's SharedObjectLimit), this would make {}",
+                    now + objects
+                ),
+            ));
+        }
+        Ok(())
+    }
+
+    /// Another process added the object `handle` and keeps paying `cost` for it (its
+    /// reservation was kept).
+    pub fn add_guest(&self, handle: Handle, who: Arc<OwnerUsage>, cost: Usage) {
+        let mut st = self.lock();
+        st.guest_total = sum(st.guest_total, cost);
+        if let Some((old, old_cost)) = st.guests.insert(handle, (who, cost)) {
+            // A slot reused under the same handle cannot happen; stay exact if it did.
+            old.change(old_cost, Usage::default());
+            st.guest_total = less(st.guest_total, old_cost);
         }
     }
 
-    /// The plane is gone: it holds nothing.
+    /// The plane now holds what `plane` reports: the owner pays for what no other process
+    /// pays for. Objects other processes added that are gone stop counting for them.
+    pub fn update(&self, plane: &dyn Backend) {
+        let usage = plane.usage();
+        let mut st = self.lock();
+        if usage.objects < st.objects && !st.guests.is_empty() {
+            let slots = plane.slot_count();
+            let mut gone = Usage::default();
+            st.guests.retain(|h, (who, cost)| {
+                let alive =
+                    (h.slot as usize) < slots && plane.body_state(h.slot as usize).matches(*h);
+                if !alive {
+                    who.change(*cost, Usage::default());
+                    gone = sum(gone, *cost);
+                }
+                alive
+            });
+            st.guest_total = less(st.guest_total, gone);
+        }
+        st.objects = usage.objects;
+        let share = less(usage, st.guest_total);
+        if st.share != share {
+            self.owner.change(st.share, share);
+            st.share = share;
+        }
+    }
+
+    /// The plane is gone: it holds nothing, and nobody pays for it any more.
     pub fn release(&self) {
-        self.set(Usage::default());
+        let mut st = self.lock();
+        self.owner.change(st.share, Usage::default());
+        for (_, (who, cost)) in st.guests.drain() {
+            who.change(cost, Usage::default());
+        }
+        *st = PlaneState::default();
+    }
+}
+
+fn sum(a: Usage, b: Usage) -> Usage {
+    Usage {
+        objects: a.objects + b.objects,
+        mesh_vertices: a.mesh_vertices + b.mesh_vertices,
+        state_bytes: a.state_bytes + b.state_bytes,
+    }
+}
+
+fn less(a: Usage, b: Usage) -> Usage {
+    Usage {
+        objects: a.objects.saturating_sub(b.objects),
+        mesh_vertices: a.mesh_vertices.saturating_sub(b.mesh_vertices),
+        state_bytes: a.state_bytes.saturating_sub(b.state_bytes),
     }
 }
 
@@ -238,16 +341,30 @@ mod tests {
     }
 
     #[test]
-    fn a_plane_that_goes_gives_its_count_back() {
+    fn a_plane_that_goes_gives_back_what_its_adders_pay() {
         let owner = Arc::new(OwnerUsage::default());
+        let guest = Arc::new(OwnerUsage::default());
         let plane = PlaneUsage::new(owner.clone());
-        plane.set(Usage {
-            objects: 7,
-            mesh_vertices: 30,
-            state_bytes: 1_000,
-        });
-        assert_eq!(owner.get().objects, 7);
+        let limits = Limits::DEFAULT;
+        guest.reserve(&limits, cost(1)).unwrap().keep();
+        let one = Usage {
+            objects: 1,
+            ..Usage::default()
+        };
+        plane.add_guest(
+            Handle {
+                slot: 3,
+                generation: 1,
+            },
+            guest.clone(),
+            one,
+        );
+        assert_eq!(guest.get().objects, 1);
+        assert_eq!(owner.get().objects, 0);
+        plane.set_guest_limit(1);
+        assert!(plane.check_guest_room(7, 1).is_err());
         drop(plane);
+        assert_eq!(guest.get(), Usage::default());
         assert_eq!(owner.get(), Usage::default());
     }
 

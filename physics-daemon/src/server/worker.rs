@@ -31,7 +31,7 @@ use shm_layout::{
 
 use super::dispatch::unknown_plane;
 use super::limits::{exceeded, Limits};
-use crate::backend::{self, Backend};
+use crate::backend::{self, Backend, Usage};
 use crate::publish::PlaneOutput;
 use crate::DaemonError;
 
@@ -64,12 +64,15 @@ pub(super) enum Event {
     Failed { plane: PlaneId },
 }
 
-/// The quotas a run is checked against: the limits, and how many reply bytes the request
-/// it belongs to may still fill.
-#[derive(Debug, Clone, Copy)]
+/// The quotas a run is checked against: the limits, how many reply bytes the request it
+/// belongs to may still fill, and who pays for what it adds.
+#[derive(Debug, Clone)]
 pub(super) struct Budget {
     pub limits: Limits,
     pub reply_left: usize,
+    /// The requesting process's total when it is not the plane owner's (a `Shared` plane):
+    /// the objects it adds count against it.
+    pub guest: Option<Arc<super::quota::OwnerUsage>>,
 }
 
 /// A plane's usage, counted in its owner's total.
@@ -123,7 +126,7 @@ impl PlaneCell {
         &self,
         id: PlaneId,
         ops: Vec<PlaneOp>,
-        budget: Budget,
+        budget: &Budget,
         usage: &SharedUsage,
     ) -> Inline {
         if !ops.iter().all(PlaneCell::inline_op) || self.queued.load(Ordering::SeqCst) != 0 {
@@ -142,7 +145,7 @@ impl PlaneCell {
             return Inline::HandOver(ops);
         };
         let before = schedule_of(plane.as_ref());
-        let (results, failed) = run_ops(id, plane.as_mut(), ops, &budget, usage, None, None);
+        let (results, failed) = run_ops(id, plane.as_mut(), ops, budget, usage, None, None);
         if failed {
             *guard = None;
             usage.release();
@@ -152,7 +155,7 @@ impl PlaneCell {
                 reschedule: false,
             };
         }
-        usage.set(plane.usage());
+        usage.update(plane.as_ref());
         let reschedule = schedule_of(plane.as_ref()) != before;
         Inline::Applied {
             results,
@@ -384,7 +387,12 @@ fn create(setup: &Setup) -> Result<(Worker, Reply), CommandError> {
     out.publish(plane.as_mut()).map_err(internal)?;
     let info = plane.apply(PlaneOp::Info)?;
     tracing::info!(plane = id, kind = ?setup.kind, ?info, "plane created");
-    setup.usage.set(plane.usage());
+    for prop in &setup.props {
+        if let PlaneProp::SharedObjectLimit(limit) = prop {
+            setup.usage.set_guest_limit(*limit);
+        }
+    }
+    setup.usage.update(plane.as_ref());
     *setup.cell.lock() = Some(plane);
     Ok((
         Worker {
@@ -446,7 +454,7 @@ impl Worker {
                 return false;
             }
         }
-        self.usage.set(plane.usage());
+        self.usage.update(plane.as_ref());
         drop(guard);
         // Keep the cadence; after a stall, restart from now instead of catching up.
         let now = Instant::now();
@@ -477,7 +485,7 @@ impl Worker {
                     *guard = None;
                     self.usage.release();
                 } else {
-                    self.usage.set(plane.usage());
+                    self.usage.update(plane.as_ref());
                 }
                 (results, failed)
             }
@@ -534,7 +542,7 @@ fn run_ops(
     let mut ops = ops.into_iter();
     for op in ops.by_ref() {
         let outcome = catch_unwind(AssertUnwindSafe(|| {
-            apply_op(plane, out, panic_on_step_dt, op, budget, usage)
+            apply_op(id, plane, out, panic_on_step_dt, op, budget, usage)
         }));
         match outcome {
             Ok(result) => {
@@ -557,6 +565,7 @@ fn run_ops(
 }
 
 fn apply_op(
+    id: PlaneId,
     plane: &mut dyn Backend,
     out: Option<&PlaneOutput>,
     panic_on_step_dt: Option<f32>,
@@ -565,17 +574,39 @@ fn apply_op(
     usage: &SharedUsage,
 ) -> CommandResult {
     let cost = op.cost();
+    if let PlaneOp::Set(PlaneProp::SharedObjectLimit(limit)) = op {
+        let result = apply_inner(plane, out, panic_on_step_dt, op);
+        if result.is_ok() {
+            usage.set_guest_limit(limit);
+        }
+        return result;
+    }
+    if cost == Default::default() {
+        return apply_inner(plane, out, panic_on_step_dt, op);
+    }
+    // An object another process adds to this (shared) plane counts against that process,
+    // within the owner's SharedObjectLimit, for as long as the object lives.
+    if let (Some(guest), PlaneOp::AddObject { .. }) = (&budget.guest, &op) {
+        usage.check_guest_room(id, cost.objects as u64)?;
+        let reserved = guest.reserve(&budget.limits, cost)?;
+        let result = apply_inner(plane, out, panic_on_step_dt, op);
+        if let Ok(Reply::Object { handle, .. }) = &result {
+            reserved.keep();
+            let paid = Usage {
+                objects: cost.objects as u64,
+                mesh_vertices: cost.mesh_vertices,
+                state_bytes: cost.state_bytes,
+            };
+            usage.add_guest(*handle, guest.clone(), paid);
+        }
+        usage.update(&*plane);
+        return result;
+    }
     // Reserved before the op runs, released after the plane's count holds what it added:
     // runs of the same process on other planes cannot overtake it.
-    let _reserved = if cost == Default::default() {
-        None
-    } else {
-        Some(usage.owner().reserve(&budget.limits, cost)?)
-    };
+    let _reserved = usage.owner().reserve(&budget.limits, cost)?;
     let result = apply_inner(plane, out, panic_on_step_dt, op);
-    if _reserved.is_some() {
-        usage.set(plane.usage());
-    }
+    usage.update(&*plane);
     result
 }
 

@@ -50,7 +50,14 @@ pub enum PlaneProp {
     DeferGpu(bool),
     /// An option of a GUI plane (`PhysicsService.NewGUI`); 3D planes refuse it.
     Gui(super::gui_plane::GuiPlaneProp),
+    /// Most objects other clients (processes) may have added to a `Shared` plane at once;
+    /// what they add counts against their own quotas. Only the owner sets it. Default
+    /// [`NO_SHARED_OBJECT_LIMIT`]: no cap beyond the adders' quotas; 0: others add nothing.
+    SharedObjectLimit(u32),
 }
+
+/// Default `SharedObjectLimit`: no cap beyond the adders' own quotas.
+pub const NO_SHARED_OBJECT_LIMIT: u32 = u32::MAX;
 
 /// Default `MaxLinearSpeed`: 10,000 units/s. With units like Roblox studs (≈ 0.28 m) that is
 /// about 2.8 km/s, above any projectile a game fires (a rifle bullet is ≈ 3,200 units/s) and
@@ -102,6 +109,8 @@ pub struct PlaneSettings {
     pub max_angular_speed: f32,
     /// `DeferGpu`, default false (the CPU, rapier).
     pub defer_gpu: bool,
+    /// `SharedObjectLimit`, default [`NO_SHARED_OBJECT_LIMIT`].
+    pub shared_object_limit: u32,
 }
 
 impl Default for PlaneSettings {
@@ -124,6 +133,7 @@ impl Default for PlaneSettings {
             max_linear_speed: DEFAULT_MAX_LINEAR_SPEED,
             max_angular_speed: DEFAULT_MAX_ANGULAR_SPEED,
             defer_gpu: false,
+            shared_object_limit: NO_SHARED_OBJECT_LIMIT,
         }
     }
 }
@@ -161,6 +171,7 @@ impl PlaneSettings {
             PlaneProp::MaxLinearSpeed(v) => self.max_linear_speed = v,
             PlaneProp::MaxAngularSpeed(w) => self.max_angular_speed = w,
             PlaneProp::DeferGpu(on) => self.defer_gpu = on,
+            PlaneProp::SharedObjectLimit(n) => self.shared_object_limit = n,
             PlaneProp::Gui(g) => {
                 return Err(CommandError::invalid_field(
                     g.name(),
@@ -197,6 +208,7 @@ impl PlaneProp {
             PlaneProp::MaxAngularSpeed(_) => "MaxAngularSpeed",
             PlaneProp::DeferGpu(_) => "DeferGpu",
             PlaneProp::Gui(g) => g.name(),
+            PlaneProp::SharedObjectLimit(_) => "SharedObjectLimit",
         }
     }
 
@@ -236,6 +248,7 @@ impl PlaneProp {
             | PlaneProp::Shared(b)
             | PlaneProp::DeferGpu(b) => b.to_string(),
             PlaneProp::Gui(g) => format!("{g:?}"),
+            PlaneProp::SharedObjectLimit(n) => n.to_string(),
         }
     }
 

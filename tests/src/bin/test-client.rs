@@ -4,6 +4,9 @@
 //! test-client read DOMAIN PLANE SLOT GEN   attach, print "tick=T x y z" of that body
 //! test-client hold-once DOMAIN             create a plane, print "plane=ID", exit
 //! test-client start-and-hold DOMAIN        start a daemon on demand, print "daemon=PID", sleep
+//! test-client share DOMAIN LIMIT N         create a Shared plane with SharedObjectLimit
+//!                                          LIMIT, print "plane=ID"; on a line from stdin
+//!                                          add N cubes to a private plane, print "added=K"
 
 use std::io::Write;
 
@@ -60,6 +63,36 @@ fn main() {
                 p[1],
                 p[2]
             );
+        }
+        "share" => {
+            let n = |i: usize| args[i].parse::<u32>().expect("number");
+            let shared = client
+                .create_plane(&PlaneOptions {
+                    shared: Some(true),
+                    shared_object_limit: Some(n(3)),
+                    ..PlaneOptions::manual()
+                })
+                .expect("create shared plane");
+            println!("plane={}", shared.id());
+            std::io::stdout().flush().unwrap();
+            let mut line = String::new();
+            std::io::stdin().read_line(&mut line).unwrap();
+            let own = client
+                .create_plane(&PlaneOptions::manual())
+                .expect("create plane");
+            let added = (0..n(4))
+                .take_while(|i| {
+                    own.add(
+                        Shape::Cube { size: [0.5; 3] },
+                        Pose::at([*i as f32, 0.0, 0.0]),
+                        &[],
+                    )
+                    .is_ok()
+                })
+                .count();
+            println!("added={added}");
+            std::io::stdout().flush().unwrap();
+            std::thread::sleep(std::time::Duration::from_secs(3600));
         }
         other => panic!("unknown mode {other}"),
     }
