@@ -71,6 +71,9 @@ pub fn install(lua: &Lua, client: Client) -> mlua::Result<Host> {
     let globals = lua.globals();
     globals.set("import", import)?;
     globals.set("Heart", scheduler.heart.clone())?;
+    // The reference's controller snippet uses DynMesh without importing it.
+    let dyn_mesh: Table = globals.get::<mlua::Function>("import")?.call("DynMesh")?;
+    globals.set("DynMesh", dyn_mesh)?;
     globals.set("wait", scheduler::wait_function(lua)?)?;
     Ok(Host::new(lua, scheduler, client))
 }

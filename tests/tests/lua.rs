@@ -556,7 +556,7 @@ fn impulses_read_back_at_once_and_divide_by_the_mass_just_written() {
 
 #[test]
 fn parts_follow_their_collision_groups_renaming_and_removal() {
-    let daemon = TestDaemon::start("first-group-rename");
+    let daemon = TestDaemon::start("first-groups");
     let r = run(&daemon, "tests/lua/group_rename.luau");
     r.assert_ok();
     assert!(r.stdout().contains("group rename ok"), "{}", r.stdout());
@@ -611,4 +611,12 @@ fn small_messages_say_what_to_do() {
     let r = run(&daemon, "tests/lua/small_messages.luau");
     r.assert_ok();
     assert!(r.stdout().contains("small messages ok"), "{}", r.stdout());
+}
+
+#[test]
+fn dyn_mesh_welds_ride_along_with_their_driver() {
+    let daemon = TestDaemon::start("first-dyn-mesh");
+    let r = run(&daemon, "tests/lua/dyn_mesh.luau");
+    r.assert_ok();
+    assert!(r.stdout().contains("dyn mesh ok"), "{}", r.stdout());
 }

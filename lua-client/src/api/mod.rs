@@ -8,6 +8,7 @@ pub mod collision_groups;
 pub mod contact_points;
 pub mod contacts;
 pub mod controller;
+pub mod dyn_mesh;
 pub mod gui_basic;
 pub mod gui_controller;
 pub mod gui_object;
@@ -30,7 +31,13 @@ use mlua::{Function, Lua, Table, Value};
 use crate::props::{Props, Target};
 
 /// The modules `import` knows, in the order error messages list them.
-pub const MODULES: [&str; 4] = ["PhysicsService", "Renderable", "Primitives", "GUI"];
+pub const MODULES: [&str; 5] = [
+    "PhysicsService",
+    "Renderable",
+    "Primitives",
+    "GUI",
+    "DynMesh",
+];
 
 /// Methods of the types whose `__index` is ours alone (see [`index`]).
 pub struct MethodTables {
@@ -60,6 +67,7 @@ pub fn modules(lua: &Lua, client: Client) -> mlua::Result<Table> {
     modules.set("Renderable", part::module(lua)?)?;
     modules.set("Primitives", crate::values::module(lua)?)?;
     modules.set("GUI", gui_basic::module(lua)?)?;
+    modules.set("DynMesh", dyn_mesh::module(lua)?)?;
     freeze(&modules)?;
     Ok(modules)
 }

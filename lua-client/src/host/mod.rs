@@ -30,6 +30,11 @@ pub trait Watched {
     fn listeners(&self) -> usize;
     /// Fires the change signal if the value moved since it last fired.
     fn fire_if_changed(&self, lua: &Lua) -> mlua::Result<()>;
+    /// Whether its listeners keep a script's frames running (a script's change handlers
+    /// do; work the host does for the script, such as welds, does not).
+    fn keeps_running(&self) -> bool {
+        true
+    }
 }
 
 /// A host's handle on the installed API: drives frames.

@@ -91,7 +91,7 @@ impl Scheduler {
             .borrow()
             .iter()
             .filter_map(Weak::upgrade)
-            .any(|w| w.listeners() > 0)
+            .any(|w| w.listeners() > 0 && w.keeps_running())
     }
 
     /// One frame. Physics results come first: the change signals of simulated parts with
