@@ -203,7 +203,8 @@ impl<'a> Gen<'a> {
             u if u < 0.45 => self.add_object(wild),
             // The newer op families take small slices, so object ops (mostly applied) keep
             // their share and a run still exercises the engine, not only the checks.
-            u if u < 0.48 => PlaneOp::Query(self.query(wild, id)),
+            u if u < 0.475 => PlaneOp::Query(self.query(wild, id)),
+            u if u < 0.48 => PlaneOp::Explode(self.explosion(wild, id)),
             u if u < 0.485 => PlaneOp::CollisionGroups(self.collision_groups(wild)),
             u if u < 0.51 => PlaneOp::Controller(self.controller_op(wild, id)),
             u if u < 0.53 => PlaneOp::Gui(self.gui_op(wild, id)),
@@ -268,7 +269,7 @@ impl<'a> Gen<'a> {
             let v = r.log_f32(0.01, 5.0);
             r.maybe_wild(wild, v)
         };
-        match r.below(7) {
+        match r.below(11) {
             0 => QueryOp::Raycast {
                 rays: (0..r.below(70))
                     .map(|_| Ray {
@@ -305,10 +306,61 @@ impl<'a> Gen<'a> {
                 size: [radius, 2.0, 1.0],
                 filter,
             },
-            _ => QueryOp::InPart {
+            6 => QueryOp::InPart {
                 object: self.handle(wild, id),
                 filter,
             },
+            7 => QueryOp::ProbeGround {
+                position: r.vec3(wild, 30.0),
+                radius,
+                max_distance: r.maybe_wild(wild, 20.0),
+                max_slope: r.maybe_wild(wild, 45.0),
+                filter,
+            },
+            8 => QueryOp::ClosestPoint {
+                position: r.vec3(wild, 30.0),
+                max_distance: r.maybe_wild(wild, 50.0),
+                filter,
+            },
+            9 => QueryOp::Clearance {
+                shape: Shape::Capsule {
+                    size: [radius, radius * 3.0, radius],
+                },
+                pose: r.pose(wild, 30.0),
+                max_distance: r.maybe_wild(wild, 50.0),
+                own: None,
+                filter,
+            },
+            _ => QueryOp::ProbeWall {
+                pose: r.pose(wild, 30.0),
+                radius,
+                height: r.maybe_wild(wild, 3.0),
+                max_distance: r.maybe_wild(wild, 1.0),
+                max_slope: r.maybe_wild(wild, 45.0),
+                filter,
+            },
+        }
+    }
+
+    /// An explosion with valid or wild numbers and filter.
+    fn explosion(&mut self, wild: bool, id: PlaneId) -> shm_layout::Explosion {
+        let filter = QueryFilter {
+            list: (0..self.rng.below(3))
+                .map(|_| self.handle(wild, id))
+                .collect(),
+            ..QueryFilter::default()
+        };
+        let r = &mut *self.rng;
+        shm_layout::Explosion {
+            center: r.vec3(wild, 30.0),
+            radius: r.maybe_wild(wild, 8.0),
+            impulse: r.maybe_wild(wild, 20.0),
+            falloff: *r.pick(&[
+                shm_layout::Falloff::Linear,
+                shm_layout::Falloff::None,
+                shm_layout::Falloff::InverseSquare,
+            ]),
+            filter,
         }
     }
 

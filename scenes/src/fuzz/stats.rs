@@ -299,9 +299,14 @@ pub fn all_op_names() -> Vec<String> {
         "BoundsInRadius",
         "BoundsInBox",
         "InPart",
+        "ProbeGround",
+        "ClosestPoint",
+        "Clearance",
+        "ProbeWall",
     ] {
         names.push(format!("Plane.Query.{q}"));
     }
+    names.push("Plane.Explode".into());
     for c in [
         "Create",
         "Set",
