@@ -6,7 +6,7 @@
 
 use std::time::{Duration, Instant};
 
-use client_sdk::{ErrorKind, PlaneOptions, Pose, Shape};
+use client_sdk::{Client, ErrorKind, PlaneOptions, Pose, Shape};
 use iceoryx2::pending_response::PendingResponse;
 use iceoryx2::port::client::Client as RequestPort;
 use iceoryx2::port::listener::Listener;
@@ -319,4 +319,116 @@ fn a_forgotten_client_says_hello_again() {
     client.raw_request(&bye).unwrap();
     // The SDK gets NotConnected, says Hello again and repeats the command.
     falls_one_step(&client);
+}
+
+/// A `hoarder` process (see `tests/src/bin/hoarder.rs`) holding slots; killed when dropped.
+struct Hoarder(std::process::Child);
+
+impl Hoarder {
+    fn start(args: &[&str]) -> Hoarder {
+        use std::io::BufRead;
+        let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_hoarder"))
+            .args(args)
+            .stdout(std::process::Stdio::piped())
+            .spawn()
+            .expect("spawn hoarder");
+        let mut line = String::new();
+        std::io::BufReader::new(child.stdout.take().unwrap())
+            .read_line(&mut line)
+            .unwrap();
+        assert_eq!(line.trim(), "ready", "the hoarder could not take its slots");
+        Hoarder(child)
+    }
+}
+
+impl Drop for Hoarder {
+    fn drop(&mut self) {
+        let _ = self.0.kill();
+        let _ = self.0.wait();
+    }
+}
+
+/// How long until `f` succeeds (polled every 20 ms), or `None` after `limit`.
+fn time_until<T>(limit: Duration, mut f: impl FnMut() -> Option<T>) -> Option<(T, Duration)> {
+    let started = Instant::now();
+    while started.elapsed() < limit {
+        if let Some(v) = f() {
+            return Some((v, started.elapsed()));
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    None
+}
+
+#[test]
+fn nodes_that_never_say_hello_are_evicted() {
+    let mut daemon = TestDaemon::start_with("hostile-nodes", &["--hello-timeout-ms", "3000"], &[]);
+    let victim = daemon.client();
+    let survivor = victim.create_plane(&PlaneOptions::manual()).unwrap();
+    // 126 nodes with the daemon's node and the victim's fill the control service's 128
+    // node places: nobody else can open it.
+    let hoarder = Hoarder::start(&["nodes", &daemon.domain, "126"]);
+    let (_, waited) = time_until(Duration::from_secs(30), || {
+        Client::connect(&daemon.domain).ok()
+    })
+    .expect("a new client got in");
+    // Before: never (`ExceedsMaxNumberOfNodes` until the hoarder exits). Now the hoarder's
+    // nodes go as it creates them (over --max-nodes-per-process and --max-ports-per-process,
+    // or older than --hello-timeout-ms); while the daemon removes them, Hellos can go
+    // unanswered and the SDK asks again with new ports every second. Measured here: 8 to 13 s
+    // after the hoarder holds all 126 (2 shared cores).
+    assert!(waited < Duration::from_secs(20), "waited {waited:?}");
+    serves_on(&mut daemon, &survivor);
+    drop(hoarder);
+
+    // Few nodes (under the per-process cap) without Hello go after --hello-timeout-ms.
+    let _few = Hoarder::start(&["nodes", &daemon.domain, "8"]);
+    let started = Instant::now();
+    let held = || {
+        let config = names::config(&daemon.domain).unwrap();
+        let node = NodeBuilder::new()
+            .config(&config)
+            .signal_handling_mode(SignalHandlingMode::Disabled)
+            .create::<ipc::Service>()
+            .unwrap();
+        let control = node
+            .service_builder(&names::control())
+            .request_response::<[u8], [u8]>()
+            .request_user_header::<u128>()
+            .open()
+            .unwrap();
+        control.dynamic_config().number_of_clients()
+    };
+    // The victim's port and the hoarder's 8 (a fresh client's port went with its client):
+    // not evicted at once.
+    assert_eq!(held(), 9);
+    time_until(Duration::from_secs(10), || (held() == 1).then_some(()))
+        .expect("the nodes without Hello were evicted");
+    // Held when ready (above), gone after the timeout (3 s from when the daemon first saw
+    // them, no later than `ready`) plus one guard period (500 ms) and the polling.
+    let total = started.elapsed();
+    assert!(
+        total < Duration::from_millis(4500),
+        "evicted after {total:?}"
+    );
+    serves_on(&mut daemon, &survivor);
+}
+
+#[test]
+fn one_process_cannot_hold_a_planes_reader_slots() {
+    let mut daemon = TestDaemon::start("hostile-readers");
+    let victim = daemon.client();
+    let plane = victim.create_plane(&PlaneOptions::manual()).unwrap();
+    // The victim's reader and 63 of the hoarder's fill the plane's 64 reader places.
+    let _hoarder = Hoarder::start(&["readers", &daemon.domain, &plane.id().to_string(), "63"]);
+    let reader = daemon.client();
+    let (attached, waited) = time_until(Duration::from_secs(5), || {
+        reader.attach_plane(plane.id()).ok()
+    })
+    .expect("another client could attach");
+    // Over --max-ports-per-process (16): evicted at the next housekeeping.
+    assert!(waited < Duration::from_millis(1500), "waited {waited:?}");
+    plane.step(0.1).unwrap();
+    assert_eq!(attached.info().unwrap().tick, 1);
+    serves_on(&mut daemon, &plane);
 }
