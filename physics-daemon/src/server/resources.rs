@@ -222,16 +222,29 @@ impl Guard {
         let now = Instant::now();
         let own = std::process::id();
         let mut alive = Vec::new();
+        let mut dead = Vec::new();
         let _ = Node::<ipc::Service>::list(config, |state| {
-            if let NodeState::Alive(view) = &state {
-                let id = *view.id();
-                let pid = id.pid::<ipc::Service>().map_or(0, |p| p.value() as u32);
-                if pid != own {
-                    alive.push((id, pid));
+            match state {
+                NodeState::Alive(view) => {
+                    let id = *view.id();
+                    let pid = id.pid::<ipc::Service>().map_or(0, |p| p.value() as u32);
+                    if pid != own {
+                        alive.push((id, pid));
+                    }
                 }
+                NodeState::Dead(view) => dead.push(view),
+                _ => {}
             }
             CallbackProgression::Continue
         });
+        // What killed processes left (also without any client connected, when the loop does
+        // no housekeeping): their node records, ports, connections and data segments.
+        for view in dead {
+            let id = view.id().value();
+            if let Err(e) = view.try_remove_stale_resources() {
+                tracing::debug!(node = format!("{id:032x}"), "cleanup of a dead node: {e:?}");
+            }
+        }
         self.seen
             .retain(|id, _| alive.iter().any(|(n, _)| n.value() == *id));
         self.evicted.retain(|id, at| {
