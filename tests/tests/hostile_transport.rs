@@ -548,3 +548,105 @@ fn a_killed_hoarders_files_go_within_a_period() {
     assert!(took < Duration::from_millis(2500), "took {took:?}");
     falls_one_step(&daemon.client());
 }
+
+/// A fresh directory under /tmp for one test, removed when dropped.
+struct TempDir(std::path::PathBuf);
+
+impl TempDir {
+    fn new(tag: &str) -> TempDir {
+        let dir = std::env::temp_dir().join(integration_tests::unique_domain(tag));
+        std::fs::create_dir(&dir).unwrap();
+        TempDir(dir)
+    }
+}
+
+impl Drop for TempDir {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+fn as_root() {
+    // SAFETY: geteuid(2) has no side effects.
+    assert_eq!(
+        unsafe { libc::geteuid() },
+        0,
+        "making files of another user needs root"
+    );
+}
+
+#[test]
+fn a_squatted_root_directory_is_reported_with_its_owner_and_a_way_out() {
+    as_root();
+    let dir = TempDir::new("squat-root");
+    // Another user (nobody) made the directory the daemon would use first.
+    let root = dir.0.join("iceoryx2");
+    std::fs::create_dir(&root).unwrap();
+    std::os::unix::fs::chown(&root, Some(65534), Some(65534)).unwrap();
+    let domain = integration_tests::unique_domain("squat-root");
+    let mut daemon = std::process::Command::new(client_sdk::daemon_executable())
+        .args(["--domain", &domain])
+        .env(names::RUNTIME_DIR_ENV, &dir.0)
+        .env("PHYSICS_LOG", "error")
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let exited = time_until(Duration::from_secs(10), || daemon.try_wait().unwrap());
+    if exited.is_none() {
+        let _ = daemon.kill();
+    }
+    let out = daemon.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        exited.is_some(),
+        "the daemon started in a squatted directory"
+    );
+    assert!(!out.status.success(), "{stderr}");
+    for part in [
+        root.to_string_lossy().as_ref(),
+        "nobody, uid 65534",
+        "the root directory",
+        names::RUNTIME_DIR_ENV,
+    ] {
+        assert!(stderr.contains(part), "missing {part:?} in: {stderr}");
+    }
+}
+
+#[test]
+fn the_root_directory_is_the_users_runtime_directory() {
+    use std::os::unix::fs::PermissionsExt;
+    let dir = TempDir::new("xdg");
+    std::fs::set_permissions(&dir.0, std::fs::Permissions::from_mode(0o700)).unwrap();
+    let domain = integration_tests::unique_domain("xdg");
+    let with_env = |cmd: &mut std::process::Command| {
+        cmd.env_remove(names::RUNTIME_DIR_ENV)
+            .env("XDG_RUNTIME_DIR", &dir.0)
+            .env("PHYSICS_LOG", "warn");
+    };
+    let mut daemon = std::process::Command::new(client_sdk::daemon_executable());
+    daemon.args(["--domain", &domain]);
+    with_env(&mut daemon);
+    let mut daemon = daemon.spawn().unwrap();
+    // A client with the same environment finds it and gets a plane.
+    let got = time_until(Duration::from_secs(10), || {
+        let mut client = std::process::Command::new(env!("CARGO_BIN_EXE_test-client"));
+        client.args(["hold-once", &domain]);
+        with_env(&mut client);
+        let out = client.output().unwrap();
+        out.status
+            .success()
+            .then(|| String::from_utf8_lossy(&out.stdout).to_string())
+    });
+    // SAFETY: kill(2) on our own child.
+    unsafe { libc::kill(daemon.id() as i32, libc::SIGINT) };
+    let _ = daemon.wait();
+    let (said, _) = got.expect("a client of the same user reached the daemon");
+    assert!(said.starts_with("plane="), "{said}");
+    // Its node records went under $XDG_RUNTIME_DIR/iceoryx2 (mode 0700, the user's own), and
+    // none into the /tmp default this test process uses.
+    let root = dir.0.join("iceoryx2");
+    assert!(root.is_dir(), "no {}", root.display());
+    assert!(integration_tests::domain_files(&domain)
+        .iter()
+        .all(|f| f.starts_with("/dev/shm")));
+}
