@@ -304,7 +304,7 @@ impl Guard {
                         if targets.contains(&id.value()) {
                             joined.push((
                                 id,
-                                details.static_details.service_hash().clone(),
+                                *details.static_details.service_hash(),
                                 details.static_details.name().to_string(),
                             ));
                         }
@@ -340,7 +340,7 @@ impl Guard {
         });
         lists.push((
             names::control().to_string(),
-            control.service_hash().clone(),
+            *control.service_hash(),
             holders,
         ));
         for id in planes {
@@ -354,7 +354,7 @@ impl Guard {
             });
             lists.push((
                 names::plane_bodies(id).to_string(),
-                services.bodies.service_hash().clone(),
+                *services.bodies.service_hash(),
                 holders,
             ));
             let mut holders = Vec::new();
@@ -364,7 +364,7 @@ impl Guard {
             });
             lists.push((
                 names::plane_events(id).to_string(),
-                services.events.service_hash().clone(),
+                *services.events.service_hash(),
                 holders,
             ));
             let mut holders = Vec::new();
@@ -374,7 +374,7 @@ impl Guard {
             });
             lists.push((
                 names::plane_tick(id).to_string(),
-                services.tick.service_hash().clone(),
+                *services.tick.service_hash(),
                 holders,
             ));
         }
@@ -394,35 +394,34 @@ impl Guard {
     }
 
     fn plane_services(&mut self, node: &Node<ipc::Service>, id: PlaneId) -> Option<&PlaneServices> {
-        if !self.planes.contains_key(&id) {
-            // The plane's worker creates these; until it has, there is nothing to look at.
-            let bodies = node
-                .service_builder(&names::plane_bodies(id))
-                .publish_subscribe::<[BodyState]>()
-                .user_header::<TickHeader>()
-                .open()
-                .ok()?;
-            let events = node
-                .service_builder(&names::plane_events(id))
-                .publish_subscribe::<[EventRecord]>()
-                .user_header::<TickHeader>()
-                .open()
-                .ok()?;
-            let tick = node
-                .service_builder(&names::plane_tick(id))
-                .event()
-                .open()
-                .ok()?;
-            self.planes.insert(
-                id,
-                PlaneServices {
+        match self.planes.entry(id) {
+            std::collections::hash_map::Entry::Occupied(e) => Some(e.into_mut()),
+            std::collections::hash_map::Entry::Vacant(e) => {
+                // The plane's worker creates these; until it has, there is nothing to look at.
+                let bodies = node
+                    .service_builder(&names::plane_bodies(id))
+                    .publish_subscribe::<[BodyState]>()
+                    .user_header::<TickHeader>()
+                    .open()
+                    .ok()?;
+                let events = node
+                    .service_builder(&names::plane_events(id))
+                    .publish_subscribe::<[EventRecord]>()
+                    .user_header::<TickHeader>()
+                    .open()
+                    .ok()?;
+                let tick = node
+                    .service_builder(&names::plane_tick(id))
+                    .event()
+                    .open()
+                    .ok()?;
+                Some(e.insert(PlaneServices {
                     bodies,
                     events,
                     tick,
-                },
-            );
+                }))
+            }
         }
-        self.planes.get(&id)
     }
 }
 
