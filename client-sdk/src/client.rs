@@ -146,6 +146,9 @@ pub struct Client {
     inner: Rc<Inner>,
 }
 
+/// How long the handshake waits for an answer before it asks again.
+const HELLO_RETRY: Duration = Duration::from_secs(1);
+
 impl Client {
     /// Connects to the daemon of `domain` and performs the version handshake.
     pub fn connect(domain: &str) -> Result<Client, Error> {
@@ -170,7 +173,23 @@ impl Client {
             crate_version: inner.options.crate_version.clone(),
             pid: std::process::id(),
         };
-        match inner.round_trip(vec![hello])?.pop() {
+        // A Hello can be lost while the daemon evicts another process's ports from the
+        // control service (see the daemon's `server/resources.rs`): ask again with fresh
+        // ports every HELLO_RETRY, within the request timeout.
+        let timeout = inner.options.request_timeout;
+        let deadline = Instant::now() + timeout;
+        inner.options.request_timeout = timeout.min(HELLO_RETRY);
+        let welcome = loop {
+            match inner.round_trip(vec![hello.clone()]) {
+                Err(Error::Timeout(_)) if Instant::now() < deadline => {
+                    tracing::debug!("no answer to Hello: asking again with new ports");
+                    inner.transport = Transport::open(&inner.options.domain)?;
+                }
+                other => break other,
+            }
+        };
+        inner.options.request_timeout = timeout;
+        match welcome?.pop() {
             Some(Ok(Reply::Welcome {
                 daemon_pid,
                 daemon_node_id,

@@ -56,9 +56,19 @@ impl Transport {
             domain: domain.to_string(),
             detail,
         };
-        // A crashed daemon leaves its services behind: look for a live daemon process first.
+        // A crashed daemon leaves its services behind: look for a live daemon process first,
+        // and remove what dead processes left, so the domain is clean for the next daemon.
         if daemon_alive(&config, 0) == Some(false) {
-            return Err(no_daemon("no live daemon process in this domain".into()));
+            let removed = remove_dead_nodes(&config);
+            let detail = if removed > 0 {
+                format!(
+                    "no live daemon process in this domain (removed what {removed} dead \
+                     processes' nodes left)"
+                )
+            } else {
+                "no live daemon process in this domain".to_string()
+            };
+            return Err(no_daemon(detail));
         }
         let node = NodeBuilder::new()
             .name(&NodeName::new("physics-client").expect("valid node name"))
@@ -282,4 +292,23 @@ fn daemon_alive(config: &Config, daemon_node: u128) -> Option<bool> {
     })
     .ok()?;
     Some(alive)
+}
+
+/// Removes the resources of dead nodes of the domain (a killed daemon's or client's);
+/// returns how many dead nodes were found.
+fn remove_dead_nodes(config: &Config) -> usize {
+    let mut dead = Vec::new();
+    let _ = Node::<ipc::Service>::list(config, |state| {
+        if let NodeState::Dead(view) = state {
+            dead.push(view);
+        }
+        CallbackProgression::Continue
+    });
+    let n = dead.len();
+    for view in dead {
+        if let Err(e) = view.try_remove_stale_resources() {
+            tracing::debug!("cleanup of a dead node: {e:?}");
+        }
+    }
+    n
 }

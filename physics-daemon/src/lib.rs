@@ -36,8 +36,7 @@ pub enum DaemonError {
     /// Another user owns files of the domain (planted or left behind): no node of the
     /// domain could start safely.
     #[error(
-        "another user (uid {uid}) owns {path}, a file of domain {domain:?}: remove it (as that \
-         user or root) or use another domain"
+        "another user ({owner}, uid {uid}) owns {path}, {what} of domain {domain:?}: {way_out}"
     )]
     ForeignFiles {
         /// The domain.
@@ -46,6 +45,12 @@ pub enum DaemonError {
         path: String,
         /// Its owner.
         uid: u32,
+        /// The owner's user name (or "unknown user").
+        owner: String,
+        /// "a file" or "the root directory".
+        what: &'static str,
+        /// What to do about it.
+        way_out: String,
     },
     /// iceoryx2 failed.
     #[error("shared-memory transport: {0}")]

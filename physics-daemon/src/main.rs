@@ -1,4 +1,6 @@
 //! `physics-daemon [--domain NAME]`: serves every physics plane of one domain.
+//! `physics-daemon --cleanup [--domain NAME]`: removes what dead processes of the domain
+//! left behind (a killed daemon's or client's shared memory and files), then exits.
 
 use std::process::ExitCode;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -21,6 +23,10 @@ struct Args {
     starter_pid: Option<u32>,
     #[command(flatten)]
     limits: physics_daemon::server::Limits,
+    /// Remove what dead processes of the domain left behind (shared memory, node records),
+    /// print what was removed, and exit. Live processes keep everything of theirs.
+    #[arg(long)]
+    cleanup: bool,
 }
 
 fn main() -> ExitCode {
@@ -33,6 +39,9 @@ fn main() -> ExitCode {
         .with_writer(std::io::stderr)
         .init();
 
+    if args.cleanup {
+        return cleanup(&args.domain);
+    }
     let shutdown = Arc::new(AtomicBool::new(false));
     let flag = shutdown.clone();
     let domain = args.domain.clone();
@@ -69,4 +78,21 @@ fn main() -> ExitCode {
             ExitCode::FAILURE
         }
     }
+}
+
+/// `--cleanup`: removes a dead deployment's leftovers and says what is left.
+fn cleanup(domain: &str) -> ExitCode {
+    let files = physics_daemon::server::files::domain_files;
+    let before = files(domain).len();
+    if let Err(e) = physics_daemon::cleanup_domain(domain) {
+        tracing::error!("{e}");
+        return ExitCode::FAILURE;
+    }
+    let left = files(domain).len();
+    println!(
+        "domain {domain}: removed {} files of dead processes; {left} left (held by live \
+         processes)",
+        before.saturating_sub(left)
+    );
+    ExitCode::SUCCESS
 }

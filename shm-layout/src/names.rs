@@ -51,12 +51,34 @@ pub fn prefix(domain: &str) -> String {
     format!("phys_{domain}_")
 }
 
-/// The directory of the domain's sockets and node records: one per user, so another local
-/// user cannot take the shared default directory away (`/tmp/iceoryx2-UID/`).
+/// Environment variable naming the directory that holds the domain's sockets and node
+/// records (it must belong to the user and be writable by nobody else).
+pub const RUNTIME_DIR_ENV: &str = "PHYSICS_RUNTIME_DIR";
+
+/// The directory of the domain's sockets and node records, one that another local user
+/// cannot have created: `$PHYSICS_RUNTIME_DIR/iceoryx2/` when set; else
+/// `$XDG_RUNTIME_DIR/iceoryx2/` when that names a directory of this user that nobody else may
+/// write (the login manager makes `/run/user/UID` so, mode 0700); else `/tmp/iceoryx2-UID/`,
+/// which any user could create first (the daemon then refuses to start and says so).
 pub fn root_path() -> String {
+    if let Some(dir) = std::env::var_os(RUNTIME_DIR_ENV).filter(|d| !d.is_empty()) {
+        return format!("{}/iceoryx2/", dir.to_string_lossy().trim_end_matches('/'));
+    }
     // SAFETY: getuid(2) cannot fail and has no side effects.
     let uid = unsafe { libc::getuid() };
+    if let Some(dir) = std::env::var_os("XDG_RUNTIME_DIR").filter(|d| !d.is_empty()) {
+        if private_dir_of(std::path::Path::new(&dir), uid) {
+            return format!("{}/iceoryx2/", dir.to_string_lossy().trim_end_matches('/'));
+        }
+    }
     format!("/tmp/iceoryx2-{uid}/")
+}
+
+/// Whether `dir` is a directory (not a link) of user `uid` that no other user may write.
+fn private_dir_of(dir: &std::path::Path, uid: u32) -> bool {
+    use std::os::unix::fs::MetadataExt;
+    std::fs::symlink_metadata(dir)
+        .is_ok_and(|m| m.is_dir() && m.uid() == uid && m.mode() & 0o022 == 0)
 }
 
 /// The iceoryx2 configuration of a domain.

@@ -33,6 +33,11 @@ impl Clients {
         self.connected.contains_key(&id)
     }
 
+    /// The node ids of the connected clients.
+    pub fn ids(&self) -> impl Iterator<Item = u128> + '_ {
+        self.connected.keys().copied()
+    }
+
     /// Whether no client is connected.
     pub fn is_empty(&self) -> bool {
         self.connected.is_empty()

@@ -197,6 +197,8 @@ impl Daemon {
             pid,
             self.options.limits.clients_per_process,
         )?;
+        // The resource guard must not take it for a node that never said Hello.
+        self.update_watch();
         tracing::info!(client = format!("{client:032x}"), pid, "client connected");
         Ok(Reply::Welcome {
             daemon_pid: std::process::id(),

@@ -32,16 +32,52 @@ pub fn foreign(domain: &str) -> Vec<(PathBuf, u32)> {
     found
 }
 
-/// Fails with a clear error when another user owns files of the domain.
+/// Fails with a clear error when another user owns files of the domain or its root
+/// directory: it names the file, its owner and a way out.
 pub fn check_ownership(domain: &str) -> Result<(), DaemonError> {
-    match foreign(domain).first() {
-        None => Ok(()),
-        Some((path, uid)) => Err(DaemonError::ForeignFiles {
-            domain: domain.to_string(),
-            path: path.display().to_string(),
-            uid: *uid,
-        }),
-    }
+    let Some((path, uid)) = foreign(domain).into_iter().next() else {
+        return Ok(());
+    };
+    let root = PathBuf::from(names::root_path());
+    let is_root = path == root || path.starts_with(&root) && path.is_dir();
+    let (what, way_out) = if is_root {
+        (
+            "the root directory",
+            format!(
+                "have root remove it, or set {} (or XDG_RUNTIME_DIR) to a directory only you \
+                 can write, e.g. `mkdir -m 700 ~/.physics && export {}=~/.physics`",
+                names::RUNTIME_DIR_ENV,
+                names::RUNTIME_DIR_ENV
+            ),
+        )
+    } else {
+        (
+            "a file",
+            "have that user or root remove it, or use another domain (--domain): /dev/shm is \
+             one namespace for every user, and a domain name others cannot guess cannot be \
+             taken"
+                .to_string(),
+        )
+    };
+    Err(DaemonError::ForeignFiles {
+        domain: domain.to_string(),
+        path: path.display().to_string(),
+        uid,
+        owner: user_name(uid).unwrap_or_else(|| "unknown user".to_string()),
+        what,
+        way_out,
+    })
+}
+
+/// The name of user `uid` from /etc/passwd.
+fn user_name(uid: u32) -> Option<String> {
+    let passwd = std::fs::read_to_string("/etc/passwd").ok()?;
+    passwd.lines().find_map(|line| {
+        let mut fields = line.split(':');
+        let name = fields.next()?;
+        let id: u32 = fields.nth(1)?.parse().ok()?;
+        (id == uid).then(|| name.to_string())
+    })
 }
 
 /// Takes write access to the domain's files away from everyone but their owner.

@@ -46,6 +46,22 @@ pub struct Limits {
     /// overlap queries' own cap is `MAX_QUERY_RESULTS` objects a query).
     #[arg(long = "max-reply-bytes", default_value_t = Limits::DEFAULT.reply_bytes)]
     pub reply_bytes: usize,
+    /// Milliseconds a node may hold places in the daemon's services without saying Hello.
+    #[arg(long = "hello-timeout-ms", default_value_t = Limits::DEFAULT.hello_timeout_ms)]
+    pub hello_timeout_ms: u64,
+    /// iceoryx2 nodes one process may keep in the daemon's domain.
+    #[arg(
+        long = "max-nodes-per-process",
+        default_value_t = Limits::DEFAULT.nodes_per_process
+    )]
+    pub nodes_per_process: usize,
+    /// iceoryx2 ports (request ports, subscribers, listeners) one process may hold in one
+    /// service of the daemon.
+    #[arg(
+        long = "max-ports-per-process",
+        default_value_t = Limits::DEFAULT.ports_per_process
+    )]
+    pub ports_per_process: usize,
 }
 
 impl Limits {
@@ -61,6 +77,9 @@ impl Limits {
         commands_per_request: 262_144,
         reply_bytes: 8 << 20,
         state_bytes_per_client: 64 << 20,
+        hello_timeout_ms: 5_000,
+        nodes_per_process: 32,
+        ports_per_process: 16,
     };
 }
 

@@ -29,6 +29,7 @@ pub mod limits;
 mod origin;
 mod quota;
 mod request_bytes;
+pub mod resources;
 mod worker;
 
 use std::collections::{BTreeMap, HashMap, VecDeque};
@@ -134,6 +135,8 @@ pub struct Daemon {
     origins: origin::Origins,
     /// Who pays for what the command being routed adds, when not the plane's owner.
     guest: Option<Arc<quota::OwnerUsage>>,
+    /// What the resource guard thread needs to know (who said Hello, which planes exist).
+    watch: Arc<resources::Watch>,
 }
 
 /// Wakes the loop of the daemon of `domain` (e.g. from a signal handler thread after setting
@@ -170,10 +173,14 @@ pub fn run_with(domain: &str, shutdown: &AtomicBool, options: Options) -> Result
     files::check_ownership(domain)?;
     remove_dead_nodes(&config);
     let beats = heartbeat::Control::default();
+    let watch = Arc::new(resources::Watch::default());
+    let limits = options.limits;
     std::thread::scope(|s| {
         s.spawn(|| heartbeat::run(&config, &beats));
-        let served = serve(domain, &config, shutdown, options, &beats);
+        s.spawn(|| resources::run(&config, &limits, &watch));
+        let served = serve(domain, &config, shutdown, options, &beats, watch.clone());
         beats.stop();
+        watch.stop();
         served
     })?;
     release_domain(&config);
@@ -219,6 +226,7 @@ fn serve(
     shutdown: &AtomicBool,
     options: Options,
     beats: &heartbeat::Control,
+    watch: Arc<resources::Watch>,
 ) -> Result<(), DaemonError> {
     let node = NodeBuilder::new()
         .name(&NodeName::new(names::DAEMON_NODE_NAME).expect("valid node name"))
@@ -293,6 +301,7 @@ fn serve(
         control,
         origins: origin::Origins::default(),
         guest: None,
+        watch,
     };
     // iceoryx2 creates its node-counter segment world-writable: narrow it to this user.
     files::restrict(domain);
@@ -323,6 +332,7 @@ fn serve(
         beats.beat(!daemon.clients.is_empty());
         if daemon.clients.is_empty() {
             if Instant::now() >= next_housekeeping {
+                daemon.update_watch();
                 if daemon.starter_gone() {
                     tracing::info!(
                         starter = daemon.options.starter_pid,
@@ -334,6 +344,7 @@ fn serve(
             }
         } else if Instant::now() >= next_housekeeping {
             daemon.release_gone_clients();
+            daemon.update_watch();
             daemon.workers.retain(|w| !w.is_finished());
             daemon.owners.prune();
             next_housekeeping = Instant::now() + HOUSEKEEPING;
@@ -600,6 +611,12 @@ impl Daemon {
                 .is_some_and(|(_, rest)| rest.starts_with('Z') || rest.starts_with('X')),
             Err(_) => true,
         }
+    }
+
+    /// Tells the resource guard who is connected and which planes exist.
+    fn update_watch(&self) {
+        self.watch
+            .update(self.clients.ids(), self.planes.keys().copied());
     }
 
     fn release_gone_clients(&mut self) {

@@ -748,7 +748,7 @@ impl<
                     let (header, number_of_elements) = match checked {
                         Ok(v) => v,
                         Err(reason) => {
-                            warn!(from self, "Dropped a request from client {:x} since {}.", details.origin, reason);
+                            warn!(from "Server::receive()", "Dropped a request from client {:x} since {}.", details.origin, reason);
                             continue;
                         }
                     };
@@ -884,7 +884,7 @@ impl<
                     let (header, number_of_elements) = match checked {
                         Ok(v) => v,
                         Err(reason) => {
-                            warn!(from self, "Dropped a request from client {:x} since {}.", details.origin, reason);
+                            warn!(from "Server::receive()", "Dropped a request from client {:x} since {}.", details.origin, reason);
                             continue;
                         }
                     };

@@ -1,0 +1,484 @@
+//! Caps on the iceoryx2 resources a client process holds in the daemon's services. Every
+//! service has a fixed number of node and port slots (`max_nodes`, `max_clients`,
+//! `max_subscribers`, `max_listeners`), and iceoryx2 lets any process of the user take them:
+//! one process could hold 63 of a plane's 64 reader slots, or 127 nodes that never say Hello
+//! could fill the control service (`ExceedsMaxNumberOfNodes` for everyone after).
+//!
+//! A thread of its own (with its own node, so the request loop never waits for it) looks at
+//! who holds what every [`PERIOD`] and evicts the excess: it removes
+//! the offending node from the service, exactly as it removes a dead process's node (its
+//! ports there, their connections and data segments; iceoryx2's slots are owner-tagged, so
+//! the evicted process cannot later release a slot someone else got). The evicted process
+//! keeps running; its ports in that service are cut off. Evicted are
+//!
+//! - a node that has not said Hello within `--hello-timeout-ms` of the daemon first seeing it
+//!   (from every daemon service it joined),
+//! - the nodes of a process beyond `--max-nodes-per-process` (those without Hello first,
+//!   then the newest),
+//! - in each service, the nodes of a process holding more than `--max-ports-per-process`
+//!   ports there (the node with the most ports first).
+//!
+//! Identities here come from iceoryx2's node and port lists (see `docs/security.md` for
+//! what a process of the same user can still forge).
+
+use std::collections::{BTreeSet, HashMap, HashSet};
+use std::sync::{Condvar, Mutex};
+use std::time::{Duration, Instant};
+
+use iceoryx2::config::Config;
+use iceoryx2::identifiers::UniqueNodeId;
+use iceoryx2::node::NodeView;
+use iceoryx2::prelude::*;
+use iceoryx2::service::internal::ServiceInternal;
+use iceoryx2::service::service_hash::ServiceHash;
+use shm_layout::{names, BodyState, EventRecord, PlaneId, TickHeader};
+
+use super::origin::ControlService;
+use super::Limits;
+use crate::DaemonError;
+
+/// Time between two looks.
+pub const PERIOD: Duration = Duration::from_millis(500);
+
+/// How long an evicted node is left alone before it is looked at again (it may have joined
+/// services again).
+const RECHECK_EVICTED: Duration = Duration::from_secs(10);
+
+type BodyService = iceoryx2::service::port_factory::publish_subscribe::PortFactory<
+    ipc::Service,
+    [BodyState],
+    TickHeader,
+>;
+type EventService = iceoryx2::service::port_factory::publish_subscribe::PortFactory<
+    ipc::Service,
+    [EventRecord],
+    TickHeader,
+>;
+type TickService = iceoryx2::service::port_factory::event::PortFactory<ipc::Service>;
+
+/// One plane's services, opened by the daemon's loop to read their port lists.
+struct PlaneServices {
+    bodies: BodyService,
+    events: EventService,
+    tick: TickService,
+}
+
+/// What was evicted, and why (logged by the loop; tests read the log).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Eviction {
+    /// The evicted node's id.
+    pub node: u128,
+    /// Its process.
+    pub pid: u32,
+    /// The service it was removed from.
+    pub service: String,
+    /// Why.
+    pub reason: String,
+}
+
+/// What the request loop tells the guard thread: who said Hello, which planes exist, and
+/// when to stop.
+#[derive(Debug, Default)]
+pub struct Watch {
+    state: Mutex<WatchState>,
+    changed: Condvar,
+}
+
+#[derive(Debug, Default)]
+struct WatchState {
+    connected: HashSet<u128>,
+    planes: Vec<PlaneId>,
+    stop: bool,
+}
+
+impl Watch {
+    /// Records the connected clients (node ids) and the planes.
+    pub fn update(
+        &self,
+        connected: impl Iterator<Item = u128>,
+        planes: impl Iterator<Item = PlaneId>,
+    ) {
+        if let Ok(mut state) = self.state.lock() {
+            state.connected = connected.collect();
+            state.planes = planes.collect();
+        }
+    }
+
+    /// Ends the guard thread.
+    pub fn stop(&self) {
+        if let Ok(mut state) = self.state.lock() {
+            state.stop = true;
+            self.changed.notify_all();
+        }
+    }
+
+    /// Waits one period; false once stopped.
+    fn wait(&self) -> bool {
+        let Ok(state) = self.state.lock() else {
+            return false;
+        };
+        match self.changed.wait_timeout_while(state, PERIOD, |s| !s.stop) {
+            Ok((state, _)) => !state.stop,
+            Err(_) => false,
+        }
+    }
+}
+
+/// Runs the guard until `watch` says stop. Errors are logged: without the guard the daemon
+/// still serves (only without the caps).
+pub fn run(config: &Config, limits: &Limits, watch: &Watch) {
+    if let Err(e) = guard(config, limits, watch) {
+        tracing::warn!("resource guard stopped: {e}");
+    }
+}
+
+fn guard(config: &Config, limits: &Limits, watch: &Watch) -> Result<(), DaemonError> {
+    let ipc = |what: &str, e: &dyn core::fmt::Debug| {
+        DaemonError::Ipc(format!("resource guard: cannot open the {what}: {e:?}"))
+    };
+    let node = NodeBuilder::new()
+        .config(config)
+        .signal_handling_mode(SignalHandlingMode::Disabled)
+        .create::<ipc::Service>()
+        .map_err(|e| ipc("node", &e))?;
+    let mut control: Option<ControlService> = None;
+    let mut guard = Guard::default();
+    while watch.wait() {
+        // The loop creates the control service after this thread starts.
+        if control.is_none() {
+            control = node
+                .service_builder(&names::control())
+                .request_response::<[u8], [u8]>()
+                .request_user_header::<u128>()
+                .open()
+                .ok();
+        }
+        let Some(control) = &control else { continue };
+        let (connected, planes) = match watch.state.lock() {
+            Ok(s) => (s.connected.clone(), s.planes.clone()),
+            Err(_) => return Ok(()),
+        };
+        guard.planes.retain(|id, _| planes.contains(id));
+        let started = Instant::now();
+        let evictions = guard.enforce(
+            &node,
+            config,
+            control,
+            planes.into_iter(),
+            &|id| connected.contains(&id),
+            limits,
+        );
+        for e in &evictions {
+            tracing::warn!(
+                node = format!("{:032x}", e.node),
+                pid = e.pid,
+                service = e.service,
+                "evicted: {}",
+                e.reason
+            );
+        }
+        if !evictions.is_empty() {
+            tracing::info!(
+                evictions = evictions.len(),
+                took_ms = started.elapsed().as_secs_f64() * 1e3,
+                "resource caps enforced"
+            );
+        }
+    }
+    Ok(())
+}
+
+/// The guard's view of who holds what.
+#[derive(Default)]
+struct Guard {
+    /// Live nodes of other processes, and when the daemon first saw each.
+    seen: HashMap<u128, Instant>,
+    /// Nodes evicted, and when.
+    evicted: HashMap<u128, Instant>,
+    planes: HashMap<PlaneId, PlaneServices>,
+}
+
+/// A node as the node list shows it.
+#[derive(Clone, Copy)]
+struct Seen {
+    id: UniqueNodeId,
+    pid: u32,
+    first_seen: Instant,
+    connected: bool,
+}
+
+impl Guard {
+    /// Looks at every node and port of the daemon's services and evicts what is over the
+    /// caps in `limits`. `connected` tells whether a node has said Hello.
+    fn enforce(
+        &mut self,
+        node: &Node<ipc::Service>,
+        config: &Config,
+        control: &ControlService,
+        planes: impl Iterator<Item = PlaneId>,
+        connected: &dyn Fn(u128) -> bool,
+        limits: &Limits,
+    ) -> Vec<Eviction> {
+        let now = Instant::now();
+        let own = std::process::id();
+        let mut alive = Vec::new();
+        let mut dead = Vec::new();
+        let _ = Node::<ipc::Service>::list(config, |state| {
+            match state {
+                NodeState::Alive(view) => {
+                    let id = *view.id();
+                    let pid = id.pid::<ipc::Service>().map_or(0, |p| p.value() as u32);
+                    if pid != own {
+                        alive.push((id, pid));
+                    }
+                }
+                NodeState::Dead(view) => dead.push(view),
+                _ => {}
+            }
+            CallbackProgression::Continue
+        });
+        // What killed processes left (also without any client connected, when the loop does
+        // no housekeeping): their node records, ports, connections and data segments.
+        for view in dead {
+            let id = view.id().value();
+            if let Err(e) = view.try_remove_stale_resources() {
+                tracing::debug!(node = format!("{id:032x}"), "cleanup of a dead node: {e:?}");
+            }
+        }
+        self.seen
+            .retain(|id, _| alive.iter().any(|(n, _)| n.value() == *id));
+        self.evicted.retain(|id, at| {
+            now.duration_since(*at) < RECHECK_EVICTED && self.seen.contains_key(id)
+        });
+        let nodes: Vec<Seen> = alive
+            .iter()
+            .map(|(id, pid)| Seen {
+                id: *id,
+                pid: *pid,
+                first_seen: *self.seen.entry(id.value()).or_insert(now),
+                connected: connected(id.value()),
+            })
+            .filter(|n| !self.evicted.contains_key(&n.id.value()))
+            .collect();
+
+        // Nodes to remove from every service they joined.
+        let mut everywhere: Vec<(Seen, String)> = Vec::new();
+        let timeout = Duration::from_millis(limits.hello_timeout_ms);
+        for n in &nodes {
+            if !n.connected && now.duration_since(n.first_seen) >= timeout {
+                everywhere.push((*n, format!("no Hello within {timeout:?}")));
+            }
+        }
+        let mut by_pid: HashMap<u32, Vec<Seen>> = HashMap::new();
+        for n in &nodes {
+            by_pid.entry(n.pid).or_default().push(*n);
+        }
+        for (pid, mut list) in by_pid {
+            if list.len() <= limits.nodes_per_process {
+                continue;
+            }
+            // Keep connected ones first, then the oldest.
+            list.sort_by_key(|n| (!n.connected, std::cmp::Reverse(now - n.first_seen)));
+            let held = list.len();
+            for n in list.into_iter().skip(limits.nodes_per_process) {
+                if !everywhere.iter().any(|(e, _)| e.id == n.id) {
+                    everywhere.push((
+                        n,
+                        format!(
+                            "process {pid} holds {held} nodes (--max-nodes-per-process {})",
+                            limits.nodes_per_process
+                        ),
+                    ));
+                }
+            }
+        }
+
+        let mut done = Vec::new();
+        if !everywhere.is_empty() {
+            let targets: BTreeSet<u128> = everywhere.iter().map(|(n, _)| n.id.value()).collect();
+            let mut joined: Vec<(UniqueNodeId, ServiceHash, String)> = Vec::new();
+            let _ = ipc::Service::list(config, |details| {
+                if let Some(dynamic) = &details.dynamic_details {
+                    for state in &dynamic.nodes {
+                        let id = *state.node_id();
+                        if targets.contains(&id.value()) {
+                            joined.push((
+                                id,
+                                *details.static_details.service_hash(),
+                                details.static_details.name().to_string(),
+                            ));
+                        }
+                    }
+                }
+                CallbackProgression::Continue
+            });
+            for (id, hash, service) in joined {
+                let Some((n, reason)) = everywhere.iter().find(|(n, _)| n.id == id) else {
+                    continue;
+                };
+                if evict(&id, &hash, config) {
+                    done.push(Eviction {
+                        node: id.value(),
+                        pid: n.pid,
+                        service,
+                        reason: reason.clone(),
+                    });
+                }
+            }
+            for (n, _) in &everywhere {
+                self.evicted.insert(n.id.value(), now);
+            }
+        }
+
+        // Ports per process in each service.
+        let cap = limits.ports_per_process;
+        let mut lists: Vec<(String, ServiceHash, Vec<UniqueNodeId>)> = Vec::new();
+        let mut holders = Vec::new();
+        control.dynamic_config().list_clients(|d| {
+            holders.push(d.node_id);
+            CallbackProgression::Continue
+        });
+        lists.push((
+            names::control().to_string(),
+            *control.service_hash(),
+            holders,
+        ));
+        for id in planes {
+            let Some(services) = self.plane_services(node, id) else {
+                continue;
+            };
+            let mut holders = Vec::new();
+            services.bodies.dynamic_config().list_subscribers(|d| {
+                holders.push(d.node_id);
+                CallbackProgression::Continue
+            });
+            lists.push((
+                names::plane_bodies(id).to_string(),
+                *services.bodies.service_hash(),
+                holders,
+            ));
+            let mut holders = Vec::new();
+            services.events.dynamic_config().list_subscribers(|d| {
+                holders.push(d.node_id);
+                CallbackProgression::Continue
+            });
+            lists.push((
+                names::plane_events(id).to_string(),
+                *services.events.service_hash(),
+                holders,
+            ));
+            let mut holders = Vec::new();
+            services.tick.dynamic_config().list_listeners(|d| {
+                holders.push(d.node_id);
+                CallbackProgression::Continue
+            });
+            lists.push((
+                names::plane_tick(id).to_string(),
+                *services.tick.service_hash(),
+                holders,
+            ));
+        }
+        for (service, hash, holders) in lists {
+            for (pid, node_id, reason) in over_port_cap(&holders, cap, own) {
+                if evict(&node_id, &hash, config) {
+                    done.push(Eviction {
+                        node: node_id.value(),
+                        pid,
+                        service: service.clone(),
+                        reason,
+                    });
+                }
+            }
+        }
+        done
+    }
+
+    fn plane_services(&mut self, node: &Node<ipc::Service>, id: PlaneId) -> Option<&PlaneServices> {
+        match self.planes.entry(id) {
+            std::collections::hash_map::Entry::Occupied(e) => Some(e.into_mut()),
+            std::collections::hash_map::Entry::Vacant(e) => {
+                // The plane's worker creates these; until it has, there is nothing to look at.
+                let bodies = node
+                    .service_builder(&names::plane_bodies(id))
+                    .publish_subscribe::<[BodyState]>()
+                    .user_header::<TickHeader>()
+                    .open()
+                    .ok()?;
+                let events = node
+                    .service_builder(&names::plane_events(id))
+                    .publish_subscribe::<[EventRecord]>()
+                    .user_header::<TickHeader>()
+                    .open()
+                    .ok()?;
+                let tick = node
+                    .service_builder(&names::plane_tick(id))
+                    .event()
+                    .open()
+                    .ok()?;
+                Some(e.insert(PlaneServices {
+                    bodies,
+                    events,
+                    tick,
+                }))
+            }
+        }
+    }
+}
+
+/// The nodes to evict from one service whose ports `holders` (one entry per port, naming
+/// its node) hold: per process over `cap`, the node with the most ports first.
+fn over_port_cap(
+    holders: &[UniqueNodeId],
+    cap: usize,
+    own: u32,
+) -> Vec<(u32, UniqueNodeId, String)> {
+    let mut per_node: HashMap<u128, (UniqueNodeId, u32, usize)> = HashMap::new();
+    for id in holders {
+        let pid = id.pid::<ipc::Service>().map_or(0, |p| p.value() as u32);
+        per_node.entry(id.value()).or_insert((*id, pid, 0)).2 += 1;
+    }
+    let mut per_pid: HashMap<u32, Vec<(UniqueNodeId, usize)>> = HashMap::new();
+    for (_, (id, pid, n)) in per_node {
+        if pid != own {
+            per_pid.entry(pid).or_default().push((id, n));
+        }
+    }
+    let mut out = Vec::new();
+    for (pid, mut nodes) in per_pid {
+        let mut total: usize = nodes.iter().map(|(_, n)| n).sum();
+        if total <= cap {
+            continue;
+        }
+        let held = total;
+        nodes.sort_by_key(|(_, n)| std::cmp::Reverse(*n));
+        for (id, n) in nodes {
+            if total <= cap {
+                break;
+            }
+            total -= n;
+            out.push((
+                pid,
+                id,
+                format!("process {pid} holds {held} ports (--max-ports-per-process {cap})"),
+            ));
+        }
+    }
+    out
+}
+
+/// Removes node `id` from the service `hash` as if it had died. Returns whether it worked.
+fn evict(id: &UniqueNodeId, hash: &ServiceHash, config: &Config) -> bool {
+    // iceoryx2's own dead-node cleanup of one service (public, though hidden from its docs).
+    match <ipc::Service as ServiceInternal<ipc::Service>>::__internal_remove_node_from_service(
+        id, hash, config,
+    ) {
+        Ok(()) => true,
+        Err(e) => {
+            tracing::warn!(
+                node = format!("{:032x}", id.value()),
+                "eviction failed: {e:?}"
+            );
+            false
+        }
+    }
+}
