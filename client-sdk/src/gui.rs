@@ -324,7 +324,7 @@ impl GuiObject {
             Error::Command(shm_layout::CommandError::new(
                 shm_layout::ErrorKind::StaleHandle,
                 format!(
-                    "GUI object {:?} of plane {} no longer exists",
+                    "GUI object {} of plane {} no longer exists",
                     self.handle,
                     self.plane.plane.id()
                 ),

@@ -40,7 +40,7 @@ impl Object {
             Error::Command(shm_layout::CommandError::new(
                 shm_layout::ErrorKind::StaleHandle,
                 format!(
-                    "object {:?} of plane {} no longer exists",
+                    "object {} of plane {} no longer exists",
                     self.handle,
                     self.plane.id()
                 ),

@@ -27,6 +27,13 @@ pub struct Handle {
     pub generation: u32,
 }
 
+/// `#slot.generation` (`#3.1`): how messages name an object, with no Rust syntax.
+impl core::fmt::Display for Handle {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        write!(f, "#{}.{}", self.slot, self.generation)
+    }
+}
+
 /// The state of one slot after a tick. 64 bytes: one cache line per body.
 #[derive(Debug, Clone, Copy, PartialEq, Default, ZeroCopySend)]
 #[type_name("physics::BodyState")]

@@ -151,6 +151,9 @@ fn stale_and_unknown_handles_are_detected() {
             assert_eq!(errors.len(), 1);
             assert_eq!(errors[0].kind, ErrorKind::StaleHandle);
             assert!(errors[0].message.contains("stale"), "{}", errors[0].message);
+            // Objects are named as users read them, never in Rust's debug syntax.
+            let m = &errors[0].message;
+            assert!(m.contains("object #") && !m.contains("Handle {"), "{m}");
         }
         other => panic!("expected a batch error, got {:?}", other.err()),
     }

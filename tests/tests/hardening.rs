@@ -392,6 +392,10 @@ fn stale_handles_name_the_object() {
     let e = command_error(fake.info().unwrap_err());
     assert_eq!(e.kind, ErrorKind::StaleHandle);
     assert!(e.message.contains("does not exist"), "{e}");
+    assert!(
+        e.message.contains("#99.1") && !e.message.contains("Handle {"),
+        "{e}"
+    );
 }
 
 #[test]

@@ -99,7 +99,7 @@ impl<T> SlotTable<T> {
         let entry = self.entries.get(handle.slot as usize).ok_or_else(|| {
             CommandError::new(
                 ErrorKind::StaleHandle,
-                format!("{what} {handle:?} does not exist"),
+                format!("{what} {handle} does not exist"),
             )
         })?;
         match entry.value {
@@ -107,7 +107,7 @@ impl<T> SlotTable<T> {
             _ => Err(CommandError::new(
                 ErrorKind::StaleHandle,
                 format!(
-                    "{what} {handle:?} is stale: slot {} now holds generation {} ({})",
+                    "{what} {handle} is stale: slot {} now holds generation {} ({})",
                     handle.slot,
                     entry.generation,
                     if entry.value.is_some() {

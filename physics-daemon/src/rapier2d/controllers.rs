@@ -58,7 +58,7 @@ impl Plane {
         {
             if self.body(handle)?.controller.is_some() {
                 return Err(CommandError::invalid(format!(
-                    "object {handle:?} already has a controller"
+                    "object {handle} already has a controller"
                 )));
             }
             let mut settings = GuiControllerSettings::default();
@@ -85,8 +85,7 @@ impl Plane {
             self.controlled.push(handle.slot);
             return Ok(applied);
         }
-        let no_controller =
-            || CommandError::invalid(format!("object {handle:?} has no controller"));
+        let no_controller = || CommandError::invalid(format!("object {handle} has no controller"));
         if let GuiControllerOp::Destroy = op {
             self.body(handle)?
                 .controller

@@ -309,7 +309,7 @@ impl Plane {
         self.controllers.get_mut(&handle.slot).ok_or_else(|| {
             CommandError::invalid_field(
                 "controller",
-                format!("object {handle:?} of plane {} is not a controller", self.id),
+                format!("object {handle} of plane {} is not a controller", self.id),
             )
         })
     }
@@ -387,7 +387,7 @@ impl Plane {
         let c = self.controllers.get(&handle.slot).ok_or_else(|| {
             CommandError::invalid_field(
                 "controller",
-                format!("object {handle:?} is not a controller"),
+                format!("object {handle} is not a controller"),
             )
         })?;
         Ok(ControllerInfo {

@@ -246,7 +246,7 @@ impl Plane {
         let collider = *self.world.bodies[body]
             .colliders()
             .first()
-            .ok_or_else(|| CommandError::invalid(format!("object {object:?} has no collider")))?;
+            .ok_or_else(|| CommandError::invalid(format!("object {object} has no collider")))?;
         Ok((body, collider))
     }
 
