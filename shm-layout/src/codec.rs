@@ -248,9 +248,7 @@ mod tests {
         let mut bytes = encode_request(&sample_request());
         assert!(decode_request(&bytes).is_ok());
         bytes.extend_from_slice(&[0u8; 7]);
-        let e = decode_request(&bytes)
-            .err()
-            .expect("trailing bytes refused");
+        let e = decode_request(&bytes).expect_err("trailing bytes refused");
         assert!(e.to_string().contains("7 bytes follow"), "{e}");
     }
 }
