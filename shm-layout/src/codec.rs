@@ -84,7 +84,17 @@ impl<'a> Frame<'a> {
                     .collect(),
             });
         }
-        postcard::from_bytes(self.body).map_err(|e| DecodeError::Body(e.to_string()))
+        // Nothing may follow the value: a length that runs past it (a forged request header,
+        // say) is an error, not bytes silently ignored.
+        let (value, rest) =
+            postcard::take_from_bytes(self.body).map_err(|e| DecodeError::Body(e.to_string()))?;
+        if !rest.is_empty() {
+            return Err(DecodeError::Body(format!(
+                "{} bytes follow the encoded value",
+                rest.len()
+            )));
+        }
+        Ok(value)
     }
 }
 
@@ -237,5 +247,14 @@ mod tests {
             let _ = decode_request(&bytes);
             let _ = decode_response(&bytes);
         }
+    }
+
+    #[test]
+    fn bytes_after_the_value_are_an_error() {
+        let mut bytes = encode_request(&sample_request());
+        assert!(decode_request(&bytes).is_ok());
+        bytes.extend_from_slice(&[0u8; 7]);
+        let e = decode_request(&bytes).expect_err("trailing bytes refused");
+        assert!(e.to_string().contains("7 bytes follow"), "{e}");
     }
 }

@@ -65,7 +65,8 @@ impl Daemon {
             }
             Ok(_) => {}
         }
-        let request = codec::decode_request(bytes).map_err(|e| rejected(e.to_string()))?;
+        let request = codec::decode_request(bytes)
+            .map_err(|e| rejected(format!("{e} (a request of {} bytes)", bytes.len())))?;
         let max_commands = limits.commands_per_request;
         if request.commands.len() > max_commands {
             return Err(codec::encode_response(&Response::Rejected(exceeded(

@@ -49,14 +49,15 @@ pub struct Limits {
     /// Milliseconds a node may hold places in the daemon's services without saying Hello.
     #[arg(long = "hello-timeout-ms", default_value_t = Limits::DEFAULT.hello_timeout_ms)]
     pub hello_timeout_ms: u64,
-    /// iceoryx2 nodes one process may keep in the daemon's domain.
+    /// iceoryx2 nodes one process may keep in the daemon's domain (never fewer than its
+    /// clients).
     #[arg(
         long = "max-nodes-per-process",
         default_value_t = Limits::DEFAULT.nodes_per_process
     )]
     pub nodes_per_process: usize,
     /// iceoryx2 ports (request ports, subscribers, listeners) one process may hold in one
-    /// service of the daemon.
+    /// service of the daemon (never fewer than its clients).
     #[arg(
         long = "max-ports-per-process",
         default_value_t = Limits::DEFAULT.ports_per_process

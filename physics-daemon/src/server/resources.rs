@@ -274,19 +274,20 @@ impl Guard {
             by_pid.entry(n.pid).or_default().push(*n);
         }
         for (pid, mut list) in by_pid {
-            if list.len() <= limits.nodes_per_process {
+            // A process may always hold as many nodes as it may hold clients.
+            let node_cap = limits.nodes_per_process.max(limits.clients_per_process);
+            if list.len() <= node_cap {
                 continue;
             }
             // Keep connected ones first, then the oldest.
             list.sort_by_key(|n| (!n.connected, std::cmp::Reverse(now - n.first_seen)));
             let held = list.len();
-            for n in list.into_iter().skip(limits.nodes_per_process) {
+            for n in list.into_iter().skip(node_cap) {
                 if !everywhere.iter().any(|(e, _)| e.id == n.id) {
                     everywhere.push((
                         n,
                         format!(
-                            "process {pid} holds {held} nodes (--max-nodes-per-process {})",
-                            limits.nodes_per_process
+                            "process {pid} holds {held} nodes (--max-nodes-per-process {node_cap})"
                         ),
                     ));
                 }
@@ -331,7 +332,8 @@ impl Guard {
         }
 
         // Ports per process in each service.
-        let cap = limits.ports_per_process;
+        // Each client of a process has one port per service.
+        let cap = limits.ports_per_process.max(limits.clients_per_process);
         let mut lists: Vec<(String, ServiceHash, Vec<UniqueNodeId>)> = Vec::new();
         let mut holders = Vec::new();
         control.dynamic_config().list_clients(|d| {
