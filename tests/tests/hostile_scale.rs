@@ -641,3 +641,72 @@ fn objects_added_to_a_shared_plane_count_against_the_adder() {
     let _ = owner.kill();
     let _ = owner.wait();
 }
+
+fn rss_bytes(pid: u32) -> u64 {
+    let status = std::fs::read_to_string(format!("/proc/{pid}/status")).unwrap();
+    let kib: u64 = status
+        .lines()
+        .find(|l| l.starts_with("VmRSS:"))
+        .and_then(|l| l.split_whitespace().nth(1))
+        .and_then(|n| n.parse().ok())
+        .unwrap();
+    kib * 1024
+}
+
+/// Empty planes cost ~10 MB each (their shared-memory output), so many processes each
+/// creating planes up to their quota took the daemon down long before its 1,024-plane cap.
+/// Now the daemon admits planes (and what they hold) only within `--max-memory-mb`, counting
+/// each plane as PLANE_BYTES, which the measured cost must stay under.
+#[test]
+fn planes_are_admitted_within_the_daemon_memory_budget() {
+    use physics_daemon::server::quota::PLANE_BYTES;
+    let fit = 5u64;
+    let mb = (fit * PLANE_BYTES + PLANE_BYTES / 2) >> 20;
+    let daemon =
+        TestDaemon::start_with("hostile-memory", &["--max-memory-mb", &mb.to_string()], &[]);
+    let first = daemon.client();
+    let second = daemon.client();
+    let before = rss_bytes(daemon.pid());
+    let mut planes: Vec<_> = (0..fit)
+        .map(|i| {
+            let c = if i % 2 == 0 { &first } else { &second };
+            c.create_plane(&PlaneOptions::manual()).unwrap()
+        })
+        .collect();
+    std::thread::sleep(Duration::from_millis(200));
+    let per_plane = (rss_bytes(daemon.pid()) - before) / fit;
+    eprintln!("an empty plane costs the daemon {} KiB", per_plane >> 10);
+    assert!(
+        per_plane <= PLANE_BYTES,
+        "an empty plane costs {per_plane} bytes, counted as {PLANE_BYTES}"
+    );
+    // Full: the next plane is refused, naming the flag, whoever asks.
+    let e = second.create_plane(&PlaneOptions::manual()).unwrap_err();
+    assert!(e.to_string().contains("--max-memory-mb"), "{e}");
+    // Objects count too: a plane's worth of cubes does not fit in the half plane left.
+    let objects = (PLANE_BYTES / physics_daemon::server::quota::OBJECT_BYTES) as usize;
+    let adds = (0..objects)
+        .map(|i| {
+            Cmd::plane(
+                planes[0].id(),
+                PlaneOp::AddObject {
+                    shape: cube(),
+                    pose: Pose::at([i as f32, 0.0, 0.0]),
+                    props: vec![],
+                },
+            )
+        })
+        .collect();
+    let (r, _) = send(&first, adds);
+    let refused = r.iter().filter(|r| r.is_err()).count();
+    assert!(
+        refused > 0 && refused < objects,
+        "{refused} of {objects} refused"
+    );
+    // A destroyed plane gives its room back.
+    planes.pop().unwrap().destroy().unwrap();
+    let again = integration_tests::eventually(Duration::from_secs(5), || {
+        second.create_plane(&PlaneOptions::manual()).ok()
+    });
+    assert!(again.is_some(), "the room never came back");
+}

@@ -26,7 +26,7 @@ mod dispatch;
 pub mod files;
 pub mod heartbeat;
 pub mod limits;
-mod quota;
+pub mod quota;
 mod worker;
 
 use std::collections::{BTreeMap, HashMap, VecDeque};
@@ -265,6 +265,7 @@ fn serve(
         .map_err(|e| DaemonError::Ipc(format!("cannot attach the worker wake-up: {e:?}")))?;
     let (events_tx, events) = mpsc::channel();
 
+    let memory_limit = options.limits.memory_bytes();
     let mut daemon = Daemon {
         domain: domain.to_string(),
         config: config.clone(),
@@ -281,7 +282,7 @@ fn serve(
         events_tx,
         waker: Arc::new(Waker::new(wake_end)),
         workers: Vec::new(),
-        owners: quota::Owners::default(),
+        owners: quota::Owners::new(memory_limit),
         reply_left: 0,
         guest: None,
     };
