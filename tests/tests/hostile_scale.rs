@@ -3,8 +3,8 @@
 //! debug build yet fails the old code. Reply amplification (overlap queries capped, paged
 //! and counted), queries off the request loop and bounded per request, the quota race of
 //! many connections, controller paths counted against a quota, objects added to another's
-//! shared plane counted against the adder, planes slower than 1 Hz, and `Threads` capped by
-//! cores.
+//! shared plane counted against the adder, planes slower than 1 Hz, `Threads` capped by
+//! cores, planes admitted within the daemon's memory, and fair CPU shares between clients.
 
 use std::sync::{Arc, Barrier};
 use std::time::{Duration, Instant};
@@ -709,4 +709,55 @@ fn planes_are_admitted_within_the_daemon_memory_budget() {
         second.create_plane(&PlaneOptions::manual()).ok()
     });
     assert!(again.is_some(), "the room never came back");
+}
+
+/// One process ticks 32 planes as fast as it may (TickRate 10,000) while another steps its
+/// own plane. The busy process used to take every core; now each process gets its fair
+/// CPU share (cores / processes) and a process past it slows its own planes only.
+#[test]
+fn a_process_past_its_cpu_share_slows_itself_not_others() {
+    use std::io::{BufRead, BufReader};
+    let daemon = TestDaemon::start("hostile-cpu");
+    let victim = daemon.client();
+    let mine = victim.create_plane(&PlaneOptions::manual()).unwrap();
+    for i in 0..20 {
+        mine.add(cube(), Pose::at([i as f32, 0.0, 0.0]), &[])
+            .unwrap();
+    }
+    let step = |n: usize| -> Vec<Duration> {
+        (0..n)
+            .map(|_| {
+                let t = Instant::now();
+                mine.step(1.0 / 60.0).unwrap();
+                let took = t.elapsed();
+                std::thread::sleep(Duration::from_millis(5));
+                took
+            })
+            .collect()
+    };
+    let alone = step(60);
+    let mut hog = std::process::Command::new(env!("CARGO_BIN_EXE_test-client"))
+        .args(["burn", &daemon.domain, "32", "10000"])
+        .stdout(std::process::Stdio::piped())
+        .spawn()
+        .expect("spawn test-client");
+    let mut lines = BufReader::new(hog.stdout.take().unwrap()).lines();
+    assert_eq!(lines.next().unwrap().unwrap(), "ready");
+    std::thread::sleep(Duration::from_millis(500));
+    let during = step(60);
+    let _ = hog.kill();
+    let _ = hog.wait();
+    let (a50, a99) = (percentile(alone.clone(), 0.5), percentile(alone, 0.99));
+    let (d50, d99) = (percentile(during.clone(), 0.5), percentile(during, 0.99));
+    eprintln!("step alone p50 {a50:?} p99 {a99:?}; beside the hog p50 {d50:?} p99 {d99:?}");
+    // 2 cores shared with the hog's threads: a step may wait for a time slice, not for the
+    // hog's backlog.
+    assert!(
+        d50 <= (a50 * 2).max(Duration::from_millis(3)),
+        "p50 {d50:?} beside the hog, {a50:?} alone"
+    );
+    assert!(
+        d99 <= (a99 * 2).max(Duration::from_millis(30)),
+        "p99 {d99:?} beside the hog, {a99:?} alone"
+    );
 }

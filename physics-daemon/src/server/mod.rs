@@ -23,6 +23,7 @@
 
 pub mod clients;
 mod dispatch;
+pub mod fair;
 pub mod files;
 pub mod heartbeat;
 pub mod limits;

@@ -80,6 +80,8 @@ pub struct OwnerUsage {
     state_bytes: AtomicU64,
     /// The daemon's total, which every change of this one also moves.
     memory: Arc<DaemonMemory>,
+    /// The process's CPU account (fair shares between processes).
+    pub cpu: super::fair::CpuAccount,
 }
 
 /// A reservation: released when dropped (by then the plane's own count holds what the op
@@ -363,6 +365,7 @@ impl Drop for PlaneUsage {
 pub struct Owners {
     by_pid: HashMap<u32, Arc<OwnerUsage>>,
     memory: Arc<DaemonMemory>,
+    shares: Arc<super::fair::CpuShares>,
 }
 
 impl Owners {
@@ -371,26 +374,32 @@ impl Owners {
         Owners {
             by_pid: HashMap::new(),
             memory: Arc::new(DaemonMemory::new(memory_limit)),
+            shares: Arc::default(),
         }
     }
 
     /// The counter of process `pid` (made on first use).
     pub fn of(&mut self, pid: u32) -> Arc<OwnerUsage> {
-        let memory = &self.memory;
-        self.by_pid
+        let (memory, shares) = (&self.memory, &self.shares);
+        let owner = self
+            .by_pid
             .entry(pid)
             .or_insert_with(|| {
                 Arc::new(OwnerUsage {
                     memory: memory.clone(),
+                    cpu: super::fair::CpuAccount::new(shares.clone()),
                     ..OwnerUsage::default()
                 })
             })
-            .clone()
+            .clone();
+        self.shares.set_processes(self.by_pid.len());
+        owner
     }
 
     /// Forgets the counters no plane uses any more (they hold zero).
     pub fn prune(&mut self) {
         self.by_pid.retain(|_, o| Arc::strong_count(o) > 1);
+        self.shares.set_processes(self.by_pid.len());
     }
 }
 
