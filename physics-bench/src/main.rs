@@ -9,6 +9,7 @@
 //! `physics-bench queries [--quick] [--out DIR]` writes DIR/queries.json and DIR/queries.md.
 //! `physics-bench controllers [--quick] [--out DIR]` writes DIR/controllers.json and .md.
 //! `physics-bench gpu [--quick] [--out DIR]` writes DIR/gpu.json and DIR/gpu.md.
+//! `physics-bench hostile [--out DIR]` writes DIR/hostile.json and DIR/hostile.md.
 //!
 //! Its parts, shared by the subcommands:
 //!
@@ -29,6 +30,7 @@ mod daemon;
 mod error;
 mod fuzz;
 mod gpu;
+mod hostile;
 mod ipc;
 mod load;
 mod maps;
@@ -84,6 +86,10 @@ enum Bench {
     /// The GPU path (DeferGpu) against the CPU: time per tick of 1k to 1M bodies falling
     /// into a container (spatial hash, every pair, rapier), scaling ratios, the adapter.
     Gpu(gpu::GpuArgs),
+    /// Hostile clients at scale against real daemons: one verdict row per attack (reply
+    /// amplification, queries beside steps, quota race, paths, slow planes, Threads, empty
+    /// planes' memory, CPU shares).
+    Hostile(hostile::HostileArgs),
 }
 
 fn main() -> ExitCode {
@@ -109,6 +115,7 @@ fn main() -> ExitCode {
         Bench::Controllers(args) => controllers::run(args),
         Bench::Maps(args) => maps::run(args),
         Bench::Gpu(args) => gpu::run(args),
+        Bench::Hostile(args) => hostile::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

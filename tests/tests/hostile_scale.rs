@@ -3,8 +3,8 @@
 //! debug build yet fails the old code. Reply amplification (overlap queries capped, paged
 //! and counted), queries off the request loop and bounded per request, the quota race of
 //! many connections, controller paths counted against a quota, objects added to another's
-//! shared plane counted against the adder, planes slower than 1 Hz, and `Threads` capped by
-//! cores.
+//! shared plane counted against the adder, planes slower than 1 Hz, `Threads` capped by
+//! cores, planes admitted within the daemon's memory, and fair CPU shares between clients.
 
 use std::sync::{Arc, Barrier};
 use std::time::{Duration, Instant};
@@ -640,4 +640,124 @@ fn objects_added_to_a_shared_plane_count_against_the_adder() {
     assert_eq!(fill(QUOTA), LIMIT);
     let _ = owner.kill();
     let _ = owner.wait();
+}
+
+fn rss_bytes(pid: u32) -> u64 {
+    let status = std::fs::read_to_string(format!("/proc/{pid}/status")).unwrap();
+    let kib: u64 = status
+        .lines()
+        .find(|l| l.starts_with("VmRSS:"))
+        .and_then(|l| l.split_whitespace().nth(1))
+        .and_then(|n| n.parse().ok())
+        .unwrap();
+    kib * 1024
+}
+
+/// Empty planes cost ~10 MB each (their shared-memory output), so many processes each
+/// creating planes up to their quota took the daemon down long before its 1,024-plane cap.
+/// Now the daemon admits planes (and what they hold) only within `--max-memory-mb`, counting
+/// each plane as PLANE_BYTES, which the measured cost must stay under.
+#[test]
+fn planes_are_admitted_within_the_daemon_memory_budget() {
+    use physics_daemon::server::quota::PLANE_BYTES;
+    let fit = 5u64;
+    let mb = (fit * PLANE_BYTES + PLANE_BYTES / 2) >> 20;
+    let daemon =
+        TestDaemon::start_with("hostile-memory", &["--max-memory-mb", &mb.to_string()], &[]);
+    let first = daemon.client();
+    let second = daemon.client();
+    let before = rss_bytes(daemon.pid());
+    let mut planes: Vec<_> = (0..fit)
+        .map(|i| {
+            let c = if i % 2 == 0 { &first } else { &second };
+            c.create_plane(&PlaneOptions::manual()).unwrap()
+        })
+        .collect();
+    std::thread::sleep(Duration::from_millis(200));
+    let per_plane = (rss_bytes(daemon.pid()) - before) / fit;
+    eprintln!("an empty plane costs the daemon {} KiB", per_plane >> 10);
+    assert!(
+        per_plane <= PLANE_BYTES,
+        "an empty plane costs {per_plane} bytes, counted as {PLANE_BYTES}"
+    );
+    // Full: the next plane is refused, naming the flag, whoever asks.
+    let e = second.create_plane(&PlaneOptions::manual()).unwrap_err();
+    assert!(e.to_string().contains("--max-memory-mb"), "{e}");
+    // Objects count too: a plane's worth of cubes does not fit in the half plane left.
+    let objects = (PLANE_BYTES / physics_daemon::server::quota::OBJECT_BYTES) as usize;
+    let adds = (0..objects)
+        .map(|i| {
+            Cmd::plane(
+                planes[0].id(),
+                PlaneOp::AddObject {
+                    shape: cube(),
+                    pose: Pose::at([i as f32, 0.0, 0.0]),
+                    props: vec![],
+                },
+            )
+        })
+        .collect();
+    let (r, _) = send(&first, adds);
+    let refused = r.iter().filter(|r| r.is_err()).count();
+    assert!(
+        refused > 0 && refused < objects,
+        "{refused} of {objects} refused"
+    );
+    // A destroyed plane gives its room back.
+    planes.pop().unwrap().destroy().unwrap();
+    let again = integration_tests::eventually(Duration::from_secs(5), || {
+        second.create_plane(&PlaneOptions::manual()).ok()
+    });
+    assert!(again.is_some(), "the room never came back");
+}
+
+/// One process ticks 32 planes as fast as it may (TickRate 10,000) while another steps its
+/// own plane. The busy process used to take every core; now each process gets its fair
+/// CPU share (cores / processes) and a process past it slows its own planes only.
+#[test]
+fn a_process_past_its_cpu_share_slows_itself_not_others() {
+    use std::io::{BufRead, BufReader};
+    let daemon = TestDaemon::start("hostile-cpu");
+    let victim = daemon.client();
+    let mine = victim.create_plane(&PlaneOptions::manual()).unwrap();
+    for i in 0..20 {
+        mine.add(cube(), Pose::at([i as f32, 0.0, 0.0]), &[])
+            .unwrap();
+    }
+    let step = |n: usize| -> Vec<Duration> {
+        (0..n)
+            .map(|_| {
+                let t = Instant::now();
+                mine.step(1.0 / 60.0).unwrap();
+                let took = t.elapsed();
+                std::thread::sleep(Duration::from_millis(5));
+                took
+            })
+            .collect()
+    };
+    let alone = step(60);
+    let mut hog = std::process::Command::new(env!("CARGO_BIN_EXE_test-client"))
+        .args(["burn", &daemon.domain, "32", "10000"])
+        .stdout(std::process::Stdio::piped())
+        .spawn()
+        .expect("spawn test-client");
+    let mut lines = BufReader::new(hog.stdout.take().unwrap()).lines();
+    assert_eq!(lines.next().unwrap().unwrap(), "ready");
+    std::thread::sleep(Duration::from_millis(500));
+    let during = step(60);
+    let _ = hog.kill();
+    let _ = hog.wait();
+    let (a50, a99) = (percentile(alone.clone(), 0.5), percentile(alone, 0.99));
+    let (d50, d99) = (percentile(during.clone(), 0.5), percentile(during, 0.99));
+    eprintln!("step alone p50 {a50:?} p99 {a99:?}; beside the hog p50 {d50:?} p99 {d99:?}");
+    // 2 cores shared with the hog's threads: a step may wait for a time slice, not for the
+    // hog's backlog.
+    assert!(
+        d50 <= (a50 * 2).max(Duration::from_millis(3)),
+        "p50 {d50:?} beside the hog, {a50:?} alone"
+    );
+    assert!(
+        d99 <= (a99 * 2).max(Duration::from_millis(30)),
+        "p99 {d99:?} beside the hog, {a99:?} alone"
+    );
 }

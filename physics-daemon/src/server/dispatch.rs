@@ -235,7 +235,10 @@ impl Daemon {
         let id = self.next_plane_id;
         let ticket = self.next_ticket;
         let owner_pid = self.clients.get(owner).map_or(0, |c| c.pid);
-        let usage = Arc::new(SharedUsage::new(self.owners.of(owner_pid)));
+        let usage = match SharedUsage::admit(self.owners.of(owner_pid)) {
+            Ok(usage) => Arc::new(usage),
+            Err(e) => return refuse(e),
+        };
         let cell = Arc::new(PlaneCell::default());
         let (jobs, receiver) = mpsc::channel();
         let shared = PlaneProp::shared_in(&props);

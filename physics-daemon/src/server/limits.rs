@@ -42,6 +42,11 @@ pub struct Limits {
         default_value_t = Limits::DEFAULT.state_bytes_per_client
     )]
     pub state_bytes_per_client: u64,
+    /// Memory the daemon admits, all clients together, in MiB: planes (11 MiB each, measured:
+    /// mostly their shared-memory output) and what they hold (4 KiB an object, 32 bytes a
+    /// mesh vertex, controller paths). 0: half of the machine's memory.
+    #[arg(long = "max-memory-mb", default_value_t = Limits::DEFAULT.memory_mb)]
+    pub memory_mb: u64,
     /// Bytes of the reply to one request: results past it are refused with `Quota` (the
     /// overlap queries' own cap is `MAX_QUERY_RESULTS` objects a query).
     #[arg(long = "max-reply-bytes", default_value_t = Limits::DEFAULT.reply_bytes)]
@@ -77,11 +82,28 @@ impl Limits {
         request_bytes: 16 << 20,
         commands_per_request: 262_144,
         reply_bytes: 8 << 20,
+        memory_mb: 0,
         state_bytes_per_client: 64 << 20,
         hello_timeout_ms: 5_000,
         nodes_per_process: 32,
         ports_per_process: 16,
     };
+}
+
+impl Limits {
+    /// `--max-memory-mb` in bytes (0: half of MemTotal; without /proc/meminfo, no limit).
+    pub fn memory_bytes(&self) -> u64 {
+        if self.memory_mb > 0 {
+            return self.memory_mb.saturating_mul(1 << 20);
+        }
+        std::fs::read_to_string("/proc/meminfo")
+            .ok()
+            .and_then(|m| {
+                let line = m.lines().find(|l| l.starts_with("MemTotal:"))?;
+                line.split_whitespace().nth(1)?.parse::<u64>().ok()
+            })
+            .map_or(u64::MAX, |kib| kib * 1024 / 2)
+    }
 }
 
 impl Default for Limits {

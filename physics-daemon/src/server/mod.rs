@@ -23,11 +23,12 @@
 
 pub mod clients;
 mod dispatch;
+pub mod fair;
 pub mod files;
 pub mod heartbeat;
 pub mod limits;
 mod origin;
-mod quota;
+pub mod quota;
 mod request_bytes;
 pub mod resources;
 mod worker;
@@ -280,6 +281,7 @@ fn serve(
         .map_err(|e| DaemonError::Ipc(format!("cannot attach the worker wake-up: {e:?}")))?;
     let (events_tx, events) = mpsc::channel();
 
+    let memory_limit = options.limits.memory_bytes();
     let mut daemon = Daemon {
         domain: domain.to_string(),
         config: config.clone(),
@@ -296,7 +298,7 @@ fn serve(
         events_tx,
         waker: Arc::new(Waker::new(wake_end)),
         workers: Vec::new(),
-        owners: quota::Owners::default(),
+        owners: quota::Owners::new(memory_limit),
         reply_left: 0,
         control,
         origins: origin::Origins::default(),

@@ -15,6 +15,62 @@ use shm_layout::{CommandError, ErrorKind, Handle, OpCost, PlaneId};
 use super::limits::{exceeded, Limits};
 use crate::backend::{Backend, Usage};
 
+/// Memory one empty plane costs the daemon, measured: its shared-memory output (the event
+/// service's per-reader queues, 64 readers × 64 ticks, are ~9 MB of it), node and engine.
+pub const PLANE_BYTES: u64 = 11 << 20;
+/// Memory one object costs, measured (~2.8 KB for a lone cube) plus room for its contacts.
+pub const OBJECT_BYTES: u64 = 4 << 10;
+/// Memory one mesh vertex (or triangle) costs: positions, indices and the BVH.
+pub const VERTEX_BYTES: u64 = 32;
+
+/// What the daemon admits, all clients together, against `--max-memory-mb`: planes and what
+/// they hold, counted as [`PLANE_BYTES`], [`OBJECT_BYTES`] and so on.
+#[derive(Debug)]
+pub struct DaemonMemory {
+    bytes: AtomicU64,
+    limit: u64,
+}
+
+impl DaemonMemory {
+    /// A budget of `limit` bytes.
+    pub fn new(limit: u64) -> DaemonMemory {
+        DaemonMemory {
+            bytes: AtomicU64::new(0),
+            limit,
+        }
+    }
+
+    fn take(&self, n: u64) -> Result<(), CommandError> {
+        take(&self.bytes, n, self.limit).map_err(|sum| {
+            exceeded(
+                "memory of the daemon (planes and what they hold)",
+                format!("{} MiB", self.limit >> 20),
+                "max-memory-mb",
+                format!("{} MiB", sum.div_ceil(1 << 20)),
+            )
+        })
+    }
+
+    fn give(&self, n: u64) {
+        self.bytes.fetch_sub(n, Ordering::SeqCst);
+    }
+}
+
+impl Default for DaemonMemory {
+    fn default() -> Self {
+        DaemonMemory::new(u64::MAX)
+    }
+}
+
+/// The bytes `usage` costs the daemon.
+fn bytes_of(usage: Usage) -> u64 {
+    usage
+        .objects
+        .saturating_mul(OBJECT_BYTES)
+        .saturating_add(usage.mesh_vertices.saturating_mul(VERTEX_BYTES))
+        .saturating_add(usage.state_bytes)
+}
+
 /// What the planes of one client process hold, all together, plus what ops in flight have
 /// reserved.
 #[derive(Debug, Default)]
@@ -22,6 +78,10 @@ pub struct OwnerUsage {
     objects: AtomicU64,
     mesh_vertices: AtomicU64,
     state_bytes: AtomicU64,
+    /// The daemon's total, which every change of this one also moves.
+    memory: Arc<DaemonMemory>,
+    /// The process's CPU account (fair shares between processes).
+    pub cpu: super::fair::CpuAccount,
 }
 
 /// A reservation: released when dropped (by then the plane's own count holds what the op
@@ -43,6 +103,11 @@ impl Reserved<'_> {
 
 impl Drop for Reserved<'_> {
     fn drop(&mut self) {
+        self.owner.memory.give(bytes_of(Usage {
+            objects: self.objects,
+            mesh_vertices: self.mesh_vertices,
+            state_bytes: self.state_bytes,
+        }));
         self.owner
             .state_bytes
             .fetch_sub(self.state_bytes, Ordering::SeqCst);
@@ -119,6 +184,17 @@ impl OwnerUsage {
                 sum,
             ));
         }
+        let memory = bytes_of(Usage {
+            objects,
+            mesh_vertices: vertices,
+            state_bytes: bytes,
+        });
+        if let Err(e) = self.memory.take(memory) {
+            self.objects.fetch_sub(objects, Ordering::SeqCst);
+            self.mesh_vertices.fetch_sub(vertices, Ordering::SeqCst);
+            self.state_bytes.fetch_sub(bytes, Ordering::SeqCst);
+            return Err(e);
+        }
         Ok(Reserved {
             owner: self,
             objects,
@@ -129,6 +205,8 @@ impl OwnerUsage {
 
     /// Moves the count from `old` to `new` (one plane's usage changed).
     fn change(&self, old: Usage, new: Usage) {
+        self.memory.bytes.fetch_add(bytes_of(new), Ordering::SeqCst);
+        self.memory.give(bytes_of(old));
         // Add first, then take away: the count never dips below what is held.
         self.objects.fetch_add(new.objects, Ordering::SeqCst);
         self.objects.fetch_sub(old.objects, Ordering::SeqCst);
@@ -167,13 +245,15 @@ struct PlaneState {
 }
 
 impl PlaneUsage {
-    /// A plane that holds nothing yet, counted for `owner`.
-    pub fn new(owner: Arc<OwnerUsage>) -> PlaneUsage {
-        PlaneUsage {
+    /// A plane that holds nothing yet, counted for `owner`; its own [`PLANE_BYTES`] are
+    /// admitted against the daemon's memory budget until it is dropped.
+    pub fn admit(owner: Arc<OwnerUsage>) -> Result<PlaneUsage, CommandError> {
+        owner.memory.take(PLANE_BYTES)?;
+        Ok(PlaneUsage {
             state: Mutex::default(),
             owner,
             guest_limit: AtomicU32::new(NO_SHARED_OBJECT_LIMIT),
-        }
+        })
     }
 
     fn lock(&self) -> std::sync::MutexGuard<'_, PlaneState> {
@@ -276,24 +356,50 @@ fn less(a: Usage, b: Usage) -> Usage {
 impl Drop for PlaneUsage {
     fn drop(&mut self) {
         self.release();
+        self.owner.memory.give(PLANE_BYTES);
     }
 }
 
-/// The [`OwnerUsage`] of every client process, by process id.
+/// The [`OwnerUsage`] of every client process, by process id, and the daemon's memory.
 #[derive(Default)]
 pub struct Owners {
     by_pid: HashMap<u32, Arc<OwnerUsage>>,
+    memory: Arc<DaemonMemory>,
+    shares: Arc<super::fair::CpuShares>,
 }
 
 impl Owners {
+    /// No owner yet; the daemon admits at most `memory_limit` bytes.
+    pub fn new(memory_limit: u64) -> Owners {
+        Owners {
+            by_pid: HashMap::new(),
+            memory: Arc::new(DaemonMemory::new(memory_limit)),
+            shares: Arc::default(),
+        }
+    }
+
     /// The counter of process `pid` (made on first use).
     pub fn of(&mut self, pid: u32) -> Arc<OwnerUsage> {
-        self.by_pid.entry(pid).or_default().clone()
+        let (memory, shares) = (&self.memory, &self.shares);
+        let owner = self
+            .by_pid
+            .entry(pid)
+            .or_insert_with(|| {
+                Arc::new(OwnerUsage {
+                    memory: memory.clone(),
+                    cpu: super::fair::CpuAccount::new(shares.clone()),
+                    ..OwnerUsage::default()
+                })
+            })
+            .clone();
+        self.shares.set_processes(self.by_pid.len());
+        owner
     }
 
     /// Forgets the counters no plane uses any more (they hold zero).
     pub fn prune(&mut self) {
         self.by_pid.retain(|_, o| Arc::strong_count(o) > 1);
+        self.shares.set_processes(self.by_pid.len());
     }
 }
 
@@ -344,7 +450,7 @@ mod tests {
     fn a_plane_that_goes_gives_back_what_its_adders_pay() {
         let owner = Arc::new(OwnerUsage::default());
         let guest = Arc::new(OwnerUsage::default());
-        let plane = PlaneUsage::new(owner.clone());
+        let plane = PlaneUsage::admit(owner.clone()).unwrap();
         let limits = Limits::DEFAULT;
         guest.reserve(&limits, cost(1)).unwrap().keep();
         let one = Usage {
@@ -386,5 +492,26 @@ mod tests {
         );
         assert!(e.message.contains("11"), "{}", e.message);
         assert_eq!(owner.get(), Usage::default());
+    }
+
+    #[test]
+    fn the_daemon_memory_budget_admits_planes_and_objects_within_it() {
+        let mut owners = Owners::new(2 * PLANE_BYTES + 10 * OBJECT_BYTES);
+        let (a, b) = (owners.of(1), owners.of(2));
+        let pa = PlaneUsage::admit(a.clone()).unwrap();
+        let pb = PlaneUsage::admit(b.clone()).unwrap();
+        let e = PlaneUsage::admit(a.clone()).expect_err("a third plane does not fit");
+        assert!(e.message.contains("--max-memory-mb"), "{}", e.message);
+        let limits = Limits::DEFAULT;
+        for _ in 0..10 {
+            b.reserve(&limits, cost(1)).unwrap().keep();
+        }
+        assert!(a.reserve(&limits, cost(1)).is_err(), "objects count too");
+        drop(pa);
+        assert!(
+            PlaneUsage::admit(a).is_ok(),
+            "a dropped plane gives its bytes back"
+        );
+        drop(pb);
     }
 }

@@ -424,6 +424,12 @@ impl Worker {
         let (Some(due), Some(period)) = (self.next_tick.filter(|t| *t <= now), self.period) else {
             return true;
         };
+        // The owner's process is past its CPU share (see `fair`): this plane waits too.
+        if let Some(ready) = self.usage.owner().cpu.ready_at(now) {
+            self.next_tick = Some(ready);
+            return true;
+        }
+        let started = Instant::now();
         let mut guard = self.cell.lock();
         let Some(plane) = guard.as_mut() else {
             return false;
@@ -459,11 +465,14 @@ impl Worker {
         // Keep the cadence; after a stall, restart from now instead of catching up.
         let now = Instant::now();
         let next = due + period;
-        self.next_tick = Some(if next + period * 4 < now {
+        let next = if next + period * 4 < now {
             now + period
         } else {
             next
-        });
+        };
+        // A process past its CPU share slows its own planes.
+        let ready = self.usage.owner().cpu.charge(now - started, now);
+        self.next_tick = Some(ready.map_or(next, |r| r.max(next)));
         true
     }
 
@@ -579,6 +588,14 @@ fn apply_op(
         if result.is_ok() {
             usage.set_guest_limit(limit);
         }
+        return result;
+    }
+    if let PlaneOp::Step { .. } = op {
+        // Explicit steps are charged to the owner's CPU account (never postponed).
+        let started = Instant::now();
+        let result = apply_inner(plane, out, panic_on_step_dt, op);
+        let now = Instant::now();
+        usage.owner().cpu.charge(now - started, now);
         return result;
     }
     if cost == Default::default() {

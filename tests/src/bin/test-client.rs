@@ -7,6 +7,8 @@
 //! test-client share DOMAIN LIMIT N         create a Shared plane with SharedObjectLimit
 //!                                          LIMIT, print "plane=ID"; on a line from stdin
 //!                                          add N cubes to a private plane, print "added=K"
+//! test-client burn DOMAIN N RATE           create N planes ticking at RATE Hz, each with 50
+//!                                          balls on a floor, print "ready", sleep
 
 use std::io::Write;
 
@@ -93,6 +95,36 @@ fn main() {
             println!("added={added}");
             std::io::stdout().flush().unwrap();
             std::thread::sleep(std::time::Duration::from_secs(3600));
+        }
+        "burn" => {
+            let n = args[3].parse::<u32>().expect("number");
+            let rate = args[4].parse::<f32>().expect("rate");
+            let planes: Vec<_> = (0..n)
+                .map(|_| {
+                    let plane = client
+                        .create_plane(&PlaneOptions {
+                            tick_rate: Some(rate),
+                            never_sleep: Some(true),
+                            ..PlaneOptions::default()
+                        })
+                        .expect("create plane");
+                    for i in 0..50 {
+                        plane
+                            .add(
+                                Shape::Sphere { radius: 0.5 },
+                                Pose::at([(i % 10) as f32 * 1.5, 1.0 + (i / 10) as f32, 0.0]),
+                                &[],
+                            )
+                            .expect("add");
+                    }
+                    plane
+                })
+                .collect();
+            client.flush().expect("flush");
+            println!("ready");
+            std::io::stdout().flush().unwrap();
+            std::thread::sleep(std::time::Duration::from_secs(3600));
+            drop(planes);
         }
         other => panic!("unknown mode {other}"),
     }
