@@ -6,6 +6,10 @@
 //! `--max-request-bytes` before it starts. Decoding then works on the private copy, so a
 //! sender that rewrites its request while the daemon decodes it cannot make one check see
 //! other bytes than the use after it.
+//!
+//! Cost, measured on a 2-core machine (release): 1.0 µs for a 256-byte request, 1.3 µs at
+//! 4 KiB, 5.5 µs at 64 KiB, 92 µs at 1 MiB (a plain copy: 0.01, 0.06, 0.7 and 18 µs), next to
+//! a request round trip of ~20 µs with event wake-up.
 
 /// Why a request's bytes could not be taken.
 #[derive(Debug, Clone, PartialEq, Eq)]
