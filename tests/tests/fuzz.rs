@@ -27,6 +27,7 @@ fn the_daemon_survives_fuzzed_requests_and_serves_on() {
     let mut config = FuzzConfig::new(seed(), Duration::from_secs(12));
     // Short run: a quota round often enough that every quota comes round at least once.
     config.quota_every = 25;
+    config.until_covered = true;
     println!("fuzz seed {} (PHYSICS_FUZZ_SEED replays it)", config.seed);
     let args = config.quotas.daemon_args();
     let args: Vec<&str> = args.iter().map(String::as_str).collect();

@@ -118,6 +118,10 @@ pub struct FuzzConfig {
     pub quota_every: u64,
     /// Longest wait for one reply before the request counts as unanswered.
     pub request_timeout: Duration,
+    /// Past `duration`, keep sending (up to twice as long again) until every op of
+    /// `stats::all_op_names` but Goodbye went out at least once: a short run on a loaded
+    /// machine then still covers every op.
+    pub until_covered: bool,
 }
 
 impl FuzzConfig {
@@ -130,6 +134,7 @@ impl FuzzConfig {
             quotas: Quotas::FUZZ,
             quota_every: 150,
             request_timeout: Duration::from_secs(20),
+            until_covered: false,
         }
     }
 }
@@ -176,7 +181,13 @@ pub fn run(
     };
     let started = Instant::now();
     let mut last_progress = started;
-    while started.elapsed() < config.duration && !engine.stop {
+    let more = |stats: &FuzzStats, elapsed: Duration| {
+        elapsed < config.duration
+            || (config.until_covered
+                && elapsed < config.duration * 3
+                && stats.ops_not_sent().iter().any(|op| op != "Goodbye"))
+    };
+    while more(&engine.stats, started.elapsed()) && !engine.stop {
         engine.batch();
         if last_progress.elapsed() >= Duration::from_secs(1) {
             engine.stats.seconds = started.elapsed().as_secs_f64();
