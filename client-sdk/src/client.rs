@@ -288,9 +288,7 @@ impl Client {
     /// for the next call into each (or [`Client::take_refused`]) and `flush` reports only
     /// a failure to send.
     pub fn flush(&self) -> Result<(), Error> {
-        if !self.inner.state.borrow().queue.is_empty() {
-            self.send(Vec::new())?;
-        }
+        self.send_queue()?;
         if self.inner.options.refusals_at_next_call {
             return Ok(());
         }

@@ -272,12 +272,8 @@ impl Plane {
                 let mut overlay = self.shared.overlay.borrow_mut();
                 match overlay.get(handle, tick) {
                     Some(entry) if !entry.impulse_pending => entry.apply(handle, base),
-                    Some(_) => {
-                        // Not settled by that send (it failed before a reply): show the
-                        // sample rather than loop.
-                        base
-                    }
-                    None => base,
+                    // Gone, or not settled by that send: the sample, rather than a loop.
+                    _ => base,
                 }
             }
             Some(entry) => entry.apply(handle, base),

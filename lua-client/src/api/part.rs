@@ -235,6 +235,8 @@ pub struct PartState {
     last_fired: Cell<Option<CFrame>>,
     /// Whether its body was asked to report contacts (while Touched / TouchEnded listen).
     reporting: Cell<bool>,
+    /// Whether the context's group registry already holds it (`Context::note_group_member`).
+    grouped: Cell<bool>,
     /// The mesh of a MeshPart.
     mesh: RefCell<Option<Rc<MeshData>>>,
     /// The CFrame value last handed to scripts (reads of an unmoved pose reuse it).
@@ -259,6 +261,7 @@ impl PartState {
             signals: RefCell::default(),
             last_fired: Cell::new(None),
             reporting: Cell::new(false),
+            grouped: Cell::new(false),
             mesh: RefCell::new(None),
             cframe_value: CFrameCache::default(),
             anchor_on_add: Cell::new(false),
@@ -362,6 +365,11 @@ impl PartState {
         }
         *this.collision_group.borrow_mut() = name;
         Ok(())
+    }
+
+    /// Marks the part as held by the group registry; true the first time.
+    pub(crate) fn mark_grouped(&self) -> bool {
+        !self.grouped.replace(true)
     }
 
     /// The part's group was renamed (or removed: `to` is [`DEFAULT_GROUP`]); its body, if any,

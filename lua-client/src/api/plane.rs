@@ -220,15 +220,15 @@ impl Context {
 
     /// Remembers `part`, just put in a group other than "Default".
     pub(crate) fn note_group_member(&self, part: &Rc<PartState>) {
-        let mut members = self.group_members.borrow_mut();
-        if !members
-            .iter()
-            .any(|w| std::ptr::eq(w.as_ptr(), Rc::as_ptr(part)))
-        {
-            // Forget collected parts before growing.
-            members.retain(|w| w.strong_count() > 0);
-            members.push(Rc::downgrade(part));
+        if !part.mark_grouped() {
+            return;
         }
+        let mut members = self.group_members.borrow_mut();
+        // Forget collected parts now and then (amortised: when the length doubles).
+        if members.len().is_power_of_two() {
+            members.retain(|w| w.strong_count() > 0);
+        }
+        members.push(Rc::downgrade(part));
     }
 
     /// Group `from` is now called `to` (removed: `to` is "Default"): every part in it

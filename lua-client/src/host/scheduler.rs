@@ -191,17 +191,11 @@ fn contain(
     if sched.watchdog.stopped().is_some() || matches!(e, mlua::Error::MemoryError(_)) {
         return resumed;
     }
-    let defined = handler
-        .function
-        .info()
-        .short_src
-        .map(|src| {
-            format!(
-                "{src}:{}",
-                handler.function.info().line_defined.unwrap_or(0)
-            )
-        })
-        .unwrap_or_else(|| "?".to_string());
+    let info = handler.function.info();
+    let defined = match info.short_src {
+        Some(src) => format!("{src}:{}", info.line_defined.unwrap_or(0)),
+        None => "?".to_string(),
+    };
     let message = e.to_string();
     let traceback = if message.contains("stack traceback") {
         message
