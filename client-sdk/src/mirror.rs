@@ -61,6 +61,12 @@ impl Mirror {
         }
     }
 
+    /// Forgets everything mirrored (the plane was restored from a snapshot).
+    pub fn forget_all(&mut self) {
+        self.plane = None;
+        self.objects.clear();
+    }
+
     /// Forgets the plane's options (a write was rejected, say).
     pub fn forget_plane(&mut self) {
         self.plane = None;

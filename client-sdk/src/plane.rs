@@ -369,6 +369,16 @@ impl Plane {
         result.map(|_| ())
     }
 
+    /// Forgets what this process keeps of the plane's state (written values not yet
+    /// published, counts, mirrored properties) and takes the newest sample: after a restore
+    /// the daemon's state is the truth.
+    pub(crate) fn forget_local_state(&self) {
+        *self.shared.overlay.borrow_mut() = Default::default();
+        *self.shared.members.borrow_mut() = Default::default();
+        self.shared.mirror.borrow_mut().forget_all();
+        let _ = self.shared.refresh();
+    }
+
     /// False once this process destroyed the plane or the daemon no longer knows it.
     pub fn is_alive(&self) -> bool {
         if !self.shared.alive.get() {

@@ -35,6 +35,7 @@ pub mod query;
 pub mod records;
 pub mod settings;
 pub mod shape;
+pub mod snapshot;
 pub mod validate;
 
 pub use axis_motor::AxisMotor;
@@ -57,6 +58,7 @@ pub use settings::{
     ObjectSettings, Pin, PlaneProp, PlaneSettings, Restraint, RotateTo, Vec2,
 };
 pub use shape::{Shape, ShapeKind};
+pub use snapshot::SnapshotHeader;
 
 /// Bumped whenever a record layout or the command encoding changes. Client and daemon must
 /// agree on it; the handshake reports both values when they differ.

@@ -70,6 +70,10 @@ impl Backend for Plane {
             PlaneOp::Info => Ok(Reply::Plane(self.info())),
             PlaneOp::Set(prop) => self.set(prop).map(|_| Reply::Done),
             PlaneOp::Gui(op) => self.gui(op),
+            PlaneOp::Snapshot => self.snapshot().map(Reply::Snapshot),
+            PlaneOp::Restore(bytes) => self.restore(&bytes).map(|_| Reply::Applied {
+                tick: self.tick,
+            }),
             PlaneOp::Object { handle, op } => match op {
                 ObjectOp::Wake => self.gui(GuiOp::Object {
                     handle,

@@ -54,6 +54,8 @@ impl Plane {
                 format!("{op:?} is handled by the server, not the plane"),
             )),
             PlaneOp::Explode(explosion) => self.explode(explosion),
+            PlaneOp::Snapshot => self.snapshot().map(Reply::Snapshot),
+            PlaneOp::Restore(bytes) => self.restore(&bytes).map(|_| applied(self)),
         }
     }
 }

@@ -37,6 +37,7 @@ mod probes;
 mod properties;
 mod publish;
 mod queries;
+mod snapshot;
 mod solver;
 
 use std::sync::mpsc;
@@ -58,7 +59,7 @@ use part::Part;
 pub use objects::MAX_SLOTS;
 
 /// One object: its rapier body and what the API says about it.
-#[derive(Debug)]
+#[derive(Debug, serde::Serialize, serde::Deserialize)]
 struct Body {
     handle: RigidBodyHandle,
     /// Boxed: the slot table stays small, so the publisher's pass over every slot reads one

@@ -633,7 +633,10 @@ fn apply_inner(
     panic_on_step_dt: Option<f32>,
     op: PlaneOp,
 ) -> CommandResult {
-    let needs_output = matches!(op, PlaneOp::Step { .. } | PlaneOp::Info);
+    let needs_output = matches!(
+        op,
+        PlaneOp::Step { .. } | PlaneOp::Info | PlaneOp::Restore(_)
+    );
     let out = match out {
         Some(out) => Some(out),
         None if needs_output => {
@@ -655,6 +658,14 @@ fn apply_inner(
                 }
             }
             Ok(Reply::Stepped { tick: plane.tick() })
+        }
+        // Readers see the restored state at once, as after a step.
+        op @ PlaneOp::Restore(_) => {
+            let reply = plane.apply(op)?;
+            if let Some(out) = out {
+                out.publish(plane).map_err(super::dispatch::internal)?;
+            }
+            Ok(reply)
         }
         op => {
             if op == PlaneOp::Info {

@@ -372,6 +372,7 @@ pub fn reply_name(reply: &Reply) -> &'static str {
         Reply::Probe(_) => "Probe",
         Reply::Contacts(_) => "Contacts",
         Reply::ObjectPage { .. } => "ObjectPage",
+        Reply::Snapshot(_) => "Snapshot",
     }
 }
 
@@ -423,6 +424,8 @@ pub fn op_name(command: &Command) -> String {
                 MapOp::Discard => "Plane.Map.Discard".into(),
             },
             PlaneOp::Explode(_) => "Plane.Explode".into(),
+            PlaneOp::Snapshot => "Plane.Snapshot".into(),
+            PlaneOp::Restore(_) => "Plane.Restore".into(),
         },
     }
 }
