@@ -109,7 +109,12 @@ impl PlaneCell {
     pub fn inline_op(op: &PlaneOp) -> bool {
         !matches!(
             op,
-            PlaneOp::Step { .. } | PlaneOp::Info | PlaneOp::Map(_) | PlaneOp::Query(_)
+            PlaneOp::Step { .. }
+                | PlaneOp::Info
+                | PlaneOp::Map(_)
+                | PlaneOp::Query(_)
+                | PlaneOp::Snapshot
+                | PlaneOp::Restore(_)
         ) && op.cost().mesh_vertices == 0
     }
 
@@ -642,7 +647,7 @@ fn apply_inner(
         None if needs_output => {
             return Err(CommandError::new(
                 ErrorKind::Internal,
-                format!("{op:?} must run on the plane's worker"),
+                format!("{} must run on the plane's worker", op_name(&op)),
             ))
         }
         None => None,
@@ -676,6 +681,16 @@ fn apply_inner(
             }
             plane.apply(op)
         }
+    }
+}
+
+/// The op's variant for messages (never its payload: a restore carries megabytes).
+fn op_name(op: &PlaneOp) -> &'static str {
+    match op {
+        PlaneOp::Step { .. } => "Step",
+        PlaneOp::Info => "Info",
+        PlaneOp::Restore(_) => "Restore",
+        _ => "this op",
     }
 }
 
