@@ -134,9 +134,27 @@ impl Plane {
     /// handles (handles this process holds read the restored poses), the same tick. Writes
     /// this process made that are not in the snapshot are forgotten. Returns the tick.
     pub fn restore(&self, snapshot: &PlaneSnapshot) -> Result<u64, Error> {
+        self.restore_with(snapshot, &[])
+    }
+
+    /// [`Plane::restore`], then `overrides` applied as at the plane's creation (Threads,
+    /// TickRate, Enabled, Gravity...; not DeferGpu).
+    pub fn restore_with(
+        &self,
+        snapshot: &PlaneSnapshot,
+        overrides: &[PlaneProp],
+    ) -> Result<u64, Error> {
+        let overrides = overrides
+            .iter()
+            .map(|p| p.checked())
+            .collect::<Result<Vec<_>, _>>()
+            .map_err(Error::invalid_value)?;
         let reply = self.client().call(Command::plane(
             self.id(),
-            PlaneOp::Restore(snapshot.bytes.to_vec()),
+            PlaneOp::Restore {
+                bytes: snapshot.bytes.to_vec(),
+                overrides,
+            },
         ));
         self.forget_local_state();
         match reply? {
@@ -164,14 +182,7 @@ impl Client {
         };
         self.note_owned(info.id);
         let plane = self.attach_plane(info.id)?;
-        let made = (|| {
-            plane.restore(snapshot)?;
-            for prop in overrides {
-                plane.set_now(*prop)?;
-            }
-            Ok(())
-        })();
-        if let Err(e) = made {
+        if let Err(e) = plane.restore_with(snapshot, overrides) {
             let _ = plane.destroy();
             return Err(e);
         }

@@ -75,9 +75,15 @@ pub enum PlaneOp {
     /// The plane's whole state as it is between ticks; replies [`crate::Reply::Snapshot`].
     Snapshot,
     /// The plane becomes exactly the state of a snapshot of the same kind (same objects
-    /// under the same handles, same tick); refused, the plane stays as it was. Replies
-    /// [`crate::Reply::Applied`] with the restored tick.
-    Restore(Vec<u8>),
+    /// under the same handles, same tick), then `overrides` apply as at creation (a plane
+    /// started from a snapshot with another TickRate or Threads); refused, the plane stays
+    /// as it was. Replies [`crate::Reply::Applied`] with the restored tick.
+    Restore {
+        /// The snapshot ([`crate::snapshot`] framing).
+        bytes: Vec<u8>,
+        /// Options applied after the state (DeferGpu excluded).
+        overrides: Vec<PlaneProp>,
+    },
 }
 
 /// What an op may add to a plane, for the daemon's per-client quotas.
@@ -145,7 +151,7 @@ impl PlaneOp {
             },
             // What the snapshot's header says it holds (the plane refuses a body that
             // holds more).
-            PlaneOp::Restore(bytes) => match crate::snapshot::header(bytes) {
+            PlaneOp::Restore { bytes, .. } => match crate::snapshot::header(bytes) {
                 Ok((h, _)) => OpCost {
                     objects: h.objects.min(u32::MAX as u64) as u32,
                     mesh_vertices: h.mesh_vertices,

@@ -620,3 +620,14 @@ fn dyn_mesh_welds_ride_along_with_their_driver() {
     r.assert_ok();
     assert!(r.stdout().contains("dyn mesh ok"), "{}", r.stdout());
 }
+
+#[test]
+fn planes_snapshot_restore_and_start_from_snapshots_in_luau() {
+    let daemon = TestDaemon::start("lua-snapshot");
+    let r = run(&daemon, "tests/lua/snapshot.luau");
+    // physics-lua runs in the repository root.
+    let file = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../lua-snapshot-test.snap");
+    let _ = std::fs::remove_file(file);
+    r.assert_ok();
+    assert!(r.stdout().contains("snapshot lua ok"), "{}", r.stdout());
+}

@@ -154,9 +154,7 @@ fn replay(game: &mut Game, log: &[Entry]) -> Vec<u64> {
                 }
                 Entry::Destroy(at, i) if at == t => game.objects[i].destroy(),
                 Entry::Move(at, x, z) if at == t => game.controller.set_move_vector(x, z).unwrap(),
-                Entry::Motor(at, s) if at == t => {
-                    game.wheel.set(JointProp::MotorSpeed(s)).unwrap()
-                }
+                Entry::Motor(at, s) if at == t => game.wheel.set(JointProp::MotorSpeed(s)).unwrap(),
                 _ => {}
             }
         }
@@ -189,7 +187,10 @@ fn a_restored_plane_continues_bit_for_bit_on_the_same_daemon() {
     let client = daemon.client();
     for threads in [1, 2] {
         let (mut game, snapshot, reference) = game_and_reference(&client, threads);
-        assert!(reference.windows(2).any(|w| w[0] != w[1]), "the scene moves");
+        assert!(
+            reference.windows(2).any(|w| w[0] != w[1]),
+            "the scene moves"
+        );
         // Handles the script holds stay valid: the restored plane reads the snapshot's state.
         let tick = game.plane.restore(&snapshot).unwrap();
         assert_eq!(tick, BEFORE as u64);
@@ -273,7 +274,10 @@ fn gui_planes_restore_bit_for_bit_and_files_round_trip() {
             .add(
                 shape,
                 [30.0, 30.0],
-                [100.0 + 31.0 * (i % 10) as f32, 100.0 + 40.0 * (i / 10) as f32],
+                [
+                    100.0 + 31.0 * (i % 10) as f32,
+                    100.0 + 40.0 * (i / 10) as f32,
+                ],
                 &[],
             )
             .unwrap();
@@ -316,7 +320,11 @@ fn damaged_or_foreign_snapshots_are_refused_and_change_nothing() {
     let client = daemon.client();
     let plane = client.create_plane(&PlaneOptions::manual()).unwrap();
     let ball = plane
-        .add(Shape::Sphere { radius: 0.5 }, Pose::at([0.0, 5.0, 0.0]), &[])
+        .add(
+            Shape::Sphere { radius: 0.5 },
+            Pose::at([0.0, 5.0, 0.0]),
+            &[],
+        )
         .unwrap();
     plane.step(DT).unwrap();
     let good = plane.take_snapshot().unwrap();
@@ -342,9 +350,7 @@ fn damaged_or_foreign_snapshots_are_refused_and_change_nothing() {
     assert!(message(b"PHYSNAP1 nonsense".to_vec()).contains("snapshot refused"));
     assert!(message(vec![0; 64]).contains("not a plane snapshot"));
     // A GUI snapshot into a 3D plane.
-    let gui = client
-        .create_gui_plane(&GuiPlaneOptions::manual())
-        .unwrap();
+    let gui = client.create_gui_plane(&GuiPlaneOptions::manual()).unwrap();
     let foreign = gui.plane().take_snapshot().unwrap();
     let e = plane.restore(&foreign).unwrap_err().to_string();
     assert!(e.contains("Gui2d"), "{e}");

@@ -21,6 +21,7 @@ pub mod plane;
 pub mod probe;
 pub mod query;
 pub mod ragdoll;
+pub mod snapshot;
 pub mod static_shapes;
 
 use std::rc::Rc;

@@ -306,6 +306,7 @@ impl UserData for PhysicsPlane {
                 .map_err(|e| sdk_error("PhysicsPlane:StateHash", e))
         });
         super::query::add_methods(methods);
+        super::snapshot::add_plane_methods(methods);
         methods.add_method("NewController", |_, p, (part, opts): (Value, Value)| {
             new_controller(&p.0, part, opts, false)
         });
@@ -414,6 +415,12 @@ fn new_plane(lua: &Lua, opts: Value) -> mlua::Result<PhysicsPlane> {
         .client
         .create_plane(&options)
         .map_err(|e| sdk_error(WHAT, e))?;
+    Ok(wrap_plane(lua, plane))
+}
+
+/// The script's handle on a new plane of this client (`New`, `FromSnapshot`).
+pub(crate) fn wrap_plane(lua: &Lua, plane: Plane) -> PhysicsPlane {
+    let ctx = context(lua);
     let state = Rc::new(PlaneState {
         plane,
         alive: Cell::new(true),
@@ -425,7 +432,7 @@ fn new_plane(lua: &Lua, opts: Value) -> mlua::Result<PhysicsPlane> {
     // Probed every frame; it costs one check while no part of it has touch handlers.
     scheduler(lua).watch(state.clone());
     ctx.planes.borrow_mut().push(state.clone());
-    Ok(PhysicsPlane(state))
+    PhysicsPlane(state)
 }
 
 /// Puts `prop` into the field of the creation request that carries it.
@@ -467,5 +474,6 @@ pub fn module(lua: &Lua) -> mlua::Result<Table> {
     )?;
     super::collision_groups::install(lua, &m)?;
     m.set("NewGUI", lua.create_function(super::gui_plane::new_gui)?)?;
+    super::snapshot::install(lua, &m)?;
     Ok(m)
 }

@@ -71,9 +71,9 @@ impl Backend for Plane {
             PlaneOp::Set(prop) => self.set(prop).map(|_| Reply::Done),
             PlaneOp::Gui(op) => self.gui(op),
             PlaneOp::Snapshot => self.snapshot().map(Reply::Snapshot),
-            PlaneOp::Restore(bytes) => self.restore(&bytes).map(|_| Reply::Applied {
-                tick: self.tick,
-            }),
+            PlaneOp::Restore { bytes, overrides } => self
+                .restore(&bytes, &overrides)
+                .map(|_| Reply::Applied { tick: self.tick }),
             PlaneOp::Object { handle, op } => match op {
                 ObjectOp::Wake => self.gui(GuiOp::Object {
                     handle,

@@ -3,8 +3,8 @@
 //! continues bit for bit. The id, the quota counter and the scratch stay with the plane.
 
 use rapier2d::prelude::*;
-use shm_layout::settings::GuiPlaneSettings;
-use shm_layout::{snapshot, CommandError, ErrorKind, PlaneKind, SnapshotHeader};
+use shm_layout::settings::{GuiPlaneProp, GuiPlaneSettings};
+use shm_layout::{snapshot, CommandError, ErrorKind, PlaneKind, PlaneProp, SnapshotHeader};
 
 use super::{held, Body, Plane, MAX_SLOTS};
 use crate::backend::counted::Counter;
@@ -61,9 +61,8 @@ fn refused(what: impl std::fmt::Display) -> CommandError {
 impl Plane {
     /// The plane's whole state as snapshot bytes.
     pub fn snapshot(&self) -> Result<Vec<u8>, CommandError> {
-        let body = postcard::to_allocvec(&self.state_ref()).map_err(|e| {
-            CommandError::new(ErrorKind::Internal, format!("snapshot failed: {e}"))
-        })?;
+        let body = postcard::to_allocvec(&self.state_ref())
+            .map_err(|e| CommandError::new(ErrorKind::Internal, format!("snapshot failed: {e}")))?;
         let usage = self.usage();
         let header = SnapshotHeader {
             engine: ENGINE.to_string(),
@@ -79,11 +78,33 @@ impl Plane {
     }
 
     /// Becomes exactly the state of `bytes`; nothing changes when it is refused.
-    pub fn restore(&mut self, bytes: &[u8]) -> Result<(), CommandError> {
+    pub fn restore(&mut self, bytes: &[u8], overrides: &[PlaneProp]) -> Result<(), CommandError> {
         let (header, body) = snapshot::decode(bytes, PlaneKind::Gui2d, ENGINE)?;
         let mut state: State = postcard::from_bytes(body)
             .map_err(|e| refused(format!("its state does not decode ({e})")))?;
         check(&state)?;
+        // The overrides are checked on a copy of the decoded plane's settings first.
+        let mut checked = state.settings;
+        for prop in overrides {
+            match prop.checked()? {
+                PlaneProp::TickRate(_) | PlaneProp::Enabled(_) => {}
+                PlaneProp::Gui(GuiPlaneProp::Bounds { .. }) | PlaneProp::Shared(_) => {
+                    return Err(refused(format!(
+                        "{} cannot be set by a restore (it is the snapshot's)",
+                        prop.name()
+                    )))
+                }
+                PlaneProp::Gui(g) => {
+                    checked.apply(g, true)?;
+                }
+                other => {
+                    return Err(refused(format!(
+                        "{} is not an option of GUI planes",
+                        other.name()
+                    )))
+                }
+            }
+        }
         state.bodies.adopt_limits(&self.bodies)?;
         let paths = Counter::default();
         for (_, b) in state.bodies.iter_mut() {
@@ -107,6 +128,9 @@ impl Plane {
         self.take_state(state);
         self.events.clear();
         self.dirty.mark_all();
+        for prop in overrides {
+            self.apply_prop(*prop, true)?;
+        }
         Ok(())
     }
 }

@@ -55,7 +55,9 @@ impl Plane {
             )),
             PlaneOp::Explode(explosion) => self.explode(explosion),
             PlaneOp::Snapshot => self.snapshot().map(Reply::Snapshot),
-            PlaneOp::Restore(bytes) => self.restore(&bytes).map(|_| applied(self)),
+            PlaneOp::Restore { bytes, overrides } => {
+                self.restore(&bytes, &overrides).map(|_| applied(self))
+            }
         }
     }
 }

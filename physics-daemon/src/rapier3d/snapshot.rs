@@ -10,7 +10,8 @@
 
 use rapier3d::prelude::*;
 use shm_layout::{
-    snapshot, CollisionGroups, CommandError, ErrorKind, PlaneKind, PlaneSettings, SnapshotHeader,
+    snapshot, CollisionGroups, CommandError, ErrorKind, PlaneKind, PlaneProp, PlaneSettings,
+    SnapshotHeader,
 };
 
 use super::controllers::{self, Controllers};
@@ -70,10 +71,7 @@ plane_state! {
 }
 
 fn refused(what: impl std::fmt::Display) -> CommandError {
-    CommandError::new(
-        ErrorKind::InvalidValue,
-        format!("snapshot refused: {what}"),
-    )
+    CommandError::new(ErrorKind::InvalidValue, format!("snapshot refused: {what}"))
 }
 
 impl Plane {
@@ -86,9 +84,8 @@ impl Plane {
                 "a DeferGpu plane cannot be snapshotted yet: set DeferGpu = false first",
             ));
         }
-        let body = postcard::to_allocvec(&self.state_ref()).map_err(|e| {
-            CommandError::new(ErrorKind::Internal, format!("snapshot failed: {e}"))
-        })?;
+        let body = postcard::to_allocvec(&self.state_ref())
+            .map_err(|e| CommandError::new(ErrorKind::Internal, format!("snapshot failed: {e}")))?;
         let usage = crate::backend::Backend::usage(self);
         let header = SnapshotHeader {
             engine: ENGINE.to_string(),
@@ -105,7 +102,7 @@ impl Plane {
 
     /// Becomes exactly the state of `bytes` (same objects under the same handles). The
     /// plane keeps its id. Nothing changes when the snapshot is refused.
-    pub fn restore(&mut self, bytes: &[u8]) -> Result<(), CommandError> {
+    pub fn restore(&mut self, bytes: &[u8], overrides: &[PlaneProp]) -> Result<(), CommandError> {
         #[cfg(feature = "gpu")]
         if self.on_gpu() {
             return Err(CommandError::invalid_field(
@@ -117,12 +114,22 @@ impl Plane {
         let mut state: State = postcard::from_bytes(body)
             .map_err(|e| refused(format!("its state does not decode ({e})")))?;
         check(&state)?;
+        // The overrides are checked on the decoded settings before anything changes.
+        for prop in overrides {
+            if let PlaneProp::DeferGpu(_) = prop {
+                return Err(CommandError::invalid_field(
+                    "DeferGpu",
+                    "DeferGpu cannot be set by a restore: set it on the restored plane",
+                ));
+            }
+            state.settings.apply(*prop, true)?;
+        }
         state.bodies.adopt_limits(&self.bodies)?;
         state.joints.adopt_limits(&self.joints)?;
         // What is not state stays: the pipeline (the thread pool), the CCD workspace, the
         // table limits, the quota counter.
         state.world.physics_pipeline = std::mem::take(&mut self.world.physics_pipeline);
-                // The quota reserved what the header claims: the body may not hold more.
+        // The quota reserved what the header claims: the body may not hold more.
         let paths = crate::backend::counted::Counter::default();
         controllers::count_paths_in(&mut state.controllers, &paths);
         let held = [
@@ -150,6 +157,10 @@ impl Plane {
             self.quality_counts[body.part.hit_box_quality as usize] += 1;
         }
         self.set_threads(threads)?;
+        // Their mapping onto the engine (Gravity, NeverSleep; Threads is set above).
+        for prop in overrides {
+            self.apply_prop(*prop, true)?;
+        }
         self.dirty.mark_all();
         Ok(())
     }

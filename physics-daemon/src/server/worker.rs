@@ -114,7 +114,7 @@ impl PlaneCell {
                 | PlaneOp::Map(_)
                 | PlaneOp::Query(_)
                 | PlaneOp::Snapshot
-                | PlaneOp::Restore(_)
+                | PlaneOp::Restore { .. }
         ) && op.cost().mesh_vertices == 0
     }
 
@@ -640,7 +640,7 @@ fn apply_inner(
 ) -> CommandResult {
     let needs_output = matches!(
         op,
-        PlaneOp::Step { .. } | PlaneOp::Info | PlaneOp::Restore(_)
+        PlaneOp::Step { .. } | PlaneOp::Info | PlaneOp::Restore { .. }
     );
     let out = match out {
         Some(out) => Some(out),
@@ -665,7 +665,7 @@ fn apply_inner(
             Ok(Reply::Stepped { tick: plane.tick() })
         }
         // Readers see the restored state at once, as after a step.
-        op @ PlaneOp::Restore(_) => {
+        op @ PlaneOp::Restore { .. } => {
             let reply = plane.apply(op)?;
             if let Some(out) = out {
                 out.publish(plane).map_err(super::dispatch::internal)?;
@@ -689,7 +689,7 @@ fn op_name(op: &PlaneOp) -> &'static str {
     match op {
         PlaneOp::Step { .. } => "Step",
         PlaneOp::Info => "Info",
-        PlaneOp::Restore(_) => "Restore",
+        PlaneOp::Restore { .. } => "Restore",
         _ => "this op",
     }
 }

@@ -425,7 +425,7 @@ pub fn op_name(command: &Command) -> String {
             },
             PlaneOp::Explode(_) => "Plane.Explode".into(),
             PlaneOp::Snapshot => "Plane.Snapshot".into(),
-            PlaneOp::Restore(_) => "Plane.Restore".into(),
+            PlaneOp::Restore { .. } => "Plane.Restore".into(),
         },
     }
 }
