@@ -488,11 +488,25 @@ impl Plane {
         // The map's body joins the plane's objects (and its tick is not in the reply).
         self.shared.members.borrow_mut().unknown_change();
         match reply {
-            Reply::Map(info) => Ok(Map {
+            Reply::Map(info) => {
+                // Until a sample shows it, the map reads back as built (as an added object
+                // does): ask the daemon's tick once, so the overlay ends with the first
+                // sample that holds the map.
+                let tick = self.info()?.tick;
+                self.shared.members.borrow_mut().asked(tick);
+                self.overlay_write(info.handle, |e| {
+                    e.pose = Some(options.pose);
+                    e.velocity = Some([0.0; 3]);
+                    e.angular_velocity = Some([0.0; 3]);
+                    e.anchored = Some(true);
+                });
+                self.overlay_confirm(info.handle, tick);
+                Ok(Map {
                 object: Object::from_handle(self, info.handle),
                 meshes: meshes.len(),
                 report: info.report,
-            }),
+                })
+            }
             other => Err(Error::Protocol(format!("expected a map, got {other:?}"))),
         }
     }

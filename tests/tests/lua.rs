@@ -620,3 +620,9 @@ fn dyn_mesh_welds_ride_along_with_their_driver() {
     r.assert_ok();
     assert!(r.stdout().contains("dyn mesh ok"), "{}", r.stdout());
 }
+
+#[test]
+fn a_loaded_map_is_a_handle_queries_filters_and_contacts_hand_back() {
+    let daemon = TestDaemon::start("lua-map-handle");
+    run_ok(&daemon, "tests/lua/map_handle.luau", "map handle ok");
+}

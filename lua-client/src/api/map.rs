@@ -280,9 +280,9 @@ pub static MAP: Props<MapState> = Props {
 };
 
 /// The Lua value of a map.
-pub struct LuaMap(pub Rc<MapState>);
+pub struct Map(pub Rc<MapState>);
 
-impl UserData for LuaMap {
+impl UserData for Map {
     fn add_methods<M: UserDataMethods<Self>>(methods: &mut M) {
         // Destroying a destroyed map (or one whose plane is gone) does nothing.
         methods.add_method("Destroy", |_, m, ()| {
@@ -312,7 +312,7 @@ impl UserData for LuaMap {
         methods.add_meta_method(DESCRIBE, |_, m, ()| Ok(m.0.describe()));
         methods.add_meta_method(MetaMethod::Eq, |_, m, other: Value| {
             Ok(match other {
-                Value::UserData(ud) => ud.borrow::<LuaMap>().is_ok_and(|o| Rc::ptr_eq(&o.0, &m.0)),
+                Value::UserData(ud) => ud.borrow::<Map>().is_ok_and(|o| Rc::ptr_eq(&o.0, &m.0)),
                 _ => false,
             })
         });
@@ -322,7 +322,7 @@ impl UserData for LuaMap {
 /// The script's `Map` value of `map` (one per map: see `identity.rs`).
 pub(crate) fn map_ud(lua: &Lua, map: &Rc<MapState>) -> mlua::Result<AnyUserData> {
     super::identity::userdata(lua, Rc::as_ptr(map).cast(), super::identity::tag::MAP, || {
-        LuaMap(map.clone())
+        Map(map.clone())
     })
 }
 
@@ -332,7 +332,7 @@ pub(crate) fn map_handle(v: &Value) -> Option<Option<Handle>> {
     let Value::UserData(ud) = v else {
         return None;
     };
-    let m = ud.borrow::<LuaMap>().ok()?;
+    let m = ud.borrow::<Map>().ok()?;
     Some(m.0.alive().then(|| m.0.handle()))
 }
 
