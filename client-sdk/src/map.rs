@@ -83,48 +83,63 @@ impl Map {
         }
     }
 
+    /// The map's object while it exists; else a `StaleHandle` error naming the map.
+    fn live(&self) -> Result<&Object, Error> {
+        if self.object.is_alive()? {
+            return Ok(&self.object);
+        }
+        Err(Error::Command(shm_layout::CommandError::new(
+            shm_layout::ErrorKind::StaleHandle,
+            format!(
+                "map {} of plane {} was destroyed",
+                self.handle(),
+                self.object.plane().id()
+            ),
+        )))
+    }
+
     /// Where the map's origin is (the newest tick, with this process's writes on top).
     pub fn pose(&self) -> Result<Pose, Error> {
-        self.object.pose()
+        self.live()?.pose()
     }
 
     /// Moves the static map: bodies resting on it are woken and follow the new surface,
     /// queries see it after the next step. Maps stay anchored.
     pub fn set_pose(&self, pose: Pose) -> Result<(), Error> {
-        self.object.set_pose(pose)
+        self.live()?.set_pose(pose)
     }
 
     /// The map's surface friction, in [0, 1] (combined with a body's as `sqrt(a·b)`).
     pub fn set_friction(&self, mu: f32) -> Result<(), Error> {
-        self.object.set_friction(mu)
+        self.live()?.set_friction(mu)
     }
 
     /// The map's bounciness, clamped to [0, 1] (combined with a body's as the higher of
     /// the two).
     pub fn set_bounciness(&self, e: f32) -> Result<(), Error> {
-        self.object.set_bounciness(e)
+        self.live()?.set_bounciness(e)
     }
 
     /// Whether bodies collide with the map (queries with `respect_can_collide` skip it
     /// when false).
     pub fn set_can_collide(&self, on: bool) -> Result<(), Error> {
-        self.object.set_can_collide(on)
+        self.live()?.set_can_collide(on)
     }
 
     /// Puts the map in a registered collision group.
     pub fn set_collision_group(&self, name: &str) -> Result<(), Error> {
-        self.object.set_collision_group(name)
+        self.live()?.set_collision_group(name)
     }
 
     /// The map's collision group, by name.
     pub fn collision_group(&self) -> Result<String, Error> {
-        self.object.collision_group()
+        self.live()?.collision_group()
     }
 
     /// Friction, Bounciness, CanCollide and the collision group as the daemon holds them
     /// (the property mirror: one round trip the first time).
     pub fn properties(&self) -> Result<shm_layout::ObjectInfo, Error> {
-        self.object.properties()
+        self.live()?.properties()
     }
 }
 
