@@ -517,9 +517,9 @@ impl Plane {
                 });
                 self.overlay_confirm(info.handle, tick);
                 Ok(Map {
-                object: Object::from_handle(self, info.handle),
-                meshes: meshes.len(),
-                report: info.report,
+                    object: Object::from_handle(self, info.handle),
+                    meshes: meshes.len(),
+                    report: info.report,
                 })
             }
             other => Err(Error::Protocol(format!("expected a map, got {other:?}"))),

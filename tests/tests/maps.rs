@@ -308,7 +308,9 @@ fn a_map_handle_filters_groups_moves_and_destroys_its_map() {
         ..Default::default()
     };
     assert_eq!(
-        s.plane.raycast([1.2, 10.0, 1.7], down, Some(&excluded)).unwrap(),
+        s.plane
+            .raycast([1.2, 10.0, 1.7], down, Some(&excluded))
+            .unwrap(),
         None,
         "the filtered map is not hit"
     );
@@ -343,7 +345,10 @@ fn a_map_handle_filters_groups_moves_and_destroys_its_map() {
     let h = 1.0f32 / 240.0;
     let fell = 2.0 - 50.0 * h * h * 240.0 * 241.0 / 2.0;
     let gy = ghost.position().unwrap()[1];
-    assert!((gy - fell).abs() < 0.01, "ghost at {gy}, free fall says {fell}");
+    assert!(
+        (gy - fell).abs() < 0.01,
+        "ghost at {gy}, free fall says {fell}"
+    );
     let sy = solid.position().unwrap()[1];
     assert!((sy - 0.5).abs() < 0.02, "the Default cube rests at {sy}");
 

@@ -150,9 +150,7 @@ impl Target for MapState {
 
     fn write(&self, name: &str, prop: ObjectProp) -> mlua::Result<()> {
         let what = format!("Map.{name}");
-        self.live(&what)?
-            .set(prop)
-            .map_err(|e| sdk_error(&what, e))
+        self.live(&what)?.set(prop).map_err(|e| sdk_error(&what, e))
     }
 }
 
@@ -204,12 +202,9 @@ pub static MAP: Props<MapState> = Props {
             }),
             set: Set::Prop(|a| Ok(ObjectProp::Pose(a.cframe()?.pose()))),
         },
-        info_row!(
-            "Friction",
-            Kind::UNIT,
-            |i| lua_number(i.friction),
-            |a| ObjectProp::Friction(a.number()? as f32)
-        ),
+        info_row!("Friction", Kind::UNIT, |i| lua_number(i.friction), |a| {
+            ObjectProp::Friction(a.number()? as f32)
+        }),
         // Documented as clamped to [0, 1], as on objects.
         info_row!(
             "Bounciness",
@@ -274,7 +269,9 @@ pub static MAP: Props<MapState> = Props {
         own_row!("Validation", |lua, m| Value::Table(m.validation(lua)?)),
         // What LoadMap's table held before it returned a Map (kept for scripts using it).
         own_row!("Meshes", |_, m| lua_number(m.map.meshes as f64)),
-        own_row!("Triangles", |_, m| lua_number(m.map.report.triangles as f64)),
+        own_row!("Triangles", |_, m| lua_number(
+            m.map.report.triangles as f64
+        )),
         own_row!("Vertices", |_, m| lua_number(m.map.report.vertices as f64)),
     ],
 };
@@ -321,9 +318,12 @@ impl UserData for Map {
 
 /// The script's `Map` value of `map` (one per map: see `identity.rs`).
 pub(crate) fn map_ud(lua: &Lua, map: &Rc<MapState>) -> mlua::Result<AnyUserData> {
-    super::identity::userdata(lua, Rc::as_ptr(map).cast(), super::identity::tag::MAP, || {
-        Map(map.clone())
-    })
+    super::identity::userdata(
+        lua,
+        Rc::as_ptr(map).cast(),
+        super::identity::tag::MAP,
+        || Map(map.clone()),
+    )
 }
 
 /// The handle of a live `Map` value, `None` for any other value; a destroyed map gives
