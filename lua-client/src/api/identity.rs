@@ -23,6 +23,8 @@ pub(crate) mod tag {
     pub const MAP: usize = 3;
     /// `PhysicsPlane` (its `PlaneState`).
     pub const PLANE: usize = 4;
+    /// `Signal` (its shared connections).
+    pub const SIGNAL: usize = 5;
 }
 
 fn table(lua: &Lua) -> mlua::Result<Table> {

@@ -226,7 +226,7 @@ impl UserData for LuaJoint {
             }
             if key == "Broke" {
                 let signal = joint_broke_signal(&j.1, j.0.handle(), &j.name());
-                return Ok(Value::UserData(lua.create_userdata(signal)?));
+                return Ok(Value::UserData(signal.userdata(lua)?));
             }
             let info =
                 j.0.info()
