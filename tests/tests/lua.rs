@@ -629,7 +629,7 @@ fn a_loaded_map_is_a_handle_queries_filters_and_contacts_hand_back() {
 
 #[test]
 fn a_signal_property_is_one_value_per_signal() {
-    let daemon = TestDaemon::start("lua-signal-identity");
+    let daemon = TestDaemon::start("lua-signal-ids");
     run_ok(
         &daemon,
         "tests/lua/signal_identity.luau",
