@@ -307,6 +307,11 @@ impl Plane {
         self.shared.overlay.borrow_mut().write(handle, f);
     }
 
+    /// The daemon applied every write recorded for `handle` by tick `tick`.
+    pub(crate) fn overlay_confirm(&self, handle: Handle, tick: u64) {
+        self.shared.overlay.borrow_mut().confirm(handle, tick);
+    }
+
     /// The determinism hash of the newest published tick ([`TickHeader::state_hash`]: every
     /// body's pose, velocities, flags and generation, bit for bit, in slot order). Two runs
     /// of the same commands agree on it tick by tick; a replay that diverges shows it on the

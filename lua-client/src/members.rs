@@ -22,5 +22,6 @@ pub fn property_rows() -> Vec<(&'static str, Vec<&'static str>)> {
             "PhysicsGuiObject",
             props::gui::GUI_OBJECT_ROWS.iter().map(|r| r.name).collect(),
         ),
+        names(&crate::api::map::MAP),
     ]
 }

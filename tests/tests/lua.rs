@@ -631,3 +631,19 @@ fn planes_snapshot_restore_and_start_from_snapshots_in_luau() {
     r.assert_ok();
     assert!(r.stdout().contains("snapshot lua ok"), "{}", r.stdout());
 }
+
+#[test]
+fn a_loaded_map_is_a_handle_queries_filters_and_contacts_hand_back() {
+    let daemon = TestDaemon::start("lua-map-handle");
+    run_ok(&daemon, "tests/lua/map_handle.luau", "map handle ok");
+}
+
+#[test]
+fn a_signal_property_is_one_value_per_signal() {
+    let daemon = TestDaemon::start("lua-signal-ids");
+    run_ok(
+        &daemon,
+        "tests/lua/signal_identity.luau",
+        "signal identity ok",
+    );
+}

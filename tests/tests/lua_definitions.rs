@@ -180,7 +180,13 @@ fn property_rows_match_the_declared_properties() {
     // The GUI types' row tables hold their writable options; their read-only figures
     // (ObjectCount, Sleeping, ...) are read outside the rows, so only the run-time check
     // below covers those.
-    let all_rows = ["BasePart", "PhysicsObject", "PhysicsPlane", "Controller"];
+    let all_rows = [
+        "BasePart",
+        "PhysicsObject",
+        "PhysicsPlane",
+        "Controller",
+        "Map",
+    ];
     for (owner, rows) in lua_client::property_rows() {
         let Some(members) = d.classes.get(owner) else {
             problems.push(format!("class {owner} (a property table) is not declared"));

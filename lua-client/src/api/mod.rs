@@ -15,6 +15,7 @@ pub mod gui_object;
 pub mod gui_plane;
 pub(crate) mod identity;
 pub mod joint;
+pub mod map;
 pub mod object;
 pub mod part;
 pub mod plane;

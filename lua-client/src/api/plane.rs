@@ -31,6 +31,8 @@ pub struct PlaneState {
     pub(crate) contacts: ContactPump,
     /// Its character controllers by body handle (`controller.rs`).
     controllers: RefCell<HashMap<Handle, Rc<ControllerState>>>,
+    /// Its maps by body handle (`map.rs`): hits and contacts on a map hand back its Map.
+    pub(crate) maps: RefCell<HashMap<Handle, Rc<super::map::MapState>>>,
 }
 
 impl PlaneState {
@@ -120,6 +122,7 @@ impl PlaneState {
         }
         self.by_handle.borrow_mut().clear();
         self.controllers.borrow_mut().clear();
+        self.maps.borrow_mut().clear();
         self.plane.destroy()
     }
 
@@ -396,7 +399,7 @@ pub(crate) fn add(plane: &Rc<PlaneState>, part: Value) -> mlua::Result<PhysicsOb
 }
 
 /// `PhysicsService.New(opts?)`.
-fn new_plane(lua: &Lua, opts: Value) -> mlua::Result<PhysicsPlane> {
+fn new_plane(lua: &Lua, opts: Value) -> mlua::Result<mlua::AnyUserData> {
     const WHAT: &str = "PhysicsService.New";
     let opts = match opts {
         Value::Nil => None,
@@ -415,11 +418,11 @@ fn new_plane(lua: &Lua, opts: Value) -> mlua::Result<PhysicsPlane> {
         .client
         .create_plane(&options)
         .map_err(|e| sdk_error(WHAT, e))?;
-    Ok(wrap_plane(lua, plane))
+    wrap_plane(lua, plane)
 }
 
 /// The script's handle on a new plane of this client (`New`, `FromSnapshot`).
-pub(crate) fn wrap_plane(lua: &Lua, plane: Plane) -> PhysicsPlane {
+pub(crate) fn wrap_plane(lua: &Lua, plane: Plane) -> mlua::Result<mlua::AnyUserData> {
     let ctx = context(lua);
     let state = Rc::new(PlaneState {
         plane,
@@ -428,11 +431,23 @@ pub(crate) fn wrap_plane(lua: &Lua, plane: Plane) -> PhysicsPlane {
         by_handle: RefCell::default(),
         contacts: ContactPump::default(),
         controllers: RefCell::default(),
+        maps: RefCell::default(),
     });
     // Probed every frame; it costs one check while no part of it has touch handlers.
     scheduler(lua).watch(state.clone());
     ctx.planes.borrow_mut().push(state.clone());
-    PhysicsPlane(state)
+    plane_ud(lua, &state)
+}
+
+/// The script's `PhysicsPlane` value of `state` (one per plane: see `identity.rs`), so
+/// `map.Plane == plane`.
+pub(crate) fn plane_ud(lua: &Lua, state: &Rc<PlaneState>) -> mlua::Result<mlua::AnyUserData> {
+    super::identity::userdata(
+        lua,
+        Rc::as_ptr(state).cast(),
+        super::identity::tag::PLANE,
+        || PhysicsPlane(state.clone()),
+    )
 }
 
 /// Puts `prop` into the field of the creation request that carries it.

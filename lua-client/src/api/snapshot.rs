@@ -145,9 +145,7 @@ fn from_snapshot(lua: &Lua, (snapshot, opts): (Value, Value)) -> mlua::Result<Va
         .plane_from_snapshot(&snapshot, &overrides)
         .map_err(|e| sdk_error(WHAT, e))?;
     match snapshot.kind() {
-        PlaneKind::Rapier3d => lua
-            .create_userdata(wrap_plane(lua, plane))
-            .map(Value::UserData),
+        PlaneKind::Rapier3d => wrap_plane(lua, plane).map(Value::UserData),
         PlaneKind::Gui2d => lua
             .create_userdata(wrap_gui_plane(lua, GuiPlane::from_plane(plane)))
             .map(Value::UserData),

@@ -57,11 +57,7 @@ pub static PLANE: Props<PlaneState> = Props {
         Row {
             name: "EventsLost",
             kind: Kind::String,
-            get: Get::Fn(|lua, p| {
-                Ok(Value::UserData(
-                    lua.create_userdata(p.events_lost_signal())?,
-                ))
-            }),
+            get: Get::Fn(|lua, p| Ok(Value::UserData(p.events_lost_signal().userdata(lua)?))),
             set: Set::ReadOnly,
         },
         bool_row!("Enabled", enabled, PlaneProp::Enabled),
