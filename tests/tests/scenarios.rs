@@ -1,0 +1,59 @@
+//! Scenario games (`examples/scenarios/*.luau`): small games written the way a user writes
+//! them, each asserting its own outcome and printing one summary line. Each runs here with
+//! the built `physics-lua` against a fresh daemon; a test fails on a nonzero exit or a
+//! missing summary line. The scripts step their planes once per frame (TickRate 0), so
+//! `--fps 1000` only removes the real-time pace `--view` keeps, not a single step.
+
+use std::time::{Duration, Instant};
+
+use integration_tests::{physics_lua, TestDaemon};
+
+/// Runs `examples/scenarios/NAME.luau` against a fresh daemon and checks its summary line
+/// (`NAME: …`) and exit status; returns stdout.
+fn scenario(name: &str, tag: &str) -> String {
+    scenario_with(name, tag, &[])
+}
+
+fn scenario_with(name: &str, tag: &str, env: &[(&str, &str)]) -> String {
+    let daemon = TestDaemon::start_with(tag, &[], env);
+    let script = format!("examples/scenarios/{name}.luau");
+    let started = Instant::now();
+    let limit = Duration::from_secs(90);
+    let mut child = physics_lua(&daemon.domain, &script, &["--fps", "1000"])
+        .spawn()
+        .expect("spawn physics-lua");
+    while child.try_wait().expect("wait physics-lua").is_none() {
+        if started.elapsed() > limit {
+            let _ = child.kill();
+            break;
+        }
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    let out = child.wait_with_output().expect("collect output");
+    let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    println!("{stdout}");
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{script} failed after {:?}\nstdout:\n{stdout}\nstderr:\n{stderr}",
+        started.elapsed()
+    );
+    let prefix = format!("{name}: ");
+    assert!(
+        stdout.lines().any(|l| l.starts_with(&prefix)),
+        "{script}: no summary line starting {prefix:?}\nstdout:\n{stdout}\nstderr:\n{stderr}"
+    );
+    stdout
+}
+
+#[test]
+fn obby_player_reaches_the_goal() {
+    let out = scenario("obby", "sc-obby");
+    assert!(out.contains("obby: reached goal at t="), "{out}");
+}
+
+#[test]
+fn vehicle_drives_over_the_hill_on_a_triangle_map() {
+    scenario("vehicle", "sc-car");
+}
