@@ -57,3 +57,9 @@ fn obby_player_reaches_the_goal() {
 fn vehicle_drives_over_the_hill_on_a_triangle_map() {
     scenario("vehicle", "sc-car");
 }
+
+#[test]
+fn ragdoll_death_by_hitscan() {
+    let out = scenario("ragdoll_death", "sc-ragdoll");
+    assert!(out.contains("ragdoll_death: shot in the "), "{out}");
+}
