@@ -63,3 +63,8 @@ fn ragdoll_death_by_hitscan() {
     let out = scenario("ragdoll_death", "sc-ragdoll");
     assert!(out.contains("ragdoll_death: shot in the "), "{out}");
 }
+
+#[test]
+fn destructible_wall_breaks_where_the_blast_is() {
+    scenario("destructible_wall", "sc-wall");
+}
