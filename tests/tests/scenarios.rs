@@ -68,3 +68,9 @@ fn ragdoll_death_by_hitscan() {
 fn destructible_wall_breaks_where_the_blast_is() {
     scenario("destructible_wall", "sc-wall");
 }
+
+#[test]
+fn pinball_scores_on_a_gui_plane() {
+    let out = scenario("pinball", "sc-pinball");
+    assert!(out.contains("0 steps outside"), "{out}");
+}
