@@ -74,3 +74,9 @@ fn pinball_scores_on_a_gui_plane() {
     let out = scenario("pinball", "sc-pinball");
     assert!(out.contains("0 steps outside"), "{out}");
 }
+
+#[test]
+fn fps_range_hits_every_target_once_and_spares_friendlies() {
+    let out = scenario("fps_range", "sc-fps");
+    assert!(out.contains("5/5 bullet hits (1/1/1/1/1)"), "{out}");
+}
