@@ -80,3 +80,9 @@ fn fps_range_hits_every_target_once_and_spares_friendlies() {
     let out = scenario("fps_range", "sc-fps");
     assert!(out.contains("5/5 bullet hits (1/1/1/1/1)"), "{out}");
 }
+
+#[test]
+fn rope_bridge_carries_a_heavy_cart_across() {
+    let out = scenario("rope_bridge", "sc-bridge");
+    assert!(out.contains("rope_bridge: cart crossed at t="), "{out}");
+}
