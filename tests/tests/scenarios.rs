@@ -33,6 +33,12 @@ fn scenario_with(name: &str, tag: &str, env: &[(&str, &str)]) -> String {
     let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
     let stderr = String::from_utf8_lossy(&out.stderr);
     println!("{stdout}");
+    // Never a silent skip: a machine without a GPU adapter fails here, saying so.
+    assert!(
+        !stderr.contains("no GPU adapter"),
+        "{script} needs a GPU adapter and the daemon found none (on a machine without a GPU, \
+         install Mesa's lavapipe: apt-get install mesa-vulkan-drivers libvulkan1)\nstderr:\n{stderr}"
+    );
     assert_eq!(
         out.status.code(),
         Some(0),
@@ -85,4 +91,30 @@ fn fps_range_hits_every_target_once_and_spares_friendlies() {
 fn rope_bridge_carries_a_heavy_cart_across() {
     let out = scenario("rope_bridge", "sc-bridge");
     assert!(out.contains("rope_bridge: cart crossed at t="), "{out}");
+}
+
+#[test]
+fn gpu_debris_settles_beside_cpu_gameplay() {
+    let out = scenario("gpu_debris", "sc-gpu");
+    assert!(out.contains("0 still moving, 0 outside"), "{out}");
+}
+
+/// The GPU scenario without an adapter fails, and says why (the check above turns the
+/// script's error into the test's message).
+#[test]
+fn gpu_debris_without_an_adapter_fails_loudly() {
+    let result = std::panic::catch_unwind(|| {
+        scenario_with("gpu_debris", "sc-gpu-off", &[("PHYSICS_GPU", "off")])
+    });
+    let message = match result {
+        Ok(out) => panic!("gpu_debris passed without an adapter:\n{out}"),
+        Err(e) => e
+            .downcast_ref::<String>()
+            .cloned()
+            .unwrap_or_default(),
+    };
+    assert!(
+        message.contains("needs a GPU adapter") && message.contains("mesa-vulkan-drivers"),
+        "{message}"
+    );
 }
