@@ -108,10 +108,7 @@ fn gpu_debris_without_an_adapter_fails_loudly() {
     });
     let message = match result {
         Ok(out) => panic!("gpu_debris passed without an adapter:\n{out}"),
-        Err(e) => e
-            .downcast_ref::<String>()
-            .cloned()
-            .unwrap_or_default(),
+        Err(e) => e.downcast_ref::<String>().cloned().unwrap_or_default(),
     };
     assert!(
         message.contains("needs a GPU adapter") && message.contains("mesa-vulkan-drivers"),
