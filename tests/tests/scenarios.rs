@@ -115,3 +115,28 @@ fn gpu_debris_without_an_adapter_fails_loudly() {
         "{message}"
     );
 }
+
+/// Every game in `examples/scenarios/` has its test above (a new game cannot be forgotten).
+#[test]
+fn every_scenario_file_is_tested() {
+    let tested = [
+        "destructible_wall",
+        "fps_range",
+        "gpu_debris",
+        "obby",
+        "pinball",
+        "ragdoll_death",
+        "rope_bridge",
+        "vehicle",
+    ];
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/scenarios");
+    let mut found: Vec<String> = std::fs::read_dir(&dir)
+        .expect("examples/scenarios")
+        .filter_map(|e| {
+            let name = e.ok()?.file_name().into_string().ok()?;
+            name.strip_suffix(".luau").map(str::to_string)
+        })
+        .collect();
+    found.sort();
+    assert_eq!(found, tested, "scenario files vs. tests in scenarios.rs");
+}
