@@ -420,7 +420,7 @@ fn scripts_use_only_declared_members() {
     // them on a line `-- undeclared: A, B`.
     let mut problems = Vec::new();
     let mut scripts = 0;
-    for dir in ["examples", "tests/lua"] {
+    for dir in ["examples", "tests/lua", "examples/scenarios"] {
         for entry in std::fs::read_dir(repo().join(dir)).unwrap() {
             let path = entry.unwrap().path();
             if path.extension().is_none_or(|e| e != "luau") {
