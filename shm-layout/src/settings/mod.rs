@@ -11,6 +11,7 @@ pub mod gui_object;
 pub mod gui_plane;
 pub mod object;
 pub mod plane;
+pub mod table;
 
 pub use controller::{ControllerProp, ControllerSettings};
 pub use gui_object::{GuiObjectProp, GuiObjectSettings, GuiShape};
