@@ -289,11 +289,11 @@ impl Plane {
     }
 }
 
-/// Object properties the GPU path cannot honour.
+/// Object properties the GPU path cannot honour: rows flagged `cpu_only` in the object
+/// settings table, set to anything but their default.
 fn check_gpu_prop(p: &ObjectProp) -> Result<(), CommandError> {
-    match p {
-        ObjectProp::RotateTo(Some(_)) => Err(unsupported("RotateTo")),
-        ObjectProp::Pin(Some(_)) => Err(unsupported("SetPin")),
-        _ => Ok(()),
+    if p.row().cpu_only && !p.is_default() {
+        return Err(unsupported(p.name()));
     }
+    Ok(())
 }
