@@ -17,4 +17,4 @@ pub use controller::{ControllerProp, ControllerSettings};
 pub use gui_object::{GuiObjectProp, GuiObjectSettings, GuiShape};
 pub use gui_plane::{GuiPlaneProp, GuiPlaneSettings, Vec2};
 pub use object::{ObjectProp, ObjectSettings, Pin, Restraint, RotateTo};
-pub use plane::{PlaneProp, PlaneSettings};
+pub use plane::{PlaneOptions, PlaneProp, PlaneSettings};

@@ -98,8 +98,9 @@ crate::settings_table! {
         Weight(f32) "Weight" = 1.0, range: Range::AtLeast(MIN_MASS as f64), field: weight,
             flags: [derived, lua];
         /// When > 0, mass = Density × volume (wins over Weight). 0 returns to Weight.
+        /// (Lua reads the density in effect, `ObjectInfo::density`: a row of its own.)
         Density(f32) "Density" = 0.0, range: Range::NonNegative, field: density,
-            flags: [derived, lua];
+            flags: [derived];
         /// Restitution, clamped to [0, 1]; a pair uses the higher value. Default 0.
         Bounciness(f32) "Bounciness" = 0.0, range: Range::Clamped(0.0, 1.0), field: bounciness,
             flags: [lua];

@@ -76,6 +76,27 @@ crate::settings_table! {
         SharedObjectLimit(u32) "SharedObjectLimit" = NO_SHARED_OBJECT_LIMIT,
             field: shared_object_limit, flags: [lua];
     }
+    options: {
+        /// Options of a new plane: the backend, then one field per plane option (`None`
+        /// keeps the daemon's default). Either a struct literal
+        /// (`PlaneOptions { tick_rate: Some(0.0), ..Default::default() }`) or a builder over
+        /// [`PlaneProp`] (`PlaneOptions::manual().with(PlaneProp::Drag(0.1))`).
+        #[derive(Debug, Clone, Default)]
+        pub struct PlaneOptions {
+            /// Which backend simulates the plane (default: rapier3d).
+            pub kind: Option<crate::PlaneKind>,
+        }
+    }
+}
+
+impl PlaneOptions {
+    /// A manual plane: it advances only on `Step`. What tests and replays use.
+    pub fn manual() -> Self {
+        PlaneOptions {
+            tick_rate: Some(0.0),
+            ..Default::default()
+        }
+    }
 }
 
 /// A tick period must be representable: tiny positive rates are refused.

@@ -22,6 +22,10 @@
 //!   default` stores it through `f(&mut field, value)` into a field of another type. Rows
 //!   without a field live in the engine (poses, velocities, sizes).
 //! - `flags: [..]`: the [`PropRow`] booleans that are true for this row.
+//!
+//! After the rows, `options: { struct }` also declares the options struct of a creation
+//! call: the fields given, then one `Option` per stored row, with `props()`, `set(prop)` and
+//! `with(prop)` (plane options).
 
 use crate::{CommandError, Pose, Vec3};
 
@@ -378,6 +382,72 @@ macro_rules! __table_get {
     };
 }
 
+/// The options struct of a creation call (see [`settings_table!`]'s `options:`): one
+/// `Option` per stored row (`None` keeps the default) after the fields given, with a builder
+/// over the prop enum.
+#[doc(hidden)]
+#[macro_export]
+macro_rules! __table_options {
+    ([] $($rest:tt)*) => {};
+    (
+        [{
+            $(#[$ometa:meta])*
+            pub struct $Options:ident { $($extra:tt)* }
+        }]
+        $Enum:ident;
+        $([$Variant:ident($ty:ty) $name:literal $($field:ident)?])*
+    ) => {
+        $(#[$ometa])*
+        pub struct $Options {
+            $($extra)*
+            $($(
+                #[doc = concat!("`", $name, "` (see [`", stringify!($Enum), "::",
+                    stringify!($Variant), "`]); `None` keeps the default.")]
+                pub $field: Option<$ty>,
+            )?)*
+        }
+
+        impl $Options {
+            /// The options set, as the creation request carries them (in row order).
+            pub fn props(&self) -> Vec<$Enum> {
+                let mut props = Vec::new();
+                $($(
+                    if let Some(v) = self.$field {
+                        props.push($Enum::$Variant(v));
+                    }
+                )?)*
+                props
+            }
+
+            /// Sets the option `prop` stands for; false (and nothing set) for a prop that is
+            /// not an option of this call.
+            pub fn set(&mut self, prop: $Enum) -> bool {
+                match prop {
+                    $(
+                        $Enum::$Variant(v) => {
+                            $(
+                                self.$field = Some(v);
+                                return true;
+                            )?
+                            #[allow(unreachable_code)]
+                            {
+                                let _ = v;
+                                false
+                            }
+                        }
+                    )*
+                }
+            }
+
+            /// Builder form of [`Self::set`]: `PlaneOptions::manual().with(PlaneProp::Drag(0.1))`.
+            pub fn with(mut self, prop: $Enum) -> Self {
+                self.set(prop);
+                self
+            }
+        }
+    };
+}
+
 /// Declares one settings family from its rows (see the [module docs](self)): the prop
 /// enum, the settings struct with [`Default`], and on the enum `ROWS`, `DEFAULTS`, `index`,
 /// `row`, `checked`, `is_default`, `value_text` and `from_any`; on the struct `store` and
@@ -400,7 +470,13 @@ macro_rules! settings_table {
                 ;
             )*
         }
+        $(options: $options:tt)?
     ) => {
+        $crate::__table_options! {
+            [$($options)?] $Enum;
+            $([$Variant($ty) $name $($field)?])*
+        }
+
         $(#[$emeta])*
         pub enum $Enum {
             $(
@@ -687,4 +763,40 @@ mod tests {
     }
 
     use crate::settings::Restraint;
+
+    /// `PlaneOptions` has one option per stored plane row, and its builder over `PlaneProp`
+    /// and its struct literal make the same creation request.
+    #[test]
+    fn plane_options_are_a_builder_over_plane_props() {
+        use crate::PlaneOptions;
+        let mut all = PlaneOptions::default();
+        for p in PlaneProp::DEFAULTS {
+            assert_eq!(all.set(*p), p.row().stored, "{p:?}");
+        }
+        let stored: Vec<PlaneProp> = PlaneProp::DEFAULTS
+            .iter()
+            .copied()
+            .filter(|p| p.row().stored)
+            .collect();
+        assert_eq!(all.props(), stored);
+        let built = PlaneOptions::manual()
+            .with(PlaneProp::Drag(0.25))
+            .with(PlaneProp::Threads(2));
+        let literal = PlaneOptions {
+            tick_rate: Some(0.0),
+            drag: Some(0.25),
+            threads: Some(2),
+            ..Default::default()
+        };
+        assert_eq!(built.props(), literal.props());
+        assert_eq!(
+            built.props(),
+            [
+                PlaneProp::Threads(2),
+                PlaneProp::TickRate(0.0),
+                PlaneProp::Drag(0.25)
+            ]
+        );
+        assert!(!PlaneOptions::default().set(PlaneProp::Gui(crate::GuiPlaneProp::NeverSleep(true))));
+    }
 }
