@@ -367,6 +367,21 @@ macro_rules! __table_store {
     };
 }
 
+/// Whether the row's field holds its default.
+#[doc(hidden)]
+#[macro_export]
+macro_rules! __table_is_default {
+    ($s:ident, $default:expr;) => {
+        true
+    };
+    ($s:ident, $default:expr; $field:ident) => {
+        $s.$field == $default
+    };
+    ($s:ident, $default:expr; $field:ident via $via:path, $fdefault:expr) => {
+        $s.$field == $fdefault
+    };
+}
+
 /// Reads the row's field for a generic reader (fields stored in another form have none).
 #[doc(hidden)]
 #[macro_export]
@@ -515,6 +530,21 @@ macro_rules! settings_table {
                         }
                     )*
                 }
+                true
+            }
+
+            /// Whether the row at `index` of the prop enum's `ROWS` holds its default (rows
+            /// that live in the engine always do).
+            #[allow(unused_assignments)]
+            pub fn is_default_at(&self, index: usize) -> bool {
+                let mut i = 0;
+                $(
+                    if i == index {
+                        return $crate::__table_is_default!(self, $default;
+                            $($field $(via $via, $fdefault)?)?);
+                    }
+                    i += 1;
+                )*
                 true
             }
 
