@@ -140,6 +140,8 @@ crate::settings_table! {
         /// held on planes that tick by themselves and releases them with its next flush, so
         /// properties written right after an add apply before the object's first step.
         Held(bool) "Held" = false;
+        /// Multiplies the plane's Gravity for this object: 0 floats, -1 falls up. Default 1.
+        GravityScale(f32) "GravityScale" = 1.0, field: gravity_scale, flags: [lua, cpu_only];
     }
 }
 
