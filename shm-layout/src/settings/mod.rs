@@ -3,8 +3,9 @@
 //! these checks to fail early, the daemon runs them again because it trusts no client, and
 //! both read the defaults from here.
 //!
-//! Adding a property: one variant plus its check and default in [`plane`] or [`object`],
-//! one mapping onto the engine in the daemon's backend, one row in lua-client's `props/`.
+//! Adding an object property or a plane option: one row in the family's table ([`object`],
+//! [`plane`]; see [`table`]) plus its mapping onto the engine in the daemon's backend. The
+//! controller and GUI families still list theirs by hand.
 
 pub mod controller;
 pub mod gui_object;
