@@ -54,6 +54,8 @@ pub use ragdoll::{Bone, Ragdoll, RagdollDesc};
 /// The collision group every object starts in ("Default").
 pub use shm_layout::collision_groups::DEFAULT_GROUP;
 pub use shm_layout::gui_op::{GuiControllerInfo, GuiObjectInfo, GuiPlaneInfo};
+/// The settings tables: each property's name, default, range and flags, declared once.
+pub use shm_layout::settings;
 /// The limits and checks the daemon applies, for callers that want to check early.
 pub use shm_layout::validate;
 pub use shm_layout::{

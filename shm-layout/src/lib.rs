@@ -55,7 +55,7 @@ pub use query::{FilterType, Hit, QueryFilter, QueryOp, Ray};
 pub use records::*;
 pub use settings::{
     ControllerProp, ControllerSettings, GuiObjectProp, GuiPlaneProp, GuiShape, ObjectProp,
-    ObjectSettings, Pin, PlaneProp, PlaneSettings, Restraint, RotateTo, Vec2,
+    ObjectSettings, Pin, PlaneOptions, PlaneProp, PlaneSettings, Restraint, RotateTo, Vec2,
 };
 pub use shape::{Shape, ShapeKind};
 pub use snapshot::SnapshotHeader;

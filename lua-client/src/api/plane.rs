@@ -157,6 +157,28 @@ impl Target for PlaneState {
             .set_now(prop)
             .map_err(|e| sdk_error(&format!("PhysicsPlane.{name}"), e))
     }
+
+    fn table_rows() -> &'static [crate::props::Row<PlaneState>] {
+        static ROWS: std::sync::OnceLock<Vec<crate::props::Row<PlaneState>>> =
+            std::sync::OnceLock::new();
+        ROWS.get_or_init(|| crate::props::table_rows(PlaneProp::ROWS))
+    }
+
+    fn table_get(
+        &self,
+        name: &str,
+        index: usize,
+    ) -> mlua::Result<client_sdk::settings::table::AnyValue> {
+        crate::props::plane::table_get(self, name, index)
+    }
+
+    fn table_prop(
+        name: &str,
+        index: usize,
+        v: client_sdk::settings::table::AnyValue,
+    ) -> mlua::Result<PlaneProp> {
+        crate::props::plane::table_prop(name, index, v)
+    }
 }
 
 /// Planes stay alive until `:Destroy()`, whether or not the script keeps a reference.
@@ -411,7 +433,8 @@ fn new_plane(lua: &Lua, opts: Value) -> mlua::Result<mlua::AnyUserData> {
     let mut options = PlaneOptions::default();
     for pair in opts.iter().flat_map(|t| t.pairs::<Value, Value>()) {
         let (key, value) = pair?;
-        option(&mut options, PLANE.option(WHAT, &key, &value)?);
+        // No row of PhysicsPlane makes a GUI option (NewGUI has its own rows).
+        options.set(PLANE.option(WHAT, &key, &value)?);
     }
     let ctx = context(lua);
     let plane = ctx
@@ -448,32 +471,6 @@ pub(crate) fn plane_ud(lua: &Lua, state: &Rc<PlaneState>) -> mlua::Result<mlua::
         super::identity::tag::PLANE,
         || PhysicsPlane(state.clone()),
     )
-}
-
-/// Puts `prop` into the field of the creation request that carries it.
-fn option(o: &mut PlaneOptions, prop: PlaneProp) {
-    match prop {
-        PlaneProp::Gravity(v) => o.gravity = Some(v),
-        PlaneProp::Threads(v) => o.threads = Some(v),
-        PlaneProp::TickRate(v) => o.tick_rate = Some(v),
-        PlaneProp::Enabled(v) => o.enabled = Some(v),
-        PlaneProp::LinearDamping(v) => o.linear_damping = Some(v),
-        PlaneProp::AngularDamping(v) => o.angular_damping = Some(v),
-        PlaneProp::Drag(v) => o.drag = Some(v),
-        PlaneProp::Buoyancy(v) => o.buoyancy = Some(v),
-        PlaneProp::ConstantForce(v) => o.constant_force = Some(v),
-        PlaneProp::RestThreshold(v) => o.rest_threshold = Some(v),
-        PlaneProp::SolverIterations(v) => o.solver_iterations = Some(v),
-        PlaneProp::LoopSolver(v) => o.loop_solver = Some(v),
-        PlaneProp::NeverSleep(v) => o.never_sleep = Some(v),
-        PlaneProp::Shared(v) => o.shared = Some(v),
-        PlaneProp::MaxLinearSpeed(v) => o.max_linear_speed = Some(v),
-        PlaneProp::MaxAngularSpeed(v) => o.max_angular_speed = Some(v),
-        PlaneProp::DeferGpu(v) => o.defer_gpu = Some(v),
-        PlaneProp::SharedObjectLimit(v) => o.shared_object_limit = Some(v),
-        // No row of PhysicsPlane makes a GUI option (NewGUI has its own rows).
-        PlaneProp::Gui(_) => {}
-    }
 }
 
 /// The `PhysicsService` module.
