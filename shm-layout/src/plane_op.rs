@@ -105,6 +105,7 @@ impl PlaneOp {
             self,
             PlaneOp::Info
                 | PlaneOp::Query(_)
+                | PlaneOp::Snapshot
                 | PlaneOp::Controller(ControllerOp::Info { .. })
                 | PlaneOp::Joint(JointOp::Info { .. })
                 | PlaneOp::Object {

@@ -362,3 +362,69 @@ fn damaged_or_foreign_snapshots_are_refused_and_change_nothing() {
     plane.restore(&good).unwrap();
     assert_eq!(plane.state_hash().unwrap(), good.state_hash());
 }
+
+#[test]
+fn forged_snapshots_cost_the_forger_its_plane_at_most_and_only_owners_restore() {
+    let daemon = TestDaemon::start("snap-forged");
+    let victim = daemon.client();
+    let theirs = victim.create_plane(&PlaneOptions::manual()).unwrap();
+    let shared = victim
+        .create_plane(&PlaneOptions {
+            shared: Some(true),
+            ..PlaneOptions::manual()
+        })
+        .unwrap();
+    theirs
+        .add(
+            Shape::Sphere { radius: 0.5 },
+            Pose::at([0.0, 5.0, 0.0]),
+            &[],
+        )
+        .unwrap();
+    let forger = daemon.client();
+    let source = build(&forger, 1);
+    for _ in 0..10 {
+        source.plane.step(DT).unwrap();
+    }
+    let good = source.plane.take_snapshot().unwrap();
+    // Another client may not restore a plane it does not own, shared or not.
+    for plane in [&theirs, &shared] {
+        let foreign = client_sdk::Plane::clone(plane);
+        let attached = forger.attach_plane(foreign.id()).unwrap();
+        let e = attached.restore(&good).unwrap_err().to_string();
+        assert!(e.contains("only its owner may restore"), "{e}");
+    }
+    // Edited bodies with their checksum fixed up: refused, or accepted and possibly failing
+    // the forger's own plane; the victim's plane steps on either way.
+    let (header, start) = shm_layout::snapshot::header(good.bytes()).unwrap();
+    let body = &good.bytes()[start..];
+    let mut seed = 0x2545_f491_4f6c_dd1du64;
+    for round in 0..40 {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        let mut edited = body.to_vec();
+        for k in 0..3 {
+            let i = ((seed >> (k * 16)) as usize) % edited.len();
+            edited[i] ^= (seed >> 48) as u8 | 1;
+        }
+        let bytes = shm_layout::snapshot::encode(header.clone(), &edited);
+        let forged = PlaneSnapshot::from_bytes(bytes).unwrap();
+        if let Ok(plane) = forger.plane_from_snapshot(&forged, &[]) {
+            for _ in 0..3 {
+                if plane.step(DT).is_err() {
+                    break;
+                }
+            }
+        }
+        let before = theirs.state_hash().unwrap();
+        theirs
+            .step(DT)
+            .unwrap_or_else(|e| panic!("round {round}: the victim failed: {e}"));
+        assert_ne!(
+            theirs.state_hash().unwrap(),
+            before,
+            "the victim's ball falls"
+        );
+    }
+}

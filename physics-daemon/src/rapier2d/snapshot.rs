@@ -54,7 +54,7 @@ plane_state! {
     event_seq: u64,
 }
 
-fn refused(what: impl std::fmt::Display) -> CommandError {
+fn refused(what: String) -> CommandError {
     CommandError::new(ErrorKind::InvalidValue, format!("snapshot refused: {what}"))
 }
 
@@ -80,9 +80,7 @@ impl Plane {
     /// Becomes exactly the state of `bytes`; nothing changes when it is refused.
     pub fn restore(&mut self, bytes: &[u8], overrides: &[PlaneProp]) -> Result<(), CommandError> {
         let (header, body) = snapshot::decode(bytes, PlaneKind::Gui2d, ENGINE)?;
-        let mut state: State = postcard::from_bytes(body)
-            .map_err(|e| refused(format!("its state does not decode ({e})")))?;
-        check(&state)?;
+        let mut state = crate::backend::snapshot_decode::decode(body, refused, check)?;
         // The overrides are checked on a copy of the decoded plane's settings first.
         let mut checked = state.settings;
         for prop in overrides {
@@ -151,7 +149,7 @@ fn check(state: &State) -> Result<(), CommandError> {
     }
     for (_, c) in w.colliders.iter() {
         if c.parent().is_some_and(|p| w.bodies.get(p).is_none()) {
-            return Err(refused("a collider's body is missing"));
+            return Err(refused("a collider's body is missing".into()));
         }
     }
     for slot in &state.controlled {

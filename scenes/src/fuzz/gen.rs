@@ -210,6 +210,7 @@ impl<'a> Gen<'a> {
             u if u < 0.53 => PlaneOp::Gui(self.gui_op(wild, id)),
             u if u < 0.555 => PlaneOp::Joint(self.joint_op(wild, id)),
             u if u < 0.565 => PlaneOp::Map(self.map_op(wild)),
+            u if u < 0.57 => self.snapshot_op(wild),
             _ => {
                 let handle = self.handle(wild, id);
                 PlaneOp::Object {
@@ -217,6 +218,26 @@ impl<'a> Gen<'a> {
                     op: self.object_op(wild),
                 }
             }
+        }
+    }
+
+    /// A snapshot (valid), or a restore of forged bytes: random, or a snapshot's start
+    /// followed by random bytes (the daemon must refuse both by name and keep the plane).
+    fn snapshot_op(&mut self, wild: bool) -> PlaneOp {
+        if !wild {
+            return PlaneOp::Snapshot;
+        }
+        let mut bytes = Vec::new();
+        if self.rng.chance(0.5) {
+            bytes.extend_from_slice(&shm_layout::snapshot::SNAPSHOT_MAGIC);
+            bytes.extend_from_slice(&(self.rng.range(0, 64) as u32).to_le_bytes());
+        }
+        for _ in 0..self.rng.range(0, 256) {
+            bytes.push(self.rng.u32() as u8);
+        }
+        PlaneOp::Restore {
+            bytes,
+            overrides: Vec::new(),
         }
     }
 

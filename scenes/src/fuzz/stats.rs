@@ -271,6 +271,8 @@ pub fn all_op_names() -> Vec<String> {
         names.push(format!("Plane.Query.{q}"));
     }
     names.push("Plane.Explode".into());
+    names.push("Plane.Snapshot".into());
+    names.push("Plane.Restore".into());
     for c in [
         "Create",
         "Set",
