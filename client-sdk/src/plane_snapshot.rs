@@ -164,6 +164,22 @@ impl Plane {
     }
 }
 
+impl Plane {
+    /// Goes back `ticks` ticks (at most the plane's `RollbackTicks`): the plane becomes its
+    /// state after that tick, handles included; re-apply the corrected inputs and step
+    /// again. Returns the tick gone back to.
+    pub fn rewind(&self, ticks: u32) -> Result<u64, Error> {
+        let reply = self
+            .client()
+            .call(Command::plane(self.id(), PlaneOp::Rewind(ticks)));
+        self.forget_local_state();
+        match reply? {
+            Reply::Applied { tick } => Ok(tick),
+            other => Err(Error::Protocol(format!("unexpected reply {other:?}"))),
+        }
+    }
+}
+
 impl Client {
     /// A new plane holding `snapshot`'s state (of its kind: wrap a GUI plane with
     /// [`crate::GuiPlane::from_plane`]), then `overrides` applied (TickRate, Enabled,

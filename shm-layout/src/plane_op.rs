@@ -84,6 +84,9 @@ pub enum PlaneOp {
         /// Options applied after the state (DeferGpu excluded).
         overrides: Vec<PlaneProp>,
     },
+    /// Goes back this many ticks (at most `RollbackTicks`): the plane becomes its state
+    /// after that tick. Replies [`crate::Reply::Applied`] with the tick gone back to.
+    Rewind(u32),
 }
 
 /// What an op may add to a plane, for the daemon's per-client quotas.

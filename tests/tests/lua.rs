@@ -647,3 +647,9 @@ fn a_signal_property_is_one_value_per_signal() {
         "signal identity ok",
     );
 }
+
+#[test]
+fn rollback_rewinds_and_replays_bit_for_bit() {
+    let daemon = TestDaemon::start("lua-rollback");
+    run_ok(&daemon, "tests/lua/rollback.luau", "rollback ok");
+}

@@ -88,12 +88,32 @@ pub fn add_plane_methods<M: UserDataMethods<PhysicsPlane>>(methods: &mut M) {
             .map(LuaSnapshot)
             .map_err(|e| sdk_error(WHAT, e))
     });
+    add_rewind(methods);
     methods.add_method("Restore", |_, p, snapshot: Value| {
         const WHAT: &str = "PhysicsPlane:Restore";
         alive(p, WHAT)?;
         let snapshot = snapshot_arg(WHAT, &snapshot)?;
         p.0.plane
             .restore(&snapshot)
+            .map(|_| ())
+            .map_err(|e| sdk_error(WHAT, e))
+    });
+}
+
+/// `Rewind(ticks)` on `PhysicsPlane` (RollbackTicks).
+pub fn add_rewind<M: UserDataMethods<PhysicsPlane>>(methods: &mut M) {
+    methods.add_method("Rewind", |_, p, ticks: Value| {
+        const WHAT: &str = "PhysicsPlane:Rewind";
+        alive(p, WHAT)?;
+        let n = match ticks {
+            Value::Integer(n) if (0..=u32::MAX as i64).contains(&n) => n as u32,
+            Value::Number(n) if n.fract() == 0.0 && (0.0..=u32::MAX as f64).contains(&n) => {
+                n as u32
+            }
+            other => return Err(expected(WHAT, "a whole number of ticks >= 0", &other)),
+        };
+        p.0.plane
+            .rewind(n)
             .map(|_| ())
             .map_err(|e| sdk_error(WHAT, e))
     });

@@ -55,6 +55,7 @@ impl Plane {
             )),
             PlaneOp::Explode(explosion) => self.explode(explosion),
             PlaneOp::Snapshot => self.snapshot().map(Reply::Snapshot),
+            PlaneOp::Rewind(n) => self.rewind(n),
             PlaneOp::Restore { bytes, overrides } => {
                 self.restore(&bytes, &overrides).map(|_| applied(self))
             }

@@ -142,6 +142,29 @@ impl Plane {
                  {claimed:?}"
             )));
         }
+        self.adopt(state, overrides)?;
+        // Another timeline: the ticks kept for Rewind no longer lead here.
+        self.rollback.clear();
+        Ok(())
+    }
+
+    /// The plane's state in the encoding of a snapshot's body (what Rewind keeps per tick).
+    pub(super) fn state_body(&self) -> Result<Vec<u8>, CommandError> {
+        postcard::to_allocvec(&self.state_ref())
+            .map_err(|e| CommandError::new(ErrorKind::Internal, format!("snapshot failed: {e}")))
+    }
+
+    /// Becomes the state `body` (one this plane made with [`Plane::state_body`]).
+    pub(super) fn adopt_body(&mut self, body: &[u8]) -> Result<(), CommandError> {
+        let mut state = crate::backend::snapshot_decode::decode(body, refused, check)?;
+        state.bodies.adopt_limits(&self.bodies)?;
+        state.joints.adopt_limits(&self.joints)?;
+        state.world.physics_pipeline = std::mem::take(&mut self.world.physics_pipeline);
+        self.adopt(state, &[])
+    }
+
+    /// Takes a decoded and checked `state`, then `overrides` (checked already).
+    fn adopt(&mut self, mut state: State, overrides: &[PlaneProp]) -> Result<(), CommandError> {
         controllers::count_paths_in(&mut state.controllers, &self.state_bytes);
         let threads = state.settings.threads;
         self.take_state(state);

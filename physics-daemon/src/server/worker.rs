@@ -115,6 +115,7 @@ impl PlaneCell {
                 | PlaneOp::Query(_)
                 | PlaneOp::Snapshot
                 | PlaneOp::Restore { .. }
+                | PlaneOp::Rewind(_)
         ) && op.cost().mesh_vertices == 0
     }
 
@@ -640,7 +641,7 @@ fn apply_inner(
 ) -> CommandResult {
     let needs_output = matches!(
         op,
-        PlaneOp::Step { .. } | PlaneOp::Info | PlaneOp::Restore { .. }
+        PlaneOp::Step { .. } | PlaneOp::Info | PlaneOp::Restore { .. } | PlaneOp::Rewind(_)
     );
     let out = match out {
         Some(out) => Some(out),
@@ -665,7 +666,7 @@ fn apply_inner(
             Ok(Reply::Stepped { tick: plane.tick() })
         }
         // Readers see the restored state at once, as after a step.
-        op @ PlaneOp::Restore { .. } => {
+        op @ (PlaneOp::Restore { .. } | PlaneOp::Rewind(_)) => {
             let reply = plane.apply(op)?;
             if let Some(out) = out {
                 out.publish(plane).map_err(super::dispatch::internal)?;
@@ -690,6 +691,7 @@ fn op_name(op: &PlaneOp) -> &'static str {
         PlaneOp::Step { .. } => "Step",
         PlaneOp::Info => "Info",
         PlaneOp::Restore { .. } => "Restore",
+        PlaneOp::Rewind(_) => "Rewind",
         _ => "this op",
     }
 }

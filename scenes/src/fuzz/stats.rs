@@ -392,6 +392,7 @@ pub fn op_name(command: &Command) -> String {
             PlaneOp::Explode(_) => "Plane.Explode".into(),
             PlaneOp::Snapshot => "Plane.Snapshot".into(),
             PlaneOp::Restore { .. } => "Plane.Restore".into(),
+            PlaneOp::Rewind(_) => "Plane.Rewind".into(),
         },
     }
 }

@@ -75,6 +75,11 @@ crate::settings_table! {
         /// [`NO_SHARED_OBJECT_LIMIT`]: no cap beyond the adders' quotas; 0: others add nothing.
         SharedObjectLimit(u32) "SharedObjectLimit" = NO_SHARED_OBJECT_LIMIT,
             field: shared_object_limit, flags: [lua];
+        /// Ticks the plane keeps for `Rewind` (its state after each of its last K ticks,
+        /// counted in the owner's state bytes). Default 0: nothing kept, nothing paid.
+        RollbackTicks(u32) "RollbackTicks" = 0,
+            range: Range::Within(0.0, MAX_ROLLBACK_TICKS as f64), field: rollback_ticks,
+            flags: [lua];
     }
     options: {
         /// Options of a new plane: the backend, then one field per plane option (`None`
@@ -98,6 +103,9 @@ impl PlaneOptions {
         }
     }
 }
+
+/// Most ticks a plane keeps for `Rewind`.
+pub const MAX_ROLLBACK_TICKS: u32 = 64;
 
 /// A tick period must be representable: tiny positive rates are refused.
 fn check_tick_rate(hz: f32) -> Result<f32, CommandError> {
