@@ -410,12 +410,11 @@ fn nodes_that_never_say_hello_are_evicted() {
     time_until(Duration::from_secs(10), || (held() == 1).then_some(()))
         .expect("the nodes without Hello were evicted");
     // Held when ready (above), gone after the timeout (3 s from when the daemon first saw
-    // them, no later than `ready`) plus one guard period (500 ms) and the polling.
+    // them, no later than `ready`) plus one guard period (500 ms) and the polling: 3.5 s on
+    // a quiet machine. The bound leaves room for a loaded one; "not at once" is checked
+    // above.
     let total = started.elapsed();
-    assert!(
-        total < Duration::from_millis(4500),
-        "evicted after {total:?}"
-    );
+    assert!(total < Duration::from_secs(9), "evicted after {total:?}");
     serves_on(&mut daemon, &survivor);
 }
 
