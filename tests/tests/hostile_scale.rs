@@ -753,7 +753,8 @@ fn a_process_past_its_cpu_share_slows_itself_not_others() {
     // 2 cores shared with the hog's threads: a step may wait for a time slice, not for the
     // hog's backlog.
     assert!(
-        d50 <= (a50 * 2).max(Duration::from_millis(3)),
+        // Before: 11 ms (p99 350 ms). A busy machine alone gives 3.8 ms.
+        d50 <= (a50 * 3).max(Duration::from_millis(8)),
         "p50 {d50:?} beside the hog, {a50:?} alone"
     );
     assert!(
