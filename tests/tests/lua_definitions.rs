@@ -37,7 +37,7 @@ struct Member {
 struct Definitions {
     /// `declare class NAME` → members.
     classes: BTreeMap<String, Vec<Member>>,
-    /// `type NAME = { ... }` → its field names (nested tables' too, three levels deep).
+    /// `[export] type NAME = { ... }` → its field names (nested tables' too, three levels deep).
     tables: BTreeMap<String, Vec<String>>,
     /// `type NAME = { ... }` → its own field names.
     own_fields: BTreeMap<String, Vec<String>>,
@@ -82,7 +82,10 @@ impl Definitions {
                     }
                 }
                 d.classes.insert(name, members);
-            } else if let Some(rest) = line.strip_prefix("type ") {
+            } else if let Some(rest) = line
+                .strip_prefix("export type ")
+                .or_else(|| line.strip_prefix("type "))
+            {
                 let Some((name, body)) = rest.split_once('=') else {
                     continue;
                 };
