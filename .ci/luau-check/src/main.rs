@@ -50,7 +50,10 @@ fn main() -> ExitCode {
         };
         let name = format!("@{}", path.display());
         if let Err(e) = checker.add_definitions_with_name(&source, &name) {
-            eprintln!("{}: error: the definitions do not load: {e}", path.display());
+            eprintln!(
+                "{}: error: the definitions do not load: {e}",
+                path.display()
+            );
             return ExitCode::from(1);
         }
     }
@@ -64,7 +67,10 @@ fn main() -> ExitCode {
         };
         let before = errors;
         if source.lines().next().map(str::trim_end) != Some("--!strict") {
-            println!("{}:1:1: error: the first line must be --!strict", path.display());
+            println!(
+                "{}:1:1: error: the first line must be --!strict",
+                path.display()
+            );
             errors += 1;
         }
         let name = path.display().to_string();
