@@ -86,11 +86,17 @@ impl Definitions {
                 .strip_prefix("export type ")
                 .or_else(|| line.strip_prefix("type "))
             {
+                // `type Signal<T... = ...any> = {` declares `Signal`: its generic
+                // parameters (and their defaults) go first.
+                let rest = match (rest.find('<'), rest.find('>'), rest.find('=')) {
+                    (Some(lt), Some(gt), Some(eq)) if lt < eq => {
+                        format!("{}{}", &rest[..lt], &rest[gt + 1..])
+                    }
+                    _ => rest.to_string(),
+                };
                 let Some((name, body)) = rest.split_once('=') else {
                     continue;
                 };
-                // `type Signal<T...> = {` declares `Signal`.
-                let name = name.split('<').next().unwrap_or(name);
                 let mut body = body.to_string();
                 let depth = |s: &str| {
                     s.chars().fold(0i32, |d, c| match c {
