@@ -460,7 +460,7 @@ fn scripts_use_only_declared_members() {
             }
             scripts += 1;
             let text = std::fs::read_to_string(&path).unwrap();
-            let mut allowed: BTreeSet<String> = text
+            let allowed: BTreeSet<String> = text
                 .lines()
                 .filter_map(|l| l.trim().strip_prefix("-- undeclared:"))
                 .flat_map(|l| {
