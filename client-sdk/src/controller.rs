@@ -54,6 +54,14 @@ impl Plane {
 }
 
 impl Controller {
+    /// The controller whose object is `handle` on `plane` (a controller of a plane restored
+    /// from a snapshot).
+    pub fn from_handle(plane: &Plane, handle: Handle) -> Controller {
+        Controller {
+            object: Object::from_handle(plane, handle),
+        }
+    }
+
     /// The controller's body (pose, velocity, alive: zero-copy reads).
     pub fn object(&self) -> &Object {
         &self.object

@@ -78,6 +78,16 @@ impl Plane {
 }
 
 impl Joint {
+    /// The joint `handle` of `plane` (a joint of a plane restored from a snapshot, or
+    /// another process's joint).
+    pub fn from_handle(plane: &Plane, handle: Handle, kind: JointKind) -> Joint {
+        Joint {
+            plane: plane.clone(),
+            handle,
+            kind,
+        }
+    }
+
     /// The joint's handle.
     pub fn handle(&self) -> Handle {
         self.handle

@@ -28,6 +28,7 @@ mod mirror;
 mod object;
 mod overlay;
 mod plane;
+mod plane_snapshot;
 mod probe;
 mod query;
 pub mod ragdoll;
@@ -46,12 +47,15 @@ pub use joint::{Joint, JointBroke};
 pub use map::{Map, MapMesh, MapOptions};
 pub use object::Object;
 pub use plane::{Plane, PlaneOptions, Snapshot};
+pub use plane_snapshot::PlaneSnapshot;
 pub use probe::{Explosion, Falloff, ProbeHit, DEFAULT_MAX_SLOPE};
 pub use query::{Found, QueryParams};
 pub use ragdoll::{Bone, Ragdoll, RagdollDesc};
 /// The collision group every object starts in ("Default").
 pub use shm_layout::collision_groups::DEFAULT_GROUP;
 pub use shm_layout::gui_op::{GuiControllerInfo, GuiObjectInfo, GuiPlaneInfo};
+/// The settings tables: each property's name, default, range and flags, declared once.
+pub use shm_layout::settings;
 /// The limits and checks the daemon applies, for callers that want to check early.
 pub use shm_layout::validate;
 pub use shm_layout::{

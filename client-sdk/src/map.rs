@@ -56,6 +56,93 @@ pub struct Map {
     pub report: MapReport,
 }
 
+impl Map {
+    /// The map's handle: what query hits (`Hit::object`), contact events and query filters
+    /// name it by.
+    pub fn handle(&self) -> shm_layout::Handle {
+        self.object.handle()
+    }
+
+    /// The daemon's validation report (degenerate triangles dropped, duplicate vertices
+    /// merged, non-manifold, welded and open edges).
+    pub fn report(&self) -> &MapReport {
+        &self.report
+    }
+
+    /// Whether the map still exists at the newest tick (false once destroyed, or once its
+    /// plane is).
+    pub fn is_alive(&self) -> Result<bool, Error> {
+        self.object.is_alive()
+    }
+
+    /// Removes the map from its plane (sent with the next flush; reads see it gone at once).
+    /// Destroying it again does nothing.
+    pub fn destroy(&self) {
+        if self.object.is_alive().unwrap_or(false) {
+            self.object.destroy();
+        }
+    }
+
+    /// The map's object while it exists; else a `StaleHandle` error naming the map.
+    fn live(&self) -> Result<&Object, Error> {
+        if self.object.is_alive()? {
+            return Ok(&self.object);
+        }
+        Err(Error::Command(shm_layout::CommandError::new(
+            shm_layout::ErrorKind::StaleHandle,
+            format!(
+                "map {} of plane {} was destroyed",
+                self.handle(),
+                self.object.plane().id()
+            ),
+        )))
+    }
+
+    /// Where the map's origin is (the newest tick, with this process's writes on top).
+    pub fn pose(&self) -> Result<Pose, Error> {
+        self.live()?.pose()
+    }
+
+    /// Moves the static map: bodies resting on it are woken and follow the new surface,
+    /// queries see it after the next step. Maps stay anchored.
+    pub fn set_pose(&self, pose: Pose) -> Result<(), Error> {
+        self.live()?.set_pose(pose)
+    }
+
+    /// The map's surface friction, in [0, 1] (combined with a body's as `sqrt(a·b)`).
+    pub fn set_friction(&self, mu: f32) -> Result<(), Error> {
+        self.live()?.set_friction(mu)
+    }
+
+    /// The map's bounciness, clamped to [0, 1] (combined with a body's as the higher of
+    /// the two).
+    pub fn set_bounciness(&self, e: f32) -> Result<(), Error> {
+        self.live()?.set_bounciness(e)
+    }
+
+    /// Whether bodies collide with the map (queries with `respect_can_collide` skip it
+    /// when false).
+    pub fn set_can_collide(&self, on: bool) -> Result<(), Error> {
+        self.live()?.set_can_collide(on)
+    }
+
+    /// Puts the map in a registered collision group.
+    pub fn set_collision_group(&self, name: &str) -> Result<(), Error> {
+        self.live()?.set_collision_group(name)
+    }
+
+    /// The map's collision group, by name.
+    pub fn collision_group(&self) -> Result<String, Error> {
+        self.live()?.collision_group()
+    }
+
+    /// Friction, Bounciness, CanCollide and the collision group as the daemon holds them
+    /// (the property mirror: one round trip the first time).
+    pub fn properties(&self) -> Result<shm_layout::ObjectInfo, Error> {
+        self.live()?.properties()
+    }
+}
+
 fn file_error(path: &str, problem: impl std::fmt::Display) -> Error {
     Error::Invalid {
         field: "path".into(),
@@ -416,11 +503,25 @@ impl Plane {
         // The map's body joins the plane's objects (and its tick is not in the reply).
         self.shared.members.borrow_mut().unknown_change();
         match reply {
-            Reply::Map(info) => Ok(Map {
-                object: Object::from_handle(self, info.handle),
-                meshes: meshes.len(),
-                report: info.report,
-            }),
+            Reply::Map(info) => {
+                // Until a sample shows it, the map reads back as built (as an added object
+                // does): ask the daemon's tick once, so the overlay ends with the first
+                // sample that holds the map.
+                let tick = self.info()?.tick;
+                self.shared.members.borrow_mut().asked(tick);
+                self.overlay_write(info.handle, |e| {
+                    e.pose = Some(options.pose);
+                    e.velocity = Some([0.0; 3]);
+                    e.angular_velocity = Some([0.0; 3]);
+                    e.anchored = Some(true);
+                });
+                self.overlay_confirm(info.handle, tick);
+                Ok(Map {
+                    object: Object::from_handle(self, info.handle),
+                    meshes: meshes.len(),
+                    report: info.report,
+                })
+            }
             other => Err(Error::Protocol(format!("expected a map, got {other:?}"))),
         }
     }

@@ -47,10 +47,7 @@ impl Mirror {
 
     /// Records a plane option this process wrote.
     pub fn plane_written(&mut self, prop: &PlaneProp) {
-        let derived = matches!(
-            prop,
-            PlaneProp::SolverIterations(_) | PlaneProp::LoopSolver(_)
-        );
+        let derived = prop.row().derived;
         match &mut self.plane {
             Some(info) if !derived => {
                 if info.settings.apply(*prop, false).is_err() {
@@ -59,6 +56,12 @@ impl Mirror {
             }
             _ => self.plane = None,
         }
+    }
+
+    /// Forgets everything mirrored (the plane was restored from a snapshot).
+    pub fn forget_all(&mut self) {
+        self.plane = None;
+        self.objects.clear();
     }
 
     /// Forgets the plane's options (a write was rejected, say).
@@ -80,15 +83,8 @@ impl Mirror {
 
     /// Records an object property this process wrote.
     pub fn object_written(&mut self, handle: Handle, prop: &ObjectProp) {
-        let derived = matches!(
-            prop,
-            ObjectProp::Size(_)
-                | ObjectProp::Weight(_)
-                | ObjectProp::Density(_)
-                | ObjectProp::HitBoxQuality(_)
-                | ObjectProp::CenterOfMass(_)
-                | ObjectProp::Anchored(_)
-        );
+        // Rows flagged `derived`: the daemon recomputes mass, density or the like from them.
+        let derived = prop.row().derived;
         if derived {
             self.objects.remove(&handle);
         } else if let Some(info) = self.objects.get_mut(&handle) {

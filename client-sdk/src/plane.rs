@@ -5,8 +5,8 @@ use std::rc::Rc;
 use std::time::{Duration, Instant};
 
 use shm_layout::{
-    BodyState, Command, Handle, ObjectProp, PlaneId, PlaneInfo, PlaneKind, PlaneOp, PlaneProp,
-    Pose, Reply, Shape, TickHeader, Vec3,
+    BodyState, Command, Handle, ObjectProp, PlaneId, PlaneInfo, PlaneOp, PlaneProp, Pose, Reply,
+    Shape, TickHeader,
 };
 
 use crate::client::LIVENESS_PERIOD;
@@ -17,89 +17,9 @@ use crate::overlay::{Entry, Overlay};
 use crate::transport::{BodySample, BodySubscriber, TickListener, Transport};
 use crate::{Client, Error, Object};
 
-/// Options of a new plane; `None` keeps the daemon's default.
-#[derive(Debug, Clone, Default)]
-pub struct PlaneOptions {
-    /// Which backend simulates the plane (default: rapier3d).
-    pub kind: Option<PlaneKind>,
-    /// `Gravity`.
-    pub gravity: Option<Vec3>,
-    /// `Threads` (creation only).
-    pub threads: Option<u32>,
-    /// Ticks per second of wall time; 0 = manual (only [`Plane::step`] advances it).
-    pub tick_rate: Option<f32>,
-    /// `Enabled`.
-    pub enabled: Option<bool>,
-    /// `LinearDamping`.
-    pub linear_damping: Option<f32>,
-    /// `AngularDamping`.
-    pub angular_damping: Option<f32>,
-    /// `Drag`.
-    pub drag: Option<f32>,
-    /// `Buoyancy`.
-    pub buoyancy: Option<f32>,
-    /// `ConstantForce`.
-    pub constant_force: Option<Vec3>,
-    /// `RestThreshold`.
-    pub rest_threshold: Option<f32>,
-    /// `SolverIterations`.
-    pub solver_iterations: Option<u32>,
-    /// `LoopSolver`.
-    pub loop_solver: Option<bool>,
-    /// `NeverSleep`.
-    pub never_sleep: Option<bool>,
-    /// `Shared` (creation only): other clients may change the plane, not only read it.
-    pub shared: Option<bool>,
-    /// `MaxLinearSpeed` (units/s): no body moves faster. Default 10,000
-    /// (`shm_layout::settings::plane::DEFAULT_MAX_LINEAR_SPEED`).
-    pub max_linear_speed: Option<f32>,
-    /// `MaxAngularSpeed` (rad/s): no body spins faster. Default 1,000
-    /// (`shm_layout::settings::plane::DEFAULT_MAX_ANGULAR_SPEED`).
-    pub max_angular_speed: Option<f32>,
-    /// `DeferGpu`: run the plane on the GPU (wgpu compute) instead of rapier on the CPU.
-    /// Refused, naming the reason, when the daemon has no GPU adapter.
-    pub defer_gpu: Option<bool>,
-    /// `SharedObjectLimit`: most objects other clients may have added to this `Shared`
-    /// plane at once (what they add counts against their own quotas). Default: no cap.
-    pub shared_object_limit: Option<u32>,
-}
-
-impl PlaneOptions {
-    /// A manual plane: it advances only on [`Plane::step`]. What tests and replays use.
-    pub fn manual() -> Self {
-        PlaneOptions {
-            tick_rate: Some(0.0),
-            ..Default::default()
-        }
-    }
-
-    pub(crate) fn props(&self) -> Vec<PlaneProp> {
-        let o = self;
-        [
-            o.gravity.map(PlaneProp::Gravity),
-            o.threads.map(PlaneProp::Threads),
-            o.tick_rate.map(PlaneProp::TickRate),
-            o.enabled.map(PlaneProp::Enabled),
-            o.linear_damping.map(PlaneProp::LinearDamping),
-            o.angular_damping.map(PlaneProp::AngularDamping),
-            o.drag.map(PlaneProp::Drag),
-            o.buoyancy.map(PlaneProp::Buoyancy),
-            o.constant_force.map(PlaneProp::ConstantForce),
-            o.rest_threshold.map(PlaneProp::RestThreshold),
-            o.solver_iterations.map(PlaneProp::SolverIterations),
-            o.loop_solver.map(PlaneProp::LoopSolver),
-            o.never_sleep.map(PlaneProp::NeverSleep),
-            o.shared.map(PlaneProp::Shared),
-            o.max_linear_speed.map(PlaneProp::MaxLinearSpeed),
-            o.max_angular_speed.map(PlaneProp::MaxAngularSpeed),
-            o.defer_gpu.map(PlaneProp::DeferGpu),
-            o.shared_object_limit.map(PlaneProp::SharedObjectLimit),
-        ]
-        .into_iter()
-        .flatten()
-        .collect()
-    }
-}
+/// Options of a new plane: declared with the plane settings table (one field per option,
+/// a builder over [`PlaneProp`]).
+pub use shm_layout::PlaneOptions;
 
 /// What a client keeps per plane: the subscriber, the newest sample, the overlay.
 pub(crate) struct PlaneShared {
@@ -307,6 +227,11 @@ impl Plane {
         self.shared.overlay.borrow_mut().write(handle, f);
     }
 
+    /// The daemon applied every write recorded for `handle` by tick `tick`.
+    pub(crate) fn overlay_confirm(&self, handle: Handle, tick: u64) {
+        self.shared.overlay.borrow_mut().confirm(handle, tick);
+    }
+
     /// The determinism hash of the newest published tick ([`TickHeader::state_hash`]: every
     /// body's pose, velocities, flags and generation, bit for bit, in slot order). Two runs
     /// of the same commands agree on it tick by tick; a replay that diverges shows it on the
@@ -367,6 +292,16 @@ impl Plane {
             self.shared.mirror.borrow_mut().forget_plane();
         }
         result.map(|_| ())
+    }
+
+    /// Forgets what this process keeps of the plane's state (written values not yet
+    /// published, counts, mirrored properties) and takes the newest sample: after a restore
+    /// the daemon's state is the truth.
+    pub(crate) fn forget_local_state(&self) {
+        *self.shared.overlay.borrow_mut() = Default::default();
+        *self.shared.members.borrow_mut() = Default::default();
+        self.shared.mirror.borrow_mut().forget_all();
+        let _ = self.shared.refresh();
     }
 
     /// False once this process destroyed the plane or the daemon no longer knows it.

@@ -7,7 +7,8 @@ use crate::props;
 /// row order.
 pub fn property_rows() -> Vec<(&'static str, Vec<&'static str>)> {
     fn names<T: props::Target>(p: &props::Props<T>) -> (&'static str, Vec<&'static str>) {
-        (p.owner, p.rows.iter().map(|r| r.name).collect())
+        let rows = p.rows.iter().chain(T::table_rows());
+        (p.owner, rows.map(|r| r.name).collect())
     }
     vec![
         names(&props::part::PART),
@@ -22,5 +23,6 @@ pub fn property_rows() -> Vec<(&'static str, Vec<&'static str>)> {
             "PhysicsGuiObject",
             props::gui::GUI_OBJECT_ROWS.iter().map(|r| r.name).collect(),
         ),
+        names(&crate::api::map::MAP),
     ]
 }

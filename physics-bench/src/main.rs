@@ -40,6 +40,7 @@ mod queries;
 mod report;
 mod scene;
 mod sim;
+mod snapshot;
 mod soak;
 mod stability;
 mod stats;
@@ -90,6 +91,9 @@ enum Bench {
     /// amplification, queries beside steps, quota race, paths, slow planes, Threads, empty
     /// planes' memory, CPU shares).
     Hostile(hostile::HostileArgs),
+    /// Plane snapshots: Snapshot / Restore time and size (1k and 10k bodies, settled and
+    /// awake), Rewind(8) + 8 ticks against 8 ticks, the cost of keeping RollbackTicks = 8.
+    Snapshot(snapshot::SnapshotArgs),
 }
 
 fn main() -> ExitCode {
@@ -116,6 +120,7 @@ fn main() -> ExitCode {
         Bench::Maps(args) => maps::run(args),
         Bench::Gpu(args) => gpu::run(args),
         Bench::Hostile(args) => hostile::run(args),
+        Bench::Snapshot(args) => snapshot::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

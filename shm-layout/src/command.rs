@@ -241,6 +241,9 @@ pub enum Reply {
         /// More objects match after the last one (ask for the page after its slot).
         truncated: bool,
     },
+    /// A plane's whole state ([`PlaneOp::Snapshot`]): bytes framed by
+    /// [`crate::snapshot`] (header readable with [`crate::snapshot::header`]).
+    Snapshot(Vec<u8>),
 }
 
 /// The result of one command.

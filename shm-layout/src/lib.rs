@@ -35,6 +35,7 @@ pub mod query;
 pub mod records;
 pub mod settings;
 pub mod shape;
+pub mod snapshot;
 pub mod validate;
 
 pub use axis_motor::AxisMotor;
@@ -54,13 +55,14 @@ pub use query::{FilterType, Hit, QueryFilter, QueryOp, Ray};
 pub use records::*;
 pub use settings::{
     ControllerProp, ControllerSettings, GuiObjectProp, GuiPlaneProp, GuiShape, ObjectProp,
-    ObjectSettings, Pin, PlaneProp, PlaneSettings, Restraint, RotateTo, Vec2,
+    ObjectSettings, Pin, PlaneOptions, PlaneProp, PlaneSettings, Restraint, RotateTo, Vec2,
 };
 pub use shape::{Shape, ShapeKind};
+pub use snapshot::SnapshotHeader;
 
 /// Bumped whenever a record layout or the command encoding changes. Client and daemon must
 /// agree on it; the handshake reports both values when they differ.
-pub const LAYOUT_VERSION: u32 = 7;
+pub const LAYOUT_VERSION: u32 = 8;
 
 /// The crate version both sides were built from; also checked by the handshake.
 pub const CRATE_VERSION: &str = env!("CARGO_PKG_VERSION");

@@ -72,6 +72,21 @@ pub enum PlaneOp {
     /// Pushes dynamic objects and controllers away from a point; replies
     /// [`crate::Reply::Objects`] (what it affected).
     Explode(crate::probe::Explosion),
+    /// The plane's whole state as it is between ticks; replies [`crate::Reply::Snapshot`].
+    Snapshot,
+    /// The plane becomes exactly the state of a snapshot of the same kind (same objects
+    /// under the same handles, same tick), then `overrides` apply as at creation (a plane
+    /// started from a snapshot with another TickRate or Threads); refused, the plane stays
+    /// as it was. Replies [`crate::Reply::Applied`] with the restored tick.
+    Restore {
+        /// The snapshot ([`crate::snapshot`] framing).
+        bytes: Vec<u8>,
+        /// Options applied after the state (DeferGpu excluded).
+        overrides: Vec<PlaneProp>,
+    },
+    /// Goes back this many ticks (at most `RollbackTicks`): the plane becomes its state
+    /// after that tick. Replies [`crate::Reply::Applied`] with the tick gone back to.
+    Rewind(u32),
 }
 
 /// What an op may add to a plane, for the daemon's per-client quotas.
@@ -93,6 +108,7 @@ impl PlaneOp {
             self,
             PlaneOp::Info
                 | PlaneOp::Query(_)
+                | PlaneOp::Snapshot
                 | PlaneOp::Controller(ControllerOp::Info { .. })
                 | PlaneOp::Joint(JointOp::Info { .. })
                 | PlaneOp::Object {
@@ -136,6 +152,16 @@ impl PlaneOp {
             PlaneOp::Controller(ControllerOp::AppendWaypoint { .. }) => OpCost {
                 state_bytes: 12,
                 ..OpCost::default()
+            },
+            // What the snapshot's header says it holds (the plane refuses a body that
+            // holds more).
+            PlaneOp::Restore { bytes, .. } => match crate::snapshot::header(bytes) {
+                Ok((h, _)) => OpCost {
+                    objects: h.objects.min(u32::MAX as u64) as u32,
+                    mesh_vertices: h.mesh_vertices,
+                    state_bytes: h.state_bytes,
+                },
+                Err(_) => OpCost::default(),
             },
             PlaneOp::Gui(op) => OpCost {
                 state_bytes: op.path_bytes(),

@@ -345,11 +345,52 @@ pub mod assets {
         ]
     }
 
+    /// `examples/scenarios/assets/road.glb`: a road 12 wide (x in [−6, 6]) running from
+    /// z = 10 toward −Z to z = −150, flat, then a ramp up 3 over 30 (slope 0.1), a plateau,
+    /// a ramp down and flat again (`road_height`), one mesh, wound counter-clockwise seen
+    /// from above.
+    pub fn road() -> Vec<MapMesh> {
+        let mut m = MapMesh::default();
+        let mut z = 10.0f32;
+        let mut k = 0u32;
+        while z >= -150.0 {
+            let h = road_height(z);
+            m.vertices.push([-6.0, h, z]);
+            m.vertices.push([6.0, h, z]);
+            if k > 0 {
+                let (l0, r0, l1, r1) = (2 * k - 2, 2 * k - 1, 2 * k, 2 * k + 1);
+                m.triangles.push([l0, r0, r1]);
+                m.triangles.push([l0, r1, l1]);
+            }
+            k += 1;
+            z -= 10.0;
+        }
+        vec![m]
+    }
+
+    /// The road's surface height at z: 0 down to z = −40, up by 0.1 per unit to 3 at
+    /// z = −70, 3 to z = −100, down to 0 at z = −130, then 0.
+    pub fn road_height(z: f32) -> f32 {
+        let d = -z;
+        if d <= 40.0 {
+            0.0
+        } else if d <= 70.0 {
+            (d - 40.0) * 0.1
+        } else if d <= 100.0 {
+            3.0
+        } else if d <= 130.0 {
+            3.0 - (d - 100.0) * 0.1
+        } else {
+            0.0
+        }
+    }
+
     /// Every shipped asset: (path from the repository root, meshes).
     pub fn all() -> Vec<(&'static str, Vec<MapMesh>)> {
         vec![
             ("examples/assets/terrain.glb", terrain()),
             ("examples/assets/dumbbell.glb", dumbbell()),
+            ("examples/scenarios/assets/road.glb", road()),
         ]
     }
 }

@@ -620,3 +620,36 @@ fn dyn_mesh_welds_ride_along_with_their_driver() {
     r.assert_ok();
     assert!(r.stdout().contains("dyn mesh ok"), "{}", r.stdout());
 }
+
+#[test]
+fn planes_snapshot_restore_and_start_from_snapshots_in_luau() {
+    let daemon = TestDaemon::start("lua-snapshot");
+    let r = run(&daemon, "tests/lua/snapshot.luau");
+    // physics-lua runs in the repository root.
+    let file = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../lua-snapshot-test.snap");
+    let _ = std::fs::remove_file(file);
+    r.assert_ok();
+    assert!(r.stdout().contains("snapshot lua ok"), "{}", r.stdout());
+}
+
+#[test]
+fn a_loaded_map_is_a_handle_queries_filters_and_contacts_hand_back() {
+    let daemon = TestDaemon::start("lua-map-handle");
+    run_ok(&daemon, "tests/lua/map_handle.luau", "map handle ok");
+}
+
+#[test]
+fn a_signal_property_is_one_value_per_signal() {
+    let daemon = TestDaemon::start("lua-signal-ids");
+    run_ok(
+        &daemon,
+        "tests/lua/signal_identity.luau",
+        "signal identity ok",
+    );
+}
+
+#[test]
+fn rollback_rewinds_and_replays_bit_for_bit() {
+    let daemon = TestDaemon::start("lua-rollback");
+    run_ok(&daemon, "tests/lua/rollback.luau", "rollback ok");
+}

@@ -191,7 +191,13 @@ fn property_rows_match_the_declared_properties() {
     // The GUI types' row tables hold their writable options; their read-only figures
     // (ObjectCount, Sleeping, ...) are read outside the rows, so only the run-time check
     // below covers those.
-    let all_rows = ["BasePart", "PhysicsObject", "PhysicsPlane", "Controller"];
+    let all_rows = [
+        "BasePart",
+        "PhysicsObject",
+        "PhysicsPlane",
+        "Controller",
+        "Map",
+    ];
     for (owner, rows) in lua_client::property_rows() {
         let Some(members) = d.classes.get(owner) else {
             problems.push(format!("class {owner} (a property table) is not declared"));
@@ -452,7 +458,7 @@ fn scripts_use_only_declared_members() {
     // them on a line `-- undeclared: A, B`.
     let mut problems = Vec::new();
     let mut scripts = 0;
-    for dir in ["examples", "tests/lua"] {
+    for dir in ["examples", "tests/lua", "examples/scenarios"] {
         for entry in std::fs::read_dir(repo().join(dir)).unwrap() {
             let path = entry.unwrap().path();
             if path.extension().is_none_or(|e| e != "luau") {
@@ -485,4 +491,41 @@ fn scripts_use_only_declared_members() {
         "members used by scripts but not declared in physics.d.luau:\n{}",
         problems.join("\n")
     );
+}
+
+/// The settings tables' Lua rows (rows flagged `lua`) are declared with the Luau type of
+/// their kind: the declaration and the table cannot disagree on what a property holds.
+#[test]
+fn settings_table_rows_declare_their_kind() {
+    use client_sdk::settings::table::{PropKind, PropRow};
+    let d = Definitions::load();
+    let mut problems = Vec::new();
+    let tables: [(&str, &[PropRow]); 2] = [
+        ("PhysicsObject", client_sdk::ObjectProp::ROWS),
+        ("PhysicsPlane", client_sdk::PlaneProp::ROWS),
+    ];
+    let mut checked = 0;
+    for (owner, rows) in tables {
+        let members = &d.classes[owner];
+        for row in rows.iter().filter(|r| r.lua) {
+            let want = match row.kind {
+                PropKind::Bool => "boolean",
+                PropKind::Float | PropKind::Integer { .. } => "number",
+                PropKind::Vector => "vector",
+                PropKind::Pose => "CFrame",
+                PropKind::Other => "(no Luau type)",
+            };
+            match members.iter().find(|m| m.name == row.name && !m.function) {
+                Some(m) if m.ty == want => checked += 1,
+                Some(m) => problems.push(format!(
+                    "{owner}.{} is declared {} but its row holds a {want}",
+                    row.name, m.ty
+                )),
+                None => problems.push(format!("{owner}.{} is not declared", row.name)),
+            }
+        }
+    }
+    assert!(problems.is_empty(), "{}", problems.join("\n"));
+    // Objects: Weight, Bounciness, Friction, ... ; planes: every option.
+    assert!(checked >= 25, "only {checked} rows checked");
 }

@@ -286,3 +286,108 @@ fn a_character_controller_walks_across_a_tiled_map() {
         hi - lo
     );
 }
+
+/// The SDK's `Map` is a handle: hits name it, filters take it, its collision group,
+/// material, pose and existence change through it, and writes after `destroy` are refused
+/// with the map named.
+#[test]
+fn a_map_handle_filters_groups_moves_and_destroys_its_map() {
+    let s = Scene::new("map-handle", no_damping());
+    let m = s
+        .plane
+        .load_map_meshes(&[tiles(20, 1.0)], &MapOptions::default())
+        .unwrap();
+    let down = [0.0, -20.0, 0.0];
+    let hit = s.plane.raycast([1.2, 10.0, 1.7], down, None).unwrap();
+    assert_eq!(hit.map(|h| h.object), Some(m.handle()));
+    assert_eq!(m.report().triangles, 800);
+    // Read back before any sample holds it: the pose it was built at.
+    assert_eq!(m.pose().unwrap().position, [0.0; 3]);
+    let excluded = client_sdk::QueryParams {
+        filter: vec![m.handle()],
+        ..Default::default()
+    };
+    assert_eq!(
+        s.plane
+            .raycast([1.2, 10.0, 1.7], down, Some(&excluded))
+            .unwrap(),
+        None,
+        "the filtered map is not hit"
+    );
+
+    // A group that does not collide with the map's falls through; Default rests on it.
+    s.client.register_collision_group("Terrain").unwrap();
+    s.client.register_collision_group("Ghosts").unwrap();
+    s.client
+        .collision_group_set_collidable("Terrain", "Ghosts", false)
+        .unwrap();
+    m.set_collision_group("Terrain").unwrap();
+    assert_eq!(m.collision_group().unwrap(), "Terrain");
+    let ghosts = s.client.collision_group_id("Ghosts").unwrap();
+    let ghost = s
+        .plane
+        .add(
+            Shape::Cube { size: [1.0; 3] },
+            Pose::at([3.0, 2.0, 3.0]),
+            &[ObjectProp::CollisionGroup(ghosts)],
+        )
+        .unwrap();
+    let solid = s
+        .plane
+        .add(
+            Shape::Cube { size: [1.0; 3] },
+            Pose::at([-3.0, 2.0, -3.0]),
+            &[],
+        )
+        .unwrap();
+    s.run(1.0 / 60.0, 60);
+    // Free fall for 1 s in 240 substeps of 1/240 s (4 per step): y0 - g·h²·N(N+1)/2.
+    let h = 1.0f32 / 240.0;
+    let fell = 2.0 - 50.0 * h * h * 240.0 * 241.0 / 2.0;
+    let gy = ghost.position().unwrap()[1];
+    assert!(
+        (gy - fell).abs() < 0.01,
+        "ghost at {gy}, free fall says {fell}"
+    );
+    let sy = solid.position().unwrap()[1];
+    assert!((sy - 0.5).abs() < 0.02, "the Default cube rests at {sy}");
+
+    // Material writes read back from the daemon.
+    m.set_friction(0.25).unwrap();
+    m.set_bounciness(0.75).unwrap();
+    m.set_can_collide(true).unwrap();
+    let props = m.properties().unwrap();
+    assert_eq!((props.friction, props.bounciness), (0.25, 0.75));
+    let e = m.set_friction(f32::NAN).unwrap_err().to_string();
+    assert!(e.contains("Friction"), "{e}");
+    let e = m.set_collision_group("Nope").unwrap_err().to_string();
+    assert!(e.contains("Nope"), "{e}");
+
+    // The static map moves: rays meet it at its new height after a step.
+    m.set_pose(Pose::at([0.0, 5.0, 0.0])).unwrap();
+    assert_eq!(m.pose().unwrap().position, [0.0, 5.0, 0.0]);
+    s.plane.step(1.0 / 60.0).unwrap();
+    let hit = s
+        .plane
+        .raycast([1.2, 20.0, 1.7], [0.0, -30.0, 0.0], None)
+        .unwrap()
+        .expect("the moved map is hit");
+    assert_eq!(hit.object, m.handle());
+    assert!((hit.position[1] - 5.0).abs() < 1e-5, "{hit:?}");
+
+    // Destroyed: gone from queries, a second destroy does nothing, writes name the map.
+    m.destroy();
+    m.destroy();
+    assert!(!m.is_alive().unwrap());
+    s.plane.step(1.0 / 60.0).unwrap();
+    assert_eq!(
+        s.plane
+            .raycast([1.2, 20.0, 1.7], [0.0, -30.0, 0.0], None)
+            .unwrap()
+            .map(|h| h.object),
+        None
+    );
+    let e = m.set_friction(0.5).unwrap_err().to_string();
+    assert!(e.contains("map") && e.contains("destroyed"), "{e}");
+    s.client.flush().unwrap();
+}

@@ -8,7 +8,6 @@ use client_sdk::{ContactPoint, Vec3};
 use mlua::{Lua, Table, Value};
 
 use super::object::PhysicsObject;
-use super::part::BasePart;
 use crate::values::{expected, lua_number, new_vector, sdk_error};
 
 fn neg(v: Vec3) -> Vec3 {
@@ -36,7 +35,7 @@ pub fn points_table(lua: &Lua, points: &[ContactPoint], flip: bool) -> mlua::Res
 
 /// `PhysicsObject:GetContacts()`: an array with one table per object it touches now,
 /// `{Part, Position, Normal, Impulse, Points}` (`Part` nil for a body that is no part of
-/// this script, e.g. a map piece).
+/// this script; a Map for a map it loaded).
 pub fn get_contacts(lua: &Lua, this: Value) -> mlua::Result<Table> {
     let what = "PhysicsObject:GetContacts";
     let o = match &this {
@@ -49,9 +48,12 @@ pub fn get_contacts(lua: &Lua, this: Value) -> mlua::Result<Table> {
     let out = lua.create_table_with_capacity(list.len(), 0)?;
     for c in &list {
         let t = lua.create_table_with_capacity(0, 5)?;
-        let part = plane.as_ref().and_then(|p| p.part_of(c.other));
-        let part = match part {
-            Some(p) => Value::UserData(lua.create_userdata(BasePart(p))?),
+        // The part the script holds (one value per part), or the Map it touches.
+        let part = match &plane {
+            Some(plane) => match plane.part_of(c.other) {
+                Some(p) => Value::UserData(super::part::part_ud(lua, &p)?),
+                None => super::map::map_value(lua, plane, c.other)?.unwrap_or(Value::Nil),
+            },
             None => Value::Nil,
         };
         t.set("Part", part)?;

@@ -1,5 +1,5 @@
 //! Contact events for scripts: `part.Touched(otherPart, contact)` and
-//! `part.TouchEnded(otherPart)`, fired from the plane's per-tick event stream in tick order,
+//! `part.TouchEnded(otherPart)` (the other side is a Map when the part touches one), fired from the plane's per-tick event stream in tick order,
 //! once per contact start and end; and `joint.Broke(force, position)`, once when a joint
 //! breaks. A plane reads its events only while one of its parts has touch handlers or one
 //! of its joints has Broke handlers; `plane.EventsLost(n)` (or, with no handler, a line on stderr) says when a
@@ -185,7 +185,7 @@ impl PlaneState {
         }
         let other = match self.part_of(other) {
             Some(p) => Value::UserData(super::part::part_ud(lua, &p)?),
-            None => Value::Nil,
+            None => super::map::map_value(lua, self, other)?.unwrap_or(Value::Nil),
         };
         let contact = match contact {
             Some((position, normal, impulse, points, flip)) => {

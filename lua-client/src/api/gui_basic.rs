@@ -192,7 +192,7 @@ fn get(lua: &Lua, p: &PrimState, key: &Value) -> mlua::Result<Value> {
         "Shape" => Value::String(lua.create_string(p.shape.name())?),
         "Name" => Value::String(lua.create_string(&*p.name.borrow())?),
         "GetPropertyChangedSignal" | "GetPropertyChanged" => {
-            Value::Function(lua.create_function(|_, (this, name): (Value, Value)| {
+            Value::Function(lua.create_function(|lua, (this, name): (Value, Value)| {
                 let prim = this_prim("GuiPrimitive:GetPropertyChangedSignal", &this)?;
                 let n = match &name {
                     Value::String(s) => {
@@ -207,7 +207,7 @@ fn get(lua: &Lua, p: &PrimState, key: &Value) -> mlua::Result<Value> {
                         &name,
                     )
                 })?;
-                Ok(prim.0.signal(n))
+                prim.0.signal(n).userdata(lua)
             })?)
         }
         "Destroy" => Value::Function(lua.create_function(|_, this: Value| {

@@ -214,7 +214,7 @@ impl UserData for GuiControllerUd {
                 Value::String(s) => s.to_string_lossy(),
                 other => describe(other),
             };
-            let signal = |s: &Signal| Ok(Value::UserData(lua.create_userdata(s.clone())?));
+            let signal = |s: &Signal| Ok(Value::UserData(s.userdata(lua)?));
             match name.as_str() {
                 "Object" => Ok(Value::UserData(super::gui_object::gui_object_ud(
                     lua,

@@ -180,6 +180,7 @@ impl UserData for GuiPhysicsPlane {
         methods.add_method("Add", |lua, p, prim: Value| {
             super::gui_object::gui_object_ud(lua, p.0.add("GuiPhysicsPlane:Add", &prim)?)
         });
+        super::snapshot::add_gui_plane_methods(methods);
         methods.add_method("NewController", |_, p, (prim, opts): (Value, Value)| {
             p.0.new_controller("GuiPhysicsPlane:NewController", &prim, opts, false)
         });
@@ -348,6 +349,11 @@ pub fn new_gui(lua: &Lua, opts: Value) -> mlua::Result<GuiPhysicsPlane> {
         .client
         .create_gui_plane(&o)
         .map_err(|e| sdk_error(WHAT, e))?;
+    Ok(wrap_gui_plane(lua, plane))
+}
+
+/// The script's handle on a new GUI plane of this client (`NewGUI`, `FromSnapshot`).
+pub(crate) fn wrap_gui_plane(lua: &Lua, plane: GuiPlane) -> GuiPhysicsPlane {
     let state = Rc::new(GuiPlaneState {
         plane,
         alive: Cell::new(true),
@@ -362,7 +368,7 @@ pub fn new_gui(lua: &Lua, opts: Value) -> mlua::Result<GuiPhysicsPlane> {
     if let Some(planes) = lua.app_data_ref::<GuiPlanes>() {
         planes.0.borrow_mut().push(state.clone());
     }
-    Ok(GuiPhysicsPlane(state))
+    GuiPhysicsPlane(state)
 }
 
 /// Fires `signal` with `args` (used by controllers).

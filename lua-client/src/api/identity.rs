@@ -19,6 +19,12 @@ pub(crate) mod tag {
     /// `PhysicsGuiObject` (its primitive, checked against the body's handle: a primitive
     /// added again is another object).
     pub const GUI_OBJECT: usize = 2;
+    /// `Map` (its `MapState`).
+    pub const MAP: usize = 3;
+    /// `PhysicsPlane` (its `PlaneState`).
+    pub const PLANE: usize = 4;
+    /// `Signal` (its shared connections).
+    pub const SIGNAL: usize = 5;
 }
 
 fn table(lua: &Lua) -> mlua::Result<Table> {

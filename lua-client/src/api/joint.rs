@@ -1,4 +1,5 @@
-//! `plane:NewJoint(kind, objA, objB?, opts?)` and the `Joint` it returns; `plane:LoadMap`.
+//! `plane:NewJoint(kind, objA, objB?, opts?)` and the `Joint` it returns; `plane:LoadMap`
+//! (its `Map` lives in `map.rs`) and `plane:LoadProp`.
 //! Options are the SDK's `JointProp`s by name; reads (`Error`, `Broken`, `Force`, options)
 //! ask the daemon (one round trip).
 
@@ -225,7 +226,7 @@ impl UserData for LuaJoint {
             }
             if key == "Broke" {
                 let signal = joint_broke_signal(&j.1, j.0.handle(), &j.name());
-                return Ok(Value::UserData(lua.create_userdata(signal)?));
+                return Ok(Value::UserData(signal.userdata(lua)?));
             }
             let info =
                 j.0.info()
@@ -322,28 +323,22 @@ fn map_options(what: &str, opts: &Value) -> mlua::Result<MapOptions> {
     Ok(o)
 }
 
-fn load_map(lua: &Lua, plane: &PhysicsPlane, (path, opts): (String, Value)) -> mlua::Result<Table> {
+/// `plane:LoadMap(path, opts?)`: the map's `Map` (see `map.rs`).
+fn load_map(
+    lua: &Lua,
+    plane: &PhysicsPlane,
+    (path, opts): (String, Value),
+) -> mlua::Result<mlua::AnyUserData> {
     let what = "PhysicsPlane:LoadMap";
+    super::query::live(&plane.0, what)?;
     let o = map_options(what, &opts)?;
-    let path = crate::host::assets::resolve(lua, what, &path)?;
+    let resolved = crate::host::assets::resolve(lua, what, &path)?;
     let map = plane
         .0
         .plane
-        .load_map(&path, &o)
+        .load_map(&resolved, &o)
         .map_err(|e| sdk_error(what, e))?;
-    let r = &map.report;
-    let t = lua.create_table()?;
-    t.set("Meshes", map.meshes)?;
-    t.set("Triangles", r.triangles)?;
-    t.set("Vertices", r.vertices)?;
-    let v = lua.create_table()?;
-    v.set("DegenerateTriangles", r.degenerate_triangles)?;
-    v.set("DuplicateVerticesMerged", r.duplicate_vertices_merged)?;
-    v.set("NonManifoldEdges", r.non_manifold_edges)?;
-    v.set("WeldedEdges", r.welded_edges)?;
-    v.set("OpenEdges", r.open_edges)?;
-    t.set("Validation", v)?;
-    Ok(t)
+    super::map::new_map(lua, plane, map, &path)
 }
 
 /// `plane:LoadProp(path, cframe, opts?)`: the .glb as one dynamic mesh part (the convex

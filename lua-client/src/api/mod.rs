@@ -15,12 +15,14 @@ pub mod gui_object;
 pub mod gui_plane;
 pub(crate) mod identity;
 pub mod joint;
+pub mod map;
 pub mod object;
 pub mod part;
 pub mod plane;
 pub mod probe;
 pub mod query;
 pub mod ragdoll;
+pub mod snapshot;
 pub mod static_shapes;
 
 use std::rc::Rc;

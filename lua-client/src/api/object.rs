@@ -103,6 +103,28 @@ impl Target for PhysicsObject {
             .set(prop)
             .map_err(|e| sdk_error(&what(), e))
     }
+
+    fn table_rows() -> &'static [crate::props::Row<PhysicsObject>] {
+        static ROWS: std::sync::OnceLock<Vec<crate::props::Row<PhysicsObject>>> =
+            std::sync::OnceLock::new();
+        ROWS.get_or_init(|| crate::props::table_rows(ObjectProp::ROWS))
+    }
+
+    fn table_get(
+        &self,
+        name: &str,
+        index: usize,
+    ) -> mlua::Result<client_sdk::settings::table::AnyValue> {
+        crate::props::object::table_get(self, name, index)
+    }
+
+    fn table_prop(
+        name: &str,
+        index: usize,
+        v: client_sdk::settings::table::AnyValue,
+    ) -> mlua::Result<ObjectProp> {
+        crate::props::object::table_prop(name, index, v)
+    }
 }
 
 /// `self` of a method called on a PhysicsObject.

@@ -627,7 +627,7 @@ pub fn methods(lua: &Lua) -> mlua::Result<Table> {
             if created && row.name == "CFrame" {
                 scheduler(lua).watch(part.clone());
             }
-            Ok(signal)
+            signal.userdata(lua)
         }
     };
     t.set(

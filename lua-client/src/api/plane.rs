@@ -31,6 +31,8 @@ pub struct PlaneState {
     pub(crate) contacts: ContactPump,
     /// Its character controllers by body handle (`controller.rs`).
     controllers: RefCell<HashMap<Handle, Rc<ControllerState>>>,
+    /// Its maps by body handle (`map.rs`): hits and contacts on a map hand back its Map.
+    pub(crate) maps: RefCell<HashMap<Handle, Rc<super::map::MapState>>>,
 }
 
 impl PlaneState {
@@ -120,6 +122,7 @@ impl PlaneState {
         }
         self.by_handle.borrow_mut().clear();
         self.controllers.borrow_mut().clear();
+        self.maps.borrow_mut().clear();
         self.plane.destroy()
     }
 
@@ -153,6 +156,28 @@ impl Target for PlaneState {
         self.plane
             .set_now(prop)
             .map_err(|e| sdk_error(&format!("PhysicsPlane.{name}"), e))
+    }
+
+    fn table_rows() -> &'static [crate::props::Row<PlaneState>] {
+        static ROWS: std::sync::OnceLock<Vec<crate::props::Row<PlaneState>>> =
+            std::sync::OnceLock::new();
+        ROWS.get_or_init(|| crate::props::table_rows(PlaneProp::ROWS))
+    }
+
+    fn table_get(
+        &self,
+        name: &str,
+        index: usize,
+    ) -> mlua::Result<client_sdk::settings::table::AnyValue> {
+        crate::props::plane::table_get(self, name, index)
+    }
+
+    fn table_prop(
+        name: &str,
+        index: usize,
+        v: client_sdk::settings::table::AnyValue,
+    ) -> mlua::Result<PlaneProp> {
+        crate::props::plane::table_prop(name, index, v)
     }
 }
 
@@ -306,6 +331,7 @@ impl UserData for PhysicsPlane {
                 .map_err(|e| sdk_error("PhysicsPlane:StateHash", e))
         });
         super::query::add_methods(methods);
+        super::snapshot::add_plane_methods(methods);
         methods.add_method("NewController", |_, p, (part, opts): (Value, Value)| {
             new_controller(&p.0, part, opts, false)
         });
@@ -395,7 +421,7 @@ pub(crate) fn add(plane: &Rc<PlaneState>, part: Value) -> mlua::Result<PhysicsOb
 }
 
 /// `PhysicsService.New(opts?)`.
-fn new_plane(lua: &Lua, opts: Value) -> mlua::Result<PhysicsPlane> {
+fn new_plane(lua: &Lua, opts: Value) -> mlua::Result<mlua::AnyUserData> {
     const WHAT: &str = "PhysicsService.New";
     let opts = match opts {
         Value::Nil => None,
@@ -407,13 +433,20 @@ fn new_plane(lua: &Lua, opts: Value) -> mlua::Result<PhysicsPlane> {
     let mut options = PlaneOptions::default();
     for pair in opts.iter().flat_map(|t| t.pairs::<Value, Value>()) {
         let (key, value) = pair?;
-        option(&mut options, PLANE.option(WHAT, &key, &value)?);
+        // No row of PhysicsPlane makes a GUI option (NewGUI has its own rows).
+        options.set(PLANE.option(WHAT, &key, &value)?);
     }
     let ctx = context(lua);
     let plane = ctx
         .client
         .create_plane(&options)
         .map_err(|e| sdk_error(WHAT, e))?;
+    wrap_plane(lua, plane)
+}
+
+/// The script's handle on a new plane of this client (`New`, `FromSnapshot`).
+pub(crate) fn wrap_plane(lua: &Lua, plane: Plane) -> mlua::Result<mlua::AnyUserData> {
+    let ctx = context(lua);
     let state = Rc::new(PlaneState {
         plane,
         alive: Cell::new(true),
@@ -421,37 +454,23 @@ fn new_plane(lua: &Lua, opts: Value) -> mlua::Result<PhysicsPlane> {
         by_handle: RefCell::default(),
         contacts: ContactPump::default(),
         controllers: RefCell::default(),
+        maps: RefCell::default(),
     });
     // Probed every frame; it costs one check while no part of it has touch handlers.
     scheduler(lua).watch(state.clone());
     ctx.planes.borrow_mut().push(state.clone());
-    Ok(PhysicsPlane(state))
+    plane_ud(lua, &state)
 }
 
-/// Puts `prop` into the field of the creation request that carries it.
-fn option(o: &mut PlaneOptions, prop: PlaneProp) {
-    match prop {
-        PlaneProp::Gravity(v) => o.gravity = Some(v),
-        PlaneProp::Threads(v) => o.threads = Some(v),
-        PlaneProp::TickRate(v) => o.tick_rate = Some(v),
-        PlaneProp::Enabled(v) => o.enabled = Some(v),
-        PlaneProp::LinearDamping(v) => o.linear_damping = Some(v),
-        PlaneProp::AngularDamping(v) => o.angular_damping = Some(v),
-        PlaneProp::Drag(v) => o.drag = Some(v),
-        PlaneProp::Buoyancy(v) => o.buoyancy = Some(v),
-        PlaneProp::ConstantForce(v) => o.constant_force = Some(v),
-        PlaneProp::RestThreshold(v) => o.rest_threshold = Some(v),
-        PlaneProp::SolverIterations(v) => o.solver_iterations = Some(v),
-        PlaneProp::LoopSolver(v) => o.loop_solver = Some(v),
-        PlaneProp::NeverSleep(v) => o.never_sleep = Some(v),
-        PlaneProp::Shared(v) => o.shared = Some(v),
-        PlaneProp::MaxLinearSpeed(v) => o.max_linear_speed = Some(v),
-        PlaneProp::MaxAngularSpeed(v) => o.max_angular_speed = Some(v),
-        PlaneProp::DeferGpu(v) => o.defer_gpu = Some(v),
-        PlaneProp::SharedObjectLimit(v) => o.shared_object_limit = Some(v),
-        // No row of PhysicsPlane makes a GUI option (NewGUI has its own rows).
-        PlaneProp::Gui(_) => {}
-    }
+/// The script's `PhysicsPlane` value of `state` (one per plane: see `identity.rs`), so
+/// `map.Plane == plane`.
+pub(crate) fn plane_ud(lua: &Lua, state: &Rc<PlaneState>) -> mlua::Result<mlua::AnyUserData> {
+    super::identity::userdata(
+        lua,
+        Rc::as_ptr(state).cast(),
+        super::identity::tag::PLANE,
+        || PhysicsPlane(state.clone()),
+    )
 }
 
 /// The `PhysicsService` module.
@@ -467,5 +486,6 @@ pub fn module(lua: &Lua) -> mlua::Result<Table> {
     )?;
     super::collision_groups::install(lua, &m)?;
     m.set("NewGUI", lua.create_function(super::gui_plane::new_gui)?)?;
+    super::snapshot::install(lua, &m)?;
     Ok(m)
 }

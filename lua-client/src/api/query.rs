@@ -1,8 +1,8 @@
 //! Scene queries as PhysicsPlane methods, with Roblox's names and conventions: `Raycast`,
 //! `Spherecast`, `Blockcast`, `Shapecast` return a RaycastResult table or nil;
 //! `GetPartBoundsInRadius`, `GetPartBoundsInBox`, `GetPartsInPart` return arrays of
-//! BaseParts; `RaycastMany` casts many rays in one round trip. `params` is an optional table
-//! of `FilterType` ("Exclude" / "Include"), `Filter` (PhysicsObjects or BaseParts),
+//! BaseParts (and Maps); `RaycastMany` casts many rays in one round trip. `params` is an optional table
+//! of `FilterType` ("Exclude" / "Include"), `Filter` (PhysicsObjects, BaseParts or Maps),
 //! `CollisionGroup` (a registered name), `RespectCanCollide` and `MaxParts` (overlap
 //! queries list at most that many; their second return value says whether it cut the list).
 
@@ -83,12 +83,17 @@ pub(super) fn params(what: &str, v: &Value) -> mlua::Result<Option<QueryParams>>
                 let Value::Table(list) = &value else {
                     return Err(expected(
                         &field,
-                        "an array of PhysicsObjects or BaseParts",
+                        "an array of PhysicsObjects, BaseParts or Maps",
                         &value,
                     ));
                 };
                 for (i, item) in list.sequence_values::<Value>().enumerate() {
                     let item = item?;
+                    // A Map filters its map; a destroyed one filters nothing.
+                    if let Some(map) = super::map::map_handle(&item) {
+                        p.filter.extend(map);
+                        continue;
+                    }
                     // A BasePart that is not simulated, or a stale object, can be hit by
                     // nothing: it filters nothing either.
                     if let Ok(h) = object_handle(&format!("{field}[{}]", i + 1), &item) {
@@ -128,12 +133,16 @@ fn is_part_or_object(v: &Value) -> bool {
     matches!(v, Value::UserData(ud) if ud.is::<BasePart>() || ud.is::<PhysicsObject>())
 }
 
-/// The part and PhysicsObject of a handle this host added.
+/// The part and PhysicsObject of a handle this host added (a map's Map for both).
 pub(super) fn part_and_object(
     lua: &Lua,
     plane: &PlaneState,
     h: Handle,
 ) -> mlua::Result<(Value, Value)> {
+    // A map is its own part and object.
+    if let Some(map) = super::map::map_value(lua, plane, h)? {
+        return Ok((map.clone(), map));
+    }
     let Some(part) = plane.part_of(h) else {
         return Ok((Value::Nil, Value::Nil));
     };

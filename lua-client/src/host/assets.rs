@@ -59,6 +59,43 @@ impl AssetRoots {
     }
 }
 
+impl AssetRoots {
+    /// Where a file `path` may be written: its directory must lie under a root (the file
+    /// itself may not exist yet) and `path` must not name a directory; otherwise one
+    /// refusal for `what`.
+    pub fn resolve_for_write(&self, what: &str, path: &str) -> mlua::Result<PathBuf> {
+        let refused = || {
+            mlua::Error::runtime(format!(
+                "{what}: cannot write {path:?}: not a file in a directory under the asset \
+                 roots (physics-lua --asset-root)"
+            ))
+        };
+        let p = Path::new(path);
+        let name = p.file_name().ok_or_else(refused)?;
+        let dir = match p.parent() {
+            Some(d) if !d.as_os_str().is_empty() => d,
+            _ => Path::new("."),
+        };
+        let dir = dir.canonicalize().map_err(|_| refused())?;
+        if !self.roots.iter().any(|root| dir.starts_with(root)) {
+            return Err(refused());
+        }
+        let target = dir.join(name);
+        if target.is_dir() {
+            return Err(refused());
+        }
+        Ok(target)
+    }
+}
+
+/// Where `lua`'s scripts may write the file `path` (see [`AssetRoots::resolve_for_write`]).
+pub fn resolve_for_write(lua: &Lua, what: &str, path: &str) -> mlua::Result<PathBuf> {
+    match lua.app_data_ref::<AssetRoots>() {
+        Some(roots) => roots.resolve_for_write(what, path),
+        None => AssetRoots::new(std::env::current_dir().ok()).resolve_for_write(what, path),
+    }
+}
+
 /// `path` resolved against the roots of `lua` (the current directory when the host set
 /// none), or the refusal for `what`.
 pub fn resolve(lua: &Lua, what: &str, path: &str) -> mlua::Result<PathBuf> {

@@ -63,6 +63,17 @@ impl Signal {
         *self.0.on_listeners.borrow_mut() = Some(Box::new(f));
     }
 
+    /// The script's value of this signal: the same userdata on every read while the script
+    /// holds it (`part.Touched == part.Touched`, `rawequal`), through the identity registry.
+    pub fn userdata(&self, lua: &Lua) -> mlua::Result<mlua::AnyUserData> {
+        crate::api::identity::userdata(
+            lua,
+            Rc::as_ptr(&self.0).cast(),
+            crate::api::identity::tag::SIGNAL,
+            || self.clone(),
+        )
+    }
+
     /// Drops every connection.
     pub fn disconnect_all(&self) {
         let had = !self.0.slots.borrow().is_empty();
@@ -120,6 +131,13 @@ impl UserData for Signal {
         });
         methods.add_meta_method(MetaMethod::ToString, |_, s, ()| {
             Ok(format!("Signal {}", s.0.name))
+        });
+        // Two values of one signal are equal (one value per signal is handed out anyway).
+        methods.add_meta_method(MetaMethod::Eq, |_, s, other: Value| {
+            Ok(match other {
+                Value::UserData(ud) => ud.borrow::<Signal>().is_ok_and(|o| Rc::ptr_eq(&o.0, &s.0)),
+                _ => false,
+            })
         });
     }
 }

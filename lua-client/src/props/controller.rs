@@ -47,7 +47,7 @@ macro_rules! signal_row {
         Row {
             name: $name,
             kind: Kind::String,
-            get: Get::Fn(|lua, c| Ok(Value::UserData(lua.create_userdata(c.0.signal($name))?))),
+            get: Get::Fn(|lua, c| Ok(Value::UserData(c.0.signal($name).userdata(lua)?))),
             set: Set::ReadOnly,
         }
     };

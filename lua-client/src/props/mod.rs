@@ -17,9 +17,10 @@ pub mod object;
 pub mod part;
 pub mod plane;
 
+use client_sdk::settings::table::{AnyValue, PropKind, PropRow, Range};
 use mlua::{Error as LuaError, Lua, Value};
 
-use crate::values::{describe, number, vector, CFrame};
+use crate::values::{describe, lua_number, new_vector, number, vector, CFrame};
 
 /// A Lua type whose properties are rows, and how one of its property writes reaches the SDK.
 pub trait Target: 'static {
@@ -29,6 +30,28 @@ pub trait Target: 'static {
 
     /// Sends (queues) one property write; `name` is the property, for error messages.
     fn write(&self, name: &str, prop: Self::Prop) -> Result<(), LuaError>;
+
+    /// The rows this type takes from its settings table (shm-layout's rows flagged `lua`),
+    /// looked up after its own rows. None by default.
+    fn table_rows() -> &'static [Row<Self>]
+    where
+        Self: Sized,
+    {
+        &[]
+    }
+
+    /// The stored value of the settings-table row at `index` (`name` for messages).
+    fn table_get(&self, name: &str, _index: usize) -> Result<AnyValue, LuaError> {
+        Err(LuaError::runtime(format!("{name} has no settings table")))
+    }
+
+    /// The property write of the settings-table row at `index` with value `v`.
+    fn table_prop(name: &str, _index: usize, _v: AnyValue) -> Result<Self::Prop, LuaError>
+    where
+        Self: Sized,
+    {
+        Err(LuaError::runtime(format!("{name} has no settings table")))
+    }
 }
 
 /// The Lua type a property takes, with its accepted range.
@@ -207,6 +230,7 @@ impl Arg {
         }
     }
     /// The integer.
+    #[allow(dead_code)] // table rows convert integers themselves; kept for hand rows
     pub fn integer(&self) -> Result<i64, LuaError> {
         match *self {
             Arg::Integer(i) => Ok(i),
@@ -257,6 +281,8 @@ pub enum Get<T> {
     /// Documented, but the SDK cannot read it yet (no row needs it today).
     #[allow(dead_code)]
     NotYet,
+    /// The stored value of the settings-table row at this index ([`Target::table_get`]).
+    Table(usize),
 }
 
 /// How a row writes.
@@ -266,6 +292,7 @@ pub enum Set<T: Target> {
     Prop(ToProp<T>),
     /// The creation-only flag: an option of the creation call (`PhysicsService.New`), which
     /// writes it as part of the creation request; read-only afterwards.
+    #[allow(dead_code)] // the table's `creation_only` rows use `Table`; kept for hand rows
     CreationOnly(ToProp<T>),
     /// Writable, with work beyond one SDK write (the host's own state, change signals).
     /// Not a creation option.
@@ -275,6 +302,14 @@ pub enum Set<T: Target> {
     /// Documented, but the SDK cannot write it yet (no row needs it today).
     #[allow(dead_code)]
     NotYet,
+    /// The settings-table row at `index` ([`Target::table_prop`]): writable, or an option
+    /// of the creation call only when the row is `creation_only`.
+    Table {
+        /// The row's index in its table (its wire index).
+        index: usize,
+        /// Only the creation call may set it.
+        creation_only: bool,
+    },
 }
 
 /// One property of a Lua type.
@@ -324,7 +359,10 @@ impl<T: Target> Props<T> {
             return None;
         };
         let key = s.as_bytes();
-        self.rows.iter().find(|r| r.name.as_bytes() == &*key)
+        self.rows
+            .iter()
+            .chain(T::table_rows())
+            .find(|r| r.name.as_bytes() == &*key)
     }
 
     /// The error for a documented property the SDK cannot do yet.
@@ -352,6 +390,10 @@ impl<T: Target> Props<T> {
         match row.get {
             Get::Fn(f) => f(lua, target),
             Get::NotYet => Err(self.not_supported(row.name)),
+            Get::Table(index) => {
+                let what = format!("{}.{}", self.owner, row.name);
+                any_to_lua(lua, target.table_get(&what, index)?)
+            }
         }
     }
 
@@ -372,12 +414,21 @@ impl<T: Target> Props<T> {
         match row.set {
             Set::Prop(to_prop) => target.write(row.name, to_prop(arg()?)?),
             Set::Fn(f) => f(lua, target, arg()?),
-            Set::ReadOnly | Set::CreationOnly(_) => Err(LuaError::runtime(format!(
-                "{}.{} is read-only (assigned {})",
-                self.owner,
-                row.name,
-                describe(value)
-            ))),
+            Set::Table {
+                index,
+                creation_only: false,
+            } => {
+                let what = format!("{}.{}", self.owner, row.name);
+                target.write(row.name, T::table_prop(&what, index, arg_to_any(arg()?)?)?)
+            }
+            Set::ReadOnly | Set::CreationOnly(_) | Set::Table { .. } => {
+                Err(LuaError::runtime(format!(
+                    "{}.{} is read-only (assigned {})",
+                    self.owner,
+                    row.name,
+                    describe(value)
+                )))
+            }
             Set::NotYet => Err(match row.get {
                 Get::Fn(_) => LuaError::runtime(format!(
                     "setting {}.{} is not supported yet (assigned {})",
@@ -385,7 +436,7 @@ impl<T: Target> Props<T> {
                     row.name,
                     describe(value)
                 )),
-                Get::NotYet => self.not_supported(row.name),
+                Get::NotYet | Get::Table(_) => self.not_supported(row.name),
             }),
         }
     }
@@ -406,6 +457,11 @@ impl<T: Target> Props<T> {
         };
         let to_prop = match row.set {
             Set::Prop(f) | Set::CreationOnly(f) => f,
+            Set::Table { index, .. } => {
+                let what = format!("{what} option {}", row.name);
+                let arg = row.kind.convert(&what, value)?;
+                return T::table_prop(&what, index, arg_to_any(arg)?);
+            }
             Set::NotYet => return Err(self.not_supported(row.name)),
             Set::ReadOnly => return Err(not_an_option(row.name, "is read-only, not an option")),
             Set::Fn(_) => return Err(not_an_option(row.name, "cannot be given at creation")),
@@ -415,4 +471,84 @@ impl<T: Target> Props<T> {
                 .convert(&format!("{what} option {}", row.name), value)?,
         )
     }
+}
+
+impl Kind {
+    /// The Lua kind of a settings-table row: its range as the values a script may write
+    /// (a clamped row takes any finite value and the daemon clamps it).
+    pub const fn of(row: &PropRow) -> Kind {
+        match (row.kind, row.range) {
+            (PropKind::Bool, _) => Kind::Boolean,
+            (PropKind::Float, Range::NonNegative) => Kind::NON_NEGATIVE,
+            (PropKind::Float, Range::Positive) => Kind::Positive,
+            (PropKind::Float, Range::AtLeast(min)) => Kind::Number {
+                min,
+                max: f64::INFINITY,
+            },
+            (PropKind::Float, Range::Within(min, max)) => Kind::Number { min, max },
+            (PropKind::Float, _) => Kind::ANY_NUMBER,
+            (PropKind::Integer { .. }, Range::Within(min, max)) => Kind::Integer {
+                min: min as i64,
+                max: max as i64,
+            },
+            (PropKind::Integer { .. }, Range::Clamped(..)) => Kind::ANY_INTEGER,
+            (PropKind::Integer { min, max }, _) => Kind::Integer { min, max },
+            (PropKind::Vector, Range::Extent) => Kind::PositiveVector,
+            (PropKind::Vector, _) => Kind::Vector,
+            (PropKind::Pose, _) => Kind::CFrame,
+            // Structured values have rows of their own (methods or custom rows).
+            (PropKind::Other, _) => Kind::String,
+        }
+    }
+
+    /// The Lua kind of the row of `T`'s settings table named `name`.
+    pub const fn named(rows: &'static [PropRow], name: &str) -> Kind {
+        let mut i = 0;
+        while i < rows.len() {
+            if client_sdk::settings::table::same_name(rows[i].name, name) {
+                return Kind::of(&rows[i]);
+            }
+            i += 1;
+        }
+        panic!("no such settings row")
+    }
+}
+
+/// The Lua rows of a settings table: one per row flagged `lua`, reading the stored value
+/// and writing one property of that row.
+pub fn table_rows<T: Target>(rows: &'static [PropRow]) -> Vec<Row<T>> {
+    rows.iter()
+        .enumerate()
+        .filter(|(_, r)| r.lua && r.stored)
+        .map(|(index, r)| Row {
+            name: r.name,
+            kind: Kind::of(r),
+            get: Get::Table(index),
+            set: Set::Table {
+                index,
+                creation_only: r.creation_only,
+            },
+        })
+        .collect()
+}
+
+/// A converted Lua value as a settings-table value.
+fn arg_to_any(arg: Arg) -> Result<AnyValue, LuaError> {
+    Ok(match arg {
+        Arg::Number(n) => AnyValue::Float(n as f32),
+        Arg::Integer(i) => AnyValue::Integer(i),
+        Arg::Bool(b) => AnyValue::Bool(b),
+        Arg::Vector(v) => AnyValue::Vector(v),
+        other => return Err(mismatch(&other, "a number, boolean or Vector")),
+    })
+}
+
+/// A stored settings value as a Lua value (an `f32` reads back as written).
+fn any_to_lua(_lua: &Lua, v: AnyValue) -> Result<Value, LuaError> {
+    Ok(match v {
+        AnyValue::Bool(b) => Value::Boolean(b),
+        AnyValue::Float(x) => lua_number(x),
+        AnyValue::Integer(i) => Value::Number(i as f64),
+        AnyValue::Vector(v) => new_vector(v),
+    })
 }

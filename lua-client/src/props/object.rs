@@ -2,9 +2,11 @@
 //! view of the newest tick in shared memory (no request); the other properties read the
 //! SDK's property mirror (`object.properties()`: a local lookup after the object's first
 //! read, one round trip then); Size reads through to the wrapped part.
-//! Every SDK write is one `ObjectProp`.
+//! Every SDK write is one `ObjectProp`. The stored properties with a plain value (Weight,
+//! Friction, ...) are not listed here: they are the object settings table's rows flagged
+//! `lua` ([`table_get`], [`table_prop`]).
 
-use client_sdk::validate::MAX_HIT_BOX_QUALITY;
+use client_sdk::settings::table::AnyValue;
 use client_sdk::{BodyState, ObjectInfo, ObjectProp, Pose};
 use mlua::{Error as LuaError, Value};
 
@@ -26,22 +28,6 @@ fn state(o: &PhysicsObject, what: &str) -> Result<BodyState, LuaError> {
     o.live_for(|| format!("PhysicsObject.{what}"))?
         .state()
         .map_err(|e| sdk_error(&format!("PhysicsObject.{what}"), e))
-}
-
-/// A property read back from the daemon: `$read` maps the info to a Lua value, `$write` the
-/// converted argument to the property.
-macro_rules! info_row {
-    ($name:literal, $kind:expr, |$i:ident| $read:expr, |$a:ident| $write:expr) => {
-        Row {
-            name: $name,
-            kind: $kind,
-            get: Get::Fn(|_, o| {
-                let $i = info(o, $name)?;
-                Ok($read)
-            }),
-            set: Set::Prop(|$a| Ok($write)),
-        }
-    };
 }
 
 /// A property of the published state (read-your-writes, no request): `$read` maps the
@@ -67,7 +53,7 @@ pub static OBJECT: Props<PhysicsObject> = Props {
         // The part's CFrame value is reused while the pose is the same (as `part.CFrame`).
         Row {
             name: "CFrame",
-            kind: Kind::CFrame,
+            kind: Kind::named(ObjectProp::ROWS, "CFrame"),
             get: Get::Fn(|lua, o| {
                 let s = state(o, "CFrame")?;
                 let cf = CFrame::from_pose(Pose {
@@ -80,19 +66,19 @@ pub static OBJECT: Props<PhysicsObject> = Props {
         },
         state_row!(
             "Velocity",
-            Kind::Vector,
+            Kind::named(ObjectProp::ROWS, "Velocity"),
             |_, s| new_vector(s.linear_velocity),
             |a| ObjectProp::Velocity(a.vector()?)
         ),
         state_row!(
             "AngularVelocity",
-            Kind::Vector,
+            Kind::named(ObjectProp::ROWS, "AngularVelocity"),
             |_, s| new_vector(s.angular_velocity),
             |a| ObjectProp::AngularVelocity(a.vector()?)
         ),
         state_row!(
             "Anchored",
-            Kind::Boolean,
+            Kind::named(ObjectProp::ROWS, "Anchored"),
             |_, s| Value::Boolean(s.is_anchored()),
             |a| ObjectProp::Anchored(a.bool()?)
         ),
@@ -113,7 +99,7 @@ pub static OBJECT: Props<PhysicsObject> = Props {
         Row {
             // Reads through to the wrapped part; writing resizes the part and its body.
             name: "Size",
-            kind: Kind::PositiveVector,
+            kind: Kind::named(ObjectProp::ROWS, "Size"),
             get: Get::Fn(|_, o| Ok(new_vector(o.part.size()))),
             set: Set::Fn(|lua, o, a| {
                 o.live("PhysicsObject.Size")?;
@@ -140,65 +126,28 @@ pub static OBJECT: Props<PhysicsObject> = Props {
                 )
             }),
         },
-        info_row!(
-            "ImpulseDirection",
-            Kind::Vector,
-            |i| new_vector(i.impulse_direction),
-            |a| ObjectProp::ImpulseDirection(a.vector()?)
-        ),
-        info_row!(
-            "ConstantForce",
-            Kind::Vector,
-            |i| new_vector(i.constant_force),
-            |a| ObjectProp::ConstantForce(a.vector()?)
-        ),
-        info_row!(
-            "Weight",
-            Kind::Number {
-                // validate::MIN_MASS, written as the decimal Lua users see in errors.
-                min: 1e-4,
-                max: f64::INFINITY,
-            },
-            |i| crate::values::lua_number(i.weight),
-            |a| ObjectProp::Weight(a.number()? as f32)
-        ),
-        info_row!(
-            "Density",
-            Kind::NON_NEGATIVE,
-            |i| crate::values::lua_number(i.density),
-            |a| ObjectProp::Density(a.number()? as f32)
-        ),
-        // Documented as clamped to [0, 1]: any finite number is accepted.
-        info_row!(
-            "Bounciness",
-            Kind::ANY_NUMBER,
-            |i| crate::values::lua_number(i.bounciness),
-            |a| ObjectProp::Bounciness(a.number()? as f32)
-        ),
-        info_row!(
-            "Friction",
-            Kind::UNIT,
-            |i| crate::values::lua_number(i.friction),
-            |a| ObjectProp::Friction(a.number()? as f32)
-        ),
-        info_row!(
-            "CanCollide",
-            Kind::Boolean,
-            |i| Value::Boolean(i.can_collide),
-            |a| ObjectProp::CanCollide(a.bool()?)
-        ),
-        // Documented as clamped to [1, 32]: any integer is accepted.
-        info_row!(
-            "HitBoxQuality",
-            Kind::ANY_INTEGER,
-            |i| crate::values::lua_number(i.hit_box_quality),
-            |a| ObjectProp::HitBoxQuality(a.integer()?.clamp(1, MAX_HIT_BOX_QUALITY as i64) as u32)
-        ),
-        info_row!(
-            "CenterOfMass",
-            Kind::Vector,
-            |i| new_vector(i.center_of_mass),
-            |a| ObjectProp::CenterOfMass(a.vector()?)
-        ),
+        // The density in effect (the explicit value, or Weight ÷ volume), not the stored
+        // setting the table's generic row would read.
+        Row {
+            name: "Density",
+            kind: Kind::named(ObjectProp::ROWS, "Density"),
+            get: Get::Fn(|_, o| Ok(crate::values::lua_number(info(o, "Density")?.density))),
+            set: Set::Prop(|a| Ok(ObjectProp::Density(a.number()? as f32))),
+        },
     ],
 };
+
+/// The stored value of the object settings row at `index` (the SDK's mirror).
+pub fn table_get(o: &PhysicsObject, what: &str, index: usize) -> Result<AnyValue, LuaError> {
+    let name = what.trim_start_matches("PhysicsObject.");
+    info(o, name)?
+        .settings
+        .get(index)
+        .ok_or_else(|| LuaError::runtime(format!("{what} has no plain value")))
+}
+
+/// The property write of the object settings row at `index`.
+pub fn table_prop(what: &str, index: usize, v: AnyValue) -> Result<ObjectProp, LuaError> {
+    ObjectProp::from_any(index, v)
+        .ok_or_else(|| LuaError::runtime(format!("{what} cannot take {v:?}")))
+}

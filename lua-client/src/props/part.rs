@@ -54,11 +54,7 @@ pub static PART: Props<BasePart> = Props {
         Row {
             name: "Touched",
             kind: Kind::String,
-            get: Get::Fn(|lua, p| {
-                Ok(Value::UserData(
-                    lua.create_userdata(p.0.touch_signal("Touched"))?,
-                ))
-            }),
+            get: Get::Fn(|lua, p| Ok(Value::UserData(p.0.touch_signal("Touched").userdata(lua)?))),
             set: Set::ReadOnly,
         },
         Row {
@@ -66,7 +62,7 @@ pub static PART: Props<BasePart> = Props {
             kind: Kind::String,
             get: Get::Fn(|lua, p| {
                 Ok(Value::UserData(
-                    lua.create_userdata(p.0.touch_signal("TouchEnded"))?,
+                    p.0.touch_signal("TouchEnded").userdata(lua)?,
                 ))
             }),
             set: Set::ReadOnly,

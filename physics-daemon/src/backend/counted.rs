@@ -75,6 +75,33 @@ impl<T> CountedVec<T> {
     }
 }
 
+impl<T> CountedVec<T> {
+    /// Moves the count of this vector's buffer to `counter` (a vector restored from a
+    /// snapshot counts in its new plane's counter).
+    pub fn count_in(&mut self, counter: &Counter) {
+        self.counter.change(self.counted, 0);
+        self.counter = counter.clone();
+        self.counted = 0;
+        self.recount();
+    }
+}
+
+/// A snapshot holds the items; the counter is the restoring plane's (see
+/// [`CountedVec::count_in`]).
+impl<T: serde::Serialize> serde::Serialize for CountedVec<T> {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        self.items.serialize(s)
+    }
+}
+
+impl<'de, T: serde::Deserialize<'de>> serde::Deserialize<'de> for CountedVec<T> {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let mut v = CountedVec::new(&Counter::default());
+        v.replace(Vec::deserialize(d)?);
+        Ok(v)
+    }
+}
+
 impl<T> std::ops::Deref for CountedVec<T> {
     type Target = [T];
     fn deref(&self) -> &[T] {

@@ -10,6 +10,7 @@ mod dirty;
 pub(crate) mod held;
 pub mod pools;
 mod slot_table;
+pub(crate) mod snapshot_decode;
 
 use std::mem::MaybeUninit;
 

@@ -5,6 +5,7 @@
 
 use shm_layout::{CommandError, ErrorKind, Handle};
 
+#[derive(serde::Serialize, serde::Deserialize)]
 struct Entry<T> {
     generation: u32,
     value: Option<T>,
@@ -12,11 +13,15 @@ struct Entry<T> {
 
 /// Values addressed by generation-checked handles. Freed slots are reused (the published
 /// arrays stay dense); `what` names the values in error messages ("object").
+#[derive(serde::Serialize, serde::Deserialize)]
 pub struct SlotTable<T> {
+    /// Not part of a snapshot: a restored table takes it from the table it replaces.
+    #[serde(skip)]
     what: &'static str,
     entries: Vec<Entry<T>>,
     free: Vec<u32>,
     live: u32,
+    #[serde(skip)]
     max_slots: usize,
 }
 
@@ -30,6 +35,42 @@ impl<T> SlotTable<T> {
             live: 0,
             max_slots,
         }
+    }
+
+    /// Takes the name and slot limit of `like` (a table decoded from a snapshot has
+    /// neither) after checking that the decoded bookkeeping holds together: within the
+    /// limit, every free slot empty and listed once, the live count right.
+    pub fn adopt_limits(&mut self, like: &SlotTable<T>) -> Result<(), CommandError> {
+        let bad = |why: String| {
+            Err(CommandError::new(
+                ErrorKind::InvalidValue,
+                format!("snapshot refused: its {} table {why}", like.what),
+            ))
+        };
+        if self.entries.len() > like.max_slots {
+            return bad(format!(
+                "has {} slots (at most {})",
+                self.entries.len(),
+                like.max_slots
+            ));
+        }
+        let live = self.entries.iter().filter(|e| e.value.is_some()).count();
+        if live != self.live as usize {
+            return bad(format!("counts {} live of {live}", self.live));
+        }
+        let mut seen = vec![false; self.entries.len()];
+        for &f in &self.free {
+            match self.entries.get(f as usize) {
+                Some(e) if e.value.is_none() && !seen[f as usize] => seen[f as usize] = true,
+                _ => return bad(format!("lists slot {f} as free")),
+            }
+        }
+        if self.free.len() + live != self.entries.len() {
+            return bad("loses track of a slot".into());
+        }
+        self.what = like.what;
+        self.max_slots = like.max_slots;
+        Ok(())
     }
 
     /// The slot the next [`SlotTable::insert`] will use, or `None` when the table is full.
@@ -162,6 +203,22 @@ impl<T> SlotTable<T> {
                     Handle {
                         slot: i as u32,
                         generation: e.generation,
+                    },
+                    v,
+                )
+            })
+        })
+    }
+
+    /// Every occupied slot with its handle and value, mutably.
+    pub fn iter_mut(&mut self) -> impl Iterator<Item = (Handle, &mut T)> + '_ {
+        self.entries.iter_mut().enumerate().filter_map(|(i, e)| {
+            let generation = e.generation;
+            e.value.as_mut().map(|v| {
+                (
+                    Handle {
+                        slot: i as u32,
+                        generation,
                     },
                     v,
                 )

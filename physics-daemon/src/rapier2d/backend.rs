@@ -70,6 +70,14 @@ impl Backend for Plane {
             PlaneOp::Info => Ok(Reply::Plane(self.info())),
             PlaneOp::Set(prop) => self.set(prop).map(|_| Reply::Done),
             PlaneOp::Gui(op) => self.gui(op),
+            PlaneOp::Snapshot => self.snapshot().map(Reply::Snapshot),
+            PlaneOp::Rewind(_) => Err(CommandError::invalid_field(
+                "Rewind",
+                "GUI planes do not keep ticks for Rewind (3D planes do, with RollbackTicks)",
+            )),
+            PlaneOp::Restore { bytes, overrides } => self
+                .restore(&bytes, &overrides)
+                .map(|_| Reply::Applied { tick: self.tick }),
             PlaneOp::Object { handle, op } => match op {
                 ObjectOp::Wake => self.gui(GuiOp::Object {
                     handle,

@@ -28,7 +28,7 @@ use crate::backend::counted::CountedVec;
 const MOVED_EPSILON: f32 = 1e-3;
 
 /// One controller (lives in its body).
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub struct Controller {
     settings: GuiControllerSettings,
     uncontrolled: bool,
@@ -39,6 +39,14 @@ pub struct Controller {
     next: usize,
     on_ground: bool,
     last_position: Vec2,
+}
+
+impl Controller {
+    /// Moves the count of the waypoints to `counter` (a controller restored from a
+    /// snapshot counts in its new plane).
+    pub fn count_in(&mut self, counter: &crate::backend::counted::Counter) {
+        self.waypoints.count_in(counter);
+    }
 }
 
 impl Plane {

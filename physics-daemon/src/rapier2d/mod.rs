@@ -23,6 +23,7 @@ mod held {
 mod hooks;
 mod objects;
 mod queries;
+mod snapshot;
 
 use std::time::Instant;
 
@@ -47,7 +48,7 @@ pub const MAX_SLOTS: usize = 1 << 20;
 pub const LENGTH_UNIT: f32 = 100.0;
 
 /// One object: its rapier body and collider and what the API says about it.
-#[derive(Debug)]
+#[derive(Debug, serde::Serialize, serde::Deserialize)]
 struct Body {
     handle: RigidBodyHandle,
     collider: ColliderHandle,

@@ -54,6 +54,11 @@ impl Plane {
                 format!("{op:?} is handled by the server, not the plane"),
             )),
             PlaneOp::Explode(explosion) => self.explode(explosion),
+            PlaneOp::Snapshot => self.snapshot().map(Reply::Snapshot),
+            PlaneOp::Rewind(n) => self.rewind(n),
+            PlaneOp::Restore { bytes, overrides } => {
+                self.restore(&bytes, &overrides).map(|_| applied(self))
+            }
         }
     }
 }

@@ -41,7 +41,7 @@ const DEPENETRATION_PASSES: usize = 4;
 const TURN_MIN_SPEED: f32 = 0.1;
 
 /// What a controller stands on.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, serde::Serialize, serde::Deserialize)]
 struct Ground {
     body: RigidBodyHandle,
     /// Its pose when the controller last stood on it (for platforms moved by pose writes).
@@ -49,7 +49,7 @@ struct Ground {
 }
 
 /// One controller's own state (its body lives in the plane's slot table).
-#[derive(Debug)]
+#[derive(Debug, serde::Serialize, serde::Deserialize)]
 pub(super) struct Controller {
     pub settings: ControllerSettings,
     velocity: Vector,
@@ -968,6 +968,14 @@ impl Plane {
 /// How far from the capsule's side a wall still counts for `OnWall` (units): a few times
 /// the gap the mover keeps from what it touches.
 const WALL_SKIN: f32 = 5.0 * SKIN;
+
+/// Moves the count of every controller's path to `counter` (controllers restored from a
+/// snapshot count in their new plane).
+pub(super) fn count_paths_in(controllers: &mut Controllers, counter: &Counter) {
+    for c in controllers.values_mut() {
+        c.path.count_in(counter);
+    }
+}
 
 /// The controllers of a plane, by slot.
 pub(super) type Controllers = BTreeMap<u32, Controller>;

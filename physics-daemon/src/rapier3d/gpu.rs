@@ -85,11 +85,12 @@ impl Plane {
             if part.map.is_some() {
                 return refuse(format!("a triangle-mesh map (slot {slot})"));
             }
-            if part.rotate_to.is_some() {
-                return refuse(format!("an object with RotateTo (slot {slot})"));
-            }
-            if part.pin.is_some() {
-                return refuse(format!("an object with SetPin (slot {slot})"));
+            // Stored rows flagged `cpu_only` in the object settings table, off their default.
+            let mut rows = ObjectProp::ROWS.iter().enumerate();
+            if let Some((_, row)) =
+                rows.find(|(i, row)| row.cpu_only && !part.settings.is_default_at(*i))
+            {
+                return refuse(format!("an object with {} (slot {slot})", row.name));
             }
         }
         Ok(())
@@ -289,11 +290,11 @@ impl Plane {
     }
 }
 
-/// Object properties the GPU path cannot honour.
+/// Object properties the GPU path cannot honour: rows flagged `cpu_only` in the object
+/// settings table, set to anything but their default.
 fn check_gpu_prop(p: &ObjectProp) -> Result<(), CommandError> {
-    match p {
-        ObjectProp::RotateTo(Some(_)) => Err(unsupported("RotateTo")),
-        ObjectProp::Pin(Some(_)) => Err(unsupported("SetPin")),
-        _ => Ok(()),
+    if p.row().cpu_only && !p.is_default() {
+        return Err(unsupported(p.name()));
     }
+    Ok(())
 }

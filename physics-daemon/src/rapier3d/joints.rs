@@ -26,7 +26,7 @@ pub(super) const POSITION_MOTOR_STIFFNESS: f32 = 400.0;
 pub(super) const POSITION_MOTOR_DAMPING: f32 = 40.0;
 
 /// One joint of the plane.
-#[derive(Debug)]
+#[derive(Debug, serde::Serialize, serde::Deserialize)]
 pub(super) struct Joint {
     kind: JointKind,
     a: Handle,
@@ -50,7 +50,7 @@ pub(super) struct Joint {
 }
 
 /// What one end of a joint is to the solver.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 enum EndState {
     /// Dynamic and simulated.
     Dynamic,
@@ -82,6 +82,7 @@ impl EndState {
 }
 
 /// The plane's joints.
+#[derive(serde::Serialize, serde::Deserialize)]
 pub(super) struct Joints {
     table: SlotTable<Joint>,
     /// A fixed body without colliders: the "world" end of joints to the world.
@@ -101,6 +102,11 @@ impl Default for Joints {
 }
 
 impl Joints {
+    /// See [`SlotTable::adopt_limits`] (a snapshot's joint table).
+    pub fn adopt_limits(&mut self, like: &Joints) -> Result<(), CommandError> {
+        self.table.adopt_limits(&like.table)
+    }
+
     /// Live joints (they count as objects for the quotas).
     pub fn live(&self) -> u32 {
         self.table.live()

@@ -37,6 +37,8 @@ mod probes;
 mod properties;
 mod publish;
 mod queries;
+mod rollback;
+mod snapshot;
 mod solver;
 
 use std::sync::mpsc;
@@ -58,7 +60,7 @@ use part::Part;
 pub use objects::MAX_SLOTS;
 
 /// One object: its rapier body and what the API says about it.
-#[derive(Debug)]
+#[derive(Debug, serde::Serialize, serde::Deserialize)]
 struct Body {
     handle: RigidBodyHandle,
     /// Boxed: the slot table stays small, so the publisher's pass over every slot reads one
@@ -126,6 +128,8 @@ pub struct Plane {
     state_hash: u64,
     /// Bytes of controller paths (counted against the owner's quota).
     state_bytes: crate::backend::counted::Counter,
+    /// States of the last ticks while RollbackTicks > 0 (see `rollback`).
+    rollback: rollback::Ring,
 }
 
 impl Plane {
@@ -172,6 +176,7 @@ impl Plane {
             gpu: None,
             state_hash: 0,
             state_bytes: Default::default(),
+            rollback: Default::default(),
         };
         for prop in props {
             plane.apply_prop(*prop, true)?;
@@ -350,6 +355,7 @@ impl Plane {
             self.state_hash = hash;
         }
         self.last_step_us = started.elapsed().as_secs_f32() * 1e6;
+        self.keep_for_rollback()?;
         Ok(true)
     }
 

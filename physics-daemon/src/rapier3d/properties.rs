@@ -71,6 +71,7 @@ impl Plane {
             }
             ObjectProp::FieldRestraint(_) => body_changed = true,
             ObjectProp::Held(_) => {}
+            ObjectProp::GravityScale(k) => body.set_gravity_scale(k, true),
             // Read by the force pass every tick.
             ObjectProp::ImpulseDirection(_)
             | ObjectProp::ConstantForce(_)

@@ -152,6 +152,8 @@ impl Daemon {
         };
         match op {
             PlaneOp::Destroy => refused("only its owner may destroy it"),
+            // A restore replaces everything (and trusts the snapshot's engine state).
+            PlaneOp::Restore { .. } => refused("only its owner may restore it"),
             PlaneOp::Set(PlaneProp::SharedObjectLimit(_)) => {
                 refused("only its owner may set SharedObjectLimit")
             }

@@ -109,7 +109,13 @@ impl PlaneCell {
     pub fn inline_op(op: &PlaneOp) -> bool {
         !matches!(
             op,
-            PlaneOp::Step { .. } | PlaneOp::Info | PlaneOp::Map(_) | PlaneOp::Query(_)
+            PlaneOp::Step { .. }
+                | PlaneOp::Info
+                | PlaneOp::Map(_)
+                | PlaneOp::Query(_)
+                | PlaneOp::Snapshot
+                | PlaneOp::Restore { .. }
+                | PlaneOp::Rewind(_)
         ) && op.cost().mesh_vertices == 0
     }
 
@@ -633,13 +639,16 @@ fn apply_inner(
     panic_on_step_dt: Option<f32>,
     op: PlaneOp,
 ) -> CommandResult {
-    let needs_output = matches!(op, PlaneOp::Step { .. } | PlaneOp::Info);
+    let needs_output = matches!(
+        op,
+        PlaneOp::Step { .. } | PlaneOp::Info | PlaneOp::Restore { .. } | PlaneOp::Rewind(_)
+    );
     let out = match out {
         Some(out) => Some(out),
         None if needs_output => {
             return Err(CommandError::new(
                 ErrorKind::Internal,
-                format!("{op:?} must run on the plane's worker"),
+                format!("{} must run on the plane's worker", op_name(&op)),
             ))
         }
         None => None,
@@ -656,6 +665,14 @@ fn apply_inner(
             }
             Ok(Reply::Stepped { tick: plane.tick() })
         }
+        // Readers see the restored state at once, as after a step.
+        op @ (PlaneOp::Restore { .. } | PlaneOp::Rewind(_)) => {
+            let reply = plane.apply(op)?;
+            if let Some(out) = out {
+                out.publish(plane).map_err(super::dispatch::internal)?;
+            }
+            Ok(reply)
+        }
         op => {
             if op == PlaneOp::Info {
                 // A reader that just subscribed gets the newest tick at once.
@@ -665,6 +682,17 @@ fn apply_inner(
             }
             plane.apply(op)
         }
+    }
+}
+
+/// The op's variant for messages (never its payload: a restore carries megabytes).
+fn op_name(op: &PlaneOp) -> &'static str {
+    match op {
+        PlaneOp::Step { .. } => "Step",
+        PlaneOp::Info => "Info",
+        PlaneOp::Restore { .. } => "Restore",
+        PlaneOp::Rewind(_) => "Rewind",
+        _ => "this op",
     }
 }
 

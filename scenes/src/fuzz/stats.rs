@@ -241,55 +241,19 @@ pub fn all_op_names() -> Vec<String> {
     ]
     .map(String::from)
     .to_vec();
-    let plane_props = [
-        PlaneProp::Gravity([0.0; 3]),
-        PlaneProp::Threads(1),
-        PlaneProp::TickRate(0.0),
-        PlaneProp::Enabled(true),
-        PlaneProp::LinearDamping(0.0),
-        PlaneProp::AngularDamping(0.0),
-        PlaneProp::Drag(0.0),
-        PlaneProp::Buoyancy(0.0),
-        PlaneProp::ConstantForce([0.0; 3]),
-        PlaneProp::RestThreshold(0.0),
-        PlaneProp::SolverIterations(1),
-        PlaneProp::LoopSolver(false),
-        PlaneProp::NeverSleep(false),
-        PlaneProp::Shared(false),
-        PlaneProp::MaxLinearSpeed(1.0),
-        PlaneProp::MaxAngularSpeed(1.0),
-    ];
+    // One op per row of the plane and object settings tables (GUI plane options are
+    // counted under their own names when a GUI plane gets them).
     names.extend(
-        plane_props
+        PlaneProp::DEFAULTS
             .iter()
+            .filter(|p| !matches!(p, PlaneProp::Gui(_)))
             .map(|p| format!("Plane.Set.{}", p.name())),
     );
-    let object_props = [
-        ObjectProp::Pose(Default::default()),
-        ObjectProp::Velocity([0.0; 3]),
-        ObjectProp::AngularVelocity([0.0; 3]),
-        ObjectProp::Anchored(false),
-        ObjectProp::ReportContacts(false),
-        ObjectProp::Weight(1.0),
-        ObjectProp::Density(0.0),
-        ObjectProp::Bounciness(0.0),
-        ObjectProp::Friction(0.0),
-        ObjectProp::CanCollide(true),
-        ObjectProp::HitBoxQuality(1),
-        ObjectProp::Size([1.0; 3]),
-        ObjectProp::CenterOfMass([0.0; 3]),
-        ObjectProp::ImpulseDirection([0.0; 3]),
-        ObjectProp::ConstantForce([0.0; 3]),
-        ObjectProp::FieldRestraint(Default::default()),
-        ObjectProp::RotateTo(None),
-        ObjectProp::Pin(None),
-    ];
     names.extend(
-        object_props
+        ObjectProp::ROWS
             .iter()
-            .map(|p| format!("Object.Set.{}", object_prop_name(p))),
+            .map(|r| format!("Object.Set.{}", r.name)),
     );
-    names.push("Object.Set.CollisionGroup".into());
     names.push("Plane.CollisionGroups".into());
     for q in [
         "Raycast",
@@ -307,6 +271,8 @@ pub fn all_op_names() -> Vec<String> {
         names.push(format!("Plane.Query.{q}"));
     }
     names.push("Plane.Explode".into());
+    names.push("Plane.Snapshot".into());
+    names.push("Plane.Restore".into());
     for c in [
         "Create",
         "Set",
@@ -372,6 +338,7 @@ pub fn reply_name(reply: &Reply) -> &'static str {
         Reply::Probe(_) => "Probe",
         Reply::Contacts(_) => "Contacts",
         Reply::ObjectPage { .. } => "ObjectPage",
+        Reply::Snapshot(_) => "Snapshot",
     }
 }
 
@@ -399,7 +366,7 @@ pub fn op_name(command: &Command) -> String {
                 }
             ),
             PlaneOp::Object { op, .. } => match op {
-                ObjectOp::Set(p) => format!("Object.Set.{}", object_prop_name(p)),
+                ObjectOp::Set(p) => format!("Object.Set.{}", p.name()),
                 ObjectOp::ApplyImpulse(_) => "Object.ApplyImpulse".into(),
                 ObjectOp::Info => "Object.Info".into(),
                 ObjectOp::RecalculateCenterOfMass => "Object.RecalculateCenterOfMass".into(),
@@ -423,33 +390,10 @@ pub fn op_name(command: &Command) -> String {
                 MapOp::Discard => "Plane.Map.Discard".into(),
             },
             PlaneOp::Explode(_) => "Plane.Explode".into(),
+            PlaneOp::Snapshot => "Plane.Snapshot".into(),
+            PlaneOp::Restore { .. } => "Plane.Restore".into(),
+            PlaneOp::Rewind(_) => "Plane.Rewind".into(),
         },
-    }
-}
-
-/// The name of an object property (`Velocity`).
-pub fn object_prop_name(prop: &ObjectProp) -> &'static str {
-    match prop {
-        ObjectProp::Pose(_) => "CFrame",
-        ObjectProp::Velocity(_) => "Velocity",
-        ObjectProp::AngularVelocity(_) => "AngularVelocity",
-        ObjectProp::Anchored(_) => "Anchored",
-        ObjectProp::ReportContacts(_) => "ReportContacts",
-        ObjectProp::Weight(_) => "Weight",
-        ObjectProp::Density(_) => "Density",
-        ObjectProp::Bounciness(_) => "Bounciness",
-        ObjectProp::Friction(_) => "Friction",
-        ObjectProp::CanCollide(_) => "CanCollide",
-        ObjectProp::HitBoxQuality(_) => "HitBoxQuality",
-        ObjectProp::Size(_) => "Size",
-        ObjectProp::CenterOfMass(_) => "CenterOfMass",
-        ObjectProp::ImpulseDirection(_) => "ImpulseDirection",
-        ObjectProp::ConstantForce(_) => "ConstantForce",
-        ObjectProp::FieldRestraint(_) => "FieldRestraint",
-        ObjectProp::RotateTo(_) => "RotateTo",
-        ObjectProp::Pin(_) => "Pin",
-        ObjectProp::CollisionGroup(_) => "CollisionGroup",
-        ObjectProp::Held(_) => "Held",
     }
 }
 

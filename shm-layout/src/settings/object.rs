@@ -1,11 +1,12 @@
-//! Object properties: the wire variant, the defaults and the checks of each.
+//! Object properties: one row each in the object settings table (wire variant, name,
+//! default, range, stored field, flags), plus the structured values some of them carry.
 
 use serde::{Deserialize, Serialize};
 
+use super::table::Range;
 use crate::collision_groups::MAX_COLLISION_GROUPS;
 use crate::validate::{
-    bounded3, clamped, finite3, in_range, non_negative, pose, positive, rotation, size,
-    MAX_HIT_BOX_QUALITY, MAX_SIZE, MIN_MASS,
+    bounded3, non_negative, pose, rotation, MAX_HIT_BOX_QUALITY, MAX_SIZE, MIN_MASS,
 };
 use crate::{CommandError, Pose, Vec3};
 
@@ -28,6 +29,16 @@ pub struct Restraint {
 }
 
 impl Restraint {
+    /// Every flag `None`: keeps all locks as they are (the default).
+    pub const KEEP: Restraint = Restraint {
+        lock_x: None,
+        lock_y: None,
+        lock_z: None,
+        lock_rot_x: None,
+        lock_rot_y: None,
+        lock_rot_z: None,
+    };
+
     /// The flags in the order LockX, LockY, LockZ, LockRotX, LockRotY, LockRotZ.
     pub fn flags(&self) -> [Option<bool>; 6] {
         [
@@ -62,148 +73,118 @@ pub struct Pin {
     pub target: Pose,
 }
 
-/// An object property.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub enum ObjectProp {
-    /// Teleports the object.
-    Pose(Pose),
-    /// Linear velocity.
-    Velocity(Vec3),
-    /// Angular velocity (rad/s).
-    AngularVelocity(Vec3),
-    /// Anchored objects do not move; setting it zeroes both velocities.
-    Anchored(bool),
-    /// Report contact started / stopped events for this object.
-    ReportContacts(bool),
-    /// Mass used when `Density` is 0 (impulses divide by it; free fall ignores it). Default 1.
-    Weight(f32),
-    /// When > 0, mass = Density × volume (wins over Weight). 0 returns to Weight.
-    Density(f32),
-    /// Restitution, clamped to [0, 1]; a pair uses the higher value. Default 0.
-    Bounciness(f32),
-    /// Coulomb friction in [0, 1]; a pair uses `sqrt(a·b)`. Default 0.5.
-    Friction(f32),
-    /// When false the object passes through everything.
-    CanCollide(bool),
-    /// Fidelity dial, clamped to [1, 32]. Default 1.
-    HitBoxQuality(u32),
-    /// Full size of the object's box (a sphere takes the smallest half-extent as radius; a
-    /// mesh is scaled to it).
-    Size(Vec3),
-    /// Body-local centre of mass; non-zero switches to the real inertia of the shape.
-    CenterOfMass(Vec3),
-    /// Persistent acceleration applied every tick.
-    ImpulseDirection(Vec3),
-    /// Persistent world-space force applied every tick.
-    ConstantForce(Vec3),
-    /// Locks axes of motion; unspecified flags are kept.
-    FieldRestraint(Restraint),
-    /// `None` stops the controller (angular velocity is left as it is).
-    RotateTo(Option<RotateTo>),
-    /// `None` releases the pin.
-    Pin(Option<Pin>),
-    /// The object's collision group: an index into the plane's collision-group table.
-    CollisionGroup(u8),
-    /// Held: steps leave the object where it is (pose and velocities as before the step)
-    /// until `Held(false)`, or for at most [`MAX_HELD_TICKS`] ticks. The SDK adds objects
-    /// held on planes that tick by themselves and releases them with its next flush, so
-    /// properties written right after an add apply before the object's first step.
-    Held(bool),
+crate::settings_table! {
+    /// An object property. One row each: wire variant (row order is wire order: new rows go
+    /// last), API name, default, range, stored field and flags (see [`super::table`]).
+    #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+    pub enum ObjectProp;
+    /// The stored (not per-tick) properties of an object. [`Default`] holds the documented
+    /// defaults. Pose, velocities, Anchored and Size live in the engine's body and shape.
+    #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+    pub struct ObjectSettings;
+    rows {
+        /// Teleports the object.
+        Pose(Pose) "CFrame" = Pose::IDENTITY, flags: [published];
+        /// Linear velocity.
+        Velocity(Vec3) "Velocity" = [0.0; 3], flags: [published];
+        /// Angular velocity (rad/s).
+        AngularVelocity(Vec3) "AngularVelocity" = [0.0; 3], flags: [published];
+        /// Anchored objects do not move; setting it zeroes both velocities.
+        Anchored(bool) "Anchored" = false, flags: [published, derived];
+        /// Report contact started / stopped events for this object.
+        ReportContacts(bool) "ReportContacts" = false, field: report_contacts;
+        /// Mass used when `Density` is 0 (impulses divide by it; free fall ignores it). Default 1;
+        /// at least `validate::MIN_MASS`.
+        Weight(f32) "Weight" = 1.0, range: Range::AtLeast(MIN_MASS as f64), field: weight,
+            flags: [derived, lua];
+        /// When > 0, mass = Density × volume (wins over Weight). 0 returns to Weight.
+        /// (Lua reads the density in effect, `ObjectInfo::density`: a row of its own.)
+        Density(f32) "Density" = 0.0, range: Range::NonNegative, field: density,
+            flags: [derived];
+        /// Restitution, clamped to [0, 1]; a pair uses the higher value. Default 0.
+        Bounciness(f32) "Bounciness" = 0.0, range: Range::Clamped(0.0, 1.0), field: bounciness,
+            flags: [lua];
+        /// Coulomb friction in [0, 1]; a pair uses `sqrt(a·b)`. Default 0.5.
+        Friction(f32) "Friction" = 0.5, range: Range::Within(0.0, 1.0), field: friction,
+            flags: [lua];
+        /// When false the object passes through everything.
+        CanCollide(bool) "CanCollide" = true, field: can_collide, flags: [lua];
+        /// Fidelity dial, clamped to [1, 32]. Default 1.
+        HitBoxQuality(u32) "HitBoxQuality" = 1,
+            range: Range::Clamped(1.0, MAX_HIT_BOX_QUALITY as f64), field: hit_box_quality,
+            flags: [derived, lua];
+        /// Full size of the object's box (a sphere takes the smallest half-extent as radius; a
+        /// mesh is scaled to it).
+        Size(Vec3) "Size" = [1.0; 3], range: Range::Extent, flags: [derived];
+        /// Body-local centre of mass; non-zero switches to the real inertia of the shape.
+        CenterOfMass(Vec3) "CenterOfMass" = [0.0; 3], range: Range::Bounded(MAX_SIZE as f64),
+            field: center_of_mass, flags: [derived, lua];
+        /// Persistent acceleration applied every tick.
+        ImpulseDirection(Vec3) "ImpulseDirection" = [0.0; 3], field: impulse_direction,
+            flags: [lua];
+        /// Persistent world-space force applied every tick.
+        ConstantForce(Vec3) "ConstantForce" = [0.0; 3], field: constant_force, flags: [lua];
+        /// Locks axes of motion; unspecified flags are kept.
+        FieldRestraint(Restraint) "FieldRestraint" = Restraint::KEEP,
+            field: locks via store_locks => [bool; 6] = [false; 6];
+        /// `None` stops the controller (angular velocity is left as it is).
+        RotateTo(Option<RotateTo>) "RotateTo" = None, check: check_rotate_to, field: rotate_to,
+            flags: [cpu_only];
+        /// `None` releases the pin.
+        Pin(Option<Pin>) "SetPin" = None, check: check_pin, field: pin, flags: [cpu_only];
+        /// The object's collision group: an index into the plane's collision-group table.
+        CollisionGroup(u8) "CollisionGroup" = 0, check: check_collision_group,
+            field: collision_group;
+        /// Held: steps leave the object where it is (pose and velocities as before the step)
+        /// until `Held(false)`, or for at most [`MAX_HELD_TICKS`] ticks. The SDK adds objects
+        /// held on planes that tick by themselves and releases them with its next flush, so
+        /// properties written right after an add apply before the object's first step.
+        Held(bool) "Held" = false;
+        /// Multiplies the plane's Gravity for this object: 0 floats, -1 falls up. Default 1.
+        GravityScale(f32) "GravityScale" = 1.0, field: gravity_scale, flags: [lua, cpu_only];
+    }
+}
+
+/// `FieldRestraint` into the six lock flags: flags left `None` keep their value.
+fn store_locks(locks: &mut [bool; 6], r: Restraint) {
+    for (lock, flag) in locks.iter_mut().zip(r.flags()) {
+        if let Some(on) = flag {
+            *lock = on;
+        }
+    }
+}
+
+fn check_rotate_to(r: Option<RotateTo>) -> Result<Option<RotateTo>, CommandError> {
+    let Some(r) = r else { return Ok(None) };
+    Ok(Some(RotateTo {
+        target: rotation("RotateTo.target", r.target)?,
+        strength: non_negative("RotateTo.strength", r.strength)?,
+    }))
+}
+
+fn check_pin(p: Option<Pin>) -> Result<Option<Pin>, CommandError> {
+    let Some(p) = p else { return Ok(None) };
+    Ok(Some(Pin {
+        force: non_negative("SetPin.force", p.force)?,
+        relative: bounded3("SetPin.relative", p.relative, MAX_SIZE)?,
+        target: pose("SetPin.target", p.target)?,
+    }))
+}
+
+fn check_collision_group(g: u8) -> Result<u8, CommandError> {
+    if g as usize >= MAX_COLLISION_GROUPS {
+        return Err(CommandError::invalid_field(
+            "CollisionGroup",
+            format!("CollisionGroup must be a group index below {MAX_COLLISION_GROUPS}, got {g}"),
+        ));
+    }
+    Ok(g)
 }
 
 /// Ticks a held object waits at most for its release (about half a second at 60 Hz).
 pub const MAX_HELD_TICKS: u32 = 30;
 
-/// The stored (not per-tick) properties of an object. [`Default`] holds the documented
-/// defaults. Pose, velocities, Anchored and Size live in the engine's body and shape.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct ObjectSettings {
-    /// `ReportContacts`, default false.
-    pub report_contacts: bool,
-    /// `Weight`, default 1.
-    pub weight: f32,
-    /// `Density`, default 0 (mass from Weight).
-    pub density: f32,
-    /// `Bounciness`, default 0.
-    pub bounciness: f32,
-    /// `Friction`, default 0.5.
-    pub friction: f32,
-    /// `CanCollide`, default true.
-    pub can_collide: bool,
-    /// `HitBoxQuality`, default 1.
-    pub hit_box_quality: u32,
-    /// `CenterOfMass`, default 0 (the shape's centre).
-    pub center_of_mass: Vec3,
-    /// `ImpulseDirection`, default 0.
-    pub impulse_direction: Vec3,
-    /// `ConstantForce`, default 0.
-    pub constant_force: Vec3,
-    /// LockX, LockY, LockZ, LockRotX, LockRotY, LockRotZ, default all false.
-    pub locks: [bool; 6],
-    /// `RotateTo`, default none.
-    pub rotate_to: Option<RotateTo>,
-    /// `SetPin`, default none.
-    pub pin: Option<Pin>,
-    /// `CollisionGroup` index, default 0 ("Default").
-    pub collision_group: u8,
-}
-
-impl Default for ObjectSettings {
-    fn default() -> Self {
-        ObjectSettings {
-            report_contacts: false,
-            weight: 1.0,
-            density: 0.0,
-            bounciness: 0.0,
-            friction: 0.5,
-            can_collide: true,
-            hit_box_quality: 1,
-            center_of_mass: [0.0; 3],
-            impulse_direction: [0.0; 3],
-            constant_force: [0.0; 3],
-            locks: [false; 6],
-            rotate_to: None,
-            pin: None,
-            collision_group: 0,
-        }
-    }
-}
-
 impl ObjectSettings {
-    /// Stores a checked stored property. Returns false for the properties that live in the
-    /// engine instead (Pose, velocities, Anchored, Size), leaving the settings unchanged.
-    pub fn store(&mut self, prop: &ObjectProp) -> bool {
-        match *prop {
-            ObjectProp::ReportContacts(on) => self.report_contacts = on,
-            ObjectProp::Weight(w) => self.weight = w,
-            ObjectProp::Density(d) => self.density = d,
-            ObjectProp::Bounciness(e) => self.bounciness = e,
-            ObjectProp::Friction(mu) => self.friction = mu,
-            ObjectProp::CanCollide(on) => self.can_collide = on,
-            ObjectProp::HitBoxQuality(q) => self.hit_box_quality = q,
-            ObjectProp::CenterOfMass(c) => self.center_of_mass = c,
-            ObjectProp::ImpulseDirection(a) => self.impulse_direction = a,
-            ObjectProp::ConstantForce(f) => self.constant_force = f,
-            ObjectProp::FieldRestraint(r) => {
-                for (lock, flag) in self.locks.iter_mut().zip(r.flags()) {
-                    if let Some(on) = flag {
-                        *lock = on;
-                    }
-                }
-            }
-            ObjectProp::RotateTo(r) => self.rotate_to = r,
-            ObjectProp::Pin(p) => self.pin = p,
-            ObjectProp::CollisionGroup(g) => self.collision_group = g,
-            ObjectProp::Pose(_)
-            | ObjectProp::Velocity(_)
-            | ObjectProp::AngularVelocity(_)
-            | ObjectProp::Anchored(_)
-            | ObjectProp::Size(_)
-            | ObjectProp::Held(_) => return false,
-        }
-        true
-    }
-
     /// Whether the force pass has anything to do for this object itself.
     pub fn is_driven(&self) -> bool {
         self.impulse_direction != [0.0; 3]
@@ -214,62 +195,14 @@ impl ObjectSettings {
 }
 
 impl ObjectProp {
+    /// The property's name in the API (`"CFrame"`, `"SetPin"`).
+    pub fn name(&self) -> &'static str {
+        self.row().name
+    }
+
     /// Whether the property changes what a published body state shows (pose, velocities,
     /// the anchored flag): what a client's read-your-writes overlay must cover.
     pub fn is_published(&self) -> bool {
-        matches!(
-            self,
-            ObjectProp::Pose(_)
-                | ObjectProp::Velocity(_)
-                | ObjectProp::AngularVelocity(_)
-                | ObjectProp::Anchored(_)
-        )
-    }
-
-    /// The property as the daemon applies it, or an error naming it and the value.
-    pub fn checked(self) -> Result<ObjectProp, CommandError> {
-        use ObjectProp::*;
-        Ok(match self {
-            Pose(p) => Pose(pose("CFrame", p)?),
-            Velocity(v) => Velocity(finite3("Velocity", v)?),
-            AngularVelocity(w) => AngularVelocity(finite3("AngularVelocity", w)?),
-            Weight(w) => {
-                let w = positive("Weight", w)?;
-                if w < MIN_MASS {
-                    return Err(CommandError::invalid_field(
-                        "Weight",
-                        format!("Weight must be at least {MIN_MASS}, got {w}"),
-                    ));
-                }
-                Weight(w)
-            }
-            Density(d) => Density(non_negative("Density", d)?),
-            Bounciness(e) => Bounciness(clamped("Bounciness", e, 0.0, 1.0)?),
-            Friction(mu) => Friction(in_range("Friction", mu, 0.0, 1.0)?),
-            HitBoxQuality(q) => HitBoxQuality(q.clamp(1, MAX_HIT_BOX_QUALITY)),
-            CollisionGroup(g) if g as usize >= MAX_COLLISION_GROUPS => {
-                return Err(CommandError::invalid_field(
-                    "CollisionGroup",
-                    format!(
-                        "CollisionGroup must be a group index below {MAX_COLLISION_GROUPS}, \
-                         got {g}"
-                    ),
-                ))
-            }
-            Size(v) => Size(size("Size", v)?),
-            CenterOfMass(c) => CenterOfMass(bounded3("CenterOfMass", c, MAX_SIZE)?),
-            ImpulseDirection(a) => ImpulseDirection(finite3("ImpulseDirection", a)?),
-            ConstantForce(f) => ConstantForce(finite3("ConstantForce", f)?),
-            RotateTo(Some(r)) => RotateTo(Some(self::RotateTo {
-                target: rotation("RotateTo.target", r.target)?,
-                strength: non_negative("RotateTo.strength", r.strength)?,
-            })),
-            Pin(Some(p)) => Pin(Some(self::Pin {
-                force: non_negative("SetPin.force", p.force)?,
-                relative: bounded3("SetPin.relative", p.relative, MAX_SIZE)?,
-                target: pose("SetPin.target", p.target)?,
-            })),
-            other => other,
-        })
+        self.row().published
     }
 }

@@ -1,0 +1,161 @@
+//! A GUI plane's whole state as bytes, and back (see `rapier3d/snapshot.rs`, which this
+//! follows): rapier2d's world and the plane's own tables, so that a restored plane
+//! continues bit for bit. The id, the quota counter and the scratch stay with the plane.
+
+use rapier2d::prelude::*;
+use shm_layout::settings::{GuiPlaneProp, GuiPlaneSettings};
+use shm_layout::{snapshot, CommandError, ErrorKind, PlaneKind, PlaneProp, SnapshotHeader};
+
+use super::{held, Body, Plane, MAX_SLOTS};
+use crate::backend::counted::Counter;
+use crate::backend::{Backend, SlotTable};
+
+/// The engine named in the snapshot header.
+pub const ENGINE: &str = "rapier2d 0.36 / physics-daemon gui state 1";
+
+macro_rules! plane_state {
+    ($($field:ident: $ty:ty,)*) => {
+        #[derive(serde::Serialize)]
+        struct StateRef<'a> {
+            $($field: &'a $ty,)*
+        }
+
+        #[derive(serde::Deserialize)]
+        struct State {
+            $($field: $ty,)*
+        }
+
+        impl Plane {
+            fn state_ref(&self) -> StateRef<'_> {
+                StateRef { $($field: &self.$field,)* }
+            }
+
+            fn take_state(&mut self, state: State) {
+                $(self.$field = state.$field;)*
+            }
+        }
+    };
+}
+
+plane_state! {
+    settings: GuiPlaneSettings,
+    world: PhysicsWorld,
+    bodies: SlotTable<Body>,
+    controlled: Vec<u32>,
+    driven: u32,
+    query_stale: Vec<RigidBodyHandle>,
+    held: Vec<held::HeldBody>,
+    tick: u64,
+    sim_time: f64,
+    last_step_us: f32,
+    last_dt: f32,
+    max_penetration: f32,
+    contact_pairs: u32,
+    event_seq: u64,
+}
+
+fn refused(what: String) -> CommandError {
+    CommandError::new(ErrorKind::InvalidValue, format!("snapshot refused: {what}"))
+}
+
+impl Plane {
+    /// The plane's whole state as snapshot bytes.
+    pub fn snapshot(&self) -> Result<Vec<u8>, CommandError> {
+        let body = postcard::to_allocvec(&self.state_ref())
+            .map_err(|e| CommandError::new(ErrorKind::Internal, format!("snapshot failed: {e}")))?;
+        let usage = self.usage();
+        let header = SnapshotHeader {
+            engine: ENGINE.to_string(),
+            kind: PlaneKind::Gui2d,
+            tick: self.tick,
+            state_hash: self.header().state_hash,
+            objects: usage.objects,
+            mesh_vertices: usage.mesh_vertices,
+            state_bytes: usage.state_bytes,
+            ..SnapshotHeader::default()
+        };
+        Ok(snapshot::encode(header, &body))
+    }
+
+    /// Becomes exactly the state of `bytes`; nothing changes when it is refused.
+    pub fn restore(&mut self, bytes: &[u8], overrides: &[PlaneProp]) -> Result<(), CommandError> {
+        let (header, body) = snapshot::decode(bytes, PlaneKind::Gui2d, ENGINE)?;
+        let mut state = crate::backend::snapshot_decode::decode(body, refused, check)?;
+        // The overrides are checked on a copy of the decoded plane's settings first.
+        let mut checked = state.settings;
+        for prop in overrides {
+            match prop.checked()? {
+                PlaneProp::TickRate(_) | PlaneProp::Enabled(_) => {}
+                PlaneProp::Gui(GuiPlaneProp::Bounds { .. }) | PlaneProp::Shared(_) => {
+                    return Err(refused(format!(
+                        "{} cannot be set by a restore (it is the snapshot's)",
+                        prop.name()
+                    )))
+                }
+                PlaneProp::Gui(g) => {
+                    checked.apply(g, true)?;
+                }
+                other => {
+                    return Err(refused(format!(
+                        "{} is not an option of GUI planes",
+                        other.name()
+                    )))
+                }
+            }
+        }
+        state.bodies.adopt_limits(&self.bodies)?;
+        let paths = Counter::default();
+        for (_, b) in state.bodies.iter_mut() {
+            if let Some(c) = &mut b.controller {
+                c.count_in(&paths);
+            }
+        }
+        let held = [state.bodies.live() as u64, paths.get()];
+        let claimed = [header.objects, header.state_bytes];
+        if held.iter().zip(claimed).any(|(h, c)| *h > c) {
+            return Err(refused(format!(
+                "it holds {held:?} (objects, state bytes), its header claims {claimed:?}"
+            )));
+        }
+        for (_, b) in state.bodies.iter_mut() {
+            if let Some(c) = &mut b.controller {
+                c.count_in(&self.state_bytes);
+            }
+        }
+        state.world.physics_pipeline = std::mem::take(&mut self.world.physics_pipeline);
+        self.take_state(state);
+        self.events.clear();
+        self.dirty.mark_all();
+        for prop in overrides {
+            self.apply_prop(*prop, true)?;
+        }
+        Ok(())
+    }
+}
+
+/// Cross-references a decoded state must satisfy (see the 3D plane's `check`).
+fn check(state: &State) -> Result<(), CommandError> {
+    let w = &state.world;
+    if state.bodies.slot_count() > MAX_SLOTS {
+        return Err(refused(format!(
+            "{} object slots (at most {MAX_SLOTS})",
+            state.bodies.slot_count()
+        )));
+    }
+    for (h, body) in state.bodies.iter() {
+        if w.bodies.get(body.handle).is_none() || w.colliders.get(body.collider).is_none() {
+            return Err(refused(format!("object {h} has no engine body")));
+        }
+    }
+    for (_, c) in w.colliders.iter() {
+        if c.parent().is_some_and(|p| w.bodies.get(p).is_none()) {
+            return Err(refused("a collider's body is missing".into()));
+        }
+    }
+    for slot in &state.controlled {
+        if state.bodies.at(*slot as usize).is_none() {
+            return Err(refused(format!("controller slot {slot} has no object")));
+        }
+    }
+    Ok(())
+}
