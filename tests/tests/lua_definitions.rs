@@ -511,7 +511,8 @@ fn settings_table_rows_declare_their_kind() {
             let want = match row.kind {
                 PropKind::Bool => "boolean",
                 PropKind::Float | PropKind::Integer { .. } => "number",
-                PropKind::Vector => "vector",
+                // Declared as the class Vector (Luau's `vector` at run time; see physics.d.luau).
+                PropKind::Vector => "Vector",
                 PropKind::Pose => "CFrame",
                 PropKind::Other => "(no Luau type)",
             };
