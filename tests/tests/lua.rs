@@ -163,8 +163,8 @@ fn uncaught_error_exits_1_with_message_and_traceback() {
         "PhysicsObject.Velocity expects a Vector",
         "string \"fast\"",
         "stack traceback",
-        "fails.luau:9",
-        "fails.luau:13",
+        "fails.luau:10",
+        "fails.luau:14",
     ] {
         assert!(
             err.contains(needle),
@@ -183,9 +183,9 @@ fn uncaught_error_exits_1_with_message_and_traceback() {
     let err = r.stderr();
     for needle in [
         "handler failed on frame 3",
-        "heart_fails.luau:15",
+        "heart_fails.luau:16",
         "error in a Heart handler (the function at",
-        "heart_fails.luau:12",
+        "heart_fails.luau:13",
         "touch handler failed",
         "Touched handler",
         "failed after a wait",

@@ -11,8 +11,8 @@
 //!   against a real daemon (members documented as "not supported yet" must say so);
 //! - every member the example and test scripts use (`x.Name`, `x:Name(`) is declared.
 //!
-//! A real Luau type checker (Luau's Analysis library) is not part of this check: see the
-//! docs/lua.md, "Luau tooling".
+//! The types themselves (and every script against them, in strict mode) are checked by Luau's
+//! own type checker in `.ci/luau-tools`: see docs/lua.md, "Luau tooling".
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
@@ -37,7 +37,7 @@ struct Member {
 struct Definitions {
     /// `declare class NAME` → members.
     classes: BTreeMap<String, Vec<Member>>,
-    /// `type NAME = { ... }` → its field names (nested tables' too, three levels deep).
+    /// `[export] type NAME = { ... }` → its field names (nested tables' too, three levels deep).
     tables: BTreeMap<String, Vec<String>>,
     /// `type NAME = { ... }` → its own field names.
     own_fields: BTreeMap<String, Vec<String>>,
@@ -82,7 +82,18 @@ impl Definitions {
                     }
                 }
                 d.classes.insert(name, members);
-            } else if let Some(rest) = line.strip_prefix("type ") {
+            } else if let Some(rest) = line
+                .strip_prefix("export type ")
+                .or_else(|| line.strip_prefix("type "))
+            {
+                // `type Signal<T... = ...any> = {` declares `Signal`: its generic
+                // parameters (and their defaults) go first.
+                let rest = match (rest.find('<'), rest.find('>'), rest.find('=')) {
+                    (Some(lt), Some(gt), Some(eq)) if lt < eq => {
+                        format!("{}{}", &rest[..lt], &rest[gt + 1..])
+                    }
+                    _ => rest.to_string(),
+                };
                 let Some((name, body)) = rest.split_once('=') else {
                     continue;
                 };
@@ -199,7 +210,8 @@ fn property_rows_match_the_declared_properties() {
         }
         for m in members.iter().filter(|_| all_rows.contains(&owner)) {
             // Signals are members of their own kind, not property rows.
-            let signal = m.ty.trim_end_matches('?') == "Signal";
+            let ty = m.ty.trim_end_matches('?');
+            let signal = ty == "Signal" || ty.starts_with("Signal<");
             if !m.function && !signal && !rows.contains(&m.name.as_str()) {
                 problems.push(format!(
                     "{owner}.{} is declared but the runtime has no row for it",
@@ -293,6 +305,19 @@ fn every_declared_member_exists_at_run_time() {
         }
         decl.push_str(" },\n");
     }
+    // Host objects declared as (generic) table types rather than classes: their fields
+    // are methods.
+    for table in ["Signal"] {
+        let fields = d
+            .own_fields
+            .get(table)
+            .unwrap_or_else(|| panic!("type {table} not declared"));
+        decl.push_str(&format!("\t{table} = {{"));
+        for f in fields {
+            decl.push_str(&format!(" {{ {f:?}, true, false }},"));
+        }
+        decl.push_str(" },\n");
+    }
     decl.push_str("}\nlocal MODULES = {\n");
     for (table, module) in [
         ("PhysicsServiceModule", "PhysicsService"),
@@ -308,10 +333,28 @@ fn every_declared_member_exists_at_run_time() {
         decl.push_str(&format!("\t{module} = {{ {} }},\n", top.join(", ")));
     }
     decl.push_str("}\n");
+    // The script declares both tables empty on marked lines (so it type-checks on its own);
+    // the generated ones take the place of the first.
     let body = std::fs::read_to_string(repo().join("tests/lua/definitions.luau")).unwrap();
+    let marker = "-- filled in by lua_definitions.rs";
+    let mut replaced = 0;
+    let body: Vec<&str> = body
+        .lines()
+        .map(|l| {
+            if l.ends_with(marker) {
+                replaced += 1;
+                if replaced == 1 {
+                    return decl.as_str();
+                }
+                return "";
+            }
+            l
+        })
+        .collect();
+    assert_eq!(replaced, 2, "definitions.luau must mark DECL and MODULES");
     let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR"));
     let script = dir.join(format!("definitions-{}.luau", std::process::id()));
-    std::fs::write(&script, format!("{decl}\n{body}")).unwrap();
+    std::fs::write(&script, body.join("\n")).unwrap();
 
     let daemon = TestDaemon::start("lua-defs");
     let out = physics_lua(&daemon.domain, script.to_str().unwrap(), &[])
@@ -368,11 +411,6 @@ fn used_members(source: &str) -> BTreeSet<String> {
     used
 }
 
-/// What the host's vector metatable adds to Luau's native `vector` (physics.d.luau declares
-/// `type Vector = vector` and documents these in a comment: luau-lsp has no way to declare
-/// members of a builtin type).
-const VECTOR_MEMBERS: [&str; 8] = ["X", "Y", "Z", "Magnitude", "Unit", "Dot", "Cross", "Lerp"];
-
 /// Names given as fields in the script's own table constructors (`{ Foo = 1 }`, `, Foo = `)
 /// and functions it defines on its own tables (`function t.Foo(`, `function t:Foo(`).
 fn constructor_fields(source: &str) -> BTreeSet<String> {
@@ -428,7 +466,7 @@ fn scripts_use_only_declared_members() {
             }
             scripts += 1;
             let text = std::fs::read_to_string(&path).unwrap();
-            let mut allowed: BTreeSet<String> = text
+            let allowed: BTreeSet<String> = text
                 .lines()
                 .filter_map(|l| l.trim().strip_prefix("-- undeclared:"))
                 .flat_map(|l| {
@@ -438,7 +476,6 @@ fn scripts_use_only_declared_members() {
                         .collect::<Vec<_>>()
                 })
                 .collect();
-            allowed.extend(VECTOR_MEMBERS.iter().map(|s| s.to_string()));
             // Fields of tables the script builds itself (`local t = { Foo = 1 }`, `t.Foo`).
             let own = constructor_fields(&text);
             for name in used_members(&text) {
@@ -474,7 +511,8 @@ fn settings_table_rows_declare_their_kind() {
             let want = match row.kind {
                 PropKind::Bool => "boolean",
                 PropKind::Float | PropKind::Integer { .. } => "number",
-                PropKind::Vector => "vector",
+                // Declared as the class Vector (Luau's `vector` at run time; see physics.d.luau).
+                PropKind::Vector => "Vector",
                 PropKind::Pose => "CFrame",
                 PropKind::Other => "(no Luau type)",
             };

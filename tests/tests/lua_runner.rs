@@ -161,7 +161,7 @@ fn max_run_ms_stops_a_script_that_never_yields() {
     assert_eq!(r.status.code(), Some(1), "stderr:\n{}", r.stderr);
     // Well before the default limit of 5 s.
     assert!(r.took < Duration::from_secs(4), "took {:?}", r.took);
-    r.assert_stderr_has(&["without yielding", "--max-run-ms 300", "spin.luau:3"]);
+    r.assert_stderr_has(&["without yielding", "--max-run-ms 300", "spin.luau:4"]);
 }
 
 #[test]
@@ -175,7 +175,7 @@ fn seconds_stops_a_script_that_never_yields() {
         "took {:?}",
         r.took
     );
-    r.assert_stderr_has(&["--seconds 1", "still running", "spin.luau:3"]);
+    r.assert_stderr_has(&["--seconds 1", "still running", "spin.luau:4"]);
 }
 
 #[test]
@@ -271,7 +271,7 @@ fn a_stalled_daemon_is_reported_within_seconds() {
     let r = runner.wait(Duration::from_secs(20));
     stop_process(daemon.pid(), libc::SIGCONT);
     assert_eq!(r.status.code(), Some(1), "stderr:\n{}", r.stderr);
-    r.assert_stderr_has(&["PhysicsPlane:Step", "is stalled", "step_forever.luau:9"]);
+    r.assert_stderr_has(&["PhysicsPlane:Step", "is stalled", "step_forever.luau:10"]);
     assert!(r.took < Duration::from_secs(8), "took {:?}", r.took);
 }
 

@@ -25,7 +25,8 @@ pub fn module(lua: &Lua) -> mlua::Result<Table> {
 }
 
 /// `.X/.Y/.Z` (any case) and arithmetic are native to Luau vectors; this adds `Magnitude`,
-/// `Unit`, `:Dot`, `:Cross` and `:Lerp` through the vector type's metatable.
+/// `Unit`, `:Dot`, `:Cross` and `:Lerp` through the vector type's metatable, and the
+/// components for keys that are not constants (`v[name]`).
 fn install_metatable(lua: &Lua) -> mlua::Result<()> {
     let dot = lua.create_function(|_, (a, b): (Value, Value)| {
         let (a, b) = (vec_arg("Vector:Dot", &a)?, vec_arg("Vector:Dot", &b)?);
@@ -48,6 +49,11 @@ fn install_metatable(lua: &Lua) -> mlua::Result<()> {
         let v = vec_arg("Vector", &v)?;
         let len = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
         match &*key.as_bytes() {
+            // `v.X` is native (the VM reads the component, the f32 widened); `v["X"]` (a
+            // key that is not a constant) comes here, and reads the same number.
+            b"X" | b"x" => Ok(Value::Number(f64::from(v[0]))),
+            b"Y" | b"y" => Ok(Value::Number(f64::from(v[1]))),
+            b"Z" | b"z" => Ok(Value::Number(f64::from(v[2]))),
             b"Magnitude" => Ok(crate::values::lua_number(len)),
             b"Unit" if len > 0.0 => Ok(new_vector(v.map(|c| c / len))),
             b"Unit" => Ok(new_vector([0.0; 3])),
