@@ -136,6 +136,7 @@ impl Plane {
 /// Cross-references a decoded state must satisfy (see the 3D plane's `check`).
 fn check(state: &State) -> Result<(), CommandError> {
     let w = &state.world;
+    crate::backend::snapshot_decode::check_broad_phase::<_, 2>(&w.broad_phase).map_err(refused)?;
     if state.bodies.slot_count() > MAX_SLOTS {
         return Err(refused(format!(
             "{} object slots (at most {MAX_SLOTS})",

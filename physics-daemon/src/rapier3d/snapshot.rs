@@ -193,6 +193,7 @@ impl Plane {
 /// instead of failing inside the engine later.
 fn check(state: &State) -> Result<(), CommandError> {
     let w = &state.world;
+    crate::backend::snapshot_decode::check_broad_phase::<_, 3>(&w.broad_phase).map_err(refused)?;
     if state.bodies.slot_count() > MAX_SLOTS {
         return Err(refused(format!(
             "{} object slots (at most {MAX_SLOTS})",
@@ -312,7 +313,7 @@ mod tests {
             seed
         };
         let (mut refused, mut accepted, mut panicked) = (0, 0, Vec::new());
-        for round in 0..300 {
+        for round in 0..1000 {
             let mut edited = body.to_vec();
             match round % 3 {
                 // A few bytes changed.
