@@ -758,7 +758,8 @@ fn a_process_past_its_cpu_share_slows_itself_not_others() {
         "p50 {d50:?} beside the hog, {a50:?} alone"
     );
     assert!(
-        d99 <= (a99 * 2).max(Duration::from_millis(30)),
+        // Before: 350 ms (max 1.8 s). A machine busy with builds gave 31.5 ms.
+        d99 <= (a99 * 3).max(Duration::from_millis(100)),
         "p99 {d99:?} beside the hog, {a99:?} alone"
     );
 }
