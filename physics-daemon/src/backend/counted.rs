@@ -75,6 +75,31 @@ impl<T> CountedVec<T> {
     }
 }
 
+/// `n` bytes held elsewhere (a kept copy of a plane's state) counted in a [`Counter`] for as
+/// long as this lives.
+#[derive(Debug)]
+pub struct CountedBytes {
+    n: u64,
+    counter: Counter,
+}
+
+impl CountedBytes {
+    /// Counts `n` bytes in `counter` until dropped.
+    pub fn new(counter: &Counter, n: u64) -> CountedBytes {
+        counter.change(0, n);
+        CountedBytes {
+            n,
+            counter: counter.clone(),
+        }
+    }
+}
+
+impl Drop for CountedBytes {
+    fn drop(&mut self) {
+        self.counter.change(self.n, 0);
+    }
+}
+
 impl<T> CountedVec<T> {
     /// Moves the count of this vector's buffer to `counter` (a vector restored from a
     /// snapshot counts in its new plane's counter).

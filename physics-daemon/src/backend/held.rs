@@ -19,7 +19,7 @@ macro_rules! held_bodies {
         use super::Plane;
 
         /// One held body and its state before the current step.
-        #[derive(serde::Serialize, serde::Deserialize)]
+        #[derive(Clone, serde::Serialize, serde::Deserialize)]
         pub(super) struct HeldBody {
             handle: RigidBodyHandle,
             ticks: u32,

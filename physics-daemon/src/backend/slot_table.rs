@@ -5,7 +5,7 @@
 
 use shm_layout::{CommandError, ErrorKind, Handle};
 
-#[derive(serde::Serialize, serde::Deserialize)]
+#[derive(Clone, serde::Serialize, serde::Deserialize)]
 struct Entry<T> {
     generation: u32,
     value: Option<T>,
@@ -13,7 +13,7 @@ struct Entry<T> {
 
 /// Values addressed by generation-checked handles. Freed slots are reused (the published
 /// arrays stay dense); `what` names the values in error messages ("object").
-#[derive(serde::Serialize, serde::Deserialize)]
+#[derive(Clone, serde::Serialize, serde::Deserialize)]
 pub struct SlotTable<T> {
     /// Not part of a snapshot: a restored table takes it from the table it replaces.
     #[serde(skip)]

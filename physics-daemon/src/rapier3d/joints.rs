@@ -26,7 +26,7 @@ pub(super) const POSITION_MOTOR_STIFFNESS: f32 = 400.0;
 pub(super) const POSITION_MOTOR_DAMPING: f32 = 40.0;
 
 /// One joint of the plane.
-#[derive(Debug, serde::Serialize, serde::Deserialize)]
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub(super) struct Joint {
     kind: JointKind,
     a: Handle,
@@ -82,7 +82,7 @@ impl EndState {
 }
 
 /// The plane's joints.
-#[derive(serde::Serialize, serde::Deserialize)]
+#[derive(Clone, serde::Serialize, serde::Deserialize)]
 pub(super) struct Joints {
     table: SlotTable<Joint>,
     /// A fixed body without colliders: the "world" end of joints to the world.

@@ -60,7 +60,7 @@ use part::Part;
 pub use objects::MAX_SLOTS;
 
 /// One object: its rapier body and what the API says about it.
-#[derive(Debug, serde::Serialize, serde::Deserialize)]
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 struct Body {
     handle: RigidBodyHandle,
     /// Boxed: the slot table stays small, so the publisher's pass over every slot reads one

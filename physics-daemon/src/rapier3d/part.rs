@@ -23,7 +23,7 @@ pub const MAX_HULL_POINTS: usize = 384;
 
 /// A mesh part: vertices as given, the size they span (Size rescales them), and the points
 /// its hull is built from (all vertices, or their support points when there are many).
-#[derive(Debug, serde::Serialize, serde::Deserialize)]
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub(super) struct Mesh {
     vertices: Vec<Vec3>,
     hull_points: Vec<Vec3>,
@@ -32,7 +32,7 @@ pub(super) struct Mesh {
 
 /// The API-level properties of one object: its shape and size, and the stored settings
 /// (defaults and checks defined once in `shm_layout::settings`; read through `Deref`).
-#[derive(Debug, serde::Serialize, serde::Deserialize)]
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub(super) struct Part {
     pub shape: ShapeKind,
     pub size: Vec3,
@@ -48,7 +48,7 @@ pub(super) struct Part {
 }
 
 /// A built map's collider shape and what it counts against the mesh quota.
-#[derive(serde::Serialize, serde::Deserialize)]
+#[derive(Clone, serde::Serialize, serde::Deserialize)]
 pub(super) struct MapShape {
     pub shape: SharedShape,
     pub cost: u64,

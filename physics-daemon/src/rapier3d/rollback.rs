@@ -1,6 +1,6 @@
 //! Rollback (`RollbackTicks = K`, `PlaneOp::Rewind(n)`): a plane with K > 0 keeps its state
-//! after each of its last K ticks (a snapshot body each, counted in the owner's state
-//! bytes) and can go back n ≤ K ticks; the script then re-applies corrected inputs and
+//! after each of its last K ticks (an in-memory copy each: the engine's sets cloned, shapes
+//! shared; counted in the owner's state bytes by an estimate) and can go back n ≤ K ticks; the script then re-applies corrected inputs and
 //! steps again (rollback netcode). With K = 0 (the default) nothing is kept and a step
 //! pays nothing.
 
@@ -8,13 +8,24 @@ use std::collections::VecDeque;
 
 use shm_layout::{CommandError, Reply};
 
+use super::snapshot::State;
 use super::Plane;
-use crate::backend::counted::CountedVec;
+use crate::backend::counted::CountedBytes;
 
-/// The kept states, oldest first: `(tick, body)`.
-#[derive(Debug, Default)]
+/// What one kept tick is counted as per object slot (a snapshot body takes about 1.5 KB a
+/// body with its contacts; the copy is of the same order).
+const BYTES_PER_SLOT: u64 = 1536;
+
+/// The kept states, oldest first.
+#[derive(Default)]
 pub(super) struct Ring {
-    kept: VecDeque<(u64, CountedVec<u8>)>,
+    kept: VecDeque<(u64, Box<State>, CountedBytes)>,
+}
+
+impl std::fmt::Debug for Ring {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "Ring({} ticks)", self.kept.len())
+    }
 }
 
 impl Ring {
@@ -34,15 +45,12 @@ impl Plane {
             }
             return Ok(());
         }
-        let body = self.state_body()?;
-        // Reuse the oldest buffer once the ring is full.
-        let mut buf = match self.rollback.kept.len() > k {
-            true => self.rollback.kept.pop_front().map(|(_, b)| b),
-            false => None,
-        }
-        .unwrap_or_else(|| CountedVec::new(&self.state_bytes));
-        buf.replace(body);
-        self.rollback.kept.push_back((self.tick, buf));
+        let copy = Box::new(self.clone_state());
+        let counted = CountedBytes::new(
+            &self.state_bytes,
+            BYTES_PER_SLOT * self.bodies.slot_count() as u64,
+        );
+        self.rollback.kept.push_back((self.tick, copy, counted));
         while self.rollback.kept.len() > k + 1 {
             self.rollback.kept.pop_front();
         }
@@ -61,9 +69,14 @@ impl Plane {
             ));
         }
         let target = self.tick.checked_sub(n as u64);
-        let at = target.and_then(|t| self.rollback.kept.iter().position(|(tick, _)| *tick == t));
+        let at = target.and_then(|t| {
+            self.rollback
+                .kept
+                .iter()
+                .position(|(tick, _, _)| *tick == t)
+        });
         let (Some(target), Some(at), true) = (target, at, n <= k) else {
-            let oldest = self.rollback.kept.front().map_or(self.tick, |(t, _)| *t);
+            let oldest = self.rollback.kept.front().map_or(self.tick, |(t, _, _)| *t);
             return Err(CommandError::invalid_field(
                 "Rewind",
                 format!(
@@ -77,10 +90,15 @@ impl Plane {
             return Ok(Reply::Applied { tick: self.tick });
         }
         self.rollback.kept.truncate(at + 1);
-        let (_, body) = self.rollback.kept.pop_back().expect("found above");
-        let result = self.adopt_body(&body);
-        self.rollback.kept.push_back((target, body));
-        result?;
+        let copy = match self.rollback.kept.back() {
+            Some((_, state, _)) => state.duplicate(),
+            None => unreachable!("found above"),
+        };
+        let kept = std::mem::take(&mut self.rollback.kept);
+        self.adopt_copy(copy)?;
+        // The adopted state's own ring is empty: the ticks kept before stay.
+        self.rollback.kept = kept;
+        let _ = target;
         Ok(Reply::Applied { tick: self.tick })
     }
 }

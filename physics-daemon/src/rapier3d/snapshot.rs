@@ -22,34 +22,70 @@ use crate::backend::SlotTable;
 pub const ENGINE: &str = "rapier3d 0.36 / physics-daemon state 1";
 
 /// The plane's state, field list written once: `StateRef` borrows it to encode, `State`
-/// owns it decoded. Both encode the same fields in the same order.
+/// owns it decoded, `clone_state` copies it (Rewind). The engine's world comes first; the
+/// other fields are the plane's own and `Clone`.
 macro_rules! plane_state {
-    ($($field:ident: $ty:ty,)*) => {
+    (world, $($field:ident: $ty:ty,)*) => {
         #[derive(serde::Serialize)]
         struct StateRef<'a> {
+            world: &'a PhysicsWorld,
             $($field: &'a $ty,)*
         }
 
         #[derive(serde::Deserialize)]
-        struct State {
+        pub(super) struct State {
+            world: PhysicsWorld,
             $($field: $ty,)*
         }
 
         impl Plane {
+            /// The state as an owned copy (what Rewind keeps): the engine's sets cloned, its
+            /// per-step workspaces fresh.
+            pub(super) fn clone_state(&self) -> State {
+                State { world: copy_world(&self.world), $($field: self.$field.clone(),)* }
+            }
+
             fn state_ref(&self) -> StateRef<'_> {
-                StateRef { $($field: &self.$field,)* }
+                StateRef { world: &self.world, $($field: &self.$field,)* }
             }
 
             fn take_state(&mut self, state: State) {
+                self.world = state.world;
                 $(self.$field = state.$field;)*
+            }
+        }
+
+        impl State {
+            /// Another copy of a kept state (a second rewind to the same tick).
+            pub(super) fn duplicate(&self) -> State {
+                State { world: copy_world(&self.world), $($field: self.$field.clone(),)* }
             }
         }
     };
 }
 
+/// A copy of `w`: the engine's sets cloned (shapes shared), its per-step workspaces fresh.
+fn copy_world(w: &PhysicsWorld) -> PhysicsWorld {
+    PhysicsWorld {
+        gravity: w.gravity,
+        integration_parameters: w.integration_parameters,
+        physics_pipeline: PhysicsPipeline::new(),
+        collision_pipeline: CollisionPipeline::new(),
+        islands: w.islands.clone(),
+        broad_phase: w.broad_phase.clone(),
+        narrow_phase: w.narrow_phase.clone(),
+        bodies: w.bodies.clone(),
+        colliders: w.colliders.clone(),
+        impulse_joints: w.impulse_joints.clone(),
+        multibody_joints: w.multibody_joints.clone(),
+        soft_bodies: w.soft_bodies.clone(),
+        ccd_solver: CCDSolver::new(),
+    }
+}
+
 plane_state! {
+    world,
     settings: PlaneSettings,
-    world: PhysicsWorld,
     bodies: SlotTable<Body>,
     driven: u32,
     mesh_vertices: u64,
@@ -148,15 +184,8 @@ impl Plane {
         Ok(())
     }
 
-    /// The plane's state in the encoding of a snapshot's body (what Rewind keeps per tick).
-    pub(super) fn state_body(&self) -> Result<Vec<u8>, CommandError> {
-        postcard::to_allocvec(&self.state_ref())
-            .map_err(|e| CommandError::new(ErrorKind::Internal, format!("snapshot failed: {e}")))
-    }
-
-    /// Becomes the state `body` (one this plane made with [`Plane::state_body`]).
-    pub(super) fn adopt_body(&mut self, body: &[u8]) -> Result<(), CommandError> {
-        let mut state = crate::backend::snapshot_decode::decode(body, refused, check)?;
+    /// Becomes `state` (a copy this plane made with [`Plane::clone_state`]).
+    pub(super) fn adopt_copy(&mut self, mut state: State) -> Result<(), CommandError> {
         state.bodies.adopt_limits(&self.bodies)?;
         state.joints.adopt_limits(&self.joints)?;
         state.world.physics_pipeline = std::mem::take(&mut self.world.physics_pipeline);

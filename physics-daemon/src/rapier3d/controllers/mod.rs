@@ -58,7 +58,7 @@ struct Ground {
 }
 
 /// One controller's own state (its body lives in the plane's slot table).
-#[derive(Debug, serde::Serialize, serde::Deserialize)]
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub(super) struct Controller {
     pub settings: ControllerSettings,
     velocity: Vector,
