@@ -403,7 +403,10 @@ fn nodes_that_never_say_hello_are_evicted() {
     // got in above, or of the big hoarder's last nodes, can still be listed while iceoryx2
     // removes it (seen once as 10), so at least 9.
     let at_start = held();
-    assert!(at_start >= 9, "held {at_start} ports, expected the victim's and the hoarder's 8");
+    assert!(
+        at_start >= 9,
+        "held {at_start} ports, expected the victim's and the hoarder's 8"
+    );
     time_until(Duration::from_secs(10), || (held() == 1).then_some(()))
         .expect("the nodes without Hello were evicted");
     // Held when ready (above), gone after the timeout (3 s from when the daemon first saw

@@ -31,6 +31,7 @@ mod origin;
 pub mod quota;
 mod request_bytes;
 pub mod resources;
+pub mod trim;
 mod worker;
 
 use std::collections::{BTreeMap, HashMap, VecDeque};
@@ -49,7 +50,7 @@ use shm_layout::{names, Command, CommandResult, PlaneId};
 
 use crate::publish::MAX_NODES;
 use crate::DaemonError;
-use clients::{Clients, MAX_CLIENTS};
+use clients::Clients;
 pub use limits::Limits;
 use worker::{Event, Inline, Job, PlaneCell, SharedUsage, Waker};
 
@@ -177,7 +178,7 @@ pub fn run_with(domain: &str, shutdown: &AtomicBool, options: Options) -> Result
     let watch = Arc::new(resources::Watch::default());
     let limits = options.limits;
     std::thread::scope(|s| {
-        s.spawn(|| heartbeat::run(&config, &beats));
+        s.spawn(|| heartbeat::run(&config, &beats, limits.max_clients));
         s.spawn(|| resources::run(&config, &limits, &watch));
         let served = serve(domain, &config, shutdown, options, &beats, watch.clone());
         beats.stop();
@@ -239,8 +240,8 @@ fn serve(
         .service_builder(&names::control_wake())
         .event()
         .max_listeners(2)
-        .max_notifiers(MAX_CLIENTS * 2)
-        .max_nodes(MAX_NODES)
+        .max_notifiers(options.limits.max_clients * 2)
+        .max_nodes(control_nodes(&options.limits))
         .open_or_create()
         .map_err(|e| DaemonError::Ipc(format!("cannot create the request event: {e:?}")))?
         .listener_builder()
@@ -251,10 +252,10 @@ fn serve(
         .request_response::<[u8], [u8]>()
         .request_user_header::<u128>()
         .max_servers(1)
-        // Room beyond MAX_CLIENTS: ports that never say Hello (or a process at its
+        // Room beyond --max-clients: ports that never say Hello (or a process at its
         // per-process limit) leave ports for other processes.
-        .max_clients(MAX_CLIENTS * 2)
-        .max_nodes(MAX_NODES)
+        .max_clients(options.limits.max_clients * 2)
+        .max_nodes(control_nodes(&options.limits))
         .max_active_requests_per_client(4)
         .open_or_create()
         .map_err(|e| DaemonError::Ipc(format!("cannot create the control service: {e:?}")))?;
@@ -287,7 +288,7 @@ fn serve(
         config: config.clone(),
         node,
         server,
-        clients: Clients::default(),
+        clients: Clients::new(options.limits.max_clients),
         planes: BTreeMap::new(),
         next_plane_id: 1,
         options,
@@ -310,6 +311,7 @@ fn serve(
     tracing::info!(domain, pid = std::process::id(), "physics daemon ready");
 
     let mut next_housekeeping = Instant::now() + HOUSEKEEPING;
+    let mut trimmer = trim::Trimmer::default();
     while !shutdown.load(Ordering::Relaxed) {
         let housekeeping = !daemon.clients.is_empty() || daemon.options.starter_pid.is_some();
         let waited = if housekeeping {
@@ -335,6 +337,8 @@ fn serve(
         if daemon.clients.is_empty() {
             if Instant::now() >= next_housekeeping {
                 daemon.update_watch();
+                // What the last clients' planes held goes back to the system too.
+                trimmer.maybe_trim();
                 if daemon.starter_gone() {
                     tracing::info!(
                         starter = daemon.options.starter_pid,
@@ -349,12 +353,19 @@ fn serve(
             daemon.update_watch();
             daemon.workers.retain(|w| !w.is_finished());
             daemon.owners.prune();
+            trimmer.maybe_trim();
             next_housekeeping = Instant::now() + HOUSEKEEPING;
         }
     }
     tracing::info!(domain = daemon.domain, "shutting down");
     daemon.stop_workers();
     Ok(())
+}
+
+/// Nodes that may open the control services: every client's, one spare each for nodes
+/// that have not said Hello yet, and never fewer than a plane's services allow.
+fn control_nodes(limits: &Limits) -> usize {
+    (limits.max_clients * 2).max(MAX_NODES)
 }
 
 /// Removes what crashed processes of this domain left behind (a crashed daemon's server
