@@ -791,7 +791,7 @@ fn client_holder(domain: &str, n: usize) -> (std::process::Child, usize, Option<
 /// a table sized down by the flag is enforced, naming it.
 #[test]
 fn four_processes_of_sixteen_clients_leave_room_for_another() {
-    let daemon = TestDaemon::start("hostile-client-table");
+    let daemon = TestDaemon::start("client-table");
     let mut holders: Vec<_> = (0..4).map(|_| client_holder(&daemon.domain, 17)).collect();
     for (_, held, refused) in &holders {
         assert_eq!(
@@ -813,7 +813,7 @@ fn four_processes_of_sixteen_clients_leave_room_for_another() {
     // The table itself: 8 clients at most, 4 a process: two processes fill it, a third
     // process is refused with the flag named, and gets in once one of them is gone.
     let small = TestDaemon::start_with(
-        "client-table-small",
+        "table-small",
         &["--max-clients", "8", "--max-clients-per-process", "4"],
         &[],
     );
