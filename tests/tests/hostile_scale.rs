@@ -782,7 +782,9 @@ fn client_holder(domain: &str, n: usize) -> (std::process::Child, usize, Option<
             return (child, k.parse().unwrap(), refused);
         }
     }
-    panic!("test-client clients {n} ended without a count (refused: {refused:?})");
+    let _ = child.kill();
+    let status = child.wait();
+    panic!("test-client clients {n} ended without a count ({status:?}, refused: {refused:?})");
 }
 
 /// With a 64-client table and 16 clients a process, four processes filled the daemon and

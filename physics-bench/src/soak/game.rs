@@ -313,7 +313,7 @@ fn churn(soak: &mut SoakPlane, counts: &mut Counts) -> Result<(), Error> {
 fn joints(soak: &mut SoakPlane, counts: &mut Counts) -> Result<(), Error> {
     soak.rounds += 1;
     if let Some(h) = soak.hinge.take() {
-        if soak.rounds % 2 == 0 {
+        if soak.rounds.is_multiple_of(2) {
             h.destroy()?;
             counts.joints_destroyed += 1;
         }
@@ -382,7 +382,7 @@ fn queries(soak: &mut SoakPlane, round: u64, counts: &mut Counts) -> Result<(), 
         .collect();
     soak.plane.raycast_many(&rays, None)?;
     counts.rays += RAYS as u64;
-    if round % OVERLAP_EVERY == 0 {
+    if round.is_multiple_of(OVERLAP_EVERY) {
         soak.plane.bounds_in_radius([cx, 3.0, cz], 4.0, None)?;
         counts.overlaps += 1;
         soak.plane
@@ -507,7 +507,7 @@ fn visit(domain: &str, n: u64) -> Result<(), Error> {
         c.set_velocity([0.0, 5.0, 0.0])?;
     }
     client.flush()?;
-    if n % 2 == 0 {
+    if n.is_multiple_of(2) {
         plane.destroy()?;
     }
     Ok(())
