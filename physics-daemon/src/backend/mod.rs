@@ -8,12 +8,14 @@
 pub mod counted;
 mod dirty;
 pub(crate) mod held;
+pub mod marks;
 pub mod pools;
 mod slot_table;
 
 use std::mem::MaybeUninit;
 
 pub use dirty::Dirty;
+pub use marks::Marks;
 pub use slot_table::SlotTable;
 
 use shm_layout::{
