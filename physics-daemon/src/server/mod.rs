@@ -176,13 +176,24 @@ pub fn run_with(domain: &str, shutdown: &AtomicBool, options: Options) -> Result
     remove_dead_nodes(&config);
     let beats = heartbeat::Control::default();
     let watch = Arc::new(resources::Watch::default());
+    let trims = trim::Trims::default();
     let limits = options.limits;
     std::thread::scope(|s| {
         s.spawn(|| heartbeat::run(&config, &beats, limits.max_clients));
         s.spawn(|| resources::run(&config, &limits, &watch));
-        let served = serve(domain, &config, shutdown, options, &beats, watch.clone());
+        s.spawn(|| trim::run(&trims));
+        let served = serve(
+            domain,
+            &config,
+            shutdown,
+            options,
+            &beats,
+            watch.clone(),
+            &trims,
+        );
         beats.stop();
         watch.stop();
+        trims.stop();
         served
     })?;
     release_domain(&config);
@@ -229,6 +240,7 @@ fn serve(
     options: Options,
     beats: &heartbeat::Control,
     watch: Arc<resources::Watch>,
+    trims: &trim::Trims,
 ) -> Result<(), DaemonError> {
     let node = NodeBuilder::new()
         .name(&NodeName::new(names::DAEMON_NODE_NAME).expect("valid node name"))
@@ -318,7 +330,7 @@ fn serve(
     tracing::info!(domain, pid = std::process::id(), "physics daemon ready");
 
     let mut next_housekeeping = Instant::now() + HOUSEKEEPING;
-    let mut trimmer = trim::Trimmer::default();
+    let mut trim_schedule = trim::Schedule::default();
     while !shutdown.load(Ordering::Relaxed) {
         let housekeeping = !daemon.clients.is_empty() || daemon.options.starter_pid.is_some();
         let waited = if housekeeping {
@@ -344,8 +356,13 @@ fn serve(
         if daemon.clients.is_empty() {
             if Instant::now() >= next_housekeeping {
                 daemon.update_watch();
-                // What the last clients' planes held goes back to the system too.
-                trimmer.maybe_trim();
+                // What the last clients' planes held goes back to the system too, once
+                // their workers have ended (an idle daemon asks for nothing else).
+                let workers = daemon.workers.len();
+                daemon.workers.retain(|w| !w.is_finished());
+                if daemon.workers.len() < workers {
+                    trims.request();
+                }
                 if daemon.starter_gone() {
                     tracing::info!(
                         starter = daemon.options.starter_pid,
@@ -358,9 +375,14 @@ fn serve(
         } else if Instant::now() >= next_housekeeping {
             daemon.release_gone_clients();
             daemon.update_watch();
+            let workers = daemon.workers.len();
             daemon.workers.retain(|w| !w.is_finished());
             daemon.owners.prune();
-            trimmer.maybe_trim();
+            // A plane gone (megabytes: its world and its ports' bookkeeping) is given back
+            // now, not up to a period later.
+            if trim_schedule.due(daemon.workers.len() < workers) {
+                trims.request();
+            }
             next_housekeeping = Instant::now() + HOUSEKEEPING;
         }
     }
