@@ -81,8 +81,9 @@ enum Bench {
     /// A generated ~1M-triangle map: load time, daemon memory, and the step cost of 1,000
     /// boxes resting on it.
     Maps(maps::MapsArgs),
-    /// 4 planes × 1,000 bodies at 60 Hz with a client writing every frame for N minutes:
-    /// daemon RSS and shared-memory growth against a bound.
+    /// A game's load for N minutes (4 planes × 1,000 bodies at 60 Hz; writes, churn,
+    /// queries, controllers, joints, Touched, planes and clients coming and going): daemon
+    /// RSS and shared memory sampled every 6 s, flat within 1 MiB after the warm-up.
     Soak(soak::SoakArgs),
     /// The GPU path (DeferGpu) against the CPU: time per tick of 1k to 1M bodies falling
     /// into a container (spatial hash, every pair, rapier), scaling ratios, the adapter.

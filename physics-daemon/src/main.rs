@@ -30,6 +30,8 @@ struct Args {
 }
 
 fn main() -> ExitCode {
+    // Before any thread exists: see `trim` for why one arena.
+    physics_daemon::server::trim::limit_arenas();
     let args = Args::parse();
     tracing_subscriber::fmt()
         .with_env_filter(

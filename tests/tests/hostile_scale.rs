@@ -763,3 +763,84 @@ fn a_process_past_its_cpu_share_slows_itself_not_others() {
         "p99 {d99:?} beside the hog, {a99:?} alone"
     );
 }
+
+/// Holds `n` clients in a process of its own (`test-client clients`); returns the process
+/// and what it printed: how many it holds and the first refusal, if any.
+fn client_holder(domain: &str, n: usize) -> (std::process::Child, usize, Option<String>) {
+    use std::io::BufRead;
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_test-client"))
+        .args(["clients", domain, &n.to_string()])
+        .stdout(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut refused = None;
+    let mut lines = std::io::BufReader::new(child.stdout.take().unwrap()).lines();
+    for line in lines.by_ref() {
+        let line = line.unwrap();
+        if let Some(e) = line.strip_prefix("refused=") {
+            refused = Some(e.to_string());
+        }
+        if let Some(k) = line.strip_prefix("connected=") {
+            return (child, k.parse().unwrap(), refused);
+        }
+    }
+    let _ = child.kill();
+    let status = child.wait();
+    panic!("test-client clients {n} ended without a count ({status:?}, refused: {refused:?})");
+}
+
+/// With a 64-client table and 16 clients a process, four processes filled the daemon and
+/// every other process was refused. The table now holds `--max-clients` (256) and a
+/// process at most `--max-clients-per-process` (16): four full processes leave room, and
+/// a table sized down by the flag is enforced, naming it.
+#[test]
+fn four_processes_of_sixteen_clients_leave_room_for_another() {
+    let daemon = TestDaemon::start("client-table");
+    let mut holders: Vec<_> = (0..4).map(|_| client_holder(&daemon.domain, 17)).collect();
+    for (_, held, refused) in &holders {
+        assert_eq!(
+            *held, 16,
+            "a process holds 16 clients (refused: {refused:?})"
+        );
+        let e = refused.as_deref().unwrap_or_default();
+        assert!(e.contains("--max-clients-per-process"), "{e}");
+    }
+    // 64 clients are connected; another process (this one) still gets in and is served.
+    let late = daemon.client();
+    let plane = late.create_plane(&PlaneOptions::manual()).unwrap();
+    plane.step(1.0 / 60.0).unwrap();
+    for (child, _, _) in &mut holders {
+        let _ = child.kill();
+        let _ = child.wait();
+    }
+
+    // The table itself: 8 clients at most, 4 a process: two processes fill it, a third
+    // process is refused with the flag named, and gets in once one of them is gone.
+    let small = TestDaemon::start_with(
+        "table-small",
+        &["--max-clients", "8", "--max-clients-per-process", "4"],
+        &[],
+    );
+    let mut full: Vec<_> = (0..2).map(|_| client_holder(&small.domain, 4)).collect();
+    assert!(full.iter().all(|(_, held, _)| *held == 4));
+    match Client::connect(&small.domain) {
+        Err(client_sdk::Error::Command(e)) => {
+            assert_eq!(e.kind, ErrorKind::Quota);
+            assert!(e.message.contains("(daemon flag --max-clients)"), "{e}");
+            assert!(e.message.contains("limited to 8"), "{e}");
+        }
+        other => panic!("a ninth client connected to an 8-client table: {other:?}"),
+    }
+    let (mut gone, _, _) = full.pop().unwrap();
+    let _ = gone.kill();
+    let _ = gone.wait();
+    // The daemon notices the dead process within its housekeeping period.
+    let back = integration_tests::eventually(Duration::from_secs(5), || {
+        Client::connect(&small.domain).ok()
+    });
+    assert!(back.is_some(), "room came back once a process died");
+    for (child, _, _) in &mut full {
+        let _ = child.kill();
+        let _ = child.wait();
+    }
+}

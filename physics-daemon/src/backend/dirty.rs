@@ -9,12 +9,26 @@ pub struct Dirty {
     all: bool,
     /// `slots[..stepped]` were already seen by a step.
     stepped: usize,
+    /// Unseen marks at which `mark` next folds repeats (at least `FOLD_MIN`).
+    fold_at: usize,
 }
 
 impl Dirty {
-    /// Marks one slot as changed.
+    /// Marks one slot as changed. The slots marked since the last step fold their repeats
+    /// once they have doubled since the last fold: a plane that is written but neither
+    /// stepped nor published (manual, disabled) keeps at most twice its distinct marks
+    /// plus [`super::marks::FOLD_MIN`], not one entry a write.
     pub fn mark(&mut self, slot: u32) {
         self.slots.push(slot);
+        let seen = self.stepped.min(self.slots.len());
+        let unseen = self.slots.len() - seen;
+        if unseen >= self.fold_at.max(super::marks::FOLD_MIN) {
+            let mut tail = self.slots.split_off(seen);
+            tail.sort_unstable();
+            tail.dedup();
+            self.fold_at = 2 * tail.len();
+            self.slots.append(&mut tail);
+        }
     }
 
     /// Marks every slot as changed (a plane-wide change).
@@ -36,6 +50,7 @@ impl Dirty {
             self.slots.dedup();
         }
         self.stepped = self.slots.len();
+        self.fold_at = 0;
     }
 
     /// Hands the marked slots to `into` (appended) and forgets them. Returns true when the
@@ -43,6 +58,7 @@ impl Dirty {
     pub fn drain(&mut self, into: &mut Vec<u32>) -> bool {
         into.append(&mut self.slots);
         self.stepped = 0;
+        self.fold_at = 0;
         std::mem::take(&mut self.all)
     }
 }

@@ -8,6 +8,7 @@
 pub mod counted;
 mod dirty;
 pub(crate) mod held;
+pub mod marks;
 pub mod pools;
 mod slot_table;
 pub(crate) mod snapshot_decode;
@@ -15,6 +16,7 @@ pub(crate) mod snapshot_decode;
 use std::mem::MaybeUninit;
 
 pub use dirty::Dirty;
+pub use marks::Marks;
 pub use slot_table::SlotTable;
 
 use shm_layout::{

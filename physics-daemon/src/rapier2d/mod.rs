@@ -70,7 +70,7 @@ pub struct Plane {
     driven: u32,
     dirty: Dirty,
     /// An op moved, added or reshaped a body since the last step (queries refresh first).
-    query_stale: Vec<RigidBodyHandle>,
+    query_stale: crate::backend::Marks<RigidBodyHandle>,
     /// Bodies a step must leave where it found them (see `held`).
     held: Vec<held::HeldBody>,
     tick: u64,
@@ -102,7 +102,7 @@ impl Plane {
             controlled: Vec::new(),
             driven: 0,
             dirty: Dirty::default(),
-            query_stale: Vec::new(),
+            query_stale: Default::default(),
             held: Vec::new(),
             tick: 0,
             sim_time: 0.0,

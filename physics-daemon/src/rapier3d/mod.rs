@@ -40,6 +40,8 @@ mod queries;
 mod rollback;
 mod snapshot;
 mod solver;
+#[cfg(test)]
+mod unstepped;
 
 use std::sync::mpsc;
 
@@ -116,7 +118,7 @@ pub struct Plane {
     groups: CollisionGroups,
     /// Bodies an op added, moved or reshaped since the last step: a query first brings their
     /// colliders' poses and broad-phase boxes up to date, so it sees the change.
-    query_stale: Vec<RigidBodyHandle>,
+    query_stale: crate::backend::Marks<RigidBodyHandle>,
     /// Joints (see `joints`).
     joints: joints::Joints,
     /// Map pieces uploaded since the last build (see `maps`).
@@ -169,7 +171,7 @@ impl Plane {
             groups: CollisionGroups::default(),
             controllers: Default::default(),
             pending_events: Vec::new(),
-            query_stale: Vec::new(),
+            query_stale: Default::default(),
             joints: joints::Joints::default(),
             map_pending: maps::PendingMap::default(),
             #[cfg(feature = "gpu")]

@@ -9,8 +9,10 @@ use iceoryx2::port::notifier::Notifier;
 use iceoryx2::prelude::*;
 use shm_layout::names;
 
-/// Clients one daemon serves at once.
-pub const MAX_CLIENTS: usize = 64;
+/// Clients one daemon serves at once by default (`--max-clients`): with the default
+/// `--max-clients-per-process` of 16, sixteen processes at their cap before the table is
+/// full, so a few processes cannot lock everyone else out.
+pub const MAX_CLIENTS: usize = 256;
 
 /// One connected client.
 pub struct Client {
@@ -22,12 +24,27 @@ pub struct Client {
 }
 
 /// The connected clients, by iceoryx2 node id.
-#[derive(Default)]
 pub struct Clients {
     connected: HashMap<u128, Client>,
+    /// Most clients served at once (`--max-clients`).
+    max: usize,
+}
+
+impl Default for Clients {
+    fn default() -> Self {
+        Clients::new(MAX_CLIENTS)
+    }
 }
 
 impl Clients {
+    /// No client yet; at most `max` at once.
+    pub fn new(max: usize) -> Clients {
+        Clients {
+            connected: HashMap::new(),
+            max,
+        }
+    }
+
     /// Whether the client `id` has completed its handshake.
     pub fn is_connected(&self, id: u128) -> bool {
         self.connected.contains_key(&id)
@@ -56,10 +73,12 @@ impl Clients {
         if self.is_connected(id) {
             return Ok(());
         }
-        if self.connected.len() >= MAX_CLIENTS {
-            return Err(shm_layout::CommandError::new(
-                shm_layout::ErrorKind::Quota,
-                format!("the daemon already serves {MAX_CLIENTS} clients"),
+        if self.connected.len() >= self.max {
+            return Err(super::limits::exceeded(
+                "clients of the daemon",
+                self.max,
+                "max-clients",
+                format!("{} clients", self.connected.len() + 1),
             ));
         }
         let same_process = self.connected.values().filter(|c| c.pid == pid).count();

@@ -62,14 +62,15 @@ impl Control {
 }
 
 /// Publishes beats until `control` says stop. Errors are logged: without a heartbeat the
-/// daemon still serves (clients then only have their request timeout).
-pub fn run(config: &Config, control: &Control) {
-    if let Err(e) = beat(config, control) {
+/// daemon still serves (clients then only have their request timeout). The service has
+/// reader places for twice `max_clients` (`--max-clients`).
+pub fn run(config: &Config, control: &Control, max_clients: usize) {
+    if let Err(e) = beat(config, control, max_clients) {
         tracing::warn!("heartbeat stopped: {e}");
     }
 }
 
-fn beat(config: &Config, control: &Control) -> Result<(), DaemonError> {
+fn beat(config: &Config, control: &Control, max_clients: usize) -> Result<(), DaemonError> {
     let ipc = |what: &str, e: &dyn core::fmt::Debug| {
         DaemonError::Ipc(format!("heartbeat: cannot create the {what}: {e:?}"))
     };
@@ -85,8 +86,8 @@ fn beat(config: &Config, control: &Control) -> Result<(), DaemonError> {
         .history_size(1)
         .subscriber_max_buffer_size(1)
         .max_publishers(1)
-        .max_subscribers(super::clients::MAX_CLIENTS * 2)
-        .max_nodes(MAX_NODES)
+        .max_subscribers(max_clients * 2)
+        .max_nodes((max_clients * 2).max(MAX_NODES))
         .open_or_create()
         .map_err(|e| ipc("service", &e))?
         .publisher_builder()

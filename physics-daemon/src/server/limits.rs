@@ -68,6 +68,13 @@ pub struct Limits {
         default_value_t = Limits::DEFAULT.ports_per_process
     )]
     pub ports_per_process: usize,
+    /// Clients (connections) the daemon serves at once, all processes together. The
+    /// request, wake-up and heartbeat services are sized for it (twice as many ports, for
+    /// ports that never say Hello), so it cannot be raised while the daemon runs.
+    #[arg(long = "max-clients", default_value_t = Limits::DEFAULT.max_clients,
+          value_parser = clap::builder::TypedValueParser::map(
+              clap::value_parser!(u32).range(1..=4096), |v| v as usize))]
+    pub max_clients: usize,
 }
 
 impl Limits {
@@ -87,6 +94,7 @@ impl Limits {
         hello_timeout_ms: 5_000,
         nodes_per_process: 32,
         ports_per_process: 16,
+        max_clients: super::clients::MAX_CLIENTS,
     };
 }
 

@@ -31,6 +31,7 @@ mod origin;
 pub mod quota;
 mod request_bytes;
 pub mod resources;
+pub mod trim;
 mod worker;
 
 use std::collections::{BTreeMap, HashMap, VecDeque};
@@ -49,7 +50,7 @@ use shm_layout::{names, Command, CommandResult, PlaneId};
 
 use crate::publish::MAX_NODES;
 use crate::DaemonError;
-use clients::{Clients, MAX_CLIENTS};
+use clients::Clients;
 pub use limits::Limits;
 use worker::{Event, Inline, Job, PlaneCell, SharedUsage, Waker};
 
@@ -175,13 +176,24 @@ pub fn run_with(domain: &str, shutdown: &AtomicBool, options: Options) -> Result
     remove_dead_nodes(&config);
     let beats = heartbeat::Control::default();
     let watch = Arc::new(resources::Watch::default());
+    let trims = trim::Trims::default();
     let limits = options.limits;
     std::thread::scope(|s| {
-        s.spawn(|| heartbeat::run(&config, &beats));
+        s.spawn(|| heartbeat::run(&config, &beats, limits.max_clients));
         s.spawn(|| resources::run(&config, &limits, &watch));
-        let served = serve(domain, &config, shutdown, options, &beats, watch.clone());
+        s.spawn(|| trim::run(&trims));
+        let served = serve(
+            domain,
+            &config,
+            shutdown,
+            options,
+            &beats,
+            watch.clone(),
+            &trims,
+        );
         beats.stop();
         watch.stop();
+        trims.stop();
         served
     })?;
     release_domain(&config);
@@ -228,6 +240,7 @@ fn serve(
     options: Options,
     beats: &heartbeat::Control,
     watch: Arc<resources::Watch>,
+    trims: &trim::Trims,
 ) -> Result<(), DaemonError> {
     let node = NodeBuilder::new()
         .name(&NodeName::new(names::DAEMON_NODE_NAME).expect("valid node name"))
@@ -239,8 +252,8 @@ fn serve(
         .service_builder(&names::control_wake())
         .event()
         .max_listeners(2)
-        .max_notifiers(MAX_CLIENTS * 2)
-        .max_nodes(MAX_NODES)
+        .max_notifiers(options.limits.max_clients * 2)
+        .max_nodes(control_nodes(&options.limits))
         .open_or_create()
         .map_err(|e| DaemonError::Ipc(format!("cannot create the request event: {e:?}")))?
         .listener_builder()
@@ -251,15 +264,22 @@ fn serve(
         .request_response::<[u8], [u8]>()
         .request_user_header::<u128>()
         .max_servers(1)
-        // Room beyond MAX_CLIENTS: ports that never say Hello (or a process at its
+        // Room beyond --max-clients: ports that never say Hello (or a process at its
         // per-process limit) leave ports for other processes.
-        .max_clients(MAX_CLIENTS * 2)
-        .max_nodes(MAX_NODES)
+        .max_clients(options.limits.max_clients * 2)
+        .max_nodes(control_nodes(&options.limits))
         .max_active_requests_per_client(4)
+        // One reply per request, copied out by the client at once: one place each. The
+        // server preallocates a reference count per possible reply for each of its 255
+        // growth segments (clients × 8 × these three), so the defaults (2 each) cost twice
+        // the memory for places no reply uses: 50 MB instead of 25 at 256 clients.
+        .max_response_buffer_size(1)
+        .max_borrowed_responses_per_pending_response(1)
         .open_or_create()
         .map_err(|e| DaemonError::Ipc(format!("cannot create the control service: {e:?}")))?;
     let server = control
         .server_builder()
+        .max_loaned_responses_per_request(1)
         .initial_max_slice_len(4096)
         .allocation_strategy(AllocationStrategy::PowerOfTwo)
         .create()
@@ -287,7 +307,7 @@ fn serve(
         config: config.clone(),
         node,
         server,
-        clients: Clients::default(),
+        clients: Clients::new(options.limits.max_clients),
         planes: BTreeMap::new(),
         next_plane_id: 1,
         options,
@@ -310,6 +330,7 @@ fn serve(
     tracing::info!(domain, pid = std::process::id(), "physics daemon ready");
 
     let mut next_housekeeping = Instant::now() + HOUSEKEEPING;
+    let mut trim_schedule = trim::Schedule::default();
     while !shutdown.load(Ordering::Relaxed) {
         let housekeeping = !daemon.clients.is_empty() || daemon.options.starter_pid.is_some();
         let waited = if housekeeping {
@@ -335,6 +356,13 @@ fn serve(
         if daemon.clients.is_empty() {
             if Instant::now() >= next_housekeeping {
                 daemon.update_watch();
+                // What the last clients' planes held goes back to the system too, once
+                // their workers have ended (an idle daemon asks for nothing else).
+                let workers = daemon.workers.len();
+                daemon.workers.retain(|w| !w.is_finished());
+                if daemon.workers.len() < workers {
+                    trims.request();
+                }
                 if daemon.starter_gone() {
                     tracing::info!(
                         starter = daemon.options.starter_pid,
@@ -347,14 +375,26 @@ fn serve(
         } else if Instant::now() >= next_housekeeping {
             daemon.release_gone_clients();
             daemon.update_watch();
+            let workers = daemon.workers.len();
             daemon.workers.retain(|w| !w.is_finished());
             daemon.owners.prune();
+            // A plane gone (megabytes: its world and its ports' bookkeeping) is given back
+            // now, not up to a period later.
+            if trim_schedule.due(daemon.workers.len() < workers) {
+                trims.request();
+            }
             next_housekeeping = Instant::now() + HOUSEKEEPING;
         }
     }
     tracing::info!(domain = daemon.domain, "shutting down");
     daemon.stop_workers();
     Ok(())
+}
+
+/// Nodes that may open the control services: every client's, one spare each for nodes
+/// that have not said Hello yet, and never fewer than a plane's services allow.
+fn control_nodes(limits: &Limits) -> usize {
+    (limits.max_clients * 2).max(MAX_NODES)
 }
 
 /// Removes what crashed processes of this domain left behind (a crashed daemon's server

@@ -9,6 +9,9 @@
 //!                                          add N cubes to a private plane, print "added=K"
 //! test-client burn DOMAIN N RATE           create N planes ticking at RATE Hz, each with 50
 //!                                          balls on a floor, print "ready", sleep
+//! test-client clients DOMAIN N             hold up to N clients (connections) at once,
+//!                                          print "refused=ERROR" for the first refused
+//!                                          one, then "connected=K", sleep
 
 use std::io::Write;
 
@@ -125,6 +128,22 @@ fn main() {
             std::io::stdout().flush().unwrap();
             std::thread::sleep(std::time::Duration::from_secs(3600));
             drop(planes);
+        }
+        "clients" => {
+            let n = args[3].parse::<usize>().expect("number");
+            let mut held = vec![client];
+            while held.len() < n {
+                match Client::connect(&args[2]) {
+                    Ok(c) => held.push(c),
+                    Err(e) => {
+                        println!("refused={e}");
+                        break;
+                    }
+                }
+            }
+            println!("connected={}", held.len());
+            std::io::stdout().flush().unwrap();
+            std::thread::sleep(std::time::Duration::from_secs(3600));
         }
         other => panic!("unknown mode {other}"),
     }
