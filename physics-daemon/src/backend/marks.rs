@@ -12,7 +12,7 @@ use std::hash::Hash;
 pub const FOLD_MIN: usize = 1024;
 
 /// Marked items in marking order (repeats possible until the next fold).
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub struct Marks<T> {
     items: Vec<T>,
     /// Length at which the next push folds repeats.

@@ -43,7 +43,7 @@ plane_state! {
     bodies: SlotTable<Body>,
     controlled: Vec<u32>,
     driven: u32,
-    query_stale: Vec<RigidBodyHandle>,
+    query_stale: crate::backend::Marks<RigidBodyHandle>,
     held: Vec<held::HeldBody>,
     tick: u64,
     sim_time: f64,

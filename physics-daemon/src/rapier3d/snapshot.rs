@@ -101,7 +101,7 @@ plane_state! {
     removed: Vec<(ColliderHandle, shm_layout::Handle)>,
     controllers: Controllers,
     groups: CollisionGroups,
-    query_stale: Vec<RigidBodyHandle>,
+    query_stale: crate::backend::Marks<RigidBodyHandle>,
     joints: joints::Joints,
     state_hash: u64,
 }
