@@ -164,10 +164,17 @@ fn keep_ratio(client: &Client, n: usize, repeats: usize) -> BenchResult<f64> {
 }
 
 pub fn run(args: &SnapshotArgs) -> BenchResult<()> {
-    // Snapshots of large planes pass the default 8 MiB reply limit.
+    // Snapshots of large planes pass the default 8 MiB reply limit, and 8 kept ticks of
+    // 10,000 bodies the default 64 MiB of state bytes.
     let daemon = DaemonProcess::start_with(
         "snapshot",
-        &["--max-reply-bytes".to_string(), (256u64 << 20).to_string()],
+        &[
+            "--max-reply-bytes".to_string(),
+            (256u64 << 20).to_string(),
+            // Ticks kept for Rewind count as state bytes (1.5 KB a body each).
+            "--max-state-bytes-per-client".to_string(),
+            (1u64 << 30).to_string(),
+        ],
         None,
     )?;
     let client = daemon.connect()?;

@@ -60,7 +60,8 @@ pub struct Usage {
     pub objects: u64,
     /// Mesh vertices of all its parts.
     pub mesh_vertices: u64,
-    /// Bytes of state clients grew beyond objects and meshes (controller paths).
+    /// Bytes of state clients grew beyond objects and meshes (controller paths, ticks kept
+    /// for Rewind).
     pub state_bytes: u64,
 }
 

@@ -178,7 +178,7 @@ impl OwnerUsage {
             self.objects.fetch_sub(objects, Ordering::SeqCst);
             self.mesh_vertices.fetch_sub(vertices, Ordering::SeqCst);
             return Err(exceeded(
-                "state bytes per client (controller paths)",
+                "state bytes per client (controller paths, ticks kept for Rewind)",
                 limits.state_bytes_per_client,
                 "max-state-bytes-per-client",
                 sum,
