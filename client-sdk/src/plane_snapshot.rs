@@ -36,17 +36,11 @@ impl std::fmt::Debug for PlaneSnapshot {
     }
 }
 
-fn invalid(e: shm_layout::CommandError) -> Error {
-    Error::Command(e)
-}
-
 impl PlaneSnapshot {
     /// A snapshot from bytes (as [`PlaneSnapshot::bytes`] gave them): the framing, format
     /// and checksum are checked here.
     pub fn from_bytes(bytes: Vec<u8>) -> Result<PlaneSnapshot, Error> {
-        let (header, _) = snapshot::header(&bytes).map_err(invalid)?;
-        let engine = header.engine.clone();
-        snapshot::decode(&bytes, header.kind, &engine).map_err(invalid)?;
+        let (header, _) = snapshot::verify(&bytes)?;
         Ok(PlaneSnapshot {
             header,
             bytes: bytes.into(),

@@ -130,26 +130,10 @@ pub fn header(bytes: &[u8]) -> Result<(SnapshotHeader, usize), CommandError> {
     Ok((header, 12 + len))
 }
 
-/// The header and the body of a snapshot whose body the checksum confirms, written by
-/// `engine` for a plane of `kind`.
-pub fn decode<'a>(
-    bytes: &'a [u8],
-    kind: PlaneKind,
-    engine: &str,
-) -> Result<(SnapshotHeader, &'a [u8]), CommandError> {
+/// The header and the body of a snapshot whose body the checksum confirms (any kind, any
+/// engine).
+pub fn verify(bytes: &[u8]) -> Result<(SnapshotHeader, &[u8]), CommandError> {
     let (header, start) = header(bytes)?;
-    if header.kind != kind {
-        return Err(bad(format!(
-            "it holds a {:?} plane, not a {kind:?} one",
-            header.kind
-        )));
-    }
-    if header.engine != engine {
-        return Err(bad(format!(
-            "written by engine \"{}\" (this daemon runs \"{engine}\")",
-            header.engine
-        )));
-    }
     let body = &bytes[start..];
     if body.len() as u64 != header.body_len {
         return Err(bad(format!(
@@ -163,6 +147,28 @@ pub fn decode<'a>(
         return Err(bad(format!(
             "checksum {sum:016x} does not match the header's {:016x} (corrupted)",
             header.checksum
+        )));
+    }
+    Ok((header, body))
+}
+
+/// [`verify`], for a plane of `kind` run by `engine`.
+pub fn decode<'a>(
+    bytes: &'a [u8],
+    kind: PlaneKind,
+    engine: &str,
+) -> Result<(SnapshotHeader, &'a [u8]), CommandError> {
+    let (header, body) = verify(bytes)?;
+    if header.kind != kind {
+        return Err(bad(format!(
+            "it holds a {:?} plane, not a {kind:?} one",
+            header.kind
+        )));
+    }
+    if header.engine != engine {
+        return Err(bad(format!(
+            "written by engine \"{}\" (this daemon runs \"{engine}\")",
+            header.engine
         )));
     }
     Ok((header, body))

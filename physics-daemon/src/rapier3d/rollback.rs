@@ -68,14 +68,16 @@ impl Plane {
                  ticks to go back over)",
             ));
         }
-        let target = self.tick.checked_sub(n as u64);
-        let at = target.and_then(|t| {
+        if n == 0 {
+            return Ok(Reply::Applied { tick: self.tick });
+        }
+        let at = self.tick.checked_sub(n as u64).and_then(|t| {
             self.rollback
                 .kept
                 .iter()
                 .position(|(tick, _, _)| *tick == t)
         });
-        let (Some(target), Some(at), true) = (target, at, n <= k) else {
+        let (Some(at), true) = (at, n <= k) else {
             let oldest = self.rollback.kept.front().map_or(self.tick, |(t, _, _)| *t);
             return Err(CommandError::invalid_field(
                 "Rewind",
@@ -86,19 +88,10 @@ impl Plane {
                 ),
             ));
         };
-        if n == 0 {
-            return Ok(Reply::Applied { tick: self.tick });
-        }
         self.rollback.kept.truncate(at + 1);
-        let copy = match self.rollback.kept.back() {
-            Some((_, state, _)) => state.duplicate(),
-            None => unreachable!("found above"),
-        };
-        let kept = std::mem::take(&mut self.rollback.kept);
+        // A copy: the kept state stays for another rewind to the same tick.
+        let copy = self.rollback.kept[at].1.duplicate();
         self.adopt_copy(copy)?;
-        // The adopted state's own ring is empty: the ticks kept before stay.
-        self.rollback.kept = kept;
-        let _ = target;
         Ok(Reply::Applied { tick: self.tick })
     }
 }

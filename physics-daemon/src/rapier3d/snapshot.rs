@@ -330,7 +330,7 @@ mod tests {
     /// which the plane's worker contains (the forger's plane fails, the daemon serves on:
     /// `tests/tests/snapshot.rs`). Counted here so a change that makes that worse shows.
     #[test]
-    fn edited_snapshots_with_fixed_checksums_never_panic() {
+    fn edited_snapshots_never_panic_in_restore_and_rarely_in_a_step() {
         let good = scene().snapshot().unwrap();
         let (header, start) = snapshot::header(&good).unwrap();
         let body = &good[start..];
