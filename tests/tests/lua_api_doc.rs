@@ -12,7 +12,7 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use shm_layout::settings::table::{PropRow, Range};
+use shm_layout::settings::table::{PropKind, PropRow, Range};
 use shm_layout::settings::{ObjectProp, PlaneProp};
 
 fn repo() -> PathBuf {
@@ -122,16 +122,42 @@ fn parse_definitions(text: &str) -> Vec<Block> {
     blocks
 }
 
+/// Text for one table cell: on one line, pipes escaped.
 fn cell(s: &str) -> String {
-    s.replace('|', "\\|")
+    s.split_whitespace()
+        .collect::<Vec<_>>()
+        .join(" ")
+        .replace('|', "\\|")
 }
 
-fn range_text(range: Range) -> String {
+/// A default as users write it: vectors as `(x, y, z)` without trailing `.0`s.
+fn value_text(text: String) -> String {
+    if text.starts_with("Pose {") {
+        return "identity".into();
+    }
+    let Some(inner) = text.strip_prefix('[').and_then(|t| t.strip_suffix(']')) else {
+        return text;
+    };
+    let parts: Vec<String> = inner
+        .split(", ")
+        .map(|p| p.trim_end_matches(".0").to_string())
+        .collect();
+    format!("({})", parts.join(", "))
+}
+
+fn range_text(kind: PropKind, range: Range) -> String {
+    match kind {
+        PropKind::Bool => return "true / false".into(),
+        PropKind::Other => return "see notes".into(),
+        PropKind::Pose => return "a CFrame".into(),
+        PropKind::Integer { min, max } if range == Range::Any => return format!("[{min}, {max}]"),
+        _ => {}
+    }
     match range {
         Range::Any => "any finite value".into(),
         Range::NonNegative => "≥ 0".into(),
         Range::Positive => "> 0".into(),
-        Range::AtLeast(x) => format!("≥ {x}"),
+        Range::AtLeast(x) => format!("≥ {}", x as f32),
         Range::Within(lo, hi) => format!("[{lo}, {hi}]"),
         Range::Clamped(lo, hi) => format!("clamped to [{lo}, {hi}]"),
         Range::Bounded(max) => format!("components within ±{max}"),
@@ -147,7 +173,8 @@ fn range_text(range: Range) -> String {
 fn rows_table(out: &mut String, rows: &[PropRow], defaults: &[String]) {
     out.push_str("| Name | Default | Accepts | Notes |\n|---|---|---|---|\n");
     for (row, default) in rows.iter().zip(defaults) {
-        let mut notes = row.doc.trim().to_string();
+        // Rustdoc links read as code here.
+        let mut notes = row.doc.trim().replace("[`", "`").replace("`]", "`");
         if row.creation_only {
             notes.push_str(" *Creation only.*");
         }
@@ -159,7 +186,7 @@ fn rows_table(out: &mut String, rows: &[PropRow], defaults: &[String]) {
             "| `{}` | `{}` | {} | {} |",
             row.name,
             cell(default),
-            cell(&range_text(row.range)),
+            cell(&range_text(row.kind, row.range)),
             cell(&notes)
         );
     }
@@ -184,7 +211,12 @@ fn render() -> String {
     out.push_str("## Contents\n\n- [Plane options](#plane-options)\n- [Object properties](#object-properties)\n");
     for b in &blocks {
         if b.what == "class" {
-            let _ = writeln!(out, "- class [`{}`](#class-{})", b.name, b.name.to_lowercase());
+            let _ = writeln!(
+                out,
+                "- class [`{}`](#class-{})",
+                b.name,
+                b.name.to_lowercase()
+            );
         }
     }
     out.push_str("- [Types](#types)\n- [Globals](#globals)\n\n");
@@ -193,13 +225,19 @@ fn render() -> String {
         "## Plane options\n\n`PhysicsService.New{ … }` takes them; each is also a property of \
          the plane (`plane.Gravity = …`) unless marked creation only. Rust: `PlaneProp`.\n\n",
     );
-    let defaults: Vec<String> = PlaneProp::DEFAULTS.iter().map(|p| p.value_text()).collect();
+    let defaults: Vec<String> = PlaneProp::DEFAULTS
+        .iter()
+        .map(|p| value_text(p.value_text()))
+        .collect();
     rows_table(&mut out, PlaneProp::ROWS, &defaults);
     out.push_str(
         "## Object properties\n\nProperties of a `PhysicsObject` (and of its `BasePart` where \
          the class declares them). Rust: `ObjectProp`.\n\n",
     );
-    let defaults: Vec<String> = ObjectProp::DEFAULTS.iter().map(|p| p.value_text()).collect();
+    let defaults: Vec<String> = ObjectProp::DEFAULTS
+        .iter()
+        .map(|p| value_text(p.value_text()))
+        .collect();
     rows_table(&mut out, ObjectProp::ROWS, &defaults);
 
     for b in blocks.iter().filter(|b| b.what == "class") {
@@ -208,8 +246,20 @@ fn render() -> String {
             let _ = writeln!(out, "{}\n", b.doc);
         }
         out.push_str("| Member | Notes |\n|---|---|\n");
+        // A property without a comment of its own takes its settings row's doc.
+        let rows: &[PropRow] = match b.name.as_str() {
+            "PhysicsPlane" => PlaneProp::ROWS,
+            "PhysicsObject" | "BasePart" => ObjectProp::ROWS,
+            _ => &[],
+        };
         for (decl, doc) in &b.members {
-            let _ = writeln!(out, "| `{}` | {} |", cell(decl), cell(doc));
+            let name = decl.split([':', '(']).next().unwrap_or("").trim();
+            let row_doc = rows.iter().find(|r| r.name == name).map(|r| r.doc.trim());
+            let doc = match row_doc {
+                Some(row_doc) if doc.is_empty() => row_doc.replace("[`", "`").replace("`]", "`"),
+                _ => doc.clone(),
+            };
+            let _ = writeln!(out, "| `{}` | {} |", cell(decl), cell(&doc));
         }
         out.push('\n');
     }
@@ -259,10 +309,24 @@ fn lua_api_page_is_generated_from_the_tables_and_definitions() {
 fn every_row_and_class_is_on_the_page() {
     let page = render();
     for row in PlaneProp::ROWS.iter().chain(ObjectProp::ROWS) {
-        assert!(page.contains(&format!("| `{}` |", row.name)), "{} missing", row.name);
+        assert!(
+            page.contains(&format!("| `{}` |", row.name)),
+            "{} missing",
+            row.name
+        );
     }
-    for class in ["PhysicsPlane", "PhysicsObject", "BasePart", "Controller", "Joint", "Map"] {
-        assert!(page.contains(&format!("## class {class}\n")), "{class} missing");
+    for class in [
+        "PhysicsPlane",
+        "PhysicsObject",
+        "BasePart",
+        "Controller",
+        "Joint",
+        "Map",
+    ] {
+        assert!(
+            page.contains(&format!("## class {class}\n")),
+            "{class} missing"
+        );
     }
     // A member's comment follows it into the page.
     assert!(page.contains("| `Unit: Vector` | zero for the zero vector |"));
