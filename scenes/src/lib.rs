@@ -10,13 +10,12 @@
 //!
 //! - [`target`]: the trait and its implementations.
 //! - [`builders`]: the builders.
-//! - [`fuzz`]: the fuzzer of the daemon's request decoder and command executor (not a
-//!   scene, but shared the same way: `physics-bench fuzz` and the integration tests run it).
+//!
+//! The fuzzer of the daemon's request decoder lives in its own crate, `physics-fuzz`.
 
 #![warn(missing_docs)]
 
 pub mod builders;
-pub mod fuzz;
 pub mod target;
 
 pub use builders::*;

@@ -7,7 +7,7 @@ use std::time::Duration;
 
 use client_sdk::{PlaneOptions, Pose, Shape};
 use integration_tests::TestDaemon;
-use physics_scenes::fuzz::{self, FuzzConfig, QUOTA_FLAGS};
+use physics_fuzz::{self as fuzz, FuzzConfig, QUOTA_FLAGS};
 
 /// `PHYSICS_FUZZ_SEED` replays a run; otherwise a seed from the clock (printed).
 fn seed() -> u64 {

@@ -136,7 +136,7 @@ pub fn render(r: &FuzzReport) -> String {
         "rounds refused",
         "quota errors (all frames)",
     ]);
-    for flag in physics_scenes::fuzz::QUOTA_FLAGS {
+    for flag in physics_fuzz::QUOTA_FLAGS {
         let q = r.quota_rounds.get(flag);
         t.row(&[
             format!("`{flag}`"),

@@ -1,4 +1,4 @@
-//! `physics-bench fuzz`: the fuzzer of `physics_scenes::fuzz` against a real daemon for a
+//! `physics-bench fuzz`: the fuzzer of `physics_fuzz` against a real daemon for a
 //! given time: frames, commands and replies by kind, quota rounds, op coverage, and the
 //! verdict (no crash, every request answered with a reply of the right shape).
 
@@ -8,7 +8,7 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
-use physics_scenes::fuzz::{self, FuzzConfig, FuzzStats, QUOTA_FLAGS};
+use physics_fuzz::{self as fuzz, FuzzConfig, FuzzStats, QUOTA_FLAGS};
 
 use super::daemon::DaemonProcess;
 use super::error::{BenchError, BenchResult};

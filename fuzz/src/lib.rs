@@ -23,6 +23,8 @@
 //! thread drives all clients in turn, and with manual planes the replies, hence the whole
 //! run, repeat for a seed (automatically ticking planes add wall-clock timing).
 
+#![warn(missing_docs)]
+
 pub mod gen;
 pub mod raw;
 pub mod rng;
