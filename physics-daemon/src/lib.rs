@@ -13,6 +13,7 @@
 pub mod backend;
 #[cfg(feature = "gpu")]
 pub mod gpu;
+pub mod kinds;
 pub mod publish;
 #[cfg(feature = "gui")]
 pub mod rapier2d;

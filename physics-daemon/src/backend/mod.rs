@@ -1,9 +1,10 @@
 //! The seam between the server / publisher and the simulation: every plane kind implements
-//! [`Backend`], and [`create`] is the one place that knows the kinds. The server routes ops
-//! by plane id and never looks inside them; the publisher asks the backend what changed.
+//! [`Backend`]; `crate::kinds::create`, one level up, is the one place that knows the
+//! kinds (the seam does not import its implementations). The server routes ops by plane id
+//! and never looks inside them; the publisher asks the backend what changed.
 //!
 //! Adding a plane kind: a folder of its own (like `rapier3d/`) with a type implementing
-//! [`Backend`], a [`PlaneKind`] variant in shm-layout, and one line in [`create`].
+//! [`Backend`], a [`PlaneKind`] variant in shm-layout, and one line in `kinds::create`.
 
 pub mod counted;
 mod dirty;
@@ -20,8 +21,7 @@ pub use marks::Marks;
 pub use slot_table::SlotTable;
 
 use shm_layout::{
-    BodyState, CommandError, CommandResult, EventRecord, PlaneId, PlaneKind, PlaneOp, PlaneProp,
-    TickHeader,
+    BodyState, CommandError, CommandResult, EventRecord, PlaneKind, PlaneOp, TickHeader,
 };
 
 /// Which slots [`Backend::write_states`] must write.
@@ -120,23 +120,4 @@ pub trait Backend: Send {
 
     /// What the plane holds now.
     fn usage(&self) -> Usage;
-}
-
-/// Creates a plane of `kind` with its defaults, then `props` applied in order.
-pub fn create(
-    kind: PlaneKind,
-    id: PlaneId,
-    props: &[PlaneProp],
-) -> Result<Box<dyn Backend>, CommandError> {
-    Ok(match kind {
-        PlaneKind::Rapier3d => Box::new(crate::rapier3d::Plane::new(id, props)?),
-        #[cfg(feature = "gui")]
-        PlaneKind::Gui2d => Box::new(crate::rapier2d::Plane::new(id, props)?),
-        #[cfg(not(feature = "gui"))]
-        PlaneKind::Gui2d => {
-            return Err(CommandError::invalid(
-                "this daemon was built without GUI planes (cargo feature \"gui\")",
-            ))
-        }
-    })
 }

@@ -31,7 +31,7 @@ use shm_layout::{
 
 use super::dispatch::unknown_plane;
 use super::limits::{exceeded, Limits};
-use crate::backend::{self, Backend, Usage};
+use crate::backend::{Backend, Usage};
 use crate::publish::PlaneOutput;
 use crate::DaemonError;
 
@@ -378,7 +378,7 @@ impl Drop for Worker {
 fn create(setup: &Setup) -> Result<(Worker, Reply), CommandError> {
     let id = setup.id;
     let internal = |e: DaemonError| CommandError::new(ErrorKind::Internal, e.to_string());
-    let mut plane = backend::create(setup.kind, id, &setup.props)?;
+    let mut plane = crate::kinds::create(setup.kind, id, &setup.props)?;
     let node = NodeBuilder::new()
         .config(&setup.config)
         .signal_handling_mode(SignalHandlingMode::Disabled)
