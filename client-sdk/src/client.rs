@@ -12,12 +12,10 @@ use shm_layout::{
     LAYOUT_VERSION,
 };
 
-use crate::plane::{PlaneOptions, PlaneShared};
-use crate::transport::Transport;
-use crate::{Error, Plane};
+use crate::plane_shared::PlaneShared;
+use crate::transport::{Transport, LIVENESS_PERIOD};
+use crate::Error;
 
-/// How often a waiting client checks that the daemon process is still alive.
-pub(crate) const LIVENESS_PERIOD: Duration = Duration::from_millis(100);
 /// A daemon whose heartbeat (a few beats a second, from a thread of its own) has been
 /// silent this long while a request waits, and whose process is stopped (SIGSTOP), is
 /// stalled, not slow.
@@ -228,57 +226,19 @@ impl Client {
         self.inner.daemon_pid
     }
 
-    /// Creates a plane owned by this client (released when the client goes away).
-    pub fn create_plane(&self, options: &PlaneOptions) -> Result<Plane, Error> {
-        let info = match self.call(Command::CreatePlane {
-            kind: options.kind.unwrap_or_default(),
-            props: options.props(),
-        })? {
-            Reply::Plane(info) => info,
-            other => return Err(unexpected(other)),
-        };
-        let id = info.id;
-        let plane = self.attach_plane(id)?;
-        *plane.shared.mirror.borrow_mut() =
-            crate::mirror::Mirror::exclusive(info, options.shared == Some(true));
-        self.note_owned(id);
-        let table = {
-            let state = self.inner.state.borrow_mut();
-            state.groups.clone()
-        };
-        if table != CollisionGroups::default() {
-            self.queue(Command::plane(id, PlaneOp::CollisionGroups(table)), None);
-        }
-        Ok(plane)
+    /// The per-plane state this client already keeps for `id`, if attached.
+    pub(crate) fn attached(&self, id: PlaneId) -> Option<Rc<PlaneShared>> {
+        self.inner.state.borrow().planes.get(&id).cloned()
+    }
+
+    /// Keeps `shared` as this client's state for plane `id`.
+    pub(crate) fn remember_plane(&self, id: PlaneId, shared: Rc<PlaneShared>) {
+        self.inner.state.borrow_mut().planes.insert(id, shared);
     }
 
     /// Records that this client created plane `id`.
     pub(crate) fn note_owned(&self, id: PlaneId) {
         self.inner.state.borrow_mut().owned.push(id);
-    }
-
-    /// Opens an existing plane (created by any client) for reading and writing. Returns once
-    /// the plane's newest tick is readable.
-    pub fn attach_plane(&self, id: PlaneId) -> Result<Plane, Error> {
-        if let Some(shared) = self.inner.state.borrow().planes.get(&id) {
-            return Ok(Plane::new(self.clone(), shared.clone()));
-        }
-        let shared = match PlaneShared::open(&self.inner.transport, id) {
-            Ok(s) => Rc::new(s),
-            // No such service: let the daemon say why (unknown plane, or gone).
-            Err(e) => {
-                self.call(Command::plane(id, PlaneOp::Info))?;
-                return Err(e);
-            }
-        };
-        // Asking after subscribing makes the daemon hand the newest tick to the new reader.
-        self.call(Command::plane(id, PlaneOp::Info))?;
-        self.inner
-            .state
-            .borrow_mut()
-            .planes
-            .insert(id, shared.clone());
-        Ok(Plane::new(self.clone(), shared))
     }
 
     /// Sends every queued write as one request. Errors of individual commands (including
@@ -787,7 +747,7 @@ fn process_stopped(pid: u32) -> bool {
     })
 }
 
-fn unexpected(reply: Reply) -> Error {
+pub(crate) fn unexpected(reply: Reply) -> Error {
     Error::Protocol(format!("unexpected reply {reply:?}"))
 }
 

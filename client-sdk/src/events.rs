@@ -2,16 +2,12 @@
 //! order. The daemon numbers every event; a reader that fell more than
 //! [`EVENT_BUFFER_TICKS`] ticks with events behind loses the oldest and is told how many.
 
-use std::cell::Cell;
-
 use shm_layout::{EventRecord, Handle, Vec3, EVENT_CONTACT_STARTED, EVENT_CONTACT_STOPPED};
 
-use crate::transport::EventSubscriber;
+use crate::plane_shared::EventReader;
 use crate::{Error, Plane};
 
-/// How many ticks' worth of event samples a reader's queue holds (one sample per tick that
-/// had events); past it the oldest are dropped and reported as lost.
-pub const EVENT_BUFFER_TICKS: usize = 64;
+pub use crate::transport::EVENT_BUFFER_TICKS;
 
 /// What `Plane::events` returns: the events since the last call, in order, and how many
 /// events were lost before them because the reader fell behind.
@@ -74,25 +70,9 @@ impl Contact {
     }
 }
 
-/// A subscription to a plane's events and the number (modulo 2³²) of the next event it
-/// expects.
-pub(crate) struct EventReader {
-    subscriber: EventSubscriber,
-    next_seq: Cell<u32>,
-}
-
 impl EventReader {
-    /// `start`: the plane's event count at its newest tick when the subscriber existed
-    /// (events from there on reach it).
-    pub(crate) fn new(subscriber: EventSubscriber, start: u32) -> EventReader {
-        EventReader {
-            subscriber,
-            next_seq: Cell::new(start),
-        }
-    }
-
     /// Drains the queue into `out`, counting the events missing between samples.
-    fn drain(&self, out: &mut Events) -> Result<(), Error> {
+    pub(crate) fn drain(&self, out: &mut Events) -> Result<(), Error> {
         while let Some(sample) = self
             .subscriber
             .receive()

@@ -28,6 +28,7 @@ mod mirror;
 mod object;
 mod overlay;
 mod plane;
+mod plane_shared;
 mod plane_snapshot;
 mod probe;
 mod query;

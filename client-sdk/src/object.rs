@@ -1,8 +1,8 @@
 //! Objects: reads index into the newest sample, writes join the client's batch.
 
 use shm_layout::{
-    BodyState, Command, Handle, ObjectInfo, ObjectOp, ObjectProp, Pin, Pose, Reply, Restraint,
-    RotateTo, Vec3,
+    BodyState, Command, Handle, ObjectInfo, ObjectOp, ObjectProp, Pin, PlaneOp, Pose, Reply,
+    Restraint, RotateTo, Shape, Vec3,
 };
 
 use crate::{Error, Plane};
@@ -320,5 +320,56 @@ impl std::fmt::Debug for Object {
             .field("plane", &self.plane.id())
             .field("handle", &self.handle)
             .finish()
+    }
+}
+
+impl Plane {
+    /// Adds an object; sends the queue and waits for the new handle.
+    pub fn add(&self, shape: Shape, pose: Pose, props: &[ObjectProp]) -> Result<Object, Error> {
+        shape.check().map_err(Error::invalid_value)?;
+        let pose = shm_layout::validate::pose("CFrame", pose).map_err(Error::invalid_value)?;
+        let props = props
+            .iter()
+            .map(|p| p.checked())
+            .collect::<Result<Vec<_>, _>>()
+            .map_err(Error::invalid_value)?;
+        let hold = self.client().holds_adds();
+        let mut sent = props.clone();
+        if hold {
+            sent.push(ObjectProp::Held(true));
+        }
+        let reply = self.client().call(Command::plane(
+            self.id(),
+            PlaneOp::AddObject {
+                shape,
+                pose,
+                props: sent,
+            },
+        ))?;
+        let Reply::Object { handle, tick } = reply else {
+            return Err(Error::Protocol(format!("unexpected reply {reply:?}")));
+        };
+        if hold {
+            // Released by the next flush, together with what the caller writes until then.
+            let release = PlaneOp::Object {
+                handle,
+                op: ObjectOp::Set(ObjectProp::Held(false)),
+            };
+            self.client()
+                .queue(Command::plane(self.id(), release), None);
+        }
+        // Until a sample shows it, the object reads back as created.
+        let mut overlay = self.shared.overlay.borrow_mut();
+        overlay.write(handle, |e| {
+            e.pose = Some(pose);
+            e.velocity = Some([0.0; 3]);
+            e.angular_velocity = Some([0.0; 3]);
+            for p in &props {
+                e.record(p);
+            }
+        });
+        overlay.confirm(handle, tick);
+        self.shared.members.borrow_mut().added(tick);
+        Ok(Object::new(self.clone(), handle))
     }
 }

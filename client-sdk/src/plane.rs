@@ -1,109 +1,22 @@
 //! Planes: options, zero-copy snapshots of the newest tick, stepping and waiting for ticks.
 
-use std::cell::{Cell, RefCell};
 use std::rc::Rc;
 use std::time::{Duration, Instant};
 
 use shm_layout::{
-    BodyState, Command, Handle, ObjectProp, PlaneId, PlaneInfo, PlaneOp, PlaneProp, Pose, Reply,
-    Shape, TickHeader,
+    BodyState, CollisionGroups, Command, Handle, PlaneId, PlaneInfo, PlaneOp, PlaneProp, Reply,
+    TickHeader,
 };
 
-use crate::client::LIVENESS_PERIOD;
-use crate::events::EventReader;
-use crate::members::Members;
-use crate::mirror::Mirror;
-use crate::overlay::{Entry, Overlay};
-use crate::transport::{BodySample, BodySubscriber, TickListener, Transport};
-use crate::{Client, Error, Object};
+use crate::client::unexpected;
+use crate::overlay::Entry;
+use crate::plane_shared::PlaneShared;
+use crate::transport::{BodySample, LIVENESS_PERIOD};
+use crate::{Client, Error};
 
 /// Options of a new plane: declared with the plane settings table (one field per option,
 /// a builder over [`PlaneProp`]).
 pub use shm_layout::PlaneOptions;
-
-/// What a client keeps per plane: the subscriber, the newest sample, the overlay.
-pub(crate) struct PlaneShared {
-    id: PlaneId,
-    bodies: BodySubscriber,
-    latest: RefCell<Option<Rc<BodySample>>>,
-    overlay: RefCell<Overlay>,
-    /// Created on the first wait: readers that never wait pay nothing for it.
-    ticks: RefCell<Option<TickListener>>,
-    pub(crate) events: RefCell<Option<EventReader>>,
-    alive: Cell<bool>,
-    /// The client frame in which `latest` was last refreshed.
-    refreshed_in: Cell<u64>,
-    /// The plane's options and its objects' properties as this process knows them.
-    pub(crate) mirror: RefCell<Mirror>,
-    /// Adds and removals the newest header may not count yet ([`Plane::object_count`]).
-    pub(crate) members: RefCell<Members>,
-}
-
-impl PlaneShared {
-    pub(crate) fn open(transport: &Transport, id: PlaneId) -> Result<PlaneShared, Error> {
-        let bodies = transport.plane_bodies(id)?;
-        Ok(PlaneShared {
-            id,
-            bodies,
-            latest: RefCell::new(None),
-            overlay: RefCell::default(),
-            ticks: RefCell::new(None),
-            events: RefCell::new(None),
-            alive: Cell::new(true),
-            refreshed_in: Cell::new(0),
-            mirror: RefCell::default(),
-            members: RefCell::default(),
-        })
-    }
-
-    /// The daemon applied this process's writes to `handle` after `tick`.
-    pub(crate) fn confirm(&self, handle: Handle, tick: u64) {
-        self.overlay.borrow_mut().confirm(handle, tick);
-    }
-
-    /// The daemon applied an impulse ([`Overlay::impulse_applied`]).
-    pub(crate) fn impulse_applied(&self, handle: Handle, ticket: u32, linear: [f32; 3], tick: u64) {
-        self.overlay
-            .borrow_mut()
-            .impulse_applied(handle, ticket, linear, tick);
-    }
-
-    /// The daemon refused a write to `handle`: it must not linger as if it had happened.
-    pub(crate) fn discard(&self, handle: Handle) {
-        self.overlay.borrow_mut().discard(handle);
-    }
-
-    /// Takes the newest sample if one arrived: a check of a shared-memory queue, no syscall.
-    fn refresh(&self) -> Result<(), Error> {
-        loop {
-            match self.bodies.receive() {
-                Ok(Some(sample)) => *self.latest.borrow_mut() = Some(Rc::new(sample)),
-                Ok(None) => return Ok(()),
-                // Every borrow slot is held by snapshots the caller keeps: keep the newest we have.
-                Err(iceoryx2::port::ReceiveError::ExceedsMaxBorrows) => return Ok(()),
-                Err(e) => return Err(Error::ipc("receive tick", e)),
-            }
-        }
-    }
-
-    fn latest(&self) -> Result<Option<Rc<BodySample>>, Error> {
-        self.refresh()?;
-        Ok(self.latest.borrow().clone())
-    }
-
-    /// Looks for a newer sample once per client frame (`frame` 0: every time).
-    fn refresh_in_frame(&self, frame: u64) -> Result<(), Error> {
-        if frame == 0 || self.refreshed_in.get() != frame {
-            self.refresh()?;
-            self.refreshed_in.set(frame);
-        }
-        Ok(())
-    }
-
-    fn current_tick(&self) -> Option<u64> {
-        self.latest.borrow().as_ref().map(|s| s.user_header().tick)
-    }
-}
 
 /// One tick of a plane, read in place from shared memory.
 #[derive(Clone)]
@@ -331,54 +244,6 @@ impl Plane {
         Ok(info.object_count)
     }
 
-    /// Adds an object; sends the queue and waits for the new handle.
-    pub fn add(&self, shape: Shape, pose: Pose, props: &[ObjectProp]) -> Result<Object, Error> {
-        shape.check().map_err(Error::invalid_value)?;
-        let pose = shm_layout::validate::pose("CFrame", pose).map_err(Error::invalid_value)?;
-        let props = props
-            .iter()
-            .map(|p| p.checked())
-            .collect::<Result<Vec<_>, _>>()
-            .map_err(Error::invalid_value)?;
-        let hold = self.client.holds_adds();
-        let mut sent = props.clone();
-        if hold {
-            sent.push(ObjectProp::Held(true));
-        }
-        let reply = self.client.call(Command::plane(
-            self.id(),
-            PlaneOp::AddObject {
-                shape,
-                pose,
-                props: sent,
-            },
-        ))?;
-        let Reply::Object { handle, tick } = reply else {
-            return Err(Error::Protocol(format!("unexpected reply {reply:?}")));
-        };
-        if hold {
-            // Released by the next flush, together with what the caller writes until then.
-            let release = PlaneOp::Object {
-                handle,
-                op: shm_layout::ObjectOp::Set(ObjectProp::Held(false)),
-            };
-            self.client.queue(Command::plane(self.id(), release), None);
-        }
-        // Until a sample shows it, the object reads back as created.
-        let mut overlay = self.shared.overlay.borrow_mut();
-        overlay.write(handle, |e| {
-            e.pose = Some(pose);
-            e.velocity = Some([0.0; 3]);
-            e.angular_velocity = Some([0.0; 3]);
-            for p in &props {
-                e.record(p);
-            }
-        });
-        overlay.confirm(handle, tick);
-        self.shared.members.borrow_mut().added(tick);
-        Ok(Object::new(self.clone(), handle))
-    }
-
     /// Advances a plane by `dt` seconds (with the queue sent first) and returns once the
     /// new tick is visible in [`Plane::snapshot`]. Returns the tick number.
     pub fn step(&self, dt: f32) -> Result<u64, Error> {
@@ -463,5 +328,49 @@ impl Plane {
 impl std::fmt::Debug for Plane {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("Plane").field("id", &self.id()).finish()
+    }
+}
+
+/// A client's ways to get a plane handle.
+impl Client {
+    /// Creates a plane owned by this client (released when the client goes away).
+    pub fn create_plane(&self, options: &PlaneOptions) -> Result<Plane, Error> {
+        let info = match self.call(Command::CreatePlane {
+            kind: options.kind.unwrap_or_default(),
+            props: options.props(),
+        })? {
+            Reply::Plane(info) => info,
+            other => return Err(unexpected(other)),
+        };
+        let id = info.id;
+        let plane = self.attach_plane(id)?;
+        *plane.shared.mirror.borrow_mut() =
+            crate::mirror::Mirror::exclusive(info, options.shared == Some(true));
+        self.note_owned(id);
+        let table = self.groups(CollisionGroups::clone);
+        if table != CollisionGroups::default() {
+            self.queue(Command::plane(id, PlaneOp::CollisionGroups(table)), None);
+        }
+        Ok(plane)
+    }
+
+    /// Opens an existing plane (created by any client) for reading and writing. Returns once
+    /// the plane's newest tick is readable.
+    pub fn attach_plane(&self, id: PlaneId) -> Result<Plane, Error> {
+        if let Some(shared) = self.attached(id) {
+            return Ok(Plane::new(self.clone(), shared));
+        }
+        let shared = match PlaneShared::open(self.transport(), id) {
+            Ok(s) => Rc::new(s),
+            // No such service: let the daemon say why (unknown plane, or gone).
+            Err(e) => {
+                self.call(Command::plane(id, PlaneOp::Info))?;
+                return Err(e);
+            }
+        };
+        // Asking after subscribing makes the daemon hand the newest tick to the new reader.
+        self.call(Command::plane(id, PlaneOp::Info))?;
+        self.remember_plane(id, shared.clone());
+        Ok(Plane::new(self.clone(), shared))
     }
 }

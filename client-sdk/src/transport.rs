@@ -18,6 +18,13 @@ use shm_layout::{names, BodyState, EventRecord, PlaneId, TickHeader};
 
 use crate::Error;
 
+/// How many ticks' worth of event samples a reader's queue holds (one sample per tick that
+/// had events); past it the oldest are dropped and reported as lost.
+pub const EVENT_BUFFER_TICKS: usize = 64;
+
+/// How often a waiting client checks that the daemon process is still alive.
+pub(crate) const LIVENESS_PERIOD: Duration = Duration::from_millis(100);
+
 /// How long `open` waits for a starting daemon to open its request server.
 const SERVER_WAIT: Duration = Duration::from_secs(2);
 
@@ -241,7 +248,7 @@ impl Transport {
             .open()
             .map_err(|e| Error::ipc("open event service", e))?
             .subscriber_builder()
-            .buffer_size(crate::events::EVENT_BUFFER_TICKS)
+            .buffer_size(EVENT_BUFFER_TICKS)
             .create()
             .map_err(|e| Error::ipc("create event subscriber", e))
     }

@@ -1,0 +1,116 @@
+//! What a client keeps per plane, shared by every handle to it: the body subscriber and the
+//! newest sample, the overlay of writes not yet published, the event reader, the mirror of
+//! its properties. `Client` keeps one per attached plane; `Plane` handles point at it.
+
+use std::cell::{Cell, RefCell};
+use std::rc::Rc;
+
+use shm_layout::{Handle, PlaneId};
+
+use crate::members::Members;
+use crate::mirror::Mirror;
+use crate::overlay::Overlay;
+use crate::transport::{BodySample, BodySubscriber, EventSubscriber, TickListener, Transport};
+use crate::Error;
+
+/// What a client keeps per plane: the subscriber, the newest sample, the overlay.
+pub(crate) struct PlaneShared {
+    pub(crate) id: PlaneId,
+    pub(crate) bodies: BodySubscriber,
+    pub(crate) latest: RefCell<Option<Rc<BodySample>>>,
+    pub(crate) overlay: RefCell<Overlay>,
+    /// Created on the first wait: readers that never wait pay nothing for it.
+    pub(crate) ticks: RefCell<Option<TickListener>>,
+    pub(crate) events: RefCell<Option<EventReader>>,
+    pub(crate) alive: Cell<bool>,
+    /// The client frame in which `latest` was last refreshed.
+    pub(crate) refreshed_in: Cell<u64>,
+    /// The plane's options and its objects' properties as this process knows them.
+    pub(crate) mirror: RefCell<Mirror>,
+    /// Adds and removals the newest header may not count yet ([`Plane::object_count`]).
+    pub(crate) members: RefCell<Members>,
+}
+
+impl PlaneShared {
+    pub(crate) fn open(transport: &Transport, id: PlaneId) -> Result<PlaneShared, Error> {
+        let bodies = transport.plane_bodies(id)?;
+        Ok(PlaneShared {
+            id,
+            bodies,
+            latest: RefCell::new(None),
+            overlay: RefCell::default(),
+            ticks: RefCell::new(None),
+            events: RefCell::new(None),
+            alive: Cell::new(true),
+            refreshed_in: Cell::new(0),
+            mirror: RefCell::default(),
+            members: RefCell::default(),
+        })
+    }
+
+    /// The daemon applied this process's writes to `handle` after `tick`.
+    pub(crate) fn confirm(&self, handle: Handle, tick: u64) {
+        self.overlay.borrow_mut().confirm(handle, tick);
+    }
+
+    /// The daemon applied an impulse ([`Overlay::impulse_applied`]).
+    pub(crate) fn impulse_applied(&self, handle: Handle, ticket: u32, linear: [f32; 3], tick: u64) {
+        self.overlay
+            .borrow_mut()
+            .impulse_applied(handle, ticket, linear, tick);
+    }
+
+    /// The daemon refused a write to `handle`: it must not linger as if it had happened.
+    pub(crate) fn discard(&self, handle: Handle) {
+        self.overlay.borrow_mut().discard(handle);
+    }
+
+    /// Takes the newest sample if one arrived: a check of a shared-memory queue, no syscall.
+    pub(crate) fn refresh(&self) -> Result<(), Error> {
+        loop {
+            match self.bodies.receive() {
+                Ok(Some(sample)) => *self.latest.borrow_mut() = Some(Rc::new(sample)),
+                Ok(None) => return Ok(()),
+                // Every borrow slot is held by snapshots the caller keeps: keep the newest we have.
+                Err(iceoryx2::port::ReceiveError::ExceedsMaxBorrows) => return Ok(()),
+                Err(e) => return Err(Error::ipc("receive tick", e)),
+            }
+        }
+    }
+
+    pub(crate) fn latest(&self) -> Result<Option<Rc<BodySample>>, Error> {
+        self.refresh()?;
+        Ok(self.latest.borrow().clone())
+    }
+
+    /// Looks for a newer sample once per client frame (`frame` 0: every time).
+    pub(crate) fn refresh_in_frame(&self, frame: u64) -> Result<(), Error> {
+        if frame == 0 || self.refreshed_in.get() != frame {
+            self.refresh()?;
+            self.refreshed_in.set(frame);
+        }
+        Ok(())
+    }
+
+    pub(crate) fn current_tick(&self) -> Option<u64> {
+        self.latest.borrow().as_ref().map(|s| s.user_header().tick)
+    }
+}
+
+/// A subscription to a plane's events and the number (modulo 2³²) of the next event it
+/// expects.
+pub(crate) struct EventReader {
+    pub(crate) subscriber: EventSubscriber,
+    pub(crate) next_seq: Cell<u32>,
+}
+
+impl EventReader {
+    /// `start`: the plane's event count at its newest tick when the subscriber existed
+    /// (events from there on reach it).
+    pub(crate) fn new(subscriber: EventSubscriber, start: u32) -> EventReader {
+        EventReader {
+            subscriber,
+            next_seq: Cell::new(start),
+        }
+    }
+}
