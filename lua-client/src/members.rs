@@ -11,18 +11,12 @@ pub fn property_rows() -> Vec<(&'static str, Vec<&'static str>)> {
         (p.owner, rows.map(|r| r.name).collect())
     }
     vec![
-        names(&props::part::PART),
-        names(&props::object::OBJECT),
-        names(&props::plane::PLANE),
-        names(&props::controller::CONTROLLER),
-        (
-            "GuiPhysicsPlane",
-            props::gui::GUI_PLANE_ROWS.iter().map(|r| r.name).collect(),
-        ),
-        (
-            "PhysicsGuiObject",
-            props::gui::GUI_OBJECT_ROWS.iter().map(|r| r.name).collect(),
-        ),
+        names(&crate::api::part::props::PART),
+        names(&crate::api::object::props::OBJECT),
+        names(&crate::api::plane::props::PLANE),
+        names(&crate::api::controller::props::CONTROLLER),
+        names(&crate::api::gui_plane::props::GUI_PLANE),
+        names(&crate::api::gui_object::props::GUI_OBJECT),
         names(&crate::api::map::MAP),
     ]
 }

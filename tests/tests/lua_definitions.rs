@@ -228,36 +228,49 @@ fn property_rows_match_the_declared_properties() {
 /// `add_method_mut("X"` and `.set("X", lua.create_function` / `create_async_function`.
 fn registered_names() -> BTreeMap<String, String> {
     let mut names = BTreeMap::new();
-    for dir in ["lua-client/src/api", "lua-client/src/values"] {
-        for entry in std::fs::read_dir(repo().join(dir)).unwrap() {
+    let mut files = Vec::new();
+    let mut dirs = vec![
+        repo().join("lua-client/src/api"),
+        repo().join("lua-client/src/values"),
+    ];
+    // A type with its rows beside it is a folder (`api/plane/{mod.rs, props.rs}`).
+    while let Some(dir) = dirs.pop() {
+        for entry in std::fs::read_dir(dir).unwrap() {
             let path = entry.unwrap().path();
-            let text = std::fs::read_to_string(&path).unwrap();
-            let file = path.file_name().unwrap().to_string_lossy().to_string();
-            // Join lines so `t.set(\n "X",\n lua.create_function(` reads as one.
-            let flat: String = text.split_whitespace().collect::<Vec<_>>().join(" ");
-            for pat in [
-                "add_method(\"",
-                "add_method_mut(\"",
-                "add_function(\"",
-                "add_function_mut(\"",
-                ".set( \"",
-                ".set(\"",
-            ] {
-                let mut rest = flat.as_str();
-                while let Some(i) = rest.find(pat) {
-                    rest = &rest[i + pat.len()..];
-                    let Some(end) = rest.find('"') else { break };
-                    let name = &rest[..end];
-                    let after = rest[end + 1..].trim_start_matches([',', ' ']);
-                    let is_function = !pat.starts_with(".set")
-                        || after.starts_with("lua.create_function")
-                        || after.starts_with("lua.create_async_function");
-                    let word = !name.is_empty()
-                        && name.chars().all(|c| c.is_alphanumeric() || c == '_')
-                        && name.chars().next().unwrap().is_uppercase();
-                    if is_function && word {
-                        names.entry(name.to_string()).or_insert(file.clone());
-                    }
+            if path.is_dir() {
+                dirs.push(path);
+            } else {
+                files.push(path);
+            }
+        }
+    }
+    for path in files {
+        let text = std::fs::read_to_string(&path).unwrap();
+        let file = path.display().to_string();
+        // Join lines so `t.set(\n "X",\n lua.create_function(` reads as one.
+        let flat: String = text.split_whitespace().collect::<Vec<_>>().join(" ");
+        for pat in [
+            "add_method(\"",
+            "add_method_mut(\"",
+            "add_function(\"",
+            "add_function_mut(\"",
+            ".set( \"",
+            ".set(\"",
+        ] {
+            let mut rest = flat.as_str();
+            while let Some(i) = rest.find(pat) {
+                rest = &rest[i + pat.len()..];
+                let Some(end) = rest.find('"') else { break };
+                let name = &rest[..end];
+                let after = rest[end + 1..].trim_start_matches([',', ' ']);
+                let is_function = !pat.starts_with(".set")
+                    || after.starts_with("lua.create_function")
+                    || after.starts_with("lua.create_async_function");
+                let word = !name.is_empty()
+                    && name.chars().all(|c| c.is_alphanumeric() || c == '_')
+                    && name.chars().next().unwrap().is_uppercase();
+                if is_function && word {
+                    names.entry(name.to_string()).or_insert(file.clone());
                 }
             }
         }

@@ -14,31 +14,7 @@ use client_sdk::{GuiObject, GuiObjectProp, GuiShape};
 use mlua::{Lua, MetaMethod, MultiValue, Table, UserData, UserDataMethods, Value};
 
 use crate::host::signal::Signal;
-use crate::values::{describe, expected, finite_number, number, sdk_error, Dim};
-
-/// A Dim argument as pixels, or an error naming `what`, the expectation and the value.
-pub fn dim_arg(what: &str, v: &Value) -> mlua::Result<[f32; 2]> {
-    let bad = || expected(what, "a Dim with finite components", v);
-    match v {
-        Value::UserData(ud) => {
-            let d = ud.borrow::<Dim>().map_err(|_| bad())?;
-            if d.x.is_finite() && d.y.is_finite() {
-                Ok([d.x as f32, d.y as f32])
-            } else {
-                Err(bad())
-            }
-        }
-        _ => Err(bad()),
-    }
-}
-
-/// A Dim value.
-pub fn new_dim(v: [f32; 2]) -> Dim {
-    Dim {
-        x: v[0] as f64,
-        y: v[1] as f64,
-    }
-}
+use crate::values::{describe, dim_arg, expected, finite_number, new_dim, number, sdk_error};
 
 /// What a primitive knows about itself.
 pub struct PrimState {

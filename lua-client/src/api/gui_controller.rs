@@ -11,11 +11,11 @@ use std::cell::{Cell, RefCell};
 use client_sdk::{GuiController, GuiControllerProp, GuiEvent, Handle};
 use mlua::{Lua, MetaMethod, MultiValue, Table, UserData, UserDataMethods, Value};
 
-use super::gui_basic::{dim_arg, new_dim};
 use super::gui_object::PhysicsGuiObject;
 use super::gui_plane::fire;
 use crate::host::signal::Signal;
 use crate::values::{describe, expected, number, sdk_error};
+use crate::values::{dim_arg, new_dim};
 
 /// A controller as the host holds it.
 pub struct ControllerState {

@@ -13,8 +13,7 @@ use mlua::{Lua, MetaMethod, Table, UserData, UserDataFields, UserDataMethods, Va
 
 use super::gui_plane::{wrap_gui_plane, GuiPhysicsPlane};
 use super::plane::{context, wrap_plane, PhysicsPlane};
-use crate::props::gui::gui_plane_option;
-use crate::props::plane::PLANE;
+use crate::api::plane::props::PLANE;
 use crate::values::{describe, expected, sdk_error};
 
 /// A plane's whole state at one tick (`PlaneSnapshot`).
@@ -157,7 +156,9 @@ fn from_snapshot(lua: &Lua, (snapshot, opts): (Value, Value)) -> mlua::Result<Va
         let (key, value) = pair?;
         overrides.push(match snapshot.kind() {
             PlaneKind::Rapier3d => PLANE.option(WHAT, &key, &value)?,
-            PlaneKind::Gui2d => gui_plane_option(WHAT, &key, &value)?,
+            PlaneKind::Gui2d => {
+                crate::api::gui_plane::props::GUI_PLANE.option(WHAT, &key, &value)?
+            }
         });
     }
     let client = context(lua).client.clone();

@@ -11,16 +11,10 @@
 //! - A documented property the SDK cannot do yet is a row marked `NotYet`, so wiring it later
 //!   is editing one row, and using it meanwhile is a clear error instead of a silent no-op.
 
-pub mod controller;
-pub mod gui;
-pub mod object;
-pub mod part;
-pub mod plane;
-
 use client_sdk::settings::table::{AnyValue, PropKind, PropRow, Range};
 use mlua::{Error as LuaError, Lua, Value};
 
-use crate::values::{describe, lua_number, new_vector, number, vector, CFrame};
+use crate::values::{describe, lua_number, new_vector, number, vector, CFrame, Dim};
 
 /// A Lua type whose properties are rows, and how one of its property writes reaches the SDK.
 pub trait Target: 'static {
@@ -85,6 +79,8 @@ pub enum Kind {
     String,
     /// A finite number, or nil for none (an optional setting such as `GroundY`).
     OptionalNumber,
+    /// A Dim with finite components (GUI planes: pixels).
+    Dim,
 }
 
 impl Kind {
@@ -128,6 +124,7 @@ impl Kind {
             Kind::CFrame => "a CFrame".into(),
             Kind::String => "a string".into(),
             Kind::OptionalNumber => "a finite number or nil".into(),
+            Kind::Dim => "a Dim with finite components".into(),
         }
     }
 
@@ -183,6 +180,15 @@ impl Kind {
                 Value::String(s) => Ok(Arg::String(s.to_string_lossy())),
                 _ => Err(bad()),
             },
+            Kind::Dim => match value {
+                Value::UserData(ud) => match ud.borrow::<Dim>() {
+                    Ok(d) if d.x.is_finite() && d.y.is_finite() => {
+                        Ok(Arg::Dim([d.x as f32, d.y as f32]))
+                    }
+                    _ => Err(bad()),
+                },
+                _ => Err(bad()),
+            },
         }
     }
 }
@@ -204,6 +210,8 @@ pub enum Arg {
     String(String),
     /// Nil, from [`Kind::OptionalNumber`].
     Nil,
+    /// From [`Kind::Dim`].
+    Dim([f32; 2]),
 }
 
 fn mismatch(arg: &Arg, want: &str) -> LuaError {
@@ -256,6 +264,13 @@ impl Arg {
         match *self {
             Arg::CFrame(cf) => Ok(cf),
             _ => Err(mismatch(self, "a CFrame")),
+        }
+    }
+    /// The Dim, as pixels.
+    pub fn dim(&self) -> Result<[f32; 2], LuaError> {
+        match *self {
+            Arg::Dim(d) => Ok(d),
+            _ => Err(mismatch(self, "a Dim")),
         }
     }
     /// The string.

@@ -22,7 +22,7 @@ impl fmt::Display for Dim {
     }
 }
 
-fn dim_arg(what: &str, v: &Value) -> mlua::Result<Dim> {
+fn dim_value(what: &str, v: &Value) -> mlua::Result<Dim> {
     match v {
         Value::UserData(ud) => ud
             .borrow::<Dim>()
@@ -34,14 +34,14 @@ fn dim_arg(what: &str, v: &Value) -> mlua::Result<Dim> {
 
 /// Dim ∘ Dim component-wise, or Dim ∘ number on both components.
 fn arith(what: &str, a: &Value, b: &Value, op: fn(f64, f64) -> f64) -> mlua::Result<Dim> {
-    let lhs = dim_arg(what, a)?;
+    let lhs = dim_value(what, a)?;
     match (number(b), b) {
         (Some(n), _) => Ok(Dim {
             x: op(lhs.x, n),
             y: op(lhs.y, n),
         }),
         (None, _) => {
-            let rhs = dim_arg(what, b)?;
+            let rhs = dim_value(what, b)?;
             Ok(Dim {
                 x: op(lhs.x, rhs.x),
                 y: op(lhs.y, rhs.y),
@@ -77,7 +77,7 @@ impl UserData for Dim {
         });
         methods.add_meta_method(MetaMethod::Unm, |_, d, ()| Ok(Dim { x: -d.x, y: -d.y }));
         methods.add_meta_method(MetaMethod::Eq, |_, d, o: Value| {
-            Ok(dim_arg("==", &o).is_ok_and(|o| o == *d))
+            Ok(dim_value("==", &o).is_ok_and(|o| o == *d))
         });
         methods.add_meta_method(MetaMethod::ToString, |_, d, ()| Ok(d.to_string()));
     }
@@ -93,4 +93,28 @@ pub fn new(_: &Lua, (x, y): (Value, Value)) -> mlua::Result<Dim> {
         x: comp("x", &x)?,
         y: comp("y", &y)?,
     })
+}
+
+/// A Dim argument as pixels, or an error naming `what`, the expectation and the value.
+pub fn dim_arg(what: &str, v: &Value) -> mlua::Result<[f32; 2]> {
+    let bad = || expected(what, "a Dim with finite components", v);
+    match v {
+        Value::UserData(ud) => {
+            let d = ud.borrow::<Dim>().map_err(|_| bad())?;
+            if d.x.is_finite() && d.y.is_finite() {
+                Ok([d.x as f32, d.y as f32])
+            } else {
+                Err(bad())
+            }
+        }
+        _ => Err(bad()),
+    }
+}
+
+/// A Dim value.
+pub fn new_dim(v: [f32; 2]) -> Dim {
+    Dim {
+        x: v[0] as f64,
+        y: v[1] as f64,
+    }
 }

@@ -16,7 +16,7 @@ pub use convert::{
     describe, expected, finite_number, finite_vector, lua_number, new_vector, number, sdk_error,
     vector, DESCRIBE,
 };
-pub use dim::Dim;
+pub use dim::{dim_arg, new_dim, Dim};
 
 use mlua::{Lua, Table};
 

@@ -1,15 +1,17 @@
 //! `PhysicsObject`: what `plane:Add(part)` returns. Property reads index into the newest
 //! tick in shared memory; writes join the client's per-frame batch.
 
+pub(crate) mod props;
+
 use std::rc::Rc;
 
 use client_sdk::{Object, ObjectProp, Pin, Restraint};
 use mlua::{AnyUserData, Lua, MetaMethod, Table, UserData, UserDataMethods, Value};
 
 use super::part::{Body, Ended, PartState};
-use crate::props::object::OBJECT;
 use crate::props::{Kind, Target};
 use crate::values::{describe, expected, new_vector, rotation, sdk_error, DESCRIBE};
+use props::OBJECT;
 
 /// RotateTo's documented default strength.
 const DEFAULT_STRENGTH: f64 = 8.0;
@@ -115,7 +117,7 @@ impl Target for PhysicsObject {
         name: &str,
         index: usize,
     ) -> mlua::Result<client_sdk::settings::table::AnyValue> {
-        crate::props::object::table_get(self, name, index)
+        props::table_get(self, name, index)
     }
 
     fn table_prop(
@@ -123,7 +125,7 @@ impl Target for PhysicsObject {
         index: usize,
         v: client_sdk::settings::table::AnyValue,
     ) -> mlua::Result<ObjectProp> {
-        crate::props::object::table_prop(name, index, v)
+        props::table_prop(name, index, v)
     }
 }
 

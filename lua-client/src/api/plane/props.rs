@@ -11,8 +11,8 @@ use client_sdk::settings::table::AnyValue;
 use client_sdk::PlaneProp;
 use mlua::{Error as LuaError, Value};
 
-use super::{Get, Kind, Props, Row, Set};
-use crate::api::plane::PlaneState;
+use super::PlaneState;
+use crate::props::{Get, Kind, Props, Row, Set};
 use crate::values::sdk_error;
 
 /// The rows of `PhysicsPlane` beyond its options.

@@ -4,8 +4,8 @@
 
 use mlua::Value;
 
-use super::{Get, Kind, Props, Row, Set};
-use crate::api::part::{BasePart, PartState};
+use super::{BasePart, PartState};
+use crate::props::{Get, Kind, Props, Row, Set};
 use crate::values::{new_vector, sdk_error};
 
 /// The rows of `BasePart`.

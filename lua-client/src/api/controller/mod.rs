@@ -3,6 +3,8 @@
 //! part's CFrame follows zero-copy like any simulated part. Signals (Jumped, Landed, Moved,
 //! WaypointReached, PathFinished) come from the plane's per-tick event stream.
 
+pub(crate) mod props;
+
 use std::cell::{Cell, RefCell};
 use std::rc::{Rc, Weak};
 
@@ -12,9 +14,9 @@ use mlua::{AnyUserData, Lua, MetaMethod, MultiValue, UserData, UserDataMethods, 
 use super::part::{BasePart, Body, Ended, PartState};
 use super::plane::PlaneState;
 use crate::host::signal::Signal;
-use crate::props::controller::CONTROLLER;
 use crate::props::Target;
 use crate::values::{describe, expected, finite_number, sdk_error, vector, CFrame};
+use props::CONTROLLER;
 
 /// A controller as the host holds it.
 pub struct ControllerState {

@@ -10,9 +10,9 @@ use client_sdk::settings::table::AnyValue;
 use client_sdk::{BodyState, ObjectInfo, ObjectProp, Pose};
 use mlua::{Error as LuaError, Value};
 
-use super::{Get, Kind, Props, Row, Set};
-use crate::api::object::PhysicsObject;
+use super::PhysicsObject;
 use crate::api::part::PartState;
+use crate::props::{Get, Kind, Props, Row, Set};
 use crate::values::{new_vector, sdk_error, CFrame};
 
 /// The object's properties (the SDK's mirror; one round trip the first time).

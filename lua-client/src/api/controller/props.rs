@@ -6,8 +6,8 @@
 use client_sdk::{ControllerInfo, ControllerProp};
 use mlua::{Error as LuaError, Value};
 
-use super::{Get, Kind, Props, Row, Set};
-use crate::api::controller::LuaController;
+use super::LuaController;
+use crate::props::{Get, Kind, Props, Row, Set};
 use crate::values::{new_vector, sdk_error};
 
 /// The controller's settings and state as the daemon holds them (one round trip).

@@ -1,5 +1,7 @@
 //! `PhysicsService.New` and the `PhysicsPlane` it returns.
 
+pub(crate) mod props;
+
 use std::cell::{Cell, RefCell};
 use std::rc::Rc;
 
@@ -14,9 +16,9 @@ use super::controller::{new_controller, ControllerState};
 use super::object::PhysicsObject;
 use super::part::{BasePart, Body, Ended, PartState};
 use crate::host::scheduler::scheduler;
-use crate::props::plane::PLANE;
 use crate::props::Target;
 use crate::values::{describe, expected, finite_number, sdk_error};
+use props::PLANE;
 
 /// A plane as the host holds it. Its options live in the daemon alone: the property rows
 /// read them back from there.
@@ -169,7 +171,7 @@ impl Target for PlaneState {
         name: &str,
         index: usize,
     ) -> mlua::Result<client_sdk::settings::table::AnyValue> {
-        crate::props::plane::table_get(self, name, index)
+        props::table_get(self, name, index)
     }
 
     fn table_prop(
@@ -177,7 +179,7 @@ impl Target for PlaneState {
         index: usize,
         v: client_sdk::settings::table::AnyValue,
     ) -> mlua::Result<PlaneProp> {
-        crate::props::plane::table_prop(name, index, v)
+        props::table_prop(name, index, v)
     }
 }
 

@@ -1,6 +1,8 @@
 //! `Renderable.BasePart`: the host stand-in for a visual part. Once a plane simulates it,
 //! reading `part.CFrame` returns the pose of the newest tick, read from shared memory.
 
+pub(crate) mod props;
+
 use client_sdk::DEFAULT_GROUP;
 use std::cell::{Cell, RefCell};
 use std::rc::{Rc, Weak};
@@ -12,12 +14,12 @@ use super::plane::PlaneState;
 use crate::host::scheduler::scheduler;
 use crate::host::signal::Signal;
 use crate::host::Watched;
-use crate::props::part::PART;
 use crate::props::Target;
 use crate::values::{
     describe, expected, finite_number, finite_vector, new_vector, sdk_error, CFrame, CFrameCache,
     DESCRIBE,
 };
+use props::PART;
 
 /// Shapes a BasePart can have (the collider the plane builds from it). The part's origin is
 /// the centre of its Size box for every shape.

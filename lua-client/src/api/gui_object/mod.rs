@@ -2,13 +2,16 @@
 //! the rows in `props/gui.rs`; its methods are `ApplyImpulse`, `ApplyForce`, `Wake` and
 //! `Destroy` (the primitive stays at its last simulated position).
 
+pub(crate) mod props;
+
 use std::rc::{Rc, Weak};
 
 use client_sdk::{GuiObject, GuiObjectProp};
 use mlua::{MetaMethod, UserData, UserDataMethods, Value};
 
-use super::gui_basic::{dim_arg, GuiPrimitive, PrimState};
+use super::gui_basic::{GuiPrimitive, PrimState};
 use super::gui_plane::GuiPlaneState;
+use crate::values::dim_arg;
 use crate::values::sdk_error;
 
 /// The Lua handle of a GUI body.
@@ -73,11 +76,11 @@ impl UserData for PhysicsGuiObject {
         });
         methods.add_method("Primitive", |_, o, ()| Ok(GuiPrimitive(o.prim.clone())));
         methods.add_meta_method(MetaMethod::Index, |lua, o, key: Value| {
-            crate::props::gui::object_get(lua, o, &key)
+            props::GUI_OBJECT.get(lua, o, &key)
         });
         methods.add_meta_method(
             MetaMethod::NewIndex,
-            |_, o, (key, value): (Value, Value)| crate::props::gui::object_set(o, &key, &value),
+            |lua, o, (key, value): (Value, Value)| props::GUI_OBJECT.set(lua, o, &key, &value),
         );
         methods.add_meta_method(MetaMethod::ToString, |_, o, ()| {
             Ok(if o.alive() {

@@ -6,6 +6,8 @@
 //! announces its primitives' new Position / Rotation to listeners and delivers controller
 //! signals in the order the daemon produced them.
 
+pub(crate) mod props;
+
 use std::cell::{Cell, RefCell};
 use std::collections::HashMap;
 use std::rc::Rc;
@@ -14,14 +16,14 @@ use client_sdk::validate::MAX_DT;
 use client_sdk::{GuiPlane, GuiPlaneOptions, GuiPlaneProp, Handle, PlaneProp};
 use mlua::{Lua, MetaMethod, MultiValue, UserData, UserDataMethods, Value};
 
-use super::gui_basic::{dim_arg, new_dim, GuiPrimitive, PrimState};
+use super::gui_basic::{GuiPrimitive, PrimState};
 use super::gui_controller::{ControllerState, GuiControllerUd};
 use super::gui_object::PhysicsGuiObject;
 use super::plane::context;
 use crate::host::scheduler::scheduler;
 use crate::host::Watched;
-use crate::props::gui::gui_plane_option;
 use crate::values::{describe, expected, finite_number, sdk_error};
+use crate::values::{dim_arg, new_dim};
 
 /// A GUI plane as the host holds it.
 pub struct GuiPlaneState {
@@ -264,11 +266,11 @@ impl UserData for GuiPhysicsPlane {
             p.0.destroy()
         });
         methods.add_meta_method(MetaMethod::Index, |lua, p, key: Value| {
-            crate::props::gui::plane_get(lua, &p.0, &key)
+            props::GUI_PLANE.get(lua, &p.0, &key)
         });
         methods.add_meta_method(
             MetaMethod::NewIndex,
-            |_, p, (key, value): (Value, Value)| crate::props::gui::plane_set(&p.0, &key, &value),
+            |lua, p, (key, value): (Value, Value)| props::GUI_PLANE.set(lua, &p.0, &key, &value),
         );
         methods.add_meta_method(MetaMethod::ToString, |_, p, ()| {
             Ok(match p.0.alive() {
@@ -317,7 +319,7 @@ pub fn new_gui(lua: &Lua, opts: Value) -> mlua::Result<GuiPhysicsPlane> {
             Value::String(s) if &*s.as_bytes() == b"BoundsMax" => {
                 bmax = Some(dim_arg(&format!("{WHAT} option BoundsMax"), &value)?)
             }
-            _ => match gui_plane_option(WHAT, &key, &value)? {
+            _ => match props::GUI_PLANE.option(WHAT, &key, &value)? {
                 PlaneProp::TickRate(v) => o.tick_rate = Some(v),
                 PlaneProp::Enabled(v) => o.enabled = Some(v),
                 PlaneProp::Gui(g) => match g {
