@@ -513,9 +513,10 @@ fn settings_table_rows_declare_their_kind() {
     use client_sdk::settings::table::{PropKind, PropRow};
     let d = Definitions::load();
     let mut problems = Vec::new();
-    let tables: [(&str, &[PropRow]); 2] = [
+    let tables: [(&str, &[PropRow]); 3] = [
         ("PhysicsObject", client_sdk::ObjectProp::ROWS),
         ("PhysicsPlane", client_sdk::PlaneProp::ROWS),
+        ("PhysicsGuiObject", client_sdk::GuiObjectProp::ROWS),
     ];
     let mut checked = 0;
     for (owner, rows) in tables {
@@ -526,6 +527,7 @@ fn settings_table_rows_declare_their_kind() {
                 PropKind::Float | PropKind::Integer { .. } => "number",
                 // Declared as the class Vector (Luau's `vector` at run time; see physics.d.luau).
                 PropKind::Vector => "Vector",
+                PropKind::Vector2 => "Dim",
                 PropKind::Pose => "CFrame",
                 PropKind::Other => "(no Luau type)",
             };

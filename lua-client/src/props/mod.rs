@@ -14,7 +14,7 @@
 use client_sdk::settings::table::{AnyValue, PropKind, PropRow, Range};
 use mlua::{Error as LuaError, Lua, Value};
 
-use crate::values::{describe, lua_number, new_vector, number, vector, CFrame, Dim};
+use crate::values::{describe, lua_number, new_dim, new_vector, number, vector, CFrame, Dim};
 
 /// A Lua type whose properties are rows, and how one of its property writes reaches the SDK.
 pub trait Target: 'static {
@@ -510,6 +510,7 @@ impl Kind {
             (PropKind::Integer { min, max }, _) => Kind::Integer { min, max },
             (PropKind::Vector, Range::Extent) => Kind::PositiveVector,
             (PropKind::Vector, _) => Kind::Vector,
+            (PropKind::Vector2, _) => Kind::Dim,
             (PropKind::Pose, _) => Kind::CFrame,
             // Structured values have rows of their own (methods or custom rows).
             (PropKind::Other, _) => Kind::String,
@@ -554,16 +555,18 @@ fn arg_to_any(arg: Arg) -> Result<AnyValue, LuaError> {
         Arg::Integer(i) => AnyValue::Integer(i),
         Arg::Bool(b) => AnyValue::Bool(b),
         Arg::Vector(v) => AnyValue::Vector(v),
-        other => return Err(mismatch(&other, "a number, boolean or Vector")),
+        Arg::Dim(d) => AnyValue::Vector2(d),
+        other => return Err(mismatch(&other, "a number, boolean, Vector or Dim")),
     })
 }
 
 /// A stored settings value as a Lua value (an `f32` reads back as written).
-fn any_to_lua(_lua: &Lua, v: AnyValue) -> Result<Value, LuaError> {
+fn any_to_lua(lua: &Lua, v: AnyValue) -> Result<Value, LuaError> {
     Ok(match v {
         AnyValue::Bool(b) => Value::Boolean(b),
         AnyValue::Float(x) => lua_number(x),
         AnyValue::Integer(i) => Value::Number(i as f64),
         AnyValue::Vector(v) => new_vector(v),
+        AnyValue::Vector2(d) => Value::UserData(lua.create_userdata(new_dim(d))?),
     })
 }

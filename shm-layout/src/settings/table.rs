@@ -45,6 +45,8 @@ pub enum PropKind {
     },
     /// Three `f32` components.
     Vector,
+    /// Two `f32` components (GUI planes: pixels).
+    Vector2,
     /// A position and a rotation (a CFrame).
     Pose,
     /// A structured value (a restraint, a controller, a GUI option) with its own API.
@@ -129,6 +131,8 @@ pub enum AnyValue {
     Integer(i64),
     /// A vector.
     Vector(Vec3),
+    /// A 2D vector (GUI planes).
+    Vector2([f32; 2]),
 }
 
 /// A payload type of a settings row: its kind, its check against a [`Range`], and its
@@ -244,6 +248,7 @@ macro_rules! integer_value {
 
 integer_value!(u32);
 integer_value!(u8);
+integer_value!(i32);
 
 impl PropValue for bool {
     const KIND: PropKind = PropKind::Bool;
@@ -281,6 +286,30 @@ impl PropValue for Vec3 {
     fn from_any(v: AnyValue) -> Option<Vec3> {
         match v {
             AnyValue::Vector(v) => Some(v),
+            _ => None,
+        }
+    }
+}
+
+impl PropValue for [f32; 2] {
+    const KIND: PropKind = PropKind::Vector2;
+    fn check(self, name: &str, range: &Range) -> Result<[f32; 2], CommandError> {
+        use crate::validate::extent;
+        match *range {
+            Range::Any => super::gui_plane::finite2(name, self),
+            Range::Extent => Ok([
+                extent(&format!("{name}.X"), self[0])?,
+                extent(&format!("{name}.Y"), self[1])?,
+            ]),
+            _ => Err(not_in_range(name, range, &self)),
+        }
+    }
+    fn to_any(&self) -> Option<AnyValue> {
+        Some(AnyValue::Vector2(*self))
+    }
+    fn from_any(v: AnyValue) -> Option<[f32; 2]> {
+        match v {
+            AnyValue::Vector2(v) => Some(v),
             _ => None,
         }
     }

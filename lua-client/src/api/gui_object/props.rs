@@ -1,15 +1,19 @@
 //! PhysicsGuiObject properties: rows on the shared row system (`crate::props`), like
 //! `PhysicsObject`'s. Position, Rotation, their velocities, Anchored and Sleeping read the
-//! SDK's read-your-writes view of the newest tick (no request); the other settings read the
-//! daemon's info; ZIndex, Size and Shape mirror the primitive (set them there). Every write
-//! is one `GuiObjectProp`.
+//! SDK's read-your-writes view of the newest tick (no request); ImpulseDirection reads the
+//! daemon's info; ZIndex, Size and Shape mirror the primitive (set them there). The plain
+//! stored settings (Mass, Friction, ...) are not listed here: they are the GUI object
+//! settings table's rows flagged `lua` (`Target::table_rows`). Every write is one
+//! `GuiObjectProp`.
 
-use client_sdk::settings::gui_object::MAX_GUI_FRICTION;
+use std::sync::OnceLock;
+
+use client_sdk::settings::table::AnyValue;
 use client_sdk::{GuiObjectInfo, GuiObjectProp};
 use mlua::{Error as LuaError, Lua, Value};
 
 use super::PhysicsGuiObject;
-use crate::props::{Get, Kind, Props, Row, Set, Target};
+use crate::props::{table_rows, Get, Kind, Props, Row, Set, Target};
 use crate::values::{lua_number, new_dim, sdk_error};
 
 impl Target for PhysicsGuiObject {
@@ -19,6 +23,26 @@ impl Target for PhysicsGuiObject {
         let what = format!("PhysicsGuiObject.{name}");
         self.check_alive(&what)?;
         self.object.set(prop).map_err(|e| sdk_error(&what, e))
+    }
+
+    /// The GUI object settings table's rows flagged `lua` (Mass, Friction, ...): read from
+    /// the daemon's info, written as one `GuiObjectProp`.
+    fn table_rows() -> &'static [Row<PhysicsGuiObject>] {
+        static ROWS: OnceLock<Vec<Row<PhysicsGuiObject>>> = OnceLock::new();
+        ROWS.get_or_init(|| table_rows(GuiObjectProp::ROWS))
+    }
+
+    fn table_get(&self, what: &str, index: usize) -> mlua::Result<AnyValue> {
+        let name = what.trim_start_matches("PhysicsGuiObject.");
+        info(self, name)?
+            .settings
+            .get(index)
+            .ok_or_else(|| LuaError::runtime(format!("{what} has no plain value")))
+    }
+
+    fn table_prop(what: &str, index: usize, v: AnyValue) -> mlua::Result<GuiObjectProp> {
+        GuiObjectProp::from_any(index, v)
+            .ok_or_else(|| LuaError::runtime(format!("{what} cannot take {v:?}")))
     }
 }
 
@@ -99,70 +123,10 @@ pub static GUI_OBJECT: Props<PhysicsGuiObject> = Props {
             set: Set::Prop(|a| Ok(GuiObjectProp::ImpulseDirection(a.dim()?))),
         },
         Row {
-            name: "ConstantForce",
-            kind: Kind::Dim,
-            get: from_info!("ConstantForce", constant_force, dim_value),
-            set: Set::Prop(|a| Ok(GuiObjectProp::ConstantForce(a.dim()?))),
-        },
-        Row {
-            name: "Mass",
-            kind: Kind::Number {
-                min: client_sdk::validate::MIN_MASS as f64,
-                max: f64::INFINITY,
-            },
-            get: from_info!("Mass", mass, number),
-            set: Set::Prop(|a| Ok(GuiObjectProp::Mass(a.number()? as f32))),
-        },
-        Row {
-            name: "Bounciness",
-            kind: Kind::UNIT,
-            get: from_info!("Bounciness", bounciness, number),
-            set: Set::Prop(|a| Ok(GuiObjectProp::Bounciness(a.number()? as f32))),
-        },
-        Row {
-            name: "Friction",
-            kind: Kind::Number {
-                min: 0.0,
-                max: MAX_GUI_FRICTION as f64,
-            },
-            get: from_info!("Friction", friction, number),
-            set: Set::Prop(|a| Ok(GuiObjectProp::Friction(a.number()? as f32))),
-        },
-        Row {
             name: "Anchored",
             kind: Kind::Boolean,
             get: from_tick!("Anchored", is_anchored, boolean),
             set: Set::Prop(|a| Ok(GuiObjectProp::Anchored(a.bool()?))),
-        },
-        Row {
-            name: "CanCollide",
-            kind: Kind::Boolean,
-            get: from_info!("CanCollide", can_collide, boolean),
-            set: Set::Prop(|a| Ok(GuiObjectProp::CanCollide(a.bool()?))),
-        },
-        Row {
-            name: "GravityScale",
-            kind: Kind::ANY_NUMBER,
-            get: from_info!("GravityScale", gravity_scale, number),
-            set: Set::Prop(|a| Ok(GuiObjectProp::GravityScale(a.number()? as f32))),
-        },
-        Row {
-            name: "LockedX",
-            kind: Kind::Boolean,
-            get: from_info!("LockedX", locked_x, boolean),
-            set: Set::Prop(|a| Ok(GuiObjectProp::LockedX(a.bool()?))),
-        },
-        Row {
-            name: "LockedY",
-            kind: Kind::Boolean,
-            get: from_info!("LockedY", locked_y, boolean),
-            set: Set::Prop(|a| Ok(GuiObjectProp::LockedY(a.bool()?))),
-        },
-        Row {
-            name: "LockedRotation",
-            kind: Kind::Boolean,
-            get: from_info!("LockedRotation", locked_rotation, boolean),
-            set: Set::Prop(|a| Ok(GuiObjectProp::LockedRotation(a.bool()?))),
         },
         Row {
             name: "Sleeping",
