@@ -614,7 +614,7 @@ macro_rules! settings_table {
 
             /// The variant's position in [`Self::ROWS`] (its wire index).
             pub const fn index(&self) -> usize {
-                #[allow(dead_code)]
+                #[allow(dead_code, clippy::enum_variant_names)]
                 enum Index {
                     $($Variant,)*
                 }
