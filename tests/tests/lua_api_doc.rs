@@ -161,6 +161,7 @@ fn range_text(kind: PropKind, range: Range) -> String {
         Range::Within(lo, hi) => format!("[{lo}, {hi}]"),
         Range::Clamped(lo, hi) => format!("clamped to [{lo}, {hi}]"),
         Range::Bounded(max) => format!("components within ±{max}"),
+        Range::UnitAxes(a, b) => format!("{a} and {b} within [-1, 1]"),
         Range::Extent => format!(
             "components within [{}, {}]",
             shm_layout::validate::MIN_SIZE,

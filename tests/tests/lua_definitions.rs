@@ -513,7 +513,8 @@ fn settings_table_rows_declare_their_kind() {
     use client_sdk::settings::table::{PropKind, PropRow};
     let d = Definitions::load();
     let mut problems = Vec::new();
-    let tables: [(&str, &[PropRow]); 3] = [
+    let tables: [(&str, &[PropRow]); 4] = [
+        ("Controller", client_sdk::ControllerProp::ROWS),
         ("PhysicsObject", client_sdk::ObjectProp::ROWS),
         ("PhysicsPlane", client_sdk::PlaneProp::ROWS),
         ("PhysicsGuiObject", client_sdk::GuiObjectProp::ROWS),

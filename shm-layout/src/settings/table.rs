@@ -73,6 +73,8 @@ pub enum Range {
     /// Vector components that are part extents (within `[MIN_SIZE, MAX_SIZE]`; errors name
     /// the axis).
     Extent,
+    /// Two components in `[-1, 1]` (a motion intent); errors name the axis by these names.
+    UnitAxes(&'static str, &'static str),
 }
 
 /// One row of a settings table: what every consumer may read about a property.
@@ -185,7 +187,9 @@ impl PropValue for f32 {
             }
             Range::Within(lo, hi) => in_range(name, self, lo as f32, hi as f32),
             Range::Clamped(lo, hi) => clamped(name, self, lo as f32, hi as f32),
-            Range::Bounded(_) | Range::Extent => Err(not_in_range(name, range, &self)),
+            Range::Bounded(_) | Range::Extent | Range::UnitAxes(..) => {
+                Err(not_in_range(name, range, &self))
+            }
         }
     }
     fn text(&self) -> String {
@@ -294,13 +298,20 @@ impl PropValue for Vec3 {
 impl PropValue for [f32; 2] {
     const KIND: PropKind = PropKind::Vector2;
     fn check(self, name: &str, range: &Range) -> Result<[f32; 2], CommandError> {
-        use crate::validate::extent;
+        use crate::validate::{extent, finite};
         match *range {
             Range::Any => super::gui_plane::finite2(name, self),
             Range::Extent => Ok([
                 extent(&format!("{name}.X"), self[0])?,
                 extent(&format!("{name}.Y"), self[1])?,
             ]),
+            Range::UnitAxes(a, b) => {
+                let unit = |axis: &str, c: f32| {
+                    let field = format!("{name}.{axis}");
+                    crate::validate::in_range(&field, finite(&field, c)?, -1.0, 1.0)
+                };
+                Ok([unit(a, self[0])?, unit(b, self[1])?])
+            }
             _ => Err(not_in_range(name, range, &self)),
         }
     }
@@ -341,7 +352,8 @@ structured_value!(
     super::object::Restraint,
     Option<super::object::RotateTo>,
     Option<super::object::Pin>,
-    super::gui_plane::GuiPlaneProp
+    super::gui_plane::GuiPlaneProp,
+    Option<f32>
 );
 
 /// `$a` when given, else `$b` (a type).

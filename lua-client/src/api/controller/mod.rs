@@ -153,6 +153,28 @@ impl Target for LuaController {
             .set(prop)
             .map_err(|e| sdk_error(&format!("Controller.{name}"), e))
     }
+
+    fn table_rows() -> &'static [crate::props::Row<LuaController>] {
+        static ROWS: std::sync::OnceLock<Vec<crate::props::Row<LuaController>>> =
+            std::sync::OnceLock::new();
+        ROWS.get_or_init(|| crate::props::table_rows(ControllerProp::ROWS))
+    }
+
+    fn table_get(
+        &self,
+        name: &str,
+        index: usize,
+    ) -> mlua::Result<client_sdk::settings::table::AnyValue> {
+        props::table_get(self, name, index)
+    }
+
+    fn table_prop(
+        name: &str,
+        index: usize,
+        v: client_sdk::settings::table::AnyValue,
+    ) -> mlua::Result<ControllerProp> {
+        props::table_prop(name, index, v)
+    }
 }
 
 /// A point: a Vector, or a CFrame's position.

@@ -1,8 +1,12 @@
 //! Controller properties. Position, Rotation, Velocity and OnGround read the newest tick in
 //! shared memory (no request); settings and path state read back from the daemon
-//! (`controller.info()`, one round trip). Every write is one `ControllerProp`; the writable
-//! rows are also the options of `plane:NewController(part, opts)`.
+//! (`controller.info()`, one round trip). The plain settings (WalkSpeed, JumpPower, ...) are
+//! not listed here: they are the controller settings table's rows flagged `lua`
+//! ([`table_get`], [`table_prop`]), their ranges taken from the table. Every write is one
+//! `ControllerProp`; the writable rows are also the options of `plane:NewController(part,
+//! opts)`.
 
+use client_sdk::settings::table::AnyValue;
 use client_sdk::{ControllerInfo, ControllerProp};
 use mlua::{Error as LuaError, Value};
 
@@ -10,35 +14,26 @@ use super::LuaController;
 use crate::props::{Get, Kind, Props, Row, Set};
 use crate::values::{new_vector, sdk_error};
 
+/// The stored value of the controller settings row at `index` (read back from the daemon).
+pub fn table_get(c: &LuaController, what: &str, index: usize) -> Result<AnyValue, LuaError> {
+    let name = what.trim_start_matches("Controller.");
+    info(c, name)?
+        .settings
+        .get(index)
+        .ok_or_else(|| LuaError::runtime(format!("{what} has no plain value")))
+}
+
+/// The property write of the controller settings row at `index`.
+pub fn table_prop(what: &str, index: usize, v: AnyValue) -> Result<ControllerProp, LuaError> {
+    ControllerProp::from_any(index, v)
+        .ok_or_else(|| LuaError::runtime(format!("{what} cannot take {v:?}")))
+}
+
 /// The controller's settings and state as the daemon holds them (one round trip).
 fn info(c: &LuaController, what: &str) -> Result<ControllerInfo, LuaError> {
     c.live(what)?
         .info()
         .map_err(|e| sdk_error(&format!("Controller.{what}"), e))
-}
-
-/// A number setting read back from the daemon.
-macro_rules! number_row {
-    ($name:literal, $kind:expr, $field:ident, $prop:path) => {
-        Row {
-            name: $name,
-            kind: $kind,
-            get: Get::Fn(|_, c| Ok(crate::values::lua_number(info(c, $name)?.$field))),
-            set: Set::Prop(|a| Ok($prop(a.number()? as f32))),
-        }
-    };
-}
-
-/// A boolean setting read back from the daemon.
-macro_rules! bool_row {
-    ($name:literal, $field:ident, $prop:path) => {
-        Row {
-            name: $name,
-            kind: Kind::Boolean,
-            get: Get::Fn(|_, c| Ok(Value::Boolean(info(c, $name)?.$field))),
-            set: Set::Prop(|a| Ok($prop(a.bool()?))),
-        }
-    };
 }
 
 /// A signal of the controller (created on first access).
@@ -52,11 +47,6 @@ macro_rules! signal_row {
         }
     };
 }
-
-const SPEED: Kind = Kind::Number {
-    min: 0.0,
-    max: 10_000.0,
-};
 
 /// The rows of `Controller`.
 pub static CONTROLLER: Props<LuaController> = Props {
@@ -80,40 +70,6 @@ pub static CONTROLLER: Props<LuaController> = Props {
             get: Get::Fn(|_, c| Ok(new_vector([0.0, c.yaw("Rotation")?, 0.0]))),
             set: Set::Prop(|a| Ok(ControllerProp::Rotation(a.vector()?))),
         },
-        number_row!("WalkSpeed", SPEED, walk_speed, ControllerProp::WalkSpeed),
-        number_row!("JumpPower", SPEED, jump_power, ControllerProp::JumpPower),
-        number_row!(
-            "TurnSpeed",
-            Kind::Number {
-                min: 0.0,
-                max: 10_000.0
-            },
-            turn_speed,
-            ControllerProp::TurnSpeed
-        ),
-        number_row!(
-            "Gravity",
-            Kind::Number {
-                min: -100_000.0,
-                max: 100_000.0
-            },
-            gravity,
-            ControllerProp::Gravity
-        ),
-        bool_row!(
-            "UsePlaneGravity",
-            use_plane_gravity,
-            ControllerProp::UsePlaneGravity
-        ),
-        number_row!(
-            "MaxSlope",
-            Kind::Number {
-                min: 0.0,
-                max: 89.0
-            },
-            max_slope,
-            ControllerProp::MaxSlope
-        ),
         Row {
             name: "GroundY",
             kind: Kind::OptionalNumber,
@@ -129,77 +85,6 @@ pub static CONTROLLER: Props<LuaController> = Props {
                 ))
             }),
         },
-        number_row!(
-            "CapsuleRadius",
-            Kind::Number {
-                min: 0.001,
-                max: 100_000.0
-            },
-            capsule_radius,
-            ControllerProp::CapsuleRadius
-        ),
-        number_row!(
-            "CapsuleHalfHeight",
-            Kind::Number {
-                min: 0.0,
-                max: 100_000.0
-            },
-            capsule_half_height,
-            ControllerProp::CapsuleHalfHeight
-        ),
-        number_row!(
-            "WaypointThreshold",
-            Kind::Number {
-                min: 0.001,
-                max: 100_000.0
-            },
-            waypoint_threshold,
-            ControllerProp::WaypointThreshold
-        ),
-        bool_row!(
-            "LookWhereMoving",
-            look_where_moving,
-            ControllerProp::LookWhereMoving
-        ),
-        number_row!(
-            "StepHeight",
-            Kind::Number {
-                min: 0.0,
-                max: 100_000.0
-            },
-            step_height,
-            ControllerProp::StepHeight
-        ),
-        number_row!(
-            "Acceleration",
-            Kind::Number {
-                min: 0.0,
-                max: 10_000.0
-            },
-            acceleration,
-            ControllerProp::Acceleration
-        ),
-        number_row!(
-            "Friction",
-            Kind::Number {
-                min: 0.0,
-                max: 10_000.0
-            },
-            friction,
-            ControllerProp::Friction
-        ),
-        number_row!(
-            "AirControl",
-            Kind::UNIT,
-            air_control,
-            ControllerProp::AirControl
-        ),
-        number_row!(
-            "PushStrength",
-            Kind::NON_NEGATIVE,
-            push_strength,
-            ControllerProp::PushStrength
-        ),
         Row {
             name: "OnGround",
             kind: Kind::Boolean,
