@@ -10,7 +10,7 @@
 //! Every iceoryx2 port is built in one module (`transport`); the other modules hold what it
 //! returns.
 
-#![warn(missing_docs)]
+#![deny(missing_docs)]
 
 pub mod axis_motor;
 mod client;

@@ -23,7 +23,7 @@
 //! thread drives all clients in turn, and with manual planes the replies, hence the whole
 //! run, repeat for a seed (automatically ticking planes add wall-clock timing).
 
-#![warn(missing_docs)]
+#![deny(missing_docs)]
 
 pub mod gen;
 pub mod raw;

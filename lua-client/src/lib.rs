@@ -1,4 +1,4 @@
-#![warn(missing_docs)]
+#![deny(missing_docs)]
 //! The documented Luau `PhysicsService` API on top of client-sdk.
 //!
 //! [`install`] puts the API into a host's Lua state: the global `import(name)` (modules

@@ -8,7 +8,7 @@
 //! - `gpu`: the GPU path of 3D planes (`DeferGpu`, wgpu compute), behind the `gpu` feature.
 //! - [`publish`]: writing a plane's tick into loaned shared-memory samples.
 
-#![warn(missing_docs)]
+#![deny(missing_docs)]
 
 pub mod backend;
 #[cfg(feature = "gpu")]

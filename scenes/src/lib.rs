@@ -13,7 +13,7 @@
 //!
 //! The fuzzer of the daemon's request decoder lives in its own crate, `physics-fuzz`.
 
-#![warn(missing_docs)]
+#![deny(missing_docs)]
 
 pub mod builders;
 pub mod target;

@@ -15,7 +15,7 @@
 //!
 //! No simulation code and no I/O live here, so both sides agree on one definition.
 
-#![warn(missing_docs)]
+#![deny(missing_docs)]
 
 pub mod axis_motor;
 pub mod codec;

@@ -1,10 +1,10 @@
-//! The settings table: one declarative row per property, from which [`settings_table!`]
-//! derives everything that used to be restated per property: the wire enum (variant order
-//! is row order, so the postcard variant indices stay what they were), the settings struct
-//! with its defaults, the store into it, the check (errors name the property and the value),
-//! and a const slice of [`PropRow`] metadata (name, kind, range, flags, doc) that the SDK's
-//! mirror, the Lua property rows, the fuzzer and the definitions test read instead of
-//! restating ranges and names.
+//! The settings table: one declarative row per property, from which
+//! [`settings_table!`](crate::settings_table) derives everything that used to be restated per
+//! property: the wire enum (variant order is row order, so the postcard variant indices stay what
+//! they were), the settings struct with its defaults, the store into it, the check (errors name the
+//! property and the value), and a const slice of [`PropRow`] metadata (name, kind, range, flags,
+//! doc) that the SDK's mirror, the Lua property rows, the fuzzer and the definitions test read
+//! instead of restating ranges and names.
 //!
 //! A row reads
 //!
