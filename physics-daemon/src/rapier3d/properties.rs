@@ -8,10 +8,31 @@ use super::objects::rapier_pose;
 use super::Plane;
 
 impl Plane {
-    /// Sets one property of an object (checked first; errors name the property and value).
+    /// Sets one property of an object (checked first; errors name the property and value):
+    /// the stored settings, then the rapier state the change touches, then the plane's
+    /// per-part counts.
     pub fn set_object(&mut self, handle: Handle, prop: ObjectProp) -> Result<(), CommandError> {
         let prop = prop.checked()?;
-        if let ObjectProp::CollisionGroup(g) = prop {
+        self.check_object_prop(handle, &prop)?;
+        let h = self.body_of(handle)?;
+        let before = Counted::of(&self.bodies.get(handle)?.part);
+        let touched = self.apply_to_body(handle, h, prop)?;
+        if let ObjectProp::Held(on) = prop {
+            self.hold(h, on);
+        }
+        self.reconfigure(handle, h, touched)?;
+        self.recount(before, Counted::of(&self.bodies.get(handle)?.part));
+        self.query_stale.push(h);
+        // Any change may need the body awake and seen by the next force pass.
+        self.world.bodies[h].wake_up(true);
+        self.dirty.mark(handle.slot);
+        Ok(())
+    }
+
+    /// What the plane refuses beyond the value's own check: unregistered collision groups,
+    /// and properties a triangle map cannot take.
+    fn check_object_prop(&self, handle: Handle, prop: &ObjectProp) -> Result<(), CommandError> {
+        if let ObjectProp::CollisionGroup(g) = *prop {
             if !self.groups.is_registered(g) {
                 return Err(CommandError::invalid_field(
                     "CollisionGroup",
@@ -22,17 +43,28 @@ impl Plane {
                 ));
             }
         }
-        let h = self.body_of(handle)?;
-        if self.part(handle).map.is_some() {
-            super::maps::check_map_prop(&prop)?;
+        if self.bodies.get(handle)?.part.map.is_some() {
+            super::maps::check_map_prop(prop)?;
         }
+        Ok(())
+    }
+
+    /// Stores the property in the part and applies what maps directly onto the rapier body;
+    /// returns what must be rebuilt from the part's settings.
+    fn apply_to_body(
+        &mut self,
+        handle: Handle,
+        h: RigidBodyHandle,
+        prop: ObjectProp,
+    ) -> Result<Touched, CommandError> {
         let part = &mut self.bodies.get_mut(handle)?.part;
-        let was_driven = part.is_driven();
         let was_reporting = part.report_contacts;
-        let old_quality = part.hit_box_quality;
-        // Stored settings first; then which rapier state the change touches.
         let stored = part.settings.store(&prop);
-        let (mut collider_changed, mut body_changed, mut shape_changed) = (false, false, false);
+        debug_assert_eq!(
+            stored,
+            !prop.is_published() && !matches!(prop, ObjectProp::Size(_) | ObjectProp::Held(_))
+        );
+        let mut touched = Touched::default();
         let body = &mut self.world.bodies[h];
         match prop {
             ObjectProp::Pose(p) => body.set_position(rapier_pose(p), true),
@@ -54,22 +86,22 @@ impl Plane {
             }
             ObjectProp::Size(size) => {
                 part.resize(size)?;
-                shape_changed = true;
+                touched.shape = true;
             }
             ObjectProp::ReportContacts(_) => {
-                collider_changed = was_reporting != part.report_contacts
+                touched.collider = was_reporting != part.report_contacts
             }
             ObjectProp::Weight(_)
             | ObjectProp::Density(_)
             | ObjectProp::Bounciness(_)
             | ObjectProp::Friction(_)
             | ObjectProp::CanCollide(_)
-            | ObjectProp::CollisionGroup(_) => collider_changed = true,
+            | ObjectProp::CollisionGroup(_) => touched.collider = true,
             ObjectProp::HitBoxQuality(_) | ObjectProp::CenterOfMass(_) => {
-                collider_changed = true;
-                body_changed = true;
+                touched.collider = true;
+                touched.body = true;
             }
-            ObjectProp::FieldRestraint(_) => body_changed = true,
+            ObjectProp::FieldRestraint(_) => touched.body = true,
             ObjectProp::Held(_) => {}
             ObjectProp::GravityScale(k) => body.set_gravity_scale(k, true),
             // Read by the force pass every tick.
@@ -78,15 +110,20 @@ impl Plane {
             | ObjectProp::RotateTo(_)
             | ObjectProp::Pin(_) => {}
         }
-        debug_assert_eq!(
-            stored,
-            !prop.is_published() && !matches!(prop, ObjectProp::Size(_) | ObjectProp::Held(_))
-        );
-        if let ObjectProp::Held(on) = prop {
-            self.hold(h, on);
-        }
+        Ok(touched)
+    }
+
+    /// Rebuilds the collider (a new one when the shape changed) and the body's mass and
+    /// locks from the part's settings, as far as `touched` says.
+    fn reconfigure(
+        &mut self,
+        handle: Handle,
+        h: RigidBodyHandle,
+        touched: Touched,
+    ) -> Result<(), CommandError> {
         let part = &self.bodies.get(handle)?.part;
-        if shape_changed {
+        let mut body_changed = touched.body;
+        if touched.shape {
             // Rapier recycles the contacts of pairs whose poses did not move, even when a
             // shape changed: a fresh collider gets fresh contacts.
             for c in self.world.bodies[h].colliders().to_vec() {
@@ -97,7 +134,7 @@ impl Plane {
             part.configure_collider(&mut collider, &self.groups)?;
             self.world.insert_collider(collider, Some(h));
             body_changed = true;
-        } else if collider_changed {
+        } else if touched.collider {
             for c in self.world.bodies[h].colliders().to_vec() {
                 part.configure_collider(&mut self.world.colliders[c], &self.groups)?;
             }
@@ -106,25 +143,55 @@ impl Plane {
         if body_changed {
             part.configure_body(&mut self.world.bodies[h], &self.world.colliders);
         }
-        if part.hit_box_quality != old_quality {
-            self.quality_counts[old_quality as usize] -= 1;
-            self.quality_counts[part.hit_box_quality as usize] += 1;
+        Ok(())
+    }
+
+    /// Keeps the plane's per-part counts (objects per quality, driven, reporting) in step
+    /// with one part's change.
+    fn recount(&mut self, before: Counted, after: Counted) {
+        if before.quality != after.quality {
+            self.quality_counts[before.quality as usize] -= 1;
+            self.quality_counts[after.quality as usize] += 1;
         }
-        match (was_driven, part.is_driven()) {
+        match (before.driven, after.driven) {
             (false, true) => self.driven += 1,
             (true, false) => self.driven -= 1,
             _ => {}
         }
-        match (was_reporting, part.report_contacts) {
+        match (before.reporting, after.reporting) {
             (false, true) => self.reporting += 1,
             (true, false) => self.reporting -= 1,
             _ => {}
         }
-        self.query_stale.push(h);
-        // Any change may need the body awake and seen by the next force pass.
-        self.world.bodies[h].wake_up(true);
-        self.dirty.mark(handle.slot);
-        Ok(())
+    }
+}
+
+/// What a property change leaves to rebuild from the part's settings.
+#[derive(Default, Clone, Copy)]
+struct Touched {
+    /// The collider's material, groups, flags or mass.
+    collider: bool,
+    /// The body's mass properties and locks.
+    body: bool,
+    /// The shape: a fresh collider.
+    shape: bool,
+}
+
+/// What the plane counts about a part.
+#[derive(Clone, Copy)]
+struct Counted {
+    quality: u32,
+    driven: bool,
+    reporting: bool,
+}
+
+impl Counted {
+    fn of(part: &super::part::Part) -> Counted {
+        Counted {
+            quality: part.hit_box_quality,
+            driven: part.is_driven(),
+            reporting: part.report_contacts,
+        }
     }
 }
 
