@@ -75,5 +75,6 @@ pub fn install(lua: &Lua, client: Client) -> mlua::Result<Host> {
     let dyn_mesh: Table = globals.get::<mlua::Function>("import")?.call("DynMesh")?;
     globals.set("DynMesh", dyn_mesh)?;
     globals.set("wait", scheduler::wait_function(lua)?)?;
-    Ok(Host::new(lua, scheduler, client))
+    let daemon = api::plane::context(lua);
+    Ok(Host::new(lua, scheduler, client, daemon))
 }

@@ -318,10 +318,10 @@ impl UserData for Map {
 
 /// The script's `Map` value of `map` (one per map: see `identity.rs`).
 pub(crate) fn map_ud(lua: &Lua, map: &Rc<MapState>) -> mlua::Result<AnyUserData> {
-    super::identity::userdata(
+    crate::host::identity::userdata(
         lua,
         Rc::as_ptr(map).cast(),
-        super::identity::tag::MAP,
+        crate::host::identity::tag::MAP,
         || Map(map.clone()),
     )
 }

@@ -13,7 +13,6 @@ pub mod gui_basic;
 pub mod gui_controller;
 pub mod gui_object;
 pub mod gui_plane;
-pub(crate) mod identity;
 pub mod joint;
 pub mod map;
 pub mod object;

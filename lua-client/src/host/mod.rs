@@ -5,6 +5,7 @@
 
 pub mod assets;
 pub mod errors;
+pub(crate) mod identity;
 pub mod scheduler;
 pub mod signal;
 pub mod watchdog;
@@ -37,20 +38,36 @@ pub trait Watched {
     }
 }
 
+/// The API's watch on the daemon's health, run once per frame (`PhysicsService.Stalled` /
+/// `Resumed`).
+pub trait DaemonWatch {
+    /// Fires the stall / resume signals when the daemon's health changed.
+    fn watch(&self, lua: &Lua) -> mlua::Result<()>;
+    /// Whether a script listens (the host then keeps running frames while it only waits).
+    fn watching(&self) -> bool;
+}
+
 /// A host's handle on the installed API: drives frames.
 pub struct Host {
     lua: Lua,
     scheduler: Rc<Scheduler>,
     client: Client,
+    daemon: Rc<dyn DaemonWatch>,
 }
 
 impl Host {
     /// The handle `install` returns for `lua`.
-    pub(crate) fn new(lua: &Lua, scheduler: Rc<Scheduler>, client: Client) -> Host {
+    pub(crate) fn new(
+        lua: &Lua,
+        scheduler: Rc<Scheduler>,
+        client: Client,
+        daemon: Rc<dyn DaemonWatch>,
+    ) -> Host {
         Host {
             lua: lua.clone(),
             scheduler,
             client,
+            daemon,
         }
     }
 
@@ -63,7 +80,7 @@ impl Host {
     pub fn frame(&self, dt: f64) -> mlua::Result<()> {
         // Reads in this frame take each plane's newest sample once.
         self.client.begin_frame();
-        crate::api::plane::context(&self.lua).watch_daemon(&self.lua)?;
+        self.daemon.watch(&self.lua)?;
         self.scheduler.frame(&self.lua, dt)?;
         self.flush()
     }
@@ -71,7 +88,7 @@ impl Host {
     /// Whether the script listens to `PhysicsService.Stalled` / `Resumed`: the host then
     /// runs a frame at least every [`WATCH_PERIOD`] while the script only waits.
     pub fn watching_daemon(&self) -> bool {
-        crate::api::plane::context(&self.lua).watching_daemon()
+        self.daemon.watching()
     }
 
     /// Sends the queued writes as one request.

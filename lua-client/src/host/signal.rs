@@ -66,10 +66,10 @@ impl Signal {
     /// The script's value of this signal: the same userdata on every read while the script
     /// holds it (`part.Touched == part.Touched`, `rawequal`), through the identity registry.
     pub fn userdata(&self, lua: &Lua) -> mlua::Result<mlua::AnyUserData> {
-        crate::api::identity::userdata(
+        super::identity::userdata(
             lua,
             Rc::as_ptr(&self.0).cast(),
-            crate::api::identity::tag::SIGNAL,
+            super::identity::tag::SIGNAL,
             || self.clone(),
         )
     }

@@ -98,10 +98,10 @@ pub(crate) fn gui_object_ud(
     o: PhysicsGuiObject,
 ) -> mlua::Result<mlua::AnyUserData> {
     let handle = o.object.handle();
-    super::identity::userdata_if(
+    crate::host::identity::userdata_if(
         lua,
         Rc::as_ptr(&o.prim).cast(),
-        super::identity::tag::GUI_OBJECT,
+        crate::host::identity::tag::GUI_OBJECT,
         |held: &PhysicsGuiObject| held.object.handle() == handle,
         || o,
     )

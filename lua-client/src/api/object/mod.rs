@@ -298,5 +298,5 @@ impl UserData for PhysicsObject {
 /// The script's `PhysicsObject` value of `o`'s body (one per body: see `identity.rs`).
 pub(crate) fn object_ud(lua: &Lua, o: PhysicsObject) -> mlua::Result<AnyUserData> {
     let address = Rc::as_ptr(&o.body).cast();
-    super::identity::userdata(lua, address, super::identity::tag::OBJECT, || o)
+    crate::host::identity::userdata(lua, address, crate::host::identity::tag::OBJECT, || o)
 }

@@ -707,10 +707,10 @@ pub fn module(lua: &Lua) -> mlua::Result<Table> {
 
 /// The script's `BasePart` value of `part` (one per part: see `identity.rs`).
 pub(crate) fn part_ud(lua: &Lua, part: &Rc<PartState>) -> mlua::Result<mlua::AnyUserData> {
-    super::identity::userdata(
+    crate::host::identity::userdata(
         lua,
         Rc::as_ptr(part).cast(),
-        super::identity::tag::PART,
+        crate::host::identity::tag::PART,
         || BasePart(part.clone()),
     )
 }

@@ -273,6 +273,15 @@ impl Context {
     }
 }
 
+impl crate::host::DaemonWatch for Context {
+    fn watch(&self, lua: &Lua) -> mlua::Result<()> {
+        self.watch_daemon(lua)
+    }
+    fn watching(&self) -> bool {
+        self.watching_daemon()
+    }
+}
+
 pub(crate) fn context(lua: &Lua) -> Rc<Context> {
     lua.app_data_ref::<Rc<Context>>()
         .expect("lua_client::install registers the context")
@@ -467,10 +476,10 @@ pub(crate) fn wrap_plane(lua: &Lua, plane: Plane) -> mlua::Result<mlua::AnyUserD
 /// The script's `PhysicsPlane` value of `state` (one per plane: see `identity.rs`), so
 /// `map.Plane == plane`.
 pub(crate) fn plane_ud(lua: &Lua, state: &Rc<PlaneState>) -> mlua::Result<mlua::AnyUserData> {
-    super::identity::userdata(
+    crate::host::identity::userdata(
         lua,
         Rc::as_ptr(state).cast(),
-        super::identity::tag::PLANE,
+        crate::host::identity::tag::PLANE,
         || PhysicsPlane(state.clone()),
     )
 }
