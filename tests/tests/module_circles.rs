@@ -11,7 +11,10 @@ use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
 fn repo() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).parent().unwrap().to_path_buf()
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .unwrap()
+        .to_path_buf()
 }
 
 /// The top-level modules of a crate: `src/m.rs` and `src/m/` (the binaries aside).
@@ -85,7 +88,12 @@ fn edges(krate: &str) -> BTreeMap<String, BTreeSet<String>> {
     rust_files(&src, &mut files);
     for file in files {
         let rel = file.strip_prefix(&src).unwrap();
-        let first = rel.components().next().unwrap().as_os_str().to_string_lossy();
+        let first = rel
+            .components()
+            .next()
+            .unwrap()
+            .as_os_str()
+            .to_string_lossy();
         let me = first.trim_end_matches(".rs").to_string();
         if !top.contains(&me) {
             continue;

@@ -14,6 +14,7 @@ pub mod gui_controller;
 pub mod gui_object;
 pub mod gui_plane;
 pub mod joint;
+pub(crate) mod lifecycle;
 pub mod map;
 pub mod object;
 pub mod part;

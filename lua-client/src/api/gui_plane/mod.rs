@@ -12,7 +12,6 @@ use std::cell::{Cell, RefCell};
 use std::collections::HashMap;
 use std::rc::Rc;
 
-use client_sdk::validate::MAX_DT;
 use client_sdk::{GuiPlane, GuiPlaneOptions, GuiPlaneProp, Handle, PlaneProp};
 use mlua::{Lua, MetaMethod, MultiValue, UserData, UserDataMethods, Value};
 
@@ -177,6 +176,25 @@ struct GuiPlanes(RefCell<Vec<Rc<GuiPlaneState>>>);
 #[derive(Clone)]
 pub struct GuiPhysicsPlane(pub Rc<GuiPlaneState>);
 
+impl super::lifecycle::LuaPlane for GuiPhysicsPlane {
+    const TYPE: &'static str = "GuiPhysicsPlane";
+    fn alive(&self) -> bool {
+        self.0.alive()
+    }
+    fn sdk_plane(&self) -> &client_sdk::Plane {
+        self.0.plane.plane()
+    }
+    fn after_tick(&self, lua: &Lua) -> mlua::Result<()> {
+        self.0.after_tick(lua)
+    }
+    fn destroy(&self, lua: &Lua) -> mlua::Result<()> {
+        if let Some(planes) = lua.app_data_ref::<GuiPlanes>() {
+            planes.0.borrow_mut().retain(|q| !Rc::ptr_eq(q, &self.0));
+        }
+        self.0.destroy()
+    }
+}
+
 impl UserData for GuiPhysicsPlane {
     fn add_methods<M: UserDataMethods<Self>>(methods: &mut M) {
         methods.add_method("Add", |lua, p, prim: Value| {
@@ -231,25 +249,7 @@ impl UserData for GuiPhysicsPlane {
                 Ok(Value::Table(t))
             },
         );
-        methods.add_method("Step", |lua, p, dt: Value| {
-            let dt = match finite_number("GuiPhysicsPlane:Step", &dt) {
-                Ok(dt) if dt > 0.0 && dt <= MAX_DT as f64 => dt,
-                _ => {
-                    return Err(expected(
-                        "GuiPhysicsPlane:Step",
-                        "a number of seconds in (0, 1]",
-                        &dt,
-                    ))
-                }
-            };
-            if !p.0.alive() {
-                return Ok(());
-            }
-            p.0.plane
-                .step(dt as f32)
-                .map_err(|e| sdk_error("GuiPhysicsPlane:Step", e))?;
-            p.0.after_tick(lua)
-        });
+        super::lifecycle::add_methods(methods);
         methods.add_method("SetEnabled", |_, p, on: Value| {
             p.0.check_alive("SetEnabled")?;
             let Value::Boolean(on) = on else {
@@ -259,12 +259,6 @@ impl UserData for GuiPhysicsPlane {
                 .set_common(PlaneProp::Enabled(on))
                 .map_err(|e| sdk_error("GuiPhysicsPlane:SetEnabled", e))
         });
-        methods.add_method("Destroy", |lua, p, ()| {
-            if let Some(planes) = lua.app_data_ref::<GuiPlanes>() {
-                planes.0.borrow_mut().retain(|q| !Rc::ptr_eq(q, &p.0));
-            }
-            p.0.destroy()
-        });
         methods.add_meta_method(MetaMethod::Index, |lua, p, key: Value| {
             props::GUI_PLANE.get(lua, &p.0, &key)
         });
@@ -272,12 +266,6 @@ impl UserData for GuiPhysicsPlane {
             MetaMethod::NewIndex,
             |lua, p, (key, value): (Value, Value)| props::GUI_PLANE.set(lua, &p.0, &key, &value),
         );
-        methods.add_meta_method(MetaMethod::ToString, |_, p, ()| {
-            Ok(match p.0.alive() {
-                true => format!("GuiPhysicsPlane {}", p.0.plane.plane().id()),
-                false => format!("GuiPhysicsPlane {} (destroyed)", p.0.plane.plane().id()),
-            })
-        });
     }
 }
 

@@ -5,7 +5,6 @@ pub(crate) mod props;
 use std::cell::{Cell, RefCell};
 use std::rc::Rc;
 
-use client_sdk::validate::MAX_DT;
 use std::collections::HashMap;
 
 use client_sdk::{Client, Handle, ObjectProp, Plane, PlaneInfo, PlaneOptions, PlaneProp};
@@ -17,7 +16,7 @@ use super::object::PhysicsObject;
 use super::part::{BasePart, Body, Ended, PartState};
 use crate::host::scheduler::scheduler;
 use crate::props::Target;
-use crate::values::{describe, expected, finite_number, sdk_error};
+use crate::values::{describe, expected, sdk_error};
 use props::PLANE;
 
 /// A plane as the host holds it. Its options live in the daemon alone: the property rows
@@ -292,6 +291,28 @@ pub(crate) fn context(lua: &Lua) -> Rc<Context> {
 #[derive(Clone)]
 pub struct PhysicsPlane(pub Rc<PlaneState>);
 
+impl super::lifecycle::LuaPlane for PhysicsPlane {
+    const TYPE: &'static str = "PhysicsPlane";
+    fn alive(&self) -> bool {
+        self.0.alive()
+    }
+    fn sdk_plane(&self) -> &client_sdk::Plane {
+        &self.0.plane
+    }
+    fn after_tick(&self, lua: &Lua) -> mlua::Result<()> {
+        self.0.after_tick(lua)
+    }
+    fn destroy(&self, lua: &Lua) -> mlua::Result<()> {
+        context(lua)
+            .planes
+            .borrow_mut()
+            .retain(|q| !Rc::ptr_eq(q, &self.0));
+        self.0
+            .destroy()
+            .map_err(|e| sdk_error("PhysicsPlane:Destroy", e))
+    }
+}
+
 impl UserData for PhysicsPlane {
     fn add_methods<M: UserDataMethods<Self>>(methods: &mut M) {
         methods.add_method("Add", |lua, p, part: Value| {
@@ -305,42 +326,7 @@ impl UserData for PhysicsPlane {
                 &on,
             )
         });
-        methods.add_method("Step", |lua, p, dt: Value| {
-            let dt = match finite_number("PhysicsPlane:Step", &dt) {
-                Ok(dt) if dt > 0.0 && dt <= MAX_DT as f64 => dt,
-                _ => {
-                    return Err(expected(
-                        "PhysicsPlane:Step",
-                        "a number of seconds in (0, 1]",
-                        &dt,
-                    ))
-                }
-            };
-            // Documented as a no-op on a destroyed plane (the daemon skips disabled ones).
-            if !p.0.alive() {
-                return Ok(());
-            }
-            p.0.plane
-                .step(dt as f32)
-                .map_err(|e| sdk_error("PhysicsPlane:Step", e))?;
-            p.0.after_tick(lua)
-        });
-        methods.add_method("Destroy", |lua, p, ()| {
-            context(lua)
-                .planes
-                .borrow_mut()
-                .retain(|q| !Rc::ptr_eq(q, &p.0));
-            p.0.destroy()
-                .map_err(|e| sdk_error("PhysicsPlane:Destroy", e))
-        });
-        // The newest tick's determinism hash as 16 hex digits (a u64 does not fit a Luau
-        // number): equal strings on the same tick of two runs mean bit-identical states.
-        methods.add_method("StateHash", |_, p, ()| {
-            p.0.plane
-                .state_hash()
-                .map(|h| format!("{h:016x}"))
-                .map_err(|e| sdk_error("PhysicsPlane:StateHash", e))
-        });
+        super::lifecycle::add_methods(methods);
         super::query::add_methods(methods);
         super::snapshot::add_plane_methods(methods);
         methods.add_method("NewController", |_, p, (part, opts): (Value, Value)| {
@@ -360,12 +346,6 @@ impl UserData for PhysicsPlane {
             MetaMethod::NewIndex,
             |lua, p, (key, value): (Value, Value)| PLANE.set(lua, &p.0, &key, &value),
         );
-        methods.add_meta_method(MetaMethod::ToString, |_, p, ()| {
-            Ok(match p.0.alive() {
-                true => format!("PhysicsPlane {}", p.0.plane.id()),
-                false => format!("PhysicsPlane {} (destroyed)", p.0.plane.id()),
-            })
-        });
     }
 }
 
