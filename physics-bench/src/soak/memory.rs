@@ -70,6 +70,8 @@ pub struct Drift {
     pub end: f64,
     /// max - start: what the flatness goal judges.
     pub rise: f64,
+    /// The least value of the window's last minute (what a count settles back to).
+    pub settled: f64,
     /// Least-squares slope over the window, per minute.
     pub slope_per_min: f64,
     /// The slope carried over 60 minutes.
@@ -85,6 +87,12 @@ impl Drift {
         let start = value(first) as f64;
         let max = window.iter().map(|s| value(s) as f64).fold(start, f64::max);
         let end = window.last().map_or(start, |s| value(s) as f64);
+        let last_t = window.last().map_or(0.0, |s| s.t_s);
+        let settled = window
+            .iter()
+            .filter(|s| s.t_s >= last_t - 60.0)
+            .map(|s| value(s) as f64)
+            .fold(end, f64::min);
         let points: Vec<(f64, f64)> = window.iter().map(|s| (s.t_s, value(s) as f64)).collect();
         let slope_per_min = slope(&points) * 60.0;
         Drift {
@@ -92,6 +100,7 @@ impl Drift {
             max,
             end,
             rise: max - start,
+            settled,
             slope_per_min,
             projected_per_hour: slope_per_min * 60.0,
         }
@@ -149,6 +158,8 @@ mod tests {
         assert_eq!(d.start, 0.0);
         assert_eq!(d.max, 60.0 * 1024.0);
         assert_eq!(d.rise, 60.0 * 1024.0);
+        // The least value of the last minute (the whole window here): the dip.
+        assert_eq!(d.settled, 0.0);
         // The dip at the midpoint has no leverage on the fitted slope (x - mean = 0).
         assert!((d.slope_per_min - 60.0 * 1024.0).abs() < 1e-6, "{d:?}");
         assert!((d.projected_per_hour - 3600.0 * 1024.0).abs() < 1e-3);
