@@ -17,9 +17,9 @@
 //! 7. and hands rapier its next kinematic pose.
 //!
 //! Every query of a controller's tick reads the colliders near it, gathered once per tick
-//! from the broad phase (`nearby`); controllers read the scene as the last tick left it and
-//! run on the plane's pool when it has one (`tick`). A plane without controllers skips all
-//! of it.
+//! from the broad phase (`nearby`). Controllers tick in slot order; on a plane with a pool
+//! those that read nothing another controller changes tick side by side on it (`tick`). A
+//! plane without controllers skips all of it.
 
 use std::collections::BTreeMap;
 
