@@ -76,7 +76,11 @@ fn run(threads: u32) -> Run {
     for i in 0..8 {
         let (x, z) = (-60.0 + i as f32 * 12.0, 40.0);
         let c = character(&s, [x, HALF + SKIN, z]);
-        let waypoints = [[x + 6.0, 0.0, z], [x + 6.0, 0.0, z + 6.0], [x, 0.0, z + 6.0]];
+        let waypoints = [
+            [x + 6.0, 0.0, z],
+            [x + 6.0, 0.0, z + 6.0],
+            [x, 0.0, z + 6.0],
+        ];
         assert_eq!(c.compute_path(&waypoints).unwrap(), 3);
         walkers.push(c);
     }
@@ -117,11 +121,7 @@ fn threads_2_ticks_controllers_as_threads_1_does() {
         "only {} distinct hashes",
         distinct.len()
     );
-    let first = one
-        .hashes
-        .iter()
-        .zip(&two.hashes)
-        .position(|(a, b)| a != b);
+    let first = one.hashes.iter().zip(&two.hashes).position(|(a, b)| a != b);
     assert_eq!(first, None, "Threads = 2 diverged from Threads = 1 at tick");
     for r in [&one, &two] {
         // Radius-1 capsules that walked into each other stop against each other: 2

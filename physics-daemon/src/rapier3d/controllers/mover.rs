@@ -75,7 +75,6 @@ impl Mover {
         &self,
         dt: f32,
         nearby: &Nearby<'_>,
-        bodies: &RigidBodySet,
         shape: &dyn Shape,
         pose: &Pose,
         desired: Vector,
@@ -96,8 +95,7 @@ impl Mover {
         }
         let at = |t: Vector| Pose::from_translation(t) * *pose;
         let mut remaining = desired;
-        let grounded_at_start =
-            self.grounded(dt, nearby, bodies, shape, &at(result.translation), None);
+        let grounded_at_start = self.grounded(dt, nearby, shape, &at(result.translation), None);
         let mut friction = Vector::ZERO;
         let mut moving = false;
         let mut iterations = MAX_ITERATIONS;
@@ -130,22 +128,19 @@ impl Mover {
                 remaining = self.handle_slopes(&info, desired, remaining);
             } else {
                 result.translation += remaining;
-                result.grounded =
-                    self.grounded(dt, nearby, bodies, shape, &at(result.translation), None);
+                result.grounded = self.grounded(dt, nearby, shape, &at(result.translation), None);
                 break;
             }
             result.grounded = self.grounded(
                 dt,
                 nearby,
-                bodies,
                 shape,
                 &at(result.translation),
                 Some((&mut friction, &mut remaining)),
             );
         }
         if !moving {
-            result.grounded =
-                self.grounded(dt, nearby, bodies, shape, &at(result.translation), None);
+            result.grounded = self.grounded(dt, nearby, shape, &at(result.translation), None);
         }
         if grounded_at_start {
             self.snap(nearby, shape, &at(result.translation), &mut result);
@@ -218,7 +213,6 @@ impl Mover {
         &self,
         dt: f32,
         nearby: &Nearby<'_>,
-        bodies: &RigidBodySet,
         shape: &dyn Shape,
         pose: &Pose,
         mut friction: Option<(&mut Vector, &mut Vector)>,
@@ -247,7 +241,7 @@ impl Mover {
             let kinematic = c
                 .collider
                 .parent()
-                .and_then(|p| bodies.get(p))
+                .and_then(|p| nearby.bodies().get(p))
                 .filter(|rb| rb.is_kinematic());
             let (Some(body), true) = (kinematic, touching) else {
                 continue;

@@ -106,6 +106,11 @@ impl<'a> Nearby<'a> {
         }
     }
 
+    /// The plane's bodies (the colliders' parents).
+    pub fn bodies(&self) -> &'a RigidBodySet {
+        self.scene.bodies
+    }
+
     /// Whether nothing at all is near.
     pub fn is_empty(&self) -> bool {
         self.items.is_empty()

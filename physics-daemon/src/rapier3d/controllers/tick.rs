@@ -388,15 +388,9 @@ impl<'a> Scene<'a> {
         };
         let pose = rapier3d::math::Pose::from_parts(position, yaw_rotation(c.yaw));
         let mut collisions: Vec<CharacterCollision> = Vec::new();
-        let moved = mover.move_shape(
-            dt,
-            nearby,
-            self.refs.bodies,
-            &*t.shape,
-            &pose,
-            m.desired,
-            |col| collisions.push(col),
-        );
+        let moved = mover.move_shape(dt, nearby, &*t.shape, &pose, m.desired, |col| {
+            collisions.push(col)
+        });
         let mut next = position + moved.translation;
         // Blocked while walking on the ground: try the step (lift, move, drop).
         let wanted_h = horizontal(m.desired - m.carry);
