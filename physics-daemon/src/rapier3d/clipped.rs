@@ -15,6 +15,8 @@
 //! finds no hit; two capsules meeting exactly head-on pass through each other.
 //!
 //! [`ClippedQueries`], the dispatcher every query of a 3D plane uses, answers:
+//! - a contact of a capsule with a box whose segment stays outside the box in closed form
+//!   (`capsule_contact`);
 //! - a contact of a convex shape with a box from the box's face when the shape's deepest
 //!   point lies over it (exact at any size, see [`face_contact`]);
 //! - otherwise any query against a much larger box on that box clipped to the region near
@@ -216,6 +218,9 @@ pub(super) fn contact(
     g2: &dyn Shape,
     prediction: f32,
 ) -> Result<Option<Contact>, Unsupported> {
+    if let Some(found) = super::capsule_contact::contact(pos12, g1, g2, prediction) {
+        return Ok(found);
+    }
     if let Some(b) = g2.as_cuboid() {
         if let Some(found) = face_contact(pos12, g1, b, prediction) {
             return Ok(found);

@@ -25,6 +25,7 @@ mod held {
     crate::backend::held::held_bodies!(rapier3d);
 }
 mod axis_motors;
+mod capsule_contact;
 mod contact_points;
 #[cfg(feature = "gpu")]
 mod gpu;

@@ -1,12 +1,16 @@
 //! What is under and around the capsule: the platform it rides, the ground probe, steps,
-//! depenetration.
+//! depenetration. Each reads the tick's [`Nearby`] colliders.
 
+use rapier3d::parry::bounding_volume::BoundingVolume;
+
+use super::nearby::Nearby;
+use super::tick::Scene;
 use super::*;
 
-impl Plane {
+impl Scene<'_> {
     /// The platform's motion at `foot` since the last tick: (translation to ride along,
     /// its velocity there, its yaw change).
-    pub(in crate::rapier3d) fn platform_motion(
+    pub(super) fn platform_motion(
         &self,
         c: &Controller,
         foot: Vector,
@@ -16,7 +20,7 @@ impl Plane {
         let Some(ground) = c.ground.filter(|_| c.on_ground) else {
             return none;
         };
-        let Some(body) = self.world.bodies.get(ground.body) else {
+        let Some(body) = self.refs.bodies.get(ground.body) else {
             return none;
         };
         if body.is_dynamic()
@@ -38,27 +42,27 @@ impl Plane {
     /// remaining motion (at least far enough for the capsule's bottom to clear the edge),
     /// drop back down. Accepted when it lands on walkable ground higher than it started and
     /// no higher than StepHeight.
-    #[allow(clippy::too_many_arguments)]
-    pub(in crate::rapier3d) fn step_up(
+    pub(super) fn step_up(
         &self,
-        own: RigidBodyHandle,
         shape: &SharedShape,
         position: Vector,
         yaw: f32,
         remaining: Vector,
         s: &ControllerSettings,
-        groups: InteractionGroups,
+        nearby: &mut Nearby<'_>,
     ) -> Option<Vector> {
         let dir = remaining.normalize_or_zero();
         if dir == Vector::ZERO {
             return None;
         }
-        let pred = |_: ColliderHandle, co: &Collider| {
-            co.parent() != Some(own) && co.collision_groups().test(groups) && !co.is_sensor()
-        };
-        let pipeline =
-            self.query_pipeline(rapier3d::prelude::QueryFilter::default().predicate(&pred));
         let rotation = yaw_rotation(yaw);
+        let reach = remaining.length().max(s.capsule_radius);
+        // Everything the lift, the move and the drop can touch.
+        let here = shape.compute_aabb(&rapier3d::math::Pose::from_parts(position, rotation));
+        let need = here
+            .merged(&here.translated(Vector::Y * s.step_height + dir * reach))
+            .loosened(SKIN * 4.0);
+        nearby.ensure(need, 1.0);
         let cast = |from: Vector, along: Vector, reach: f32| {
             let options = ShapeCastOptions {
                 max_time_of_impact: reach,
@@ -66,7 +70,7 @@ impl Plane {
                 stop_at_penetration: false,
                 compute_impact_geometry_on_penetration: true,
             };
-            pipeline
+            nearby
                 .cast_shape(
                     &rapier3d::math::Pose::from_parts(from, rotation),
                     along,
@@ -84,7 +88,6 @@ impl Plane {
         let lifted = position + Vector::Y * lift;
         // Forward: the remaining motion, at least enough to get the capsule's bottom over
         // the tread.
-        let reach = remaining.length().max(s.capsule_radius);
         let forward = cast(lifted, dir, reach).map_or(reach, |h| h.time_of_impact);
         if forward < SKIN * 2.0 {
             return None;
@@ -107,34 +110,30 @@ impl Plane {
         }
         // Nothing may overlap the capsule where it lands.
         let pose = rapier3d::math::Pose::from_parts(landed, rotation);
-        if pipeline.intersect_shape(pose, &**shape).next().is_some() {
+        if nearby.intersects_any(&pose, &**shape) {
             return None;
         }
         Some(landed)
     }
 
     /// Pushes the capsule at `position` out of everything it overlaps, deepest first.
-    pub(in crate::rapier3d) fn depenetrate(
+    pub(super) fn depenetrate(
         &self,
-        own: RigidBodyHandle,
         shape: &SharedShape,
         position: Vector,
-        groups: InteractionGroups,
+        nearby: &mut Nearby<'_>,
     ) -> Vector {
         let mut offset = Vector::ZERO;
         for _ in 0..DEPENETRATION_PASSES {
             let pose = rapier3d::math::Pose::from_translation(position + offset);
+            let aabb = shape.compute_aabb(&pose);
+            nearby.ensure(aabb, 1.0);
             let mut deepest: Option<(f32, Vector)> = None;
-            let pred = |_: ColliderHandle, co: &Collider| {
-                co.parent() != Some(own) && co.collision_groups().test(groups) && !co.is_sensor()
-            };
-            let pipeline =
-                self.query_pipeline(rapier3d::prelude::QueryFilter::default().predicate(&pred));
-            for (_, co) in pipeline.intersect_shape(pose, &**shape) {
+            for c in nearby.within(aabb) {
                 // The pose has no rotation: the contact's capsule-local normal is the world's.
-                let pos12 = pose.inv_mul(co.position());
+                let pos12 = pose.inv_mul(c.collider.position());
                 if let Ok(Some(contact)) =
-                    crate::rapier3d::clipped::contact(&pos12, &**shape, co.shape(), 0.0)
+                    crate::rapier3d::clipped::contact(&pos12, &**shape, c.collider.shape(), 0.0)
                 {
                     if contact.dist < 0.0 && deepest.is_none_or(|(d, _)| contact.dist < d) {
                         deepest = Some((contact.dist, contact.normal1));
@@ -153,35 +152,30 @@ impl Plane {
     /// The ground within `reach` under the capsule at `position`: (its body, the gap to it,
     /// whether the contact normal as the capsule feels it is walkable under `max_slope`,
     /// whether the surface's own normal is).
-    #[allow(clippy::too_many_arguments)]
-    pub(in crate::rapier3d) fn probe_ground(
+    pub(super) fn probe_ground(
         &self,
-        own: RigidBodyHandle,
         shape: &SharedShape,
         position: Vector,
         yaw: f32,
         reach: f32,
         max_slope: f32,
-        groups: InteractionGroups,
+        nearby: &mut Nearby<'_>,
     ) -> Option<(RigidBodyHandle, f32, bool, bool)> {
-        let pred = |_: ColliderHandle, co: &Collider| {
-            co.parent() != Some(own) && co.collision_groups().test(groups) && !co.is_sensor()
-        };
-        let pipeline =
-            self.query_pipeline(rapier3d::prelude::QueryFilter::default().predicate(&pred));
         let pose = rapier3d::math::Pose::from_parts(position, yaw_rotation(yaw));
+        let here = shape.compute_aabb(&pose);
+        nearby.ensure(here.merged(&here.translated(-Vector::Y * reach)), 1.0);
         let options = ShapeCastOptions {
             max_time_of_impact: reach,
             target_distance: 0.0,
             stop_at_penetration: false,
             compute_impact_geometry_on_penetration: true,
         };
-        let (col, hit) = pipeline.cast_shape(&pose, -Vector::Y, &**shape, options)?;
+        let (col, hit) = nearby.cast_shape(&pose, -Vector::Y, &**shape, options)?;
         // The normal as the capsule feels it: on a box's edge it leans (a box reports its
         // face normal there).
         let felt = -(pose.rotation * hit.normal2);
         let limit = max_slope.to_radians().cos() - 1e-4;
-        let body = self.world.colliders.get(col)?.parent()?;
+        let body = self.refs.colliders.get(col)?.parent()?;
         Some((
             body,
             hit.time_of_impact,

@@ -8,18 +8,22 @@
 //!    (ground friction with a stop speed, `accelerate` toward the wish speed, air control,
 //!    gravity integrated exactly so the jump apex is JumpPower² / 2g),
 //! 3. pushes itself out of anything it overlaps (depenetration, deepest first),
-//! 4. moves with rapier's shape-casting character controller (slide along walls, step up
-//!    to StepHeight, no climbing past MaxSlope, snap down slopes and steps while grounded),
+//! 4. moves with a shape-casting mover (rapier's character controller's algorithm over the
+//!    colliders near it, `mover`: slide along walls, no climbing past MaxSlope, snap down
+//!    slopes and steps while grounded) and steps up to StepHeight,
 //! 5. probes the ground under its capsule (OnGround, the platform for the next tick),
 //! 6. clips its velocity against what stopped it, pushes dynamic bodies it ran into with a
 //!    force capped at PushStrength, turns toward its velocity and advances its path,
 //! 7. and hands rapier its next kinematic pose.
 //!
-//! A plane without controllers skips all of it.
+//! Every query of a controller's tick reads the colliders near it, gathered once per tick
+//! from the broad phase (`nearby`). Controllers tick in slot order; on a plane with a pool
+//! those that read nothing another controller changes tick side by side on it (`tick`). A
+//! plane without controllers skips all of it.
 
 use std::collections::BTreeMap;
 
-use rapier3d::control::{CharacterCollision, CharacterLength, KinematicCharacterController};
+use rapier3d::control::CharacterCollision;
 use rapier3d::parry::query::ShapeCastOptions;
 use rapier3d::prelude::*;
 use shm_layout::controller_op::ControllerInfo;
@@ -35,6 +39,8 @@ use crate::backend::counted::{CountedVec, Counter};
 
 mod ground;
 mod movement;
+mod mover;
+mod nearby;
 mod ops;
 mod push;
 mod tick;

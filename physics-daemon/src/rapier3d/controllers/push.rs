@@ -1,28 +1,31 @@
 //! A controller and the bodies it meets: pushing dynamic bodies, kicks (explosions).
 
+use super::tick::{Push, Scene};
 use super::*;
 
-impl Plane {
+impl Scene<'_> {
     /// Dynamic bodies the move ran into get an impulse along the push, capped at
-    /// PushStrength × dt (a crate heavier than that cap can move blocks the controller).
-    pub(in crate::rapier3d) fn push_bodies(
-        &mut self,
+    /// PushStrength × dt (a crate heavier than that cap can move blocks the controller):
+    /// the impulses (applied when the tick commits) and the colliders that gave way.
+    pub(super) fn plan_pushes(
+        &self,
         collisions: &[CharacterCollision],
         c: &Controller,
         dt: f32,
-    ) -> Vec<ColliderHandle> {
+    ) -> (Vec<Push>, Vec<ColliderHandle>) {
         let cap = c.settings.push_strength * dt;
+        let mut pushes = Vec::new();
         let mut gave_way = Vec::new();
         for col in collisions {
             let Some(body) = self
-                .world
+                .refs
                 .colliders
                 .get(col.handle)
                 .and_then(|co| co.parent())
             else {
                 continue;
             };
-            let Some(rb) = self.world.bodies.get_mut(body) else {
+            let Some(rb) = self.refs.bodies.get(body) else {
                 continue;
             };
             if !rb.is_dynamic() {
@@ -35,15 +38,21 @@ impl Plane {
             let needed = rb.mass() * relative;
             let impulse = needed.min(cap);
             if impulse > 0.0 {
-                rb.apply_impulse_at_point(n * impulse, col.hit.witness1, true);
+                pushes.push(Push {
+                    body,
+                    impulse: n * impulse,
+                    point: col.hit.witness1,
+                });
             }
             if needed <= cap {
                 gave_way.push(col.handle);
             }
         }
-        gave_way
+        (pushes, gave_way)
     }
+}
 
+impl Plane {
     /// Adds `dv` to a controller's velocity (an explosion's kick); a kick upward lifts it
     /// off the ground.
     pub(in crate::rapier3d) fn kick_controller(&mut self, slot: u32, dv: Vector) {

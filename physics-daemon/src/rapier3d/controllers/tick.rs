@@ -1,6 +1,92 @@
 //! One controller tick: the stages listed in the module doc, in order.
+//!
+//! Controllers tick in slot order, each committing its move (pushes applied to dynamic
+//! bodies, next kinematic pose, flags, events) before the next one reads the scene, so a
+//! controller sees those before it where they are going and those after it where they were.
+//!
+//! On a plane with a pool (Threads > 1) and enough controllers to share, every controller
+//! first works out its move on the pool from the scene as the last tick left it, reading
+//! the plane only. A controller whose tick read nothing another controller changes (no
+//! other controller among the colliders near it, none near it, no dynamic body that
+//! another one also reads) got the same move it would get in slot order, and commits it;
+//! the others are ticked again in slot order as above. Either way the result is the same.
 
+use std::collections::{HashMap, HashSet};
+
+use rapier3d::parry::bounding_volume::{Aabb, BoundingVolume};
+use rayon::prelude::*;
+
+use super::mover::Mover;
+use super::nearby::{Nearby, SceneRefs};
 use super::*;
+
+/// Fewest controllers handed to the plane's pool (fewer are ticked on the plane's thread).
+const PARALLEL_FROM: usize = 8;
+
+/// The read-only view of a plane a controller's tick works from.
+#[derive(Clone, Copy)]
+pub(super) struct Scene<'a> {
+    pub refs: SceneRefs<'a>,
+    /// The plane's gravity (Y), for UsePlaneGravity.
+    pub gravity_y: f32,
+    /// The bodies of the plane's controllers, when ticks run side by side and must say
+    /// what they read that another controller's commit changes.
+    pub controllers: Option<&'a HashSet<RigidBodyHandle>>,
+}
+
+/// A controller's tick ready to commit.
+struct Outcome {
+    slot: u32,
+    controller: Controller,
+    t: TickState,
+    next: Vector,
+    pushes: Vec<Push>,
+    /// The controller's state before the tick (to tick it again).
+    saved: Saved,
+    /// The other controllers' and the dynamic bodies among the colliders near it (what
+    /// another controller's commit could change under it).
+    shared: Vec<RigidBodyHandle>,
+}
+
+/// What a controller's tick changes in it, kept to tick it again from the start.
+#[derive(Clone, Copy)]
+struct Saved {
+    velocity: Vector,
+    yaw: f32,
+    on_ground: bool,
+    ground: Option<Ground>,
+    path_index: usize,
+    jump: bool,
+}
+
+impl Saved {
+    fn of(c: &Controller) -> Saved {
+        Saved {
+            velocity: c.velocity,
+            yaw: c.yaw,
+            on_ground: c.on_ground,
+            ground: c.ground,
+            path_index: c.path_index,
+            jump: c.jump,
+        }
+    }
+
+    fn restore(self, c: &mut Controller) {
+        c.velocity = self.velocity;
+        c.yaw = self.yaw;
+        c.on_ground = self.on_ground;
+        c.ground = self.ground;
+        c.path_index = self.path_index;
+        c.jump = self.jump;
+    }
+}
+
+/// An impulse for a dynamic body the controller ran into.
+pub(super) struct Push {
+    pub body: RigidBodyHandle,
+    pub impulse: Vector,
+    pub point: Vector,
+}
 
 impl Plane {
     /// Moves every controller by one tick of `dt` (before the physics step).
@@ -9,34 +95,188 @@ impl Plane {
             return;
         }
         self.refresh_scene();
-        let slots: Vec<u32> = self.controllers.keys().copied().collect();
-        for slot in slots {
-            self.tick_controller(slot, dt);
+        let mut work = Vec::with_capacity(self.controllers.len());
+        for (slot, c) in std::mem::take(&mut self.controllers) {
+            let Some(handle) = self.bodies.handle_at(slot as usize) else {
+                continue; // its object is gone
+            };
+            match self.body_of(handle) {
+                Ok(h) => work.push((slot, handle, h, c)),
+                Err(_) => {
+                    self.controllers.insert(slot, c);
+                }
+            }
+        }
+        let pool = (work.len() >= PARALLEL_FROM)
+            .then(|| self.world.physics_pipeline.thread_pool())
+            .flatten();
+        let Some(pool) = pool else {
+            for (slot, handle, h, c) in work {
+                let o = self.scene(None).tick(slot, handle, h, c, dt);
+                self.commit_tick(o, dt);
+            }
+            return;
+        };
+        let controller_bodies: HashSet<RigidBodyHandle> =
+            work.iter().map(|(_, _, h, _)| *h).collect();
+        let outcomes: Vec<Outcome> = {
+            let scene = self.scene(Some(&controller_bodies));
+            pool.install(|| {
+                work.into_par_iter()
+                    .map(|(slot, handle, h, c)| scene.tick(slot, handle, h, c, dt))
+                    .collect()
+            })
+        };
+        // Who read what another controller may change: other controllers, controllers
+        // read by others, dynamic bodies read by two or more.
+        let mut readers: HashMap<RigidBodyHandle, u32> = HashMap::new();
+        for o in &outcomes {
+            for b in &o.shared {
+                *readers.entry(*b).or_default() += 1;
+            }
+        }
+        for o in outcomes {
+            let again =
+                o.shared.iter().any(|b| {
+                    controller_bodies.contains(b) || readers.get(b).is_some_and(|n| *n > 1)
+                }) || readers.contains_key(&o.t.h);
+            if again {
+                let Outcome {
+                    slot,
+                    mut controller,
+                    t,
+                    saved,
+                    ..
+                } = o;
+                saved.restore(&mut controller);
+                let o = self.scene(None).tick(slot, t.handle, t.h, controller, dt);
+                self.commit_tick(o, dt);
+            } else {
+                self.commit_tick(o, dt);
+            }
         }
     }
 
+    /// The read-only view a controller's tick works from; `controllers` (the bodies of the
+    /// plane's controllers) when the tick must report what it read that others change.
+    fn scene<'a>(&'a self, controllers: Option<&'a HashSet<RigidBodyHandle>>) -> Scene<'a> {
+        Scene {
+            refs: SceneRefs {
+                broad_phase: &self.world.broad_phase,
+                bodies: &self.world.bodies,
+                colliders: &self.world.colliders,
+            },
+            gravity_y: self.settings.gravity[1],
+            controllers,
+        }
+    }
+
+    /// The end of a controller's tick: its pushes, the next kinematic pose (and the
+    /// colliders and broad phase, so queries before the step see it where it is going), the
+    /// published flags and the tick's events.
+    fn commit_tick(&mut self, o: Outcome, dt: f32) {
+        let Outcome {
+            slot,
+            controller: mut c,
+            t,
+            next,
+            pushes,
+            ..
+        } = o;
+        // A finished path is cleared here, so a tick can be run again until it commits.
+        if c.path_index >= c.path.len() && !c.path.is_empty() {
+            c.path.clear();
+            c.path_index = 0;
+        }
+        for p in pushes {
+            if let Some(rb) = self.world.bodies.get_mut(p.body) {
+                rb.apply_impulse_at_point(p.impulse, p.point, true);
+            }
+        }
+        let (handle, h) = (t.handle, t.h);
+        let mut events = t.events;
+        let actual = (next - t.start) / dt;
+        if c.settings.report_moved && actual.length() > 1e-6 {
+            events.push((EVENT_CONTROLLER_MOVED, 0, actual));
+        }
+        let next_pose = rapier3d::math::Pose::from_parts(next, yaw_rotation(c.yaw));
+        self.world.bodies[h].set_next_kinematic_position(next_pose);
+        let world = &mut self.world;
+        for col in world.bodies[h].colliders() {
+            if let Some(co) = world.colliders.get_mut(*col) {
+                co.set_position(next_pose);
+                let aabb = co.compute_aabb();
+                world
+                    .broad_phase
+                    .set_aabb(&world.integration_parameters, *col, aabb);
+            }
+        }
+        if let Ok(b) = self.bodies.get_mut(handle) {
+            b.flags = shm_layout::FLAG_CONTROLLER
+                | if c.on_ground {
+                    shm_layout::FLAG_ON_GROUND
+                } else {
+                    0
+                };
+        }
+        for (kind, index, velocity) in events {
+            self.pending_events.push(EventRecord {
+                kind,
+                a_slot: handle.slot,
+                a_generation: handle.generation,
+                b_slot: index,
+                position: next.into(),
+                normal: velocity.into(),
+                ..EventRecord::default()
+            });
+        }
+        self.dirty.mark(handle.slot);
+        self.controllers.insert(slot, c);
+    }
+}
+
+impl<'a> Scene<'a> {
     /// One controller's tick: the stages of the module doc, each a function below.
-    fn tick_controller(&mut self, slot: u32, dt: f32) {
-        let Some(handle) = self.bodies.handle_at(slot as usize) else {
-            self.controllers.remove(&slot);
-            return;
-        };
-        let Ok(h) = self.body_of(handle) else {
-            return;
-        };
-        let Some(mut c) = self.controllers.remove(&slot) else {
-            return;
-        };
+    fn tick(
+        &self,
+        slot: u32,
+        handle: Handle,
+        h: RigidBodyHandle,
+        mut c: Controller,
+        dt: f32,
+    ) -> Outcome {
+        let saved = Saved::of(&c);
         let mut t = self.begin_tick(&c, handle, h);
         let mut motion = self.intended_motion(&mut c, &mut t, dt);
-        let (mut next, collisions) = self.move_capsule(&c, &t, &mut motion, dt);
-        self.settle_on_ground(&mut c, &mut t, &mut next, &mut motion);
-        self.clip_velocity(&c, &collisions, &mut motion.v, dt);
+        // What the tick can reach, gathered once from the broad phase.
+        let mut nearby = Nearby::gather(self.refs, h, t.groups, t.reach(&c, motion.desired));
+        let (mut next, collisions) = self.move_capsule(&c, &t, &mut motion, dt, &mut nearby);
+        self.settle_on_ground(&mut c, &mut t, &mut next, &mut motion, &mut nearby);
+        let pushes = self.clip_velocity(&c, &collisions, &mut motion.v, dt);
         c.turn_toward(motion.v, dt);
         c.follow_path(next, &mut t.events);
         c.velocity = motion.v;
-        self.commit_tick(&c, &t, next, dt);
-        self.controllers.insert(slot, c);
+        let shared = match self.controllers {
+            Some(controllers) => nearby
+                .items
+                .iter()
+                .filter_map(|n| n.collider.parent())
+                .filter(|b| {
+                    controllers.contains(b)
+                        || self.refs.bodies.get(*b).is_some_and(|rb| rb.is_dynamic())
+                })
+                .collect(),
+            None => Vec::new(),
+        };
+        Outcome {
+            slot,
+            controller: c,
+            t,
+            next,
+            pushes,
+            saved,
+            shared,
+        }
     }
 
     /// What the stages share: the controller's body, its capsule, its collision groups, its
@@ -44,21 +284,22 @@ impl Plane {
     fn begin_tick(&self, c: &Controller, handle: Handle, h: RigidBodyHandle) -> TickState {
         let s = c.settings;
         let g = if s.use_plane_gravity {
-            -self.settings.gravity[1]
+            -self.gravity_y
         } else {
             s.gravity
         };
-        let groups = self.world.bodies[h]
+        let bodies = self.refs.bodies;
+        let groups = bodies[h]
             .colliders()
             .first()
-            .map(|col| self.world.colliders[*col].collision_groups())
+            .map(|col| self.refs.colliders[*col].collision_groups())
             .unwrap_or_default();
         TickState {
             handle,
             h,
             shape: c.shape(),
             half_height: s.capsule_half_height + s.capsule_radius,
-            start: self.world.bodies[h].translation(),
+            start: bodies[h].translation(),
             groups,
             g,
             events: Vec::new(),
@@ -126,42 +367,30 @@ impl Plane {
         t: &TickState,
         m: &mut Motion,
         dt: f32,
+        nearby: &mut Nearby<'a>,
     ) -> (Vector, Vec<CharacterCollision>) {
         let s = c.settings;
-        let (h, groups) = (t.h, t.groups);
         // 4. Out of anything it overlaps (spawned inside geometry, a platform moved into it).
-        let depenetrated = self.depenetrate(h, &t.shape, t.start, groups);
+        let depenetrated = self.depenetrate(&t.shape, t.start, nearby);
         let position = t.start + depenetrated;
         if depenetrated.y > 0.0 && m.desired.y < 0.0 {
             m.desired.y = 0.0;
         }
+        nearby.ensure(t.swept(&c.settings, position, m.desired), 1.0);
 
         // 5. Move.
-        let kcc = KinematicCharacterController {
-            up: Vector::Y,
-            offset: CharacterLength::Absolute(SKIN),
-            slide: true,
-            // Steps are ours (`step_up`): rapier's autostep nudges only as far as the tick's
-            // motion, so a round capsule's bottom stays on the edge and taller steps fail.
-            autostep: None,
+        let snap = (c.on_ground && !m.jumped).then_some(s.step_height.max(SKIN * 4.0));
+        let mover = Mover {
+            offset: SKIN,
             max_slope_climb_angle: s.max_slope.to_radians(),
             min_slope_slide_angle: s.max_slope.to_radians(),
-            snap_to_ground: (c.on_ground && !m.jumped)
-                .then_some(CharacterLength::Absolute(s.step_height.max(SKIN * 4.0))),
-            ..KinematicCharacterController::default()
+            snap_to_ground: snap,
         };
         let pose = rapier3d::math::Pose::from_parts(position, yaw_rotation(c.yaw));
         let mut collisions: Vec<CharacterCollision> = Vec::new();
-        let moved = {
-            let exclude = |_: ColliderHandle, co: &Collider| {
-                co.parent() != Some(h) && co.collision_groups().test(groups) && !co.is_sensor()
-            };
-            let filter = rapier3d::prelude::QueryFilter::default().predicate(&exclude);
-            let pipeline = self.query_pipeline(filter);
-            kcc.move_shape(dt, &pipeline, &*t.shape, &pose, m.desired, |col| {
-                collisions.push(col)
-            })
-        };
+        let moved = mover.move_shape(dt, nearby, &*t.shape, &pose, m.desired, |col| {
+            collisions.push(col)
+        });
         let mut next = position + moved.translation;
         // Blocked while walking on the ground: try the step (lift, move, drop).
         let wanted_h = horizontal(m.desired - m.carry);
@@ -171,8 +400,7 @@ impl Plane {
             && s.step_height > 0.0
             && got_h.length() + 1e-4 < wanted_h.length() * 0.5
         {
-            if let Some(stepped) =
-                self.step_up(h, &t.shape, next, c.yaw, wanted_h - got_h, &s, groups)
+            if let Some(stepped) = self.step_up(&t.shape, next, c.yaw, wanted_h - got_h, &s, nearby)
             {
                 next = stepped;
                 // The step's face did not stop it: keep the speed.
@@ -190,10 +418,9 @@ impl Plane {
         t: &mut TickState,
         next: &mut Vector,
         m: &mut Motion,
+        nearby: &mut Nearby<'a>,
     ) {
         let s = c.settings;
-        // Rapier's controller also says whether it is grounded (it sees stair edges as
-        // ground, whose normals lean).
         let was_on_ground = c.on_ground;
         let probe = if was_on_ground && !m.jumped {
             s.step_height.max(SKIN * 4.0)
@@ -204,7 +431,7 @@ impl Plane {
         let ground = if rising {
             None
         } else {
-            self.probe_ground(t.h, &t.shape, *next, c.yaw, probe, s.max_slope, t.groups)
+            self.probe_ground(&t.shape, *next, c.yaw, probe, s.max_slope, nearby)
         };
         c.on_ground = false;
         c.ground = None;
@@ -219,7 +446,7 @@ impl Plane {
                 }
                 c.on_ground = true;
             }
-            if let Some(b) = self.world.bodies.get(body) {
+            if let Some(b) = self.refs.bodies.get(body) {
                 c.ground = Some(Ground {
                     body,
                     pose: *b.position(),
@@ -240,17 +467,17 @@ impl Plane {
         }
     }
 
-    /// Stage 7: pushes dynamic bodies it ran into, then clips the velocity against what
-    /// stopped it (slide along walls, stop at ceilings); a body pushed with less than the
-    /// cap gave way.
+    /// Stage 7: plans the pushes of dynamic bodies it ran into, then clips the velocity
+    /// against what stopped it (slide along walls, stop at ceilings); a body pushed with
+    /// less than the cap gave way.
     fn clip_velocity(
-        &mut self,
+        &self,
         c: &Controller,
         collisions: &[CharacterCollision],
         v: &mut Vector,
         dt: f32,
-    ) {
-        let gave_way = self.push_bodies(collisions, c, dt);
+    ) -> Vec<Push> {
+        let (pushes, gave_way) = self.plan_pushes(collisions, c, dt);
         for col in collisions
             .iter()
             .filter(|col| !gave_way.contains(&col.handle))
@@ -266,50 +493,7 @@ impl Plane {
                 }
             }
         }
-    }
-
-    /// The end of the tick: the next kinematic pose (and the colliders and broad phase, so
-    /// controllers ticked after this one see it where it is going), the published flags and
-    /// the tick's events.
-    fn commit_tick(&mut self, c: &Controller, t: &TickState, next: Vector, dt: f32) {
-        let (handle, h) = (t.handle, t.h);
-        let mut events = t.events.clone();
-        let actual = (next - t.start) / dt;
-        if c.settings.report_moved && actual.length() > 1e-6 {
-            events.push((EVENT_CONTROLLER_MOVED, 0, actual));
-        }
-        let next_pose = rapier3d::math::Pose::from_parts(next, yaw_rotation(c.yaw));
-        self.world.bodies[h].set_next_kinematic_position(next_pose);
-        let world = &mut self.world;
-        for col in world.bodies[h].colliders() {
-            if let Some(co) = world.colliders.get_mut(*col) {
-                co.set_position(next_pose);
-                let aabb = co.compute_aabb();
-                world
-                    .broad_phase
-                    .set_aabb(&world.integration_parameters, *col, aabb);
-            }
-        }
-        if let Ok(b) = self.bodies.get_mut(handle) {
-            b.flags = shm_layout::FLAG_CONTROLLER
-                | if c.on_ground {
-                    shm_layout::FLAG_ON_GROUND
-                } else {
-                    0
-                };
-        }
-        for (kind, index, velocity) in events {
-            self.pending_events.push(EventRecord {
-                kind,
-                a_slot: handle.slot,
-                a_generation: handle.generation,
-                b_slot: index,
-                position: next.into(),
-                normal: velocity.into(),
-                ..EventRecord::default()
-            });
-        }
-        self.dirty.mark(handle.slot);
+        pushes
     }
 }
 
@@ -324,6 +508,26 @@ struct TickState {
     g: f32,
     /// (kind, index, velocity) of the events the tick produced so far.
     events: Vec<(u32, u32, Vector)>,
+}
+
+impl TickState {
+    /// The region a tick that starts at `start` and asks for `desired` can read: the capsule
+    /// at both ends, widened by what the move's snap, the step (lift, reach, drop) and the
+    /// ground probe reach beyond them.
+    fn reach(&self, c: &Controller, desired: Vector) -> Aabb {
+        self.swept(&c.settings, self.start, desired)
+    }
+
+    /// The capsule from `from` to `from + desired`, widened as in [`TickState::reach`].
+    fn swept(&self, s: &ControllerSettings, from: Vector, desired: Vector) -> Aabb {
+        let pose = rapier3d::math::Pose::from_translation(from);
+        let a = self.shape.compute_aabb(&pose);
+        let b = self
+            .shape
+            .compute_aabb(&(rapier3d::math::Pose::from_translation(desired) * pose));
+        let margin = s.step_height.max(SKIN * 4.0) + s.capsule_radius + 0.25;
+        a.merged(&b).loosened(margin)
+    }
 }
 
 /// The movement model's result: the velocity, the displacement asked for (the platform's
@@ -357,8 +561,7 @@ impl Controller {
                 self.path_index += 1;
                 events.push((EVENT_WAYPOINT_REACHED, self.path_index as u32, Vector::ZERO));
                 if self.path_index == self.path.len() {
-                    self.path.clear();
-                    self.path_index = 0;
+                    // Cleared when the tick commits.
                     events.push((EVENT_PATH_FINISHED, 0, Vector::ZERO));
                 }
             }
