@@ -568,3 +568,62 @@ pub(super) fn plan(candidates: &[Candidate]) -> Vec<TreePlan> {
     }
     plans
 }
+
+#[cfg(test)]
+mod tests {
+    use shm_layout::{JointKind, JointOp, JointProp, ObjectOp, ObjectProp, PlaneOp, PlaneProp};
+    use shm_layout::{Pose, Reply, Shape};
+
+    use crate::backend::Backend;
+    use crate::rapier3d::Plane;
+
+    #[test]
+    fn a_pushed_pendulum_bob_takes_the_push_once() {
+        let mut p = Plane::new(
+            1,
+            &[
+                PlaneProp::TickRate(0.0),
+                PlaneProp::LinearDamping(0.0),
+                PlaneProp::AngularDamping(0.0),
+            ],
+        )
+        .unwrap();
+        let bob = p
+            .add_object(
+                &Shape::Sphere { radius: 0.1 },
+                Pose::at([0.0, 18.0, 0.0]),
+                &[ObjectProp::Weight(1.0)],
+            )
+            .unwrap();
+        let Reply::Joint { .. } = p
+            .apply(PlaneOp::Joint(JointOp::Create {
+                kind: JointKind::Ball,
+                a: bob,
+                b: None,
+                props: vec![
+                    JointProp::AnchorA([0.0, 2.0, 0.0]),
+                    JointProp::AnchorB([0.0, 20.0, 0.0]),
+                ],
+            }))
+            .unwrap()
+        else {
+            panic!()
+        };
+        for _ in 0..5 {
+            p.step(1.0 / 60.0).unwrap();
+        }
+        p.apply(PlaneOp::Object {
+            handle: bob,
+            op: ObjectOp::Set(ObjectProp::Velocity([5.0, 0.0, 0.0])),
+        })
+        .unwrap();
+        let h = p.bodies.get(bob).unwrap().handle;
+        for i in 0..6 {
+            p.step(1.0 / 240.0).unwrap();
+            let b = &p.world.bodies[h];
+            eprintln!("{i}: v {:?} y {}", b.linvel(), b.translation().y);
+        }
+        let v = p.world.bodies[h].linvel().length();
+        assert!((v - 5.0).abs() < 0.2, "speed {v}");
+    }
+}
