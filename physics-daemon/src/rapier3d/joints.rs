@@ -122,6 +122,25 @@ impl Joints {
 }
 
 impl Plane {
+    /// The articulated ball joints with limits: (link, twist limit, swing limit), a missing
+    /// limit as π.
+    pub(super) fn limited_ball_links(&self) -> Vec<(MultibodyJointHandle, f32, f32)> {
+        (0..self.joints.table.slot_count())
+            .filter_map(|i| {
+                let j = self.joints.table.at(i)?;
+                let link = j.link?;
+                articulations::needs_limit_joint(j.kind, &j.settings).then(|| {
+                    let pi = std::f32::consts::PI;
+                    (
+                        link,
+                        j.settings.twist_limit.unwrap_or(pi),
+                        j.settings.swing_limit.unwrap_or(pi),
+                    )
+                })
+            })
+            .collect()
+    }
+
     /// Forgets every joint's articulation (the trees were torn down): companions go, and
     /// each joint is looked at again before the next step.
     pub(super) fn forget_articulated(&mut self) {
@@ -642,6 +661,7 @@ impl Plane {
         let articulated = if self.joints.articulations.is_empty() {
             Default::default()
         } else {
+            self.articulations_after_ccd();
             self.articulated_forces(dt)
         };
         self.articulations_after_step();
