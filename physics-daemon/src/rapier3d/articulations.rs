@@ -38,6 +38,58 @@ use super::Plane;
 /// lengthens a unit-mass pendulum of length 2 by 0.001 %.
 const ARMATURE_PER_MASS: f32 = 1.0e-4;
 
+/// The fastest a joint of an articulation turns (rad/s, relative to its parent), as PhysX's
+/// articulations' default `maxJointVelocity` (100): rapier integrates a joint's rotation
+/// explicitly, and a 1,000 u/s hit that spun a ragdoll's limbs at ~800 rad/s (13 rad a
+/// tick) made the next steps diverge to 10⁸ u/s and NaN.
+pub(super) const MAX_JOINT_SPEED: f32 = 100.0;
+
+/// Scales down each joint's angular velocity that exceeds [`MAX_JOINT_SPEED`], the free
+/// root's spin included.
+fn clamp_joint_speeds(mb: &mut Multibody) {
+    let blocks: Vec<(usize, usize)> = mb
+        .links()
+        .map(|l| {
+            let locked = l.joint().data.locked_axes.bits();
+            let lin = (0..3).filter(|i| locked & (1 << i) == 0).count();
+            let ang = (3..6).filter(|i| locked & (1 << i) == 0).count();
+            (l.assembly_id() + lin, ang)
+        })
+        .collect();
+    let mut v = mb.generalized_velocity_mut();
+    for (at, n) in blocks {
+        let norm = (at..at + n).map(|k| v[k] * v[k]).sum::<f32>().sqrt();
+        if norm > MAX_JOINT_SPEED {
+            let k = MAX_JOINT_SPEED / norm;
+            for i in at..at + n {
+                v[i] *= k;
+            }
+        }
+    }
+}
+
+/// Makes `mb`'s joint velocities match its bodies' velocities (in the momentum sense, see
+/// `take_velocity_changes`), its Jacobians taken at the bodies' current poses.
+fn velocities_from_bodies(mb: &mut Multibody, bodies: &RigidBodySet) {
+    mb.forward_kinematics(bodies, true);
+    let qd = mb.generalized_velocity().clone_owned();
+    let dv: Vec<(Vector, Vector)> = mb
+        .links()
+        .enumerate()
+        .map(|(i, l)| {
+            let Some(rb) = bodies.get(l.rigid_body_handle()).filter(|b| b.is_dynamic()) else {
+                return (Vector::ZERO, Vector::ZERO);
+            };
+            let v = mb.body_jacobian(i) * &qd;
+            (
+                rb.linvel() - Vector::new(v[0], v[1], v[2]),
+                rb.angvel() - Vector::new(v[3], v[4], v[5]),
+            )
+        })
+        .collect();
+    take_velocity_changes(mb, bodies, &dv);
+}
+
 /// One articulated tree.
 #[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 struct Tree {
@@ -337,6 +389,7 @@ impl Plane {
                     .collect();
                 mb.forward_kinematics(&self.world.bodies, true);
                 take_velocity_changes(mb, &self.world.bodies, &dv);
+                clamp_joint_speeds(mb);
             }
             mb.update_rigid_bodies(&mut self.world.bodies, true);
             for (h, ..) in &t.links {
@@ -422,7 +475,10 @@ impl Articulations {
 impl Plane {
     /// After a step: a link the step moved off its joints (rapier's CCD puts a fast body back
     /// at its time of impact, a link included) has its articulation's coordinates reset from
-    /// the bodies' poses, so the joints hold through the hit instead of for a tick apart.
+    /// the bodies' poses, so the joints hold through the hit instead of for a tick apart; such
+    /// a link, or one the plane's speed caps slowed, also hands its velocity back to the
+    /// articulation (a 1,000 u/s hit otherwise left the joints moving as the bodies no longer
+    /// did, and the next steps diverged).
     pub(super) fn articulations_after_ccd(&mut self) {
         for t in &self.joints.articulations.trees {
             let Some(link) = self.world.multibody_joints.rigid_body_link(t.root).copied() else {
@@ -441,12 +497,43 @@ impl Plane {
                     .get(l.rigid_body_handle())
                     .is_some_and(|b| b.position() != l.local_to_world())
             });
+            // The plane's speed caps act on the bodies after rapier moved them.
+            let (w_cap, v_cap) = (
+                self.settings.max_angular_speed * 0.9999,
+                self.settings.max_linear_speed * 0.9999,
+            );
+            let capped = mb.links().any(|l| {
+                bodies
+                    .get(l.rigid_body_handle())
+                    .is_some_and(|b| b.angvel().length() >= w_cap || b.linvel().length() >= v_cap)
+            });
             if off {
                 coordinates_from_bodies(mb, bodies);
+            }
+            if off || capped {
+                velocities_from_bodies(mb, bodies);
                 mb.update_rigid_bodies(&mut self.world.bodies, true);
             }
         }
+        self.articulations_clamp_speeds();
         self.ball_limit_stops();
+    }
+
+    /// After a step: every joint's angular speed is held to [`MAX_JOINT_SPEED`] before the
+    /// next step integrates it.
+    fn articulations_clamp_speeds(&mut self) {
+        for t in &self.joints.articulations.trees {
+            let Some(link) = self.world.multibody_joints.rigid_body_link(t.root).copied() else {
+                continue;
+            };
+            if let Some(mb) = self
+                .world
+                .multibody_joints
+                .get_multibody_mut(link.multibody)
+            {
+                clamp_joint_speeds(mb);
+            }
+        }
     }
 
     /// After a step: a limited ball joint the step left past its swing or twist limit is put
