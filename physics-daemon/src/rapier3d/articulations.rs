@@ -182,9 +182,9 @@ fn coordinates_from_bodies(mb: &mut Multibody, bodies: &RigidBodySet) {
         let coords = joint.coords();
         let locked = data.locked_axes.bits();
         let mut k = link.assembly_id();
-        for i in 0..3 {
+        for (i, c) in coords.iter().take(3).enumerate() {
             if locked & (1 << i) == 0 {
-                disp[k] = rel.translation[i] - coords[i];
+                disp[k] = rel.translation[i] - c;
                 k += 1;
             }
         }

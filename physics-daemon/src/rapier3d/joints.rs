@@ -541,8 +541,8 @@ impl Plane {
             }
             plans
         } else {
-            for i in 0..self.joints.table.slot_count() {
-                articulated[i] = self.joints.table.at(i).is_some_and(|j| j.link.is_some());
+            for (i, a) in articulated.iter_mut().enumerate() {
+                *a = self.joints.table.at(i).is_some_and(|j| j.link.is_some());
             }
             Vec::new()
         };
