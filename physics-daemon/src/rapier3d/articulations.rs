@@ -853,4 +853,63 @@ mod tests {
             );
         }
     }
+
+    /// A velocity written to one link of a free (unanchored) articulation moves the pair's
+    /// centre of mass with the written momentum, in its direction: two unit balls in zero
+    /// gravity, one pushed at 4 along +Z, move their centre at 2 along +Z.
+    #[test]
+    fn a_push_on_a_free_articulation_keeps_its_momentum() {
+        let mut p = Plane::new(
+            1,
+            &[
+                PlaneProp::TickRate(0.0),
+                PlaneProp::Gravity([0.0; 3]),
+                PlaneProp::LinearDamping(0.0),
+                PlaneProp::AngularDamping(0.0),
+            ],
+        )
+        .unwrap();
+        let a = p
+            .add_object(
+                &Shape::Sphere { radius: 0.1 },
+                Pose::at([0.0, 5.0, 0.0]),
+                &[],
+            )
+            .unwrap();
+        let b = p
+            .add_object(
+                &Shape::Sphere { radius: 0.1 },
+                Pose::at([1.0, 5.0, 0.0]),
+                &[],
+            )
+            .unwrap();
+        p.apply(PlaneOp::Joint(JointOp::Create {
+            kind: JointKind::Ball,
+            a,
+            b: Some(b),
+            props: vec![
+                JointProp::AnchorA([0.5, 0.0, 0.0]),
+                JointProp::AnchorB([-0.5, 0.0, 0.0]),
+            ],
+        }))
+        .unwrap();
+        p.step(1.0 / 60.0).unwrap();
+        p.apply(PlaneOp::Object {
+            handle: a,
+            op: ObjectOp::Set(ObjectProp::Velocity([0.0, 0.0, 4.0])),
+        })
+        .unwrap();
+        for _ in 0..30 {
+            p.step(1.0 / 60.0).unwrap();
+        }
+        let (ha, hb) = (
+            p.bodies.get(a).unwrap().handle,
+            p.bodies.get(b).unwrap().handle,
+        );
+        let v = (p.world.bodies[ha].linvel() + p.world.bodies[hb].linvel()) * 0.5;
+        assert!(
+            (v.z - 2.0).abs() < 0.02 && v.x.abs() < 0.02 && v.y.abs() < 0.02,
+            "{v:?}"
+        );
+    }
 }
