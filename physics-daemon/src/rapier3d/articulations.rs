@@ -205,6 +205,49 @@ fn coordinates_from_bodies(mb: &mut Multibody, bodies: &RigidBodySet) {
     mb.forward_kinematics(bodies, true);
 }
 
+/// `mb`'s joint-space mass matrix `Σ Jᵢᵀ Mᵢ Jᵢ` over its dynamic links.
+fn mass_matrix(mb: &Multibody, bodies: &RigidBodySet) -> DMatrix<f32> {
+    let n = mb.ndofs();
+    let mut m = DMatrix::<f32>::zeros(n, n);
+    for (i, link) in mb.links().enumerate() {
+        let rb = &bodies[link.rigid_body_handle()];
+        if !rb.is_dynamic() {
+            continue;
+        }
+        let j = mb.body_jacobian(i);
+        let inertia = rb
+            .mass_properties()
+            .effective_angular_inertia()
+            .into_matrix();
+        let inertia = Matrix3::from_column_slice(&inertia.to_cols_array());
+        let (jl, ja) = (j.rows(0, 3), j.rows(3, 3));
+        m += jl.transpose() * jl * rb.mass() + ja.transpose() * inertia * ja;
+    }
+    m
+}
+
+/// Stops the relative motion of the joint coordinates `at..at + 3` of `mb` with the
+/// smallest generalized impulse (`Δq̇ = −M⁻¹Sᵀ(SM⁻¹Sᵀ)⁻¹Sq̇`, S selecting them): the rest of
+/// the tree keeps its momentum and no energy is added.
+fn stop_joint(mb: &mut Multibody, bodies: &RigidBodySet, at: usize) {
+    let n = mb.ndofs();
+    if at + 3 > n {
+        return;
+    }
+    let Some(minv) = mass_matrix(mb, bodies).cholesky().map(|c| c.inverse()) else {
+        return;
+    };
+    let qd = mb.generalized_velocity().clone_owned();
+    let a = minv.view((at, at), (3, 3)).into_owned();
+    let Some(ainv) = a.try_inverse() else { return };
+    let lambda = ainv * qd.rows(at, 3);
+    let dq = -(minv.columns(at, 3) * lambda);
+    if dq.iter().all(|x| x.is_finite()) {
+        let mut v = mb.generalized_velocity_mut();
+        v += dq;
+    }
+}
+
 /// Adds to `mb`'s generalized velocities the generalized impulse of the velocity changes
 /// `dv` (per link: linear, angular), `Δq̇ = M⁻¹ Σ Jᵢᵀ Mᵢ Δvᵢ`.
 fn take_velocity_changes(mb: &mut Multibody, bodies: &RigidBodySet, dv: &[(Vector, Vector)]) {
@@ -361,6 +404,7 @@ impl Plane {
             if !moved && !pushed {
                 continue;
             }
+
             let Some(link) = self.world.multibody_joints.rigid_body_link(t.root).copied() else {
                 continue;
             };
@@ -569,10 +613,7 @@ impl Plane {
             let mut disp = vec![0.0f32; mb.ndofs()];
             disp[at..at + 3].copy_from_slice(&[d.x, d.y, d.z]);
             mb.apply_displacements(&disp);
-            let mut v = mb.generalized_velocity_mut();
-            for k in at..at + 3 {
-                v[k] = 0.0;
-            }
+            stop_joint(mb, &self.world.bodies, at);
             touched.push(link);
         }
         for link in touched {
