@@ -90,6 +90,10 @@ fn velocities_from_bodies(mb: &mut Multibody, bodies: &RigidBodySet) {
     take_velocity_changes(mb, bodies, &dv);
 }
 
+/// Overshoot of a ball joint's limit (rad) left to its companion impulse joint before the
+/// inelastic stop puts the joint back on its limit.
+const LIMIT_SLOP: f32 = 0.05;
+
 /// One articulated tree.
 #[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 struct Tree {
@@ -600,7 +604,9 @@ impl Plane {
                 2.0 * q.z.atan2(q.w),
             ];
             let lim = [twist, swing, swing];
-            if (0..3).all(|i| a[i].abs() <= lim[i]) {
+            // Small overshoots are the companion joint's to correct (a limb resting at its
+            // limit against the floor would otherwise be put back every tick, and jitter).
+            if (0..3).all(|i| a[i].abs() <= lim[i] + LIMIT_SLOP) {
                 continue;
             }
             // Each angle clamped: q' = normalize(1, tan(aᵢ/2)) has 2·atan2(q'ᵢ, w') = aᵢ.
