@@ -16,14 +16,21 @@ struct Worst {
     torso_speed: f32,
     /// Worst limit violation and anchor separation from 1 s after the hit on.
     settled: (f32, f32),
+    /// How far the ball's centre got behind the UpperTorso's back (centre − radius 0.5 −
+    /// ball radius 0.4, along the shot) in the first 0.5 s: > 0 means it passed through.
+    behind: f32,
 }
 
-fn hit_ragdoll(max_angular_speed: Option<f32>, weight: f32, iterations: u32) -> (Worst, f32) {
+fn hit_ragdoll(
+    max_angular_speed: Option<f32>,
+    weight: f32,
+    iterations: Option<u32>,
+) -> (Worst, f32) {
     let s = Scene::new(
         "ragdoll",
         PlaneOptions {
             max_angular_speed,
-            solver_iterations: Some(iterations),
+            solver_iterations: iterations,
             ..PlaneOptions::default()
         },
     );
@@ -48,7 +55,10 @@ fn hit_ragdoll(max_angular_speed: Option<f32>, weight: f32, iterations: u32) -> 
         )
         .unwrap();
     let torso = doll.bone("UpperTorso").unwrap().clone();
-    let mut w = Worst::default();
+    let mut w = Worst {
+        behind: f32::MIN,
+        ..Worst::default()
+    };
     for tick in 1..=180u32 {
         s.plane.step(1.0 / 60.0).unwrap();
         for (name, o) in &doll.bones {
@@ -74,6 +84,10 @@ fn hit_ragdoll(max_angular_speed: Option<f32>, weight: f32, iterations: u32) -> 
             w.spin = w.spin.max(spin);
         }
         let v = torso.velocity().unwrap();
+        if tick <= 30 {
+            let gap = torso.position().unwrap()[2] - 0.5 - 0.4 - ball.position().unwrap()[2];
+            w.behind = w.behind.max(gap);
+        }
 
         w.torso_speed = w
             .torso_speed
@@ -97,27 +111,23 @@ fn hit_ragdoll(max_angular_speed: Option<f32>, weight: f32, iterations: u32) -> 
     (w, cap)
 }
 
-/// The humanoid (SolverIterations 16) hit in the chest at 1,000 u/s by a ball of a bone's
-/// weight: every bone stays finite and spins within the plane's MaxAngularSpeed; the worst
-/// limit violation and anchor separation, over the whole run and from 1 s after the hit,
-/// are reported.
+/// The humanoid at the default settings hit in the chest at 1,000 u/s by a ball of a bone's
+/// weight: every bone stays finite and spins within the plane's MaxAngularSpeed, the ball
+/// never gets behind the chest, and the joints hold.
 ///
-/// Bounds: rapier's swing and twist limits are per-axis rows solved like contacts, and a
-/// 1,000 u/s hit (the torso leaves at ~100 u/s, limbs lag by a tick's 1.7 units) drives
-/// limbs well past them before the rows catch up: measured 1.23 rad at worst, still 1.23 rad
-/// after 1 s (the right lower leg pinned past its limit against the floor, now that bodies
-/// rest on the floor without a contact skin and fast ones are stopped in the tick they hit),
-/// anchors 0.36 apart at worst and after 1 s (before those changes: ~0.95 / ~0.7 rad and
-/// ~0.5 / ~0.3). The bounds are those figures plus about 25 %: they catch a regression (a
-/// joint that fails outright leaves radians and units of error that grow), and the figures
-/// say plainly that the limits are overshot, not held, under such a hit.
+/// The ragdoll's joints form a tree, so it runs as one articulation: its anchors cannot part
+/// (what is left is float rounding), and a swing or twist limit a step overshoots by more
+/// than 0.05 rad is put back on the limit at the end of the step (an inelastic stop):
+/// measured 0.049 rad at worst. The bounds are the goals of the issue that asked for
+/// it: overshoot ≤ 0.2 rad and separation ≤ 0.02 (as impulse joints at SolverIterations
+/// 16: 1.23 rad and 0.36, and the ball passed through the chest).
 #[test]
 fn a_humanoid_ragdoll_hit_at_1000_stays_finite_and_within_its_limits() {
-    let (w, cap) = hit_ragdoll(None, 1.0, 16);
+    let (w, cap) = hit_ragdoll(None, 1.0, None);
     println!(
         "ragdoll hit at 1000 u/s: worst limit violation {:.4} rad ({} at tick {}), {:.4} rad \
-         after 1 s; worst anchor separation {:.4} ({} at tick {}), {:.4} after 1 s; max spin \
-         {:.1} rad/s (cap {cap}); torso speed {:.1}",
+         after 1 s; worst anchor separation {:.6} ({} at tick {}), {:.6} after 1 s; max spin \
+         {:.1} rad/s (cap {cap}); torso speed {:.1}; ball behind the chest by {:.3}",
         w.angle.0,
         w.angle.1,
         w.angle.2,
@@ -127,20 +137,20 @@ fn a_humanoid_ragdoll_hit_at_1000_stays_finite_and_within_its_limits() {
         w.separation.2,
         w.settled.1,
         w.spin,
-        w.torso_speed
+        w.torso_speed,
+        w.behind
     );
     assert!(w.torso_speed > 20.0, "the ball hit the chest: {w:?}");
+    assert!(w.behind <= 0.0, "the ball passed through the chest: {w:?}");
     assert!(w.spin <= cap * 1.001, "spin {} above the cap {cap}", w.spin);
-    assert!(w.angle.0 < 1.55, "limit violation {w:?}");
-    assert!(w.settled.0 < 1.55, "limit violation after 1 s {w:?}");
-    assert!(w.separation.0 < 0.65, "anchor separation {w:?}");
-    assert!(w.settled.1 < 0.45, "anchor separation after 1 s {w:?}");
+    assert!(w.angle.0 <= 0.2, "limit violation {w:?}");
+    assert!(w.separation.0 <= 0.02, "anchor separation {w:?}");
 }
 
 /// With MaxAngularSpeed 20 rad/s the bones' spins stay at or under 20 while the hit lands.
 #[test]
 fn a_ragdolls_spin_stays_under_a_low_max_angular_speed() {
-    let (w, cap) = hit_ragdoll(Some(20.0), 1.0, 16);
+    let (w, cap) = hit_ragdoll(Some(20.0), 1.0, Some(16));
     println!("ragdoll with cap {cap}: max spin {:.3}, {w:?}", w.spin);
     assert_eq!(cap, 20.0);
     assert!(w.torso_speed > 20.0, "the ball hit the chest: {w:?}");

@@ -108,6 +108,31 @@ fn build(client: &Client, threads: u32) -> Game {
             ],
         )
         .unwrap();
+    // A three-link arm with limited ball joints hung from the world (an articulation with
+    // limit companions), swinging from a tilted start.
+    let mut prev: Option<Object> = None;
+    let mut anchor = [-6.0, 6.3, -2.0];
+    for i in 0..3 {
+        let at = [-6.0 + 0.6 * (i + 1) as f32, 6.0 - 0.3 * i as f32, -2.0];
+        let link = plane
+            .add(Shape::Sphere { radius: 0.2 }, Pose::at(at), &[])
+            .unwrap();
+        plane
+            .joint(
+                JointKind::ConeTwist,
+                &link,
+                prev.as_ref(),
+                &[
+                    JointProp::AnchorA([anchor[0] - at[0], anchor[1] - at[1], 0.0]),
+                    JointProp::AnchorB(if prev.is_some() { [0.0; 3] } else { anchor }),
+                    JointProp::SwingLimit(0.6),
+                    JointProp::TwistLimit(0.3),
+                ],
+            )
+            .unwrap();
+        prev = Some(link);
+        anchor = at;
+    }
     // A ramp map and a controller walking a path across the floor.
     plane
         .load_map_meshes(

@@ -32,6 +32,8 @@ pub fn render(entries: &[Entry]) -> String {
         "unit",
         "cost",
         "passes with (cost)",
+        "before",
+        "wall s",
     ]);
     for e in entries.iter().filter(|e| e.points.is_empty()) {
         t.row(&[
@@ -43,6 +45,8 @@ pub fn render(entries: &[Entry]) -> String {
             e.unit.to_string(),
             sci(e.cost),
             remedy(e),
+            e.before.unwrap_or("—").to_string(),
+            format!("{:.1}", e.wall_s),
         ]);
     }
     md.push_str(&t.finish());

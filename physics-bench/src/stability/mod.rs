@@ -1,6 +1,7 @@
 //! `physics-bench stability`: stress scenes with automatic pass criteria, and sweeps for the
 //! critical values. In process, through the daemon's own plane code, like `accuracy`.
 
+mod before;
 mod markdown;
 pub mod scenes;
 mod stress;
@@ -63,6 +64,11 @@ pub struct Entry {
     pub critical_strongest: Option<f64>,
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub points: Vec<SweepPoint>,
+    /// The scene's figure before articulations, in words (see `before`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub before: Option<&'static str>,
+    /// Wall seconds the scene took (its remedy search included).
+    pub wall_s: f64,
 }
 
 /// Configurations tried on a scene failing at `at`: the whole TickRate × SolverIterations ×
@@ -101,6 +107,7 @@ pub fn run(args: &StabilityArgs) -> BenchResult<()> {
     let mut entries = Vec::new();
     for scene in scene_list {
         progress.phase(format!("{} at {}", scene.name, scene.config.label()));
+        let started = std::time::Instant::now();
         let check = (scene.run)(scene.config)?;
         let mut remedy = None;
         if !check.pass && !args.quick {
@@ -110,21 +117,24 @@ pub fn run(args: &StabilityArgs) -> BenchResult<()> {
             ));
             remedy = Some(find_remedy(scene.run, scene.config)?);
         }
+        let wall_s = started.elapsed().as_secs_f64();
         progress.note(format!(
-            "{:<24} {} ({:.3e} vs bound {:.3e})",
+            "{:<24} {} ({:.3e} vs bound {:.3e}, {wall_s:.1} s)",
             scene.name,
             if check.pass { "pass" } else { "FAIL" },
             check.figure,
             check.bound
         ));
-        entries.push(entry(
+        let mut e = entry(
             scene.name,
             scene.criterion.into(),
             scene.unit,
             scene.config,
             check,
             remedy,
-        ));
+        );
+        e.wall_s = wall_s;
+        entries.push(e);
         progress.done();
     }
     for sweep in sweep_list {
@@ -196,6 +206,8 @@ pub fn run(args: &StabilityArgs) -> BenchResult<()> {
             critical_default,
             critical_strongest,
             points,
+            before: before::before(sweep.name),
+            wall_s: 0.0,
         });
     }
     progress.finish();
@@ -234,6 +246,8 @@ fn entry(
         critical_default: None,
         critical_strongest: None,
         points: Vec::new(),
+        before: before::before(scene),
+        wall_s: 0.0,
     }
 }
 

@@ -16,6 +16,7 @@ use shm_layout::{CommandError, CommandResult, EventRecord, Handle, Reply, EVENT_
 
 use crate::backend::SlotTable;
 
+use super::articulations::{self, Articulations};
 use super::Plane;
 
 /// Damping of a velocity motor when `Damping` is 0: stiff enough to hold the speed within
@@ -47,6 +48,10 @@ pub(super) struct Joint {
     /// rebuilds the rapier joint before the next step.
     seen: Option<(EndState, EndState)>,
     dirty: bool,
+    /// The multibody joint while the joint is articulated (see `articulations`).
+    link: Option<MultibodyJointHandle>,
+    /// The companion impulse joint holding an articulated ball joint's limits.
+    limit: Option<ImpulseJointHandle>,
 }
 
 /// What one end of a joint is to the solver.
@@ -89,6 +94,8 @@ pub(super) struct Joints {
     ground: Option<RigidBodyHandle>,
     /// Largest positional error after the last step.
     pub max_error: f32,
+    /// The articulated joint trees.
+    pub articulations: Articulations,
 }
 
 impl Default for Joints {
@@ -97,6 +104,7 @@ impl Default for Joints {
             table: SlotTable::new("joint", MAX_JOINTS),
             ground: None,
             max_error: 0.0,
+            articulations: Articulations::default(),
         }
     }
 }
@@ -110,6 +118,45 @@ impl Joints {
     /// Live joints (they count as objects for the quotas).
     pub fn live(&self) -> u32 {
         self.table.live()
+    }
+}
+
+impl Plane {
+    /// The articulated ball joints with limits: (link, twist limit, swing limit), a missing
+    /// limit as π.
+    pub(super) fn limited_ball_links(&self) -> Vec<(MultibodyJointHandle, f32, f32)> {
+        (0..self.joints.table.slot_count())
+            .filter_map(|i| {
+                let j = self.joints.table.at(i)?;
+                let link = j.link?;
+                articulations::needs_limit_joint(j.kind, &j.settings).then(|| {
+                    let pi = std::f32::consts::PI;
+                    (
+                        link,
+                        j.settings.twist_limit.unwrap_or(pi),
+                        j.settings.swing_limit.unwrap_or(pi),
+                    )
+                })
+            })
+            .collect()
+    }
+
+    /// Forgets every joint's articulation (the trees were torn down): companions go, and
+    /// each joint is looked at again before the next step.
+    pub(super) fn forget_articulated(&mut self) {
+        for i in 0..self.joints.table.slot_count() {
+            let Some(j) = self.joints.table.at_mut(i) else {
+                continue;
+            };
+            if j.link.is_none() && j.limit.is_none() {
+                continue;
+            }
+            j.link = None;
+            j.seen = None;
+            if let Some(l) = j.limit.take() {
+                self.world.impulse_joints.remove(l, true);
+            }
+        }
     }
 }
 
@@ -329,7 +376,10 @@ impl Plane {
             broken: false,
             seen: None,
             dirty: false,
+            link: None,
+            limit: None,
         };
+        self.joints.articulations.dirty = true;
         match self.joints.table.insert(joint) {
             Ok(h) => {
                 self.joint_holds(a, 1);
@@ -351,9 +401,14 @@ impl Plane {
         let mut settings = joint.settings;
         settings.store(prop);
         settings.check(joint.kind)?;
+        let structural = articulations::articulable(joint.kind, &joint.settings)
+            != articulations::articulable(joint.kind, &settings)
+            || articulations::needs_limit_joint(joint.kind, &joint.settings)
+                != articulations::needs_limit_joint(joint.kind, &settings);
         let j = self.joints.table.get_mut(handle)?;
         j.settings = settings;
         j.dirty = true;
+        self.joints.articulations.dirty |= structural;
         Ok(())
     }
 
@@ -377,6 +432,13 @@ impl Plane {
         if let Some(r) = j.rapier {
             self.world.impulse_joints.remove(r, true);
         }
+        if let Some(l) = j.limit {
+            self.world.impulse_joints.remove(l, true);
+        }
+        if j.link.is_some() {
+            self.tear_down_articulations();
+        }
+        self.joints.articulations.dirty = true;
     }
 
     /// Removes every joint attached to an object that is being destroyed (before its body
@@ -436,17 +498,76 @@ impl Plane {
         if self.joints.table.live() == 0 {
             return;
         }
-        for i in 0..self.joints.table.slot_count() {
+        // A change of structure (see `articulations`) rebuilds the trees.
+        let states = |p: &Plane, j: &Joint| {
+            (
+                EndState::of(p.world.bodies.get(j.body_a)),
+                EndState::of(p.world.bodies.get(j.body_b)),
+            )
+        };
+        let relayout = self.joints.articulations.dirty
+            || (0..self.joints.table.slot_count()).any(|i| {
+                self.joints
+                    .table
+                    .at(i)
+                    .is_some_and(|j| !j.broken && j.seen != Some(states(self, j)))
+            });
+        let mut articulated = vec![false; self.joints.table.slot_count()];
+        let plans = if relayout {
+            self.tear_down_articulations();
+            let candidates: Vec<articulations::Candidate> = (0..self.joints.table.slot_count())
+                .filter_map(|i| {
+                    let j = self.joints.table.at(i)?;
+                    let now = states(self, j);
+                    let ok = !j.broken
+                        && articulations::articulable(j.kind, &j.settings)
+                        && now.0 != EndState::Disabled
+                        && now.1 != EndState::Disabled
+                        && (now.0 == EndState::Dynamic || now.1 == EndState::Dynamic);
+                    ok.then_some((
+                        i,
+                        j.body_a,
+                        j.body_b,
+                        now.0 == EndState::Dynamic,
+                        now.1 == EndState::Dynamic,
+                    ))
+                })
+                .collect();
+            let plans = articulations::plan(&candidates);
+            for p in &plans {
+                for e in &p.edges {
+                    articulated[e.0] = true;
+                }
+            }
+            plans
+        } else {
+            for (i, a) in articulated.iter_mut().enumerate() {
+                *a = self.joints.table.at(i).is_some_and(|j| j.link.is_some());
+            }
+            Vec::new()
+        };
+        for (i, &art) in articulated.iter().enumerate() {
             let Some(j) = self.joints.table.at(i) else {
                 continue;
             };
             if j.broken {
                 continue;
             }
-            let now = (
-                EndState::of(self.world.bodies.get(j.body_a)),
-                EndState::of(self.world.bodies.get(j.body_b)),
-            );
+            let now = states(self, j);
+            if art {
+                let old = j.rapier;
+                if let Some(r) = old {
+                    self.world.impulse_joints.remove(r, true);
+                }
+                if !relayout && j.dirty {
+                    self.update_articulated(i);
+                }
+                let j = self.joints.table.at_mut(i).expect("live slot");
+                j.rapier = None;
+                j.seen = Some(now);
+                j.dirty = false;
+                continue;
+            }
             if j.seen == Some(now) && !j.dirty {
                 continue;
             }
@@ -467,12 +588,83 @@ impl Plane {
             j.seen = Some(now);
             j.dirty = false;
         }
+        for p in plans {
+            self.build_planned_tree(p);
+        }
+        self.joints.articulations.dirty = false;
+        self.articulations_before_step();
+    }
+
+    /// Builds one planned tree: its multibody joints and the companions of limited ball
+    /// joints.
+    fn build_planned_tree(&mut self, p: articulations::TreePlan) {
+        let edges: Vec<_> = p
+            .edges
+            .iter()
+            .map(|&(slot, parent, child, flip)| {
+                let j = self.joints.table.at(slot).expect("planned joint");
+                let three = matches!(j.kind, JointKind::Ball | JointKind::ConeTwist);
+                let data =
+                    articulations::multibody_data(build(j.kind, &j.settings, j.rel), three, flip);
+                (data, parent, child)
+            })
+            .collect();
+        let links = self.build_tree(p.root, p.fixed_end, &edges, &p.bodies);
+        for (&(slot, ..), link) in p.edges.iter().zip(links) {
+            let j = self.joints.table.at(slot).expect("planned joint");
+            let limit = articulations::needs_limit_joint(j.kind, &j.settings).then(|| {
+                let data = articulations::limit_data(build(j.kind, &j.settings, j.rel));
+                (j.body_a, j.body_b, data)
+            });
+            let limit = limit.map(|(a, b, data)| self.world.insert_impulse_joint(a, b, data));
+            // Rapier refused the link (it should not): the joint stays an impulse joint.
+            let fallback = link.is_none().then(|| {
+                let j = self.joints.table.at(slot).expect("planned joint");
+                let data = build(j.kind, &j.settings, j.rel);
+                let (a, b) = (j.body_a, j.body_b);
+                self.world.insert_impulse_joint(a, b, data)
+            });
+            let j = self.joints.table.at_mut(slot).expect("planned joint");
+            j.link = link;
+            j.limit = limit;
+            j.rapier = fallback;
+        }
+    }
+
+    /// An articulated joint's options changed (motor, limits, CollideConnected): its
+    /// multibody joint and companion take them in place.
+    fn update_articulated(&mut self, i: usize) {
+        let j = self.joints.table.at(i).expect("live slot");
+        let (Some(link), limit) = (j.link, j.limit) else {
+            return;
+        };
+        let data = build(j.kind, &j.settings, j.rel);
+        let three = matches!(j.kind, JointKind::Ball | JointKind::ConeTwist);
+        // The link is keyed by its child body: the joint was flipped when A is the child.
+        let flip = link.0 == j.body_a.0;
+        if let Some((mb, id)) = self.world.multibody_joints.get_mut(link) {
+            if let Some(l) = mb.link_mut(id) {
+                l.joint.data = articulations::multibody_data(data, three, flip);
+            }
+        }
+        if let Some(l) = limit {
+            if let Some(ij) = self.world.impulse_joints.get_mut(l, true) {
+                ij.data = articulations::limit_data(data);
+            }
+        }
     }
 
     /// After a step: every joint's error and force, breaking the overloaded ones (one
     /// event each). Runs only when the plane has joints.
     pub(super) fn joints_after_step(&mut self, dt: f32) {
         self.joints.max_error = 0.0;
+        let articulated = if self.joints.articulations.is_empty() {
+            Default::default()
+        } else {
+            self.articulations_after_ccd();
+            self.articulated_forces(dt)
+        };
+        self.articulations_after_step();
         if self.joints.table.live() == 0 {
             return;
         }
@@ -489,7 +681,17 @@ impl Plane {
             };
             let force = {
                 let j = self.joints.table.at(i).expect("live slot");
+                let child = j.link.map(|l| {
+                    if l.0 == j.body_a.0 {
+                        j.body_a
+                    } else {
+                        j.body_b
+                    }
+                });
                 match j.rapier.and_then(|r| self.world.impulse_joints.get(r)) {
+                    _ if child.is_some() => child
+                        .and_then(|c| articulated.get(&c).copied())
+                        .unwrap_or(0.0),
                     Some(rj) => {
                         let imp = &rj.impulses;
                         let mut lin = Vector::new(imp[0], imp[1], imp[2]);
@@ -725,7 +927,7 @@ mod tests {
         let parked = |p: &Plane| {
             (0..p.joints.table.slot_count())
                 .filter_map(|i| p.joints.table.at(i))
-                .filter(|j| j.rapier.is_none())
+                .filter(|j| j.rapier.is_none() && j.link.is_none())
                 .count()
         };
         let step = |p: &mut Plane, i: usize, dt: f32| {

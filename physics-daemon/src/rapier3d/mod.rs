@@ -24,6 +24,7 @@ mod held {
     //! Held objects: see `crate::backend::held`.
     crate::backend::held::held_bodies!(rapier3d);
 }
+mod articulations;
 mod axis_motors;
 mod capsule_contact;
 mod contact_points;

@@ -255,6 +255,13 @@ fn check(state: &State) -> Result<(), CommandError> {
             return Err(refused(format!("controller #{slot} has no object")));
         }
     }
+    if !super::articulations::hold_together(
+        &state.joints.articulations,
+        &w.bodies,
+        &w.multibody_joints,
+    ) {
+        return Err(refused("an articulation's body is missing".into()));
+    }
     if !state.settings.gravity.iter().all(|g| g.is_finite()) {
         return Err(refused("its Gravity is not finite".into()));
     }
