@@ -19,7 +19,7 @@ use super::{held, joints, Body, Plane, MAX_SLOTS};
 use crate::backend::SlotTable;
 
 /// The engine named in the snapshot header: only a daemon of the same engine reads it.
-pub const ENGINE: &str = "rapier3d 0.36 / physics-daemon state 1";
+pub const ENGINE: &str = "rapier3d 0.36 / physics-daemon state 2";
 
 /// The plane's state, field list written once: `StateRef` borrows it to encode, `State`
 /// owns it decoded, `clone_state` copies it (Rewind). The engine's world comes first; the
@@ -156,8 +156,22 @@ impl Plane {
                     "DeferGpu cannot be set by a restore: set it on the restored plane",
                 ));
             }
+            if let PlaneProp::Name(_) | PlaneProp::Persistent(_) = prop {
+                return Err(CommandError::invalid_field(
+                    prop.name(),
+                    format!(
+                        "{} cannot be set by a restore (it belongs to the plane, like its id: \
+                         give it at creation)",
+                        prop.name()
+                    ),
+                ));
+            }
             state.settings.apply(*prop, true)?;
         }
+        // The name and persistence belong to the plane being restored, like its id: a
+        // snapshot of a named plane restored into another plane does not take the name.
+        state.settings.name = self.settings.name;
+        state.settings.persistent = self.settings.persistent;
         state.bodies.adopt_limits(&self.bodies)?;
         state.joints.adopt_limits(&self.joints)?;
         // What is not state stays: the pipeline (the thread pool), the CCD workspace, the
