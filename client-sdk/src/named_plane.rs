@@ -74,7 +74,10 @@ impl Plane {
     /// the queued writes); returns once the file is on disk, with the tick it holds. A plane
     /// that is not persistent is an error naming `Persistent`.
     pub fn save(&self) -> Result<u64, Error> {
-        match self.client().call(Command::plane(self.id(), PlaneOp::Save))? {
+        match self
+            .client()
+            .call(Command::plane(self.id(), PlaneOp::Save))?
+        {
             Reply::Saved { tick } => Ok(tick),
             other => Err(Error::Protocol(format!("unexpected reply {other:?}"))),
         }

@@ -178,14 +178,26 @@ mod tests {
             let bytes = postcard::to_allocvec(&n).unwrap();
             assert_eq!(postcard::from_bytes::<PlaneName>(&bytes).unwrap(), n);
         }
-        for bad in ["", ".hidden", "-x", "a/b", "../x", "a b", "é", &"x".repeat(33)] {
+        for bad in [
+            "",
+            ".hidden",
+            "-x",
+            "a/b",
+            "../x",
+            "a b",
+            "é",
+            &"x".repeat(33),
+        ] {
             let e = PlaneName::new(bad).unwrap_err();
             assert_eq!(e.field.as_deref(), Some("Name"), "{bad:?}");
             assert!(e.message.contains("Name must be"), "{}", e.message);
             // A forged wire value is refused the same way.
             let bytes = postcard::to_allocvec(&bad).unwrap();
             if !bad.is_empty() {
-                assert!(postcard::from_bytes::<PlaneName>(&bytes).is_err(), "{bad:?}");
+                assert!(
+                    postcard::from_bytes::<PlaneName>(&bytes).is_err(),
+                    "{bad:?}"
+                );
             }
         }
         assert!(PlaneName::NONE.is_none());

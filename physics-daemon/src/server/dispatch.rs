@@ -271,7 +271,7 @@ impl Daemon {
         let (jobs, receiver) = mpsc::channel();
         let shared = PlaneProp::shared_in(&props);
         let file = match (&self.writer, naming.name, naming.persistent) {
-            (Some(w), Some(name), true) => w.plane_file(id, name.as_str(), &cell.marks),
+            (Some(w), Some(name), true) => w.plane_file(id, name.as_str(), &cell.marks, None),
             _ => None,
         };
         let setup = worker::Setup {

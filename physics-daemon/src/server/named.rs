@@ -285,7 +285,7 @@ impl Daemon {
             events: self.events_tx.clone(),
             waker: self.waker.clone(),
             panic_on_step_dt: self.options.panic_on_step_dt,
-            file: writer.plane_file(id, loaded.name.as_str(), &cell.marks),
+            file: writer.plane_file(id, loaded.name.as_str(), &cell.marks, Some(loaded.tick)),
             restore: Some(loaded.bytes),
         };
         let handle = worker::spawn(setup, receiver).map_err(|e| {

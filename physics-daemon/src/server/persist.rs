@@ -132,6 +132,7 @@ enum Write {
         name: String,
         plane: PlaneId,
         tick: Arc<AtomicU64>,
+        recorded: Option<u64>,
     },
     /// Plane `plane`, named `name`, was destroyed: stop recording, remove its files, and
     /// ignore the writes of it still on their way.
@@ -174,13 +175,22 @@ impl Writer {
         &self.dir
     }
 
-    /// The saver a persistent plane's worker uses.
-    pub(super) fn plane_file(&self, id: PlaneId, name: &str, marks: &Marks) -> Option<PlaneFile> {
+    /// The saver a persistent plane's worker uses. `restored`: the tick of the snapshot a
+    /// restored plane starts from (its tick record is left alone until it moves past it, so
+    /// the old daemon's record survives a second crash before anyone opens the plane).
+    pub(super) fn plane_file(
+        &self,
+        id: PlaneId,
+        name: &str,
+        marks: &Marks,
+        restored: Option<u64>,
+    ) -> Option<PlaneFile> {
         let jobs = self.jobs.clone()?;
         let _ = jobs.send(Write::Track {
             name: name.to_string(),
             plane: id,
             tick: marks.tick.clone(),
+            recorded: restored,
         });
         Some(PlaneFile {
             id,
@@ -251,7 +261,11 @@ impl PlaneFile {
     }
 
     /// `Save`: writes the plane now and replies once the file is on disk.
-    pub fn save_now(&mut self, plane: &mut dyn Backend, marks: &Marks) -> Result<Reply, CommandError> {
+    pub fn save_now(
+        &mut self,
+        plane: &mut dyn Backend,
+        marks: &Marks,
+    ) -> Result<Reply, CommandError> {
         let (done, outcome) = mpsc::channel();
         marks.changed.store(false, Ordering::SeqCst);
         let tick = self.send(plane, Some(done))?;
@@ -324,6 +338,9 @@ struct Tracked {
     file: Option<File>,
 }
 
+/// A write of one batch: the plane's name, tick and bytes, and who waits for the outcome.
+type Pending = (String, u64, Vec<u8>, Vec<Sender<Result<(), String>>>);
+
 fn write_loop(dir: &Path, jobs: Receiver<Write>) {
     let mut tracked: HashMap<String, Tracked> = HashMap::new();
     // Destroyed planes: writes of theirs still on their way are dropped.
@@ -341,16 +358,21 @@ fn write_loop(dir: &Path, jobs: Receiver<Write>) {
         // Take everything queued; of several writes of one plane only the newest counts.
         let mut batch: Vec<Write> = first.into_iter().collect();
         batch.extend(jobs.try_iter());
-        let mut files: Vec<(String, u64, Vec<u8>, Vec<Sender<Result<(), String>>>)> = Vec::new();
+        let mut files: Vec<Pending> = Vec::new();
         for job in batch {
             match job {
-                Write::Track { name, plane, tick } => {
+                Write::Track {
+                    name,
+                    plane,
+                    tick,
+                    recorded,
+                } => {
                     tracked.insert(
                         name,
                         Tracked {
                             plane,
                             tick,
-                            recorded: None,
+                            recorded,
                             file: None,
                         },
                     );
@@ -368,13 +390,13 @@ fn write_loop(dir: &Path, jobs: Receiver<Write>) {
                     ] {
                         let _ = std::fs::remove_file(path);
                     }
-                    tracing::info!(plane = name, "persistent plane destroyed: its files removed");
+                    tracing::info!(
+                        plane = name,
+                        "persistent plane destroyed: its files removed"
+                    );
                 }
                 Write::File {
-                    name,
-                    plane,
-                    done,
-                    ..
+                    name, plane, done, ..
                 } if deleted.contains(&plane) => {
                     if let Some(d) = done {
                         let _ = d.send(Err(format!("plane {name:?} was destroyed")));
@@ -397,12 +419,8 @@ fn write_loop(dir: &Path, jobs: Receiver<Write>) {
             }
         }
         for (name, tick, bytes, done) in files {
-            let outcome = write_atomically(dir, &name, &bytes).map_err(|e| {
-                format!(
-                    "cannot write {}: {e}",
-                    file_of(dir, &name).display()
-                )
-            });
+            let outcome = write_atomically(dir, &name, &bytes)
+                .map_err(|e| format!("cannot write {}: {e}", file_of(dir, &name).display()));
             match &outcome {
                 Ok(()) => tracing::debug!(plane = name, tick, bytes = bytes.len(), "plane written"),
                 Err(e) => tracing::error!(plane = name, "{e}"),
@@ -525,7 +543,8 @@ pub fn load(dir: &Path) -> Vec<Loaded> {
 }
 
 fn load_one(dir: &Path, path: &Path, stem: &str) -> Result<Loaded, String> {
-    let name = PlaneName::new(stem).map_err(|e| format!("its name is not a plane name: {}", e.message))?;
+    let name =
+        PlaneName::new(stem).map_err(|e| format!("its name is not a plane name: {}", e.message))?;
     let bytes = std::fs::read(path).map_err(|e| format!("cannot read it: {e}"))?;
     let (header, _) = snapshot::verify(&bytes).map_err(|e| e.message)?;
     if header.kind != PlaneKind::Rapier3d {
@@ -570,7 +589,10 @@ mod tests {
         std::fs::write(dir.join("notes.txt"), b"x").unwrap();
         assert!(load(&dir).is_empty());
         assert!(!dir.join(".a.physnap.tmp").exists());
-        assert!(dir.join("b.physnap").exists(), "a bad file is kept for inspection");
+        assert!(
+            dir.join("b.physnap").exists(),
+            "a bad file is kept for inspection"
+        );
         let _ = std::fs::remove_dir_all(&dir);
     }
 }

@@ -431,8 +431,13 @@ fn create(setup: &Setup) -> Result<(Worker, Reply), CommandError> {
         })?;
     }
     setup.cell.marks.tick.store(plane.tick(), Ordering::SeqCst);
-    // New, or restored (the file holds it already, but a first write costs little).
-    setup.cell.marks.changed.store(true, Ordering::SeqCst);
+    // A new plane is written at once; a restored one only once it changes (its file holds
+    // it already, and a daemon killed again before anyone opens it keeps that file as is).
+    setup
+        .cell
+        .marks
+        .changed
+        .store(setup.restore.is_none(), Ordering::SeqCst);
     let node = NodeBuilder::new()
         .config(&setup.config)
         .signal_handling_mode(SignalHandlingMode::Disabled)
@@ -624,7 +629,10 @@ impl Worker {
     fn finish_file(&mut self) {
         if let Some(mut file) = self.file.take() {
             let mut guard = self.cell.lock();
-            file.finish(guard.as_mut().map(|p| p.as_mut() as &mut dyn Backend), &self.cell.marks);
+            file.finish(
+                guard.as_mut().map(|p| p.as_mut() as &mut dyn Backend),
+                &self.cell.marks,
+            );
         }
     }
 }

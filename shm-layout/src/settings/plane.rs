@@ -5,8 +5,8 @@ use serde::{Deserialize, Serialize};
 
 use super::gui_plane::GuiPlaneProp;
 use super::table::Range;
-use crate::validate::{MAX_SOLVER_ITERATIONS, MAX_THREADS, MAX_TICK_RATE, MIN_TICK_RATE};
 use crate::plane_name::PlaneName;
+use crate::validate::{MAX_SOLVER_ITERATIONS, MAX_THREADS, MAX_TICK_RATE, MIN_TICK_RATE};
 use crate::{CommandError, Vec3};
 
 crate::settings_table! {
