@@ -653,3 +653,42 @@ fn rollback_rewinds_and_replays_bit_for_bit() {
     let daemon = TestDaemon::start("lua-rollback");
     run_ok(&daemon, "tests/lua/rollback.luau", "rollback ok");
 }
+
+#[test]
+fn persistent_planes_come_back_to_luau_after_a_sigkill() {
+    let state = std::env::temp_dir().join(unique_domain("lua-state"));
+    std::fs::create_dir_all(&state).unwrap();
+    let domain = unique_domain("lua-persist");
+    let args = [
+        "--state-dir",
+        state.to_str().unwrap(),
+        "--snapshot-every",
+        "3600",
+    ];
+    // physics-lua runs in the repository root.
+    let snap = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../lua-persist-test.snap");
+    let script = "tests/lua/persistence.luau";
+    let mut daemon = TestDaemon::start_with_in(&domain, &args, &[]);
+    let first = run(&daemon, script);
+    if first.code() != Some(0) {
+        let _ = std::fs::remove_file(&snap);
+    }
+    first.assert_ok();
+    assert!(
+        first.stdout().contains("persistence run 1 ok"),
+        "{}",
+        first.stdout()
+    );
+    daemon.kill9();
+    let daemon = TestDaemon::start_with_in(&domain, &args, &[]);
+    let second = run(&daemon, script);
+    drop(daemon);
+    let _ = std::fs::remove_file(&snap);
+    let _ = std::fs::remove_dir_all(&state);
+    second.assert_ok();
+    assert!(
+        second.stdout().contains("persistence run 2 ok"),
+        "{}",
+        second.stdout()
+    );
+}

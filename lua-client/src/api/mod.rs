@@ -16,6 +16,7 @@ pub mod gui_plane;
 pub(crate) mod identity;
 pub mod joint;
 pub mod map;
+pub mod named_plane;
 pub mod object;
 pub mod part;
 pub mod plane;
