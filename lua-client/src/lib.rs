@@ -77,3 +77,10 @@ pub fn install(lua: &Lua, client: Client) -> mlua::Result<Host> {
     globals.set("wait", scheduler::wait_function(lua)?)?;
     Ok(Host::new(lua, scheduler, client))
 }
+
+/// Restores the snapshot file `path` into a new plane of the installed client, which the
+/// script gets with `PhysicsService.GetStartPlane()` (`physics-lua --snapshot FILE`). Call
+/// it after [`install`]; the error names the file and what is wrong with it.
+pub fn start_from_snapshot(lua: &Lua, path: &std::path::Path) -> Result<(), String> {
+    api::start_plane::start_from_snapshot(lua, path)
+}

@@ -114,7 +114,10 @@ pub fn run(args: &PersistArgs) -> BenchResult<()> {
     )?;
     let plain = DaemonProcess::start("persist-off")?;
     let (a, b) = (persistent.connect()?, plain.connect()?);
-    eprintln!("persist: {} awake bodies, written every {} s", args.bodies, args.every);
+    eprintln!(
+        "persist: {} awake bodies, written every {} s",
+        args.bodies, args.every
+    );
     let on = pile(&a, args.bodies, Some("bench"))?;
     let off = pile(&b, args.bodies, None)?;
     let (mut on_ms, mut off_ms) = (Vec::new(), Vec::new());
@@ -127,9 +130,7 @@ pub fn run(args: &PersistArgs) -> BenchResult<()> {
         off.step(DT)?;
         off_ms.push(t.elapsed().as_secs_f64() * 1e3);
     }
-    let file = state
-        .join(&persistent.domain)
-        .join("bench.physnap");
+    let file = state.join(&persistent.domain).join("bench.physnap");
     let file_bytes = std::fs::metadata(&file).map(|m| m.len()).unwrap_or(0);
     drop((on, off, a, b));
     drop((persistent, plain));

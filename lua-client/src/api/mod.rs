@@ -24,6 +24,7 @@ pub mod probe;
 pub mod query;
 pub mod ragdoll;
 pub mod snapshot;
+pub mod start_plane;
 pub mod static_shapes;
 
 use std::rc::Rc;

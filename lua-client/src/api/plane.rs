@@ -498,5 +498,6 @@ pub fn module(lua: &Lua) -> mlua::Result<Table> {
     m.set("NewGUI", lua.create_function(super::gui_plane::new_gui)?)?;
     super::snapshot::install(lua, &m)?;
     super::named_plane::install(lua, &m)?;
+    super::start_plane::install(lua, &m)?;
     Ok(m)
 }
