@@ -68,6 +68,10 @@ impl Backend for Plane {
         PlaneKind::Rapier3d
     }
 
+    fn snapshot_later(&self) -> Option<Result<crate::backend::SnapshotJob, CommandError>> {
+        Some(Plane::snapshot_later(self))
+    }
+
     fn apply(&mut self, op: PlaneOp) -> CommandResult {
         #[cfg(feature = "gpu")]
         if self.on_gpu() {

@@ -1,7 +1,8 @@
 //! Persistent planes (`Persistent = true`, `--state-dir DIR`, `--snapshot-every SECONDS`):
-//! each one's worker takes a snapshot (the plane's own encoder) every period when the plane
-//! changed, on `Save` and at a clean shutdown, and hands the bytes to one writer thread per
-//! daemon, which writes `DIR/<domain>/<name>.physnap` atomically (a temporary file in the
+//! each one's worker copies the plane's state (`Backend::snapshot_later`, what Rewind keeps)
+//! every period when the plane changed, on `Save` and at a clean shutdown, and hands it to one
+//! writer thread per daemon, which encodes it (the plane's own snapshot encoder, off the
+//! tick) and writes `DIR/<domain>/<name>.physnap` atomically (a temporary file in the
 //! same directory, written, fsynced, renamed over the old file, then the directory fsynced):
 //! a crash at any point leaves the previous file or the new one, never half of one. The
 //! worker never waits for the disk (except for an explicit `Save`, whose reply says the file
@@ -124,7 +125,7 @@ enum Write {
         name: String,
         plane: PlaneId,
         tick: u64,
-        bytes: Vec<u8>,
+        bytes: Bytes,
         done: Option<Sender<Result<(), String>>>,
     },
     /// Record the tick of plane `name` from now on.
@@ -302,14 +303,19 @@ impl PlaneFile {
         plane: &mut dyn Backend,
         done: Option<Sender<Result<(), String>>>,
     ) -> Result<u64, CommandError> {
-        let bytes = match plane.apply(PlaneOp::Snapshot)? {
-            Reply::Snapshot(bytes) => bytes,
-            other => {
-                return Err(CommandError::new(
-                    ErrorKind::Internal,
-                    format!("a snapshot answered {other:?}"),
-                ))
-            }
+        // A copy of the state now, encoded by the writer (off the tick), when the kind can
+        // split its snapshot; otherwise encoded here.
+        let bytes = match plane.snapshot_later() {
+            Some(job) => Bytes::Later(job?),
+            None => match plane.apply(PlaneOp::Snapshot)? {
+                Reply::Snapshot(bytes) => Bytes::Ready(bytes),
+                other => {
+                    return Err(CommandError::new(
+                        ErrorKind::Internal,
+                        format!("a snapshot answered {other:?}"),
+                    ))
+                }
+            },
         };
         let tick = plane.tick();
         self.jobs
@@ -339,7 +345,15 @@ struct Tracked {
 }
 
 /// A write of one batch: the plane's name, tick and bytes, and who waits for the outcome.
-type Pending = (String, u64, Vec<u8>, Vec<Sender<Result<(), String>>>);
+type Pending = (String, u64, Bytes, Vec<Sender<Result<(), String>>>);
+
+/// A plane's snapshot as handed to the writer.
+enum Bytes {
+    /// Encoded already.
+    Ready(Vec<u8>),
+    /// A copy of the state, encoded by the writer.
+    Later(crate::backend::SnapshotJob),
+}
 
 fn write_loop(dir: &Path, jobs: Receiver<Write>) {
     let mut tracked: HashMap<String, Tracked> = HashMap::new();
@@ -419,11 +433,19 @@ fn write_loop(dir: &Path, jobs: Receiver<Write>) {
             }
         }
         for (name, tick, bytes, done) in files {
-            let outcome = write_atomically(dir, &name, &bytes)
-                .map_err(|e| format!("cannot write {}: {e}", file_of(dir, &name).display()));
-            match &outcome {
-                Ok(()) => tracing::debug!(plane = name, tick, bytes = bytes.len(), "plane written"),
-                Err(e) => tracing::error!(plane = name, "{e}"),
+            let bytes = match bytes {
+                Bytes::Ready(b) => Ok(b),
+                Bytes::Later(job) => job().map_err(|e| e.message),
+            };
+            let outcome = bytes.and_then(|bytes| {
+                write_atomically(dir, &name, &bytes)
+                    .map(|()| {
+                        tracing::debug!(plane = name, tick, bytes = bytes.len(), "plane written")
+                    })
+                    .map_err(|e| format!("cannot write {}: {e}", file_of(dir, &name).display()))
+            });
+            if let Err(e) = &outcome {
+                tracing::error!(plane = name, "{e}");
             }
             for d in done {
                 let _ = d.send(outcome.clone());
