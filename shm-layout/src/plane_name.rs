@@ -19,6 +19,9 @@ pub const MAX_NAME_LEN: usize = 32;
 pub struct PlaneName {
     len: u8,
     bytes: [u8; MAX_NAME_LEN],
+    /// Decoded from bytes that are no plane name (a forged request): `bytes` hold its first
+    /// characters, and every check refuses it naming the field (see `Deserialize`).
+    forged: bool,
 }
 
 impl PlaneName {
@@ -26,7 +29,24 @@ impl PlaneName {
     pub const NONE: PlaneName = PlaneName {
         len: 0,
         bytes: [0; MAX_NAME_LEN],
+        forged: false,
     };
+
+    /// What the wire held when it was no plane name: its first characters, kept so the
+    /// check's error can show them.
+    fn forged(text: &str) -> PlaneName {
+        let mut end = text.len().min(MAX_NAME_LEN);
+        while !text.is_char_boundary(end) {
+            end -= 1;
+        }
+        let mut bytes = [0; MAX_NAME_LEN];
+        bytes[..end].copy_from_slice(&text.as_bytes()[..end]);
+        PlaneName {
+            len: end as u8,
+            bytes,
+            forged: true,
+        }
+    }
 
     /// `name` checked: an error naming the field `Name` and the value when it is empty,
     /// too long, or holds a character outside the set.
@@ -37,6 +57,7 @@ impl PlaneName {
         Ok(PlaneName {
             len: name.len() as u8,
             bytes,
+            forged: false,
         })
     }
 
@@ -101,7 +122,10 @@ pub fn check_text(name: &str) -> Result<(), CommandError> {
     Ok(())
 }
 
-/// On the wire a name is a string (forged bytes are checked like any other name).
+/// On the wire a name is a string. Decoding takes any string (a bad one is kept marked, cut
+/// to its first characters), so a forged name is refused by the check with an error naming
+/// the field and the value, for that command alone, instead of the whole request failing to
+/// decode.
 impl Serialize for PlaneName {
     fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
         s.serialize_str(self.as_str())
@@ -114,7 +138,7 @@ impl<'de> Deserialize<'de> for PlaneName {
         if text.is_empty() {
             return Ok(PlaneName::NONE);
         }
-        PlaneName::new(text).map_err(|e| serde::de::Error::custom(e.message))
+        Ok(PlaneName::new(text).unwrap_or_else(|_| PlaneName::forged(text)))
     }
 }
 
@@ -123,6 +147,16 @@ impl PropValue for PlaneName {
     /// Names are checked when made ([`PlaneName::new`], decoding); checked again here so a
     /// value built any other way cannot pass.
     fn check(self, _name: &str, _range: &Range) -> Result<PlaneName, CommandError> {
+        if self.forged {
+            return Err(CommandError::invalid_field(
+                "Name",
+                format!(
+                    "Name must be 1 to {MAX_NAME_LEN} characters of A-Z a-z 0-9 _ - . \
+                     starting with a letter or digit, got {:?}... (not a plane name)",
+                    self.as_str()
+                ),
+            ));
+        }
         if self.is_none() {
             return Ok(self);
         }
@@ -191,13 +225,13 @@ mod tests {
             let e = PlaneName::new(bad).unwrap_err();
             assert_eq!(e.field.as_deref(), Some("Name"), "{bad:?}");
             assert!(e.message.contains("Name must be"), "{}", e.message);
-            // A forged wire value is refused the same way.
+            // A forged wire value decodes, and its check refuses it naming the field.
             let bytes = postcard::to_allocvec(&bad).unwrap();
             if !bad.is_empty() {
-                assert!(
-                    postcard::from_bytes::<PlaneName>(&bytes).is_err(),
-                    "{bad:?}"
-                );
+                let forged = postcard::from_bytes::<PlaneName>(&bytes).unwrap();
+                let e = forged.check("Name", &Range::Any).unwrap_err();
+                assert_eq!(e.field.as_deref(), Some("Name"), "{bad:?}");
+                assert!(e.message.contains("not a plane name"), "{}", e.message);
             }
         }
         assert!(PlaneName::NONE.is_none());

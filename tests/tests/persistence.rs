@@ -521,3 +521,60 @@ fn clean_shutdown_writes_and_destroy_removes() {
     let e = plain.save().unwrap_err();
     assert!(message(&e).contains("Persistent"), "{}", message(&e));
 }
+
+/// Clients that bypass the SDK: an `OpenPlane` with a megabyte name or a path, and a
+/// creation whose `Name` is forged bytes, get errors naming the field with the value cut
+/// short; the good command of the same request still runs and the daemon serves on.
+#[test]
+fn forged_names_are_refused_by_name() {
+    use shm_layout::codec::{decode_response, encode_request};
+    use shm_layout::{Command, Request, Response};
+    let daemon = TestDaemon::start("pforged");
+    let client = daemon.client();
+    client.create_plane(&named("real")).unwrap();
+    let huge = "x".repeat(1 << 20);
+    let request = Request {
+        commands: vec![
+            Command::OpenPlane { name: huge },
+            Command::OpenPlane {
+                name: "../../etc/passwd".into(),
+            },
+            Command::ListNamedPlanes,
+        ],
+    };
+    let results =
+        match decode_response(&client.raw_request(&encode_request(&request)).unwrap()).unwrap() {
+            Response::Results(r) => r,
+            other => panic!("{other:?}"),
+        };
+    let e = results[0].as_ref().unwrap_err();
+    assert_eq!(e.field.as_deref(), Some("Name"));
+    assert!(
+        e.message.contains("1048576 bytes") && e.message.len() < 400,
+        "{}",
+        e.message
+    );
+    let e = results[1].as_ref().unwrap_err();
+    assert!(e.message.contains("'/' is not allowed"), "{}", e.message);
+    match &results[2] {
+        Ok(shm_layout::Reply::NamedPlanes(list)) => assert_eq!(list[0].name, "real"),
+        other => panic!("{other:?}"),
+    }
+    // A creation whose Name is forged bytes: refused naming the field and the value.
+    let mut bytes = encode_request(&Request {
+        commands: vec![Command::CreatePlane {
+            kind: PlaneKind::Rapier3d,
+            props: vec![PlaneProp::Name(PlaneName::new("abc").unwrap())],
+        }],
+    });
+    let at = bytes.windows(3).rposition(|w| w == b"abc").unwrap();
+    bytes[at + 1] = b'/';
+    let results = match decode_response(&client.raw_request(&bytes).unwrap()).unwrap() {
+        Response::Results(r) => r,
+        other => panic!("{other:?}"),
+    };
+    let e = results[0].as_ref().unwrap_err();
+    assert_eq!(e.field.as_deref(), Some("Name"));
+    assert!(e.message.contains("\"a/c\""), "{}", e.message);
+    assert_eq!(client.list_planes().unwrap().len(), 1);
+}

@@ -113,6 +113,8 @@ impl Daemon {
     /// `Open(name)`: the plane's id; an orphaned plane becomes `client`'s (and a restored
     /// one starts ticking again, telling its new owner what it lost).
     pub(super) fn open_plane(&mut self, client: u128, name: &str) -> CommandResult {
+        // A forged name (any length, any bytes) is refused naming at most 64 characters.
+        shm_layout::plane_name::check_text(name)?;
         let Some((id, entry)) = self.named(name) else {
             let known: Vec<String> = self.named_planes().into_iter().map(|p| p.name).collect();
             return Err(CommandError::new(
