@@ -25,6 +25,7 @@ mod joint;
 pub mod map;
 mod members;
 mod mirror;
+mod named_plane;
 mod object;
 mod overlay;
 mod plane;
@@ -46,6 +47,7 @@ pub use events::{Contact, Events, EVENT_BUFFER_TICKS};
 pub use gui::{GuiController, GuiEvent, GuiObject, GuiPlane, GuiPlaneOptions};
 pub use joint::{Joint, JointBroke};
 pub use map::{Map, MapMesh, MapOptions};
+pub use named_plane::OpenedPlane;
 pub use object::Object;
 pub use plane::{Plane, PlaneOptions, Snapshot};
 pub use plane_snapshot::PlaneSnapshot;
@@ -70,6 +72,7 @@ pub use shm_layout::{
     FLAG_ON_GROUND,
 };
 pub use shm_layout::{AxisMotor, ContactInfo, ContactPoint, MAX_CONTACT_POINTS};
+pub use shm_layout::{NamedPlane, PlaneName};
 pub use spawn::{
     connect_or_start, daemon_executable, interrupt_child, sibling_executable, start_daemon,
     start_daemon_with, DaemonChild, Session,

@@ -183,16 +183,23 @@ impl Client {
         snapshot: &PlaneSnapshot,
         overrides: &[PlaneProp],
     ) -> Result<Plane, Error> {
+        // A name and persistence belong to the new plane, not to its state: they go with
+        // the creation (where names are checked for uniqueness).
+        let (naming, overrides): (Vec<PlaneProp>, Vec<PlaneProp>) = overrides
+            .iter()
+            .partition(|p| matches!(p, PlaneProp::Name(_) | PlaneProp::Persistent(_)));
+        let mut props = vec![PlaneProp::Enabled(false)];
+        props.extend(naming);
         let info = match self.call(Command::CreatePlane {
             kind: snapshot.kind(),
-            props: vec![PlaneProp::Enabled(false)],
+            props,
         })? {
             Reply::Plane(info) => info,
             other => return Err(Error::Protocol(format!("unexpected reply {other:?}"))),
         };
         self.note_owned(info.id);
         let plane = self.attach_plane(info.id)?;
-        if let Err(e) = plane.restore_with(snapshot, overrides) {
+        if let Err(e) = plane.restore_with(snapshot, &overrides) {
             let _ = plane.destroy();
             return Err(e);
         }

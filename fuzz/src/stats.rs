@@ -339,6 +339,9 @@ pub fn reply_name(reply: &Reply) -> &'static str {
         Reply::Contacts(_) => "Contacts",
         Reply::ObjectPage { .. } => "ObjectPage",
         Reply::Snapshot(_) => "Snapshot",
+        Reply::NamedPlanes(_) => "NamedPlanes",
+        Reply::Opened(_) => "Opened",
+        Reply::Saved { .. } => "Saved",
     }
 }
 
@@ -348,6 +351,8 @@ pub fn op_name(command: &Command) -> String {
         Command::Hello { .. } => "Hello".into(),
         Command::Goodbye => "Goodbye".into(),
         Command::ListPlanes => "ListPlanes".into(),
+        Command::ListNamedPlanes => "ListNamedPlanes".into(),
+        Command::OpenPlane { .. } => "OpenPlane".into(),
         Command::CreatePlane { .. } => "CreatePlane".into(),
         Command::Plane { op, .. } => match op {
             PlaneOp::Info => "Plane.Info".into(),
@@ -393,6 +398,7 @@ pub fn op_name(command: &Command) -> String {
             PlaneOp::Snapshot => "Plane.Snapshot".into(),
             PlaneOp::Restore { .. } => "Plane.Restore".into(),
             PlaneOp::Rewind(_) => "Plane.Rewind".into(),
+            PlaneOp::Save => "Plane.Save".into(),
         },
     }
 }

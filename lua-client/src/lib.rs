@@ -78,3 +78,10 @@ pub fn install(lua: &Lua, client: Client) -> mlua::Result<Host> {
     let daemon = api::plane::context(lua);
     Ok(Host::new(lua, scheduler, client, daemon))
 }
+
+/// Restores the snapshot file `path` into a new plane of the installed client, which the
+/// script gets with `PhysicsService.GetStartPlane()` (`physics-lua --snapshot FILE`). Call
+/// it after [`install`]; the error names the file and what is wrong with it.
+pub fn start_from_snapshot(lua: &Lua, path: &std::path::Path) -> Result<(), String> {
+    api::start_plane::start_from_snapshot(lua, path)
+}

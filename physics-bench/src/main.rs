@@ -34,6 +34,7 @@ mod hostile;
 mod ipc;
 mod load;
 mod maps;
+mod persist;
 mod procfs;
 mod progress;
 mod queries;
@@ -95,6 +96,9 @@ enum Bench {
     /// Plane snapshots: Snapshot / Restore time and size (1k and 10k bodies, settled and
     /// awake), Rewind(8) + 8 ticks against 8 ticks, the cost of keeping RollbackTicks = 8.
     Snapshot(snapshot::SnapshotArgs),
+    /// Persistent planes: a plane's tick with its periodic writes (--state-dir,
+    /// --snapshot-every) against a plain plane's, side by side.
+    Persist(persist::PersistArgs),
 }
 
 fn main() -> ExitCode {
@@ -122,6 +126,7 @@ fn main() -> ExitCode {
         Bench::Gpu(args) => gpu::run(args),
         Bench::Hostile(args) => hostile::run(args),
         Bench::Snapshot(args) => snapshot::run(args),
+        Bench::Persist(args) => persist::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -23,6 +23,8 @@ struct Args {
     starter_pid: Option<u32>,
     #[command(flatten)]
     limits: physics_daemon::server::Limits,
+    #[command(flatten)]
+    persist: physics_daemon::server::persist::PersistArgs,
     /// Remove what dead processes of the domain left behind (shared memory, node records),
     /// print what was removed, and exit. Live processes keep everything of theirs.
     #[arg(long)]
@@ -72,6 +74,7 @@ fn main() -> ExitCode {
         panic_on_step_dt: std::env::var("PHYSICS_FAULT_PANIC_DT")
             .ok()
             .and_then(|v| v.parse().ok()),
+        persistence: args.persist.persistence(),
     };
     match physics_daemon::server::run_with(&args.domain, &shutdown, options) {
         Ok(()) => ExitCode::SUCCESS,

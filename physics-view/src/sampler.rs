@@ -62,6 +62,14 @@ pub enum Job {
     },
     /// Say goodbye to the daemon and exit the process.
     Shutdown,
+    /// A plane's whole state as a snapshot file's bytes (`PlaneSnapshot`), for "download
+    /// snapshot": its tick and bytes.
+    Download {
+        /// The plane.
+        plane: PlaneId,
+        /// The answer.
+        reply: oneshot::Sender<Result<(u64, Vec<u8>), String>>,
+    },
 }
 
 /// A control of the page.
@@ -421,6 +429,15 @@ impl Sampler {
                 reply,
             } => (self.control(plane, action), reply),
             Job::Shutdown => unreachable!("handled by run"),
+            Job::Download { plane, reply } => {
+                let result = self.download(plane).map_err(|e| {
+                    let message = e.to_string();
+                    self.check(&e);
+                    message
+                });
+                let _ = reply.send(result);
+                return;
+            }
         };
         let result = result.map_err(|e| {
             let message = e.to_string();
@@ -549,6 +566,13 @@ impl Sampler {
             }
         }
         Ok(out)
+    }
+
+    /// The plane's snapshot (a read: any client may take one): its tick and file bytes.
+    fn download(&mut self, id: PlaneId) -> Result<(u64, Vec<u8>), Error> {
+        let w = self.watched(id)?;
+        let snapshot = w.plane.take_snapshot()?;
+        Ok((snapshot.tick(), snapshot.bytes().to_vec()))
     }
 
     fn control(&mut self, id: PlaneId, action: Action) -> Result<Value, Error> {

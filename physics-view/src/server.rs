@@ -46,6 +46,7 @@ pub fn router(state: AppState) -> Router {
         .route("/api/plane/{id}/history", get(history))
         .route("/api/plane/{id}/body/{slot}", get(body))
         .route("/api/plane/{id}/{action}", post(control))
+        .route("/api/plane/{id}/snapshot", get(download))
         .with_state(state)
 }
 
@@ -164,4 +165,29 @@ async fn control(
         reply,
     })
     .await
+}
+
+/// "Download snapshot": the plane's whole state as a `.physnap` file (what
+/// `snapshot:Save(path)` writes; `PhysicsService.LoadSnapshot`, `FromSnapshot` and
+/// `physics-lua --snapshot FILE` take it). A read: no `--allow-control` needed.
+async fn download(State(s): State<AppState>, Path(plane): Path<u32>) -> Response {
+    let (tx, rx) = oneshot::channel();
+    if s.jobs.send(Job::Download { plane, reply: tx }).is_err() {
+        return error(StatusCode::SERVICE_UNAVAILABLE, "the sampler has stopped");
+    }
+    match rx.await {
+        Ok(Ok((tick, bytes))) => (
+            [
+                (header::CONTENT_TYPE, "application/octet-stream".to_string()),
+                (
+                    header::CONTENT_DISPOSITION,
+                    format!("attachment; filename=\"plane-{plane}-tick-{tick}.physnap\""),
+                ),
+            ],
+            bytes,
+        )
+            .into_response(),
+        Ok(Err(message)) => error(StatusCode::NOT_FOUND, message),
+        Err(_) => error(StatusCode::SERVICE_UNAVAILABLE, "the sampler has stopped"),
+    }
 }

@@ -382,6 +382,8 @@ async function refreshPlanes() {
     for (const b of document.querySelectorAll('#controls button')) {
       b.disabled = !allowControl || selected === null;
     }
+    // A snapshot is a read: offered for any plane, controls or not.
+    $('download').href = selected === null ? '#' : `/api/plane/${selected}/snapshot`;
     $('control-note').textContent = allowControl ? '' : 'read-only (start physics-view with --allow-control)';
   } catch (e) {
     $('status').textContent = String(e.message || e);

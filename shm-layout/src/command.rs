@@ -83,6 +83,16 @@ pub enum Command {
     /// Lists the ids of every plane of the daemon (any client may ask; read-only).
     /// Replies [`Reply::PlaneIds`].
     ListPlanes,
+    /// Lists the named planes of the daemon ([`crate::NamedPlane`]: name, id, kind,
+    /// persistent, tick), by name. Replies [`Reply::NamedPlanes`].
+    ListNamedPlanes,
+    /// Attaches to the named plane `name`: an orphaned plane (a persistent plane whose owner
+    /// left, or one restored from the state directory) becomes the sender's. Replies
+    /// [`Reply::Opened`].
+    OpenPlane {
+        /// The plane's name.
+        name: String,
+    },
 }
 
 impl Command {
@@ -244,6 +254,15 @@ pub enum Reply {
     /// A plane's whole state ([`PlaneOp::Snapshot`]): bytes framed by
     /// [`crate::snapshot`] (header readable with [`crate::snapshot::header`]).
     Snapshot(Vec<u8>),
+    /// The named planes, by name ([`Command::ListNamedPlanes`]).
+    NamedPlanes(Vec<crate::NamedPlane>),
+    /// A named plane opened ([`Command::OpenPlane`]).
+    Opened(crate::OpenedPlane),
+    /// A persistent plane was written to its file ([`PlaneOp::Save`]) at this tick.
+    Saved {
+        /// The tick the file holds.
+        tick: u64,
+    },
 }
 
 /// The result of one command.

@@ -29,6 +29,7 @@ pub mod joint_op;
 pub mod map_op;
 pub mod names;
 pub mod object_op;
+pub mod plane_name;
 pub mod plane_op;
 pub mod probe;
 pub mod query;
@@ -49,6 +50,7 @@ pub use gui_op::{GuiControllerOp, GuiControllerProp, GuiHit, GuiObjectOp, GuiOp,
 pub use joint_op::{AxisMode, JointInfo, JointKind, JointOp, JointProp, JointSettings};
 pub use map_op::{MapInfo, MapOp, MapReport};
 pub use object_op::ObjectOp;
+pub use plane_name::{NamedPlane, OpenedPlane, PlaneName};
 pub use plane_op::{OpCost, PlaneKind, PlaneOp};
 pub use probe::{Explosion, Falloff, ProbeHit};
 pub use query::{FilterType, Hit, QueryFilter, QueryOp, Ray};
@@ -62,7 +64,7 @@ pub use snapshot::SnapshotHeader;
 
 /// Bumped whenever a record layout or the command encoding changes. Client and daemon must
 /// agree on it; the handshake reports both values when they differ.
-pub const LAYOUT_VERSION: u32 = 8;
+pub const LAYOUT_VERSION: u32 = 9;
 
 /// The crate version both sides were built from; also checked by the handshake.
 pub const CRATE_VERSION: &str = env!("CARGO_PKG_VERSION");

@@ -87,6 +87,9 @@ pub enum PlaneOp {
     /// Goes back this many ticks (at most `RollbackTicks`): the plane becomes its state
     /// after that tick. Replies [`crate::Reply::Applied`] with the tick gone back to.
     Rewind(u32),
+    /// Writes a persistent plane to its file in the daemon's state directory now (atomically)
+    /// and replies [`crate::Reply::Saved`] once the file is on disk. Owner only.
+    Save,
 }
 
 /// What an op may add to a plane, for the daemon's per-client quotas.

@@ -50,7 +50,20 @@ impl TestDaemon {
         Self::start_with_in(&unique_domain(tag), args, env)
     }
 
-    fn start_with_in(domain: &str, args: &[&str], env: &[(&str, &str)]) -> TestDaemon {
+    /// Starts a daemon with extra flags in an existing domain (e.g. a restart with the same
+    /// `--state-dir` after the previous daemon was killed).
+    pub fn start_with_in(domain: &str, args: &[&str], env: &[(&str, &str)]) -> TestDaemon {
+        Self::spawn_in(domain, args, env, Stdio::inherit())
+    }
+
+    /// [`TestDaemon::start_with_in`] with the daemon's log (stderr, level `info`) written to
+    /// `log`.
+    pub fn start_logged_in(domain: &str, args: &[&str], log: &std::path::Path) -> TestDaemon {
+        let file = std::fs::File::create(log).expect("create the daemon log");
+        Self::spawn_in(domain, args, &[("PHYSICS_LOG", "info")], Stdio::from(file))
+    }
+
+    fn spawn_in(domain: &str, args: &[&str], env: &[(&str, &str)], stderr: Stdio) -> TestDaemon {
         let domain = domain.to_string();
         let child = Command::new(daemon_bin())
             .args(["--domain", &domain])
@@ -58,6 +71,7 @@ impl TestDaemon {
             .env("PHYSICS_LOG", "warn")
             .envs(env.iter().copied())
             .stdin(Stdio::null())
+            .stderr(stderr)
             .spawn()
             .expect("spawn physics-daemon");
         let daemon = TestDaemon {

@@ -653,3 +653,131 @@ fn rollback_rewinds_and_replays_bit_for_bit() {
     let daemon = TestDaemon::start("lua-rollback");
     run_ok(&daemon, "tests/lua/rollback.luau", "rollback ok");
 }
+
+#[test]
+fn persistent_planes_come_back_to_luau_after_a_sigkill() {
+    let state = std::env::temp_dir().join(unique_domain("lua-state"));
+    std::fs::create_dir_all(&state).unwrap();
+    let domain = unique_domain("lua-persist");
+    let args = [
+        "--state-dir",
+        state.to_str().unwrap(),
+        "--snapshot-every",
+        "3600",
+    ];
+    // physics-lua runs in the repository root.
+    let snap = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../lua-persist-test.snap");
+    let script = "tests/lua/persistence.luau";
+    let mut daemon = TestDaemon::start_with_in(&domain, &args, &[]);
+    let first = run(&daemon, script);
+    if first.code() != Some(0) {
+        let _ = std::fs::remove_file(&snap);
+    }
+    first.assert_ok();
+    assert!(
+        first.stdout().contains("persistence run 1 ok"),
+        "{}",
+        first.stdout()
+    );
+    daemon.kill9();
+    let daemon = TestDaemon::start_with_in(&domain, &args, &[]);
+    let second = run(&daemon, script);
+    drop(daemon);
+    let _ = std::fs::remove_file(&snap);
+    let _ = std::fs::remove_dir_all(&state);
+    second.assert_ok();
+    assert!(
+        second.stdout().contains("persistence run 2 ok"),
+        "{}",
+        second.stdout()
+    );
+}
+
+#[test]
+fn physics_lua_starts_from_a_snapshot_file() {
+    use client_sdk::{PlaneOptions, PlaneProp, Pose, Shape};
+    let daemon = TestDaemon::start("lua-start-snap");
+    let script = "tests/lua/start_plane.luau";
+    // Without --snapshot there is no start plane.
+    let plain = run(&daemon, script);
+    plain.assert_ok();
+    assert!(
+        plain.stdout().contains("no start plane"),
+        "{}",
+        plain.stdout()
+    );
+
+    // A ball of radius 1 dropped from 20 under g = -10, 25 ticks, no damping.
+    let (g, dt, y0, n) = (-10.0f64, 1.0f64 / 60.0, 20.0f64, 25u32);
+    let client = daemon.client();
+    let plane = client
+        .create_plane(
+            &PlaneOptions::manual()
+                .with(PlaneProp::Gravity([0.0, g as f32, 0.0]))
+                .with(PlaneProp::LinearDamping(0.0)),
+        )
+        .unwrap();
+    let ball = plane
+        .add(
+            Shape::Sphere { radius: 1.0 },
+            Pose::at([0.0, y0 as f32, 0.0]),
+            &[],
+        )
+        .unwrap();
+    for _ in 0..n {
+        plane.step(dt as f32).unwrap();
+    }
+    let snapshot = plane.take_snapshot().unwrap();
+    let y = ball.pose().unwrap().position[1] as f64;
+    plane.step(dt as f32).unwrap();
+    let next = plane.state_hash().unwrap();
+    // Semi-implicit Euler in 4 substeps a tick (see free_fall.luau).
+    let (h, m) = (dt / 4.0, 4.0 * n as f64);
+    let closed = y0 + g * h * h * m * (m + 1.0) / 2.0;
+    assert!((y - closed).abs() < 1e-3, "{y} vs {closed}");
+
+    let dir = std::env::temp_dir().join(unique_domain("lua-start"));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("report.physnap");
+    snapshot.save(&file).unwrap();
+    let r = run_in(
+        &daemon.domain,
+        script,
+        &["--snapshot", file.to_str().unwrap()],
+        Duration::from_secs(60),
+    );
+    // A damaged file: the run refuses to start, naming the file.
+    let bytes = snapshot.bytes();
+    let cut = dir.join("cut.physnap");
+    std::fs::write(&cut, &bytes[..bytes.len() / 2]).unwrap();
+    let bad = run_in(
+        &daemon.domain,
+        script,
+        &["--snapshot", cut.to_str().unwrap()],
+        Duration::from_secs(60),
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+    r.assert_ok();
+    let out = r.stdout();
+    assert!(
+        out.contains(&format!("start hash {:016x}", snapshot.state_hash())),
+        "{out}"
+    );
+    let top: f64 = out
+        .lines()
+        .find_map(|l| l.strip_prefix("ball top "))
+        .and_then(|v| v.trim().parse().ok())
+        .unwrap_or_else(|| panic!("no ball top in {out}"));
+    assert!(
+        (top - (closed + 1.0)).abs() < 1e-3,
+        "{top} vs {}",
+        closed + 1.0
+    );
+    assert!(out.contains(&format!("next hash {next:016x}")), "{out}");
+    assert_ne!(bad.code(), Some(0), "{}", bad.stdout());
+    assert!(
+        bad.stderr().contains("--snapshot") && bad.stderr().contains("cut.physnap"),
+        "{}",
+        bad.stderr()
+    );
+}

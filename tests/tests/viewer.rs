@@ -679,3 +679,99 @@ fn the_viewer_follows_a_restarted_daemon() {
         daemon.pid() as u64
     );
 }
+
+/// `GET /api/plane/{id}/snapshot` over plain HTTP: (status, head, body bytes).
+fn http_bytes(base: &str, path: &str) -> (u16, String, Vec<u8>) {
+    let host = base.trim_start_matches("http://");
+    let mut s = TcpStream::connect(host).expect("connect to the viewer");
+    s.set_read_timeout(Some(Duration::from_secs(20))).unwrap();
+    write!(
+        s,
+        "GET {path} HTTP/1.1\r\nHost: {host}\r\nConnection: close\r\n\r\n"
+    )
+    .unwrap();
+    let mut raw = Vec::new();
+    s.read_to_end(&mut raw).unwrap();
+    let split = raw
+        .windows(4)
+        .position(|w| w == b"\r\n\r\n")
+        .expect("HTTP reply");
+    let head = String::from_utf8_lossy(&raw[..split]).into_owned();
+    let status = head
+        .split_whitespace()
+        .nth(1)
+        .and_then(|c| c.parse().ok())
+        .expect("status code");
+    (status, head, raw[split + 4..].to_vec())
+}
+
+/// "Download snapshot": the page links the selected plane's snapshot; the link gives the
+/// plane's whole state as a `.physnap` file (its tick and state hash are the plane's), for
+/// a read-only viewer too; an unknown plane is a 404 naming it.
+#[test]
+fn the_page_offers_a_planes_snapshot_for_download() {
+    // Fails with how to install it when there is no browser.
+    chromium();
+    let daemon = TestDaemon::start("viewer-dl");
+    let client = daemon.client();
+    let plane = client.create_plane(&PlaneOptions::manual()).unwrap();
+    plane
+        .add(
+            Shape::Cube {
+                size: [20.0, 1.0, 20.0],
+            },
+            Pose::at([0.0, -0.5, 0.0]),
+            &[ObjectProp::Anchored(true)],
+        )
+        .unwrap();
+    plane
+        .add(
+            Shape::Sphere { radius: 0.5 },
+            Pose::at([0.0, 5.0, 0.0]),
+            &[],
+        )
+        .unwrap();
+    for _ in 0..7 {
+        plane.step(1.0 / 60.0).unwrap();
+    }
+    let viewer = Viewer::start(&daemon.domain, &[]);
+    let id = plane.id();
+    let (status, head, body) = http_bytes(&viewer.base, &format!("/api/plane/{id}/snapshot"));
+    assert_eq!(status, 200, "{head}");
+    assert!(
+        head.contains(&format!("plane-{id}-tick-7.physnap")),
+        "{head}"
+    );
+    let snapshot = client_sdk::PlaneSnapshot::from_bytes(body).unwrap();
+    assert_eq!(snapshot.tick(), 7);
+    assert_eq!(snapshot.state_hash(), plane.state_hash().unwrap());
+    // It is a file FromSnapshot takes: a plane in the same state.
+    let copy = client.plane_from_snapshot(&snapshot, &[]).unwrap();
+    assert_eq!(copy.state_hash().unwrap(), snapshot.state_hash());
+
+    let (status, body) = viewer.request("GET", "/api/plane/9999/snapshot");
+    assert_eq!(status, 404, "{body}");
+    assert!(body.contains("9999"), "{body}");
+
+    // The page's link points at the selected plane's snapshot.
+    let profile = std::env::temp_dir().join(unique_domain("viewer-dl-profile"));
+    let url = format!("{}/?plane={id}", viewer.base);
+    let want = format!("href=\"/api/plane/{id}/snapshot\"");
+    let mut link = String::new();
+    // The page sets the link once it has the plane list (retried like load_view).
+    for _ in 0..3 {
+        let dom = chromium_run(&profile, &["--dump-dom".to_string()], &url);
+        link = dom
+            .find("id=\"download\"")
+            .and_then(|i| {
+                let start = dom[..i].rfind('<')?;
+                Some(dom[start..i + dom[i..].find('>')?].to_string())
+            })
+            .unwrap_or_else(|| panic!("no download link in the page"));
+        if link.contains(&want) {
+            break;
+        }
+    }
+    let _ = std::fs::remove_dir_all(&profile);
+    assert!(link.contains(&want), "{link}");
+}

@@ -16,6 +16,7 @@ pub mod gui_plane;
 pub mod joint;
 pub(crate) mod lifecycle;
 pub mod map;
+pub mod named_plane;
 pub mod object;
 pub mod part;
 pub mod plane;
@@ -23,6 +24,7 @@ pub mod probe;
 pub mod query;
 pub mod ragdoll;
 pub mod snapshot;
+pub mod start_plane;
 pub mod static_shapes;
 
 use std::rc::Rc;

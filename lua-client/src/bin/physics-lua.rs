@@ -60,6 +60,11 @@ struct Args {
     /// script's directory and the current directory.
     #[arg(long = "asset-root")]
     asset_roots: Vec<PathBuf>,
+    /// Start from this plane snapshot file (`snapshot:Save(path)`, a persistent plane's
+    /// `.physnap`): it is restored into a new plane before the script runs, and the script
+    /// gets that plane with `PhysicsService.GetStartPlane()`.
+    #[arg(long)]
+    snapshot: Option<PathBuf>,
 }
 
 /// The asset roots of a run: `--asset-root`, or the script's directory and the current one.
@@ -308,6 +313,9 @@ fn run(args: &Args, signals: &Signals) -> Result<Ended, String> {
     install_print(&lua).map_err(lua_err)?;
     let host = lua_client::install(&lua, session.client.clone()).map_err(lua_err)?;
     asset_roots(args).install(&lua);
+    if let Some(file) = &args.snapshot {
+        lua_client::start_from_snapshot(&lua, file)?;
+    }
     // Every global is in place: from here on scripts cannot change builtins or the API.
     lua.sandbox(true).map_err(lua_err)?;
     host.set_stop_flag(signals.shared.stop.clone());

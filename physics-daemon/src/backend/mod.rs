@@ -120,4 +120,15 @@ pub trait Backend: Send {
 
     /// What the plane holds now.
     fn usage(&self) -> Usage;
+
+    /// The plane's snapshot split in two: a copy of its state taken now, on the plane's
+    /// thread, and a job that encodes it later on any thread (the persistence writer, so the
+    /// encode stays off the tick). `None`: this kind has no split; take
+    /// `PlaneOp::Snapshot` instead.
+    fn snapshot_later(&self) -> Option<Result<SnapshotJob, CommandError>> {
+        None
+    }
 }
+
+/// The encoding half of [`Backend::snapshot_later`]: gives the snapshot's bytes.
+pub type SnapshotJob = Box<dyn FnOnce() -> Result<Vec<u8>, CommandError> + Send>;

@@ -49,7 +49,7 @@ impl Plane {
             )),
             PlaneOp::Joint(op) => self.joint_op(op),
             PlaneOp::Map(op) => self.map_op(op),
-            PlaneOp::Step { .. } | PlaneOp::Destroy => Err(CommandError::new(
+            PlaneOp::Step { .. } | PlaneOp::Destroy | PlaneOp::Save => Err(CommandError::new(
                 ErrorKind::Internal,
                 format!("{op:?} is handled by the server, not the plane"),
             )),
@@ -66,6 +66,10 @@ impl Plane {
 impl Backend for Plane {
     fn kind(&self) -> PlaneKind {
         PlaneKind::Rapier3d
+    }
+
+    fn snapshot_later(&self) -> Option<Result<crate::backend::SnapshotJob, CommandError>> {
+        Some(Plane::snapshot_later(self))
     }
 
     fn apply(&mut self, op: PlaneOp) -> CommandResult {

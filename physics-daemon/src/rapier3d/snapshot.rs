@@ -19,7 +19,7 @@ use super::{held, joints, Body, Plane, MAX_SLOTS};
 use crate::backend::SlotTable;
 
 /// The engine named in the snapshot header: only a daemon of the same engine reads it.
-pub const ENGINE: &str = "rapier3d 0.36 / physics-daemon state 1";
+pub const ENGINE: &str = "rapier3d 0.36 / physics-daemon state 2";
 
 /// The plane's state, field list written once: `StateRef` borrows it to encode, `State`
 /// owns it decoded, `clone_state` copies it (Rewind). The engine's world comes first; the
@@ -59,6 +59,11 @@ macro_rules! plane_state {
             /// Another copy of a kept state (a second rewind to the same tick).
             pub(super) fn duplicate(&self) -> State {
                 State { world: copy_world(&self.world), $($field: self.$field.clone(),)* }
+            }
+
+            /// The copy borrowed to encode (`Plane::snapshot_later`).
+            fn as_ref(&self) -> StateRef<'_> {
+                StateRef { world: &self.world, $($field: &self.$field,)* }
             }
         }
     };
@@ -122,8 +127,12 @@ impl Plane {
         }
         let body = postcard::to_allocvec(&self.state_ref())
             .map_err(|e| CommandError::new(ErrorKind::Internal, format!("snapshot failed: {e}")))?;
+        Ok(snapshot::encode(self.snapshot_header(), &body))
+    }
+
+    fn snapshot_header(&self) -> SnapshotHeader {
         let usage = crate::backend::Backend::usage(self);
-        let header = SnapshotHeader {
+        SnapshotHeader {
             engine: ENGINE.to_string(),
             kind: PlaneKind::Rapier3d,
             tick: self.tick,
@@ -132,8 +141,28 @@ impl Plane {
             mesh_vertices: usage.mesh_vertices,
             state_bytes: usage.state_bytes,
             ..SnapshotHeader::default()
-        };
-        Ok(snapshot::encode(header, &body))
+        }
+    }
+
+    /// [`Plane::snapshot`] split in two: the state copied now (what Rewind keeps, cheaper
+    /// than the encode) and encoded by the returned job, on any thread, to the same bytes a
+    /// snapshot of this tick gives.
+    pub fn snapshot_later(&self) -> Result<crate::backend::SnapshotJob, CommandError> {
+        #[cfg(feature = "gpu")]
+        if self.on_gpu() {
+            return Err(CommandError::invalid_field(
+                "DeferGpu",
+                "a DeferGpu plane cannot be snapshotted yet: set DeferGpu = false first",
+            ));
+        }
+        let header = self.snapshot_header();
+        let state = self.clone_state();
+        Ok(Box::new(move || {
+            let body = postcard::to_allocvec(&state.as_ref()).map_err(|e| {
+                CommandError::new(ErrorKind::Internal, format!("snapshot failed: {e}"))
+            })?;
+            Ok(snapshot::encode(header, &body))
+        }))
     }
 
     /// Becomes exactly the state of `bytes` (same objects under the same handles). The
@@ -156,8 +185,22 @@ impl Plane {
                     "DeferGpu cannot be set by a restore: set it on the restored plane",
                 ));
             }
+            if let PlaneProp::Name(_) | PlaneProp::Persistent(_) = prop {
+                return Err(CommandError::invalid_field(
+                    prop.name(),
+                    format!(
+                        "{} cannot be set by a restore (it belongs to the plane, like its id: \
+                         give it at creation)",
+                        prop.name()
+                    ),
+                ));
+            }
             state.settings.apply(*prop, true)?;
         }
+        // The name and persistence belong to the plane being restored, like its id: a
+        // snapshot of a named plane restored into another plane does not take the name.
+        state.settings.name = self.settings.name;
+        state.settings.persistent = self.settings.persistent;
         state.bodies.adopt_limits(&self.bodies)?;
         state.joints.adopt_limits(&self.joints)?;
         // What is not state stays: the pipeline (the thread pool), the CCD workspace, the
@@ -328,6 +371,23 @@ mod tests {
             plane.step(1.0 / 60.0).unwrap();
         }
         plane
+    }
+
+    /// The split snapshot (copy now, encode on another thread) gives the bytes of a
+    /// snapshot of the same tick, and they restore to a plane that steps on identically.
+    #[test]
+    fn a_snapshot_encoded_later_is_the_snapshot() {
+        let mut plane = scene();
+        let now = plane.snapshot().unwrap();
+        let job = plane.snapshot_later().unwrap();
+        // The plane moves on before the job runs: the copy holds the tick it was taken at.
+        plane.step(1.0 / 60.0).unwrap();
+        let later = std::thread::spawn(job).join().unwrap().unwrap();
+        assert_eq!(later, now);
+        let mut copy = Plane::new(2, &[]).unwrap();
+        copy.restore(&later, &[]).unwrap();
+        copy.step(1.0 / 60.0).unwrap();
+        assert_eq!(copy.state_hash, plane.state_hash);
     }
 
     /// The restore of edited bytes whose checksum was fixed up (what a forger sends): the

@@ -113,7 +113,11 @@ impl Daemon {
                 if let Err(e) = self.check_access(client, plane, &op) {
                     return now(Err(e));
                 }
+                if op == PlaneOp::Save {
+                    return self.save_plane(plane);
+                }
                 if op == PlaneOp::Destroy {
+                    self.forget_file(plane);
                     self.remove_plane(plane);
                     tracing::info!(plane, "plane destroyed");
                     return now(Ok(Reply::Done));
@@ -122,6 +126,7 @@ impl Daemon {
                 while let Some(Command::Plane { plane: next, op }) = rest.front() {
                     if *next != plane
                         || *op == PlaneOp::Destroy
+                        || *op == PlaneOp::Save
                         || self.check_access(client, plane, op).is_err()
                     {
                         break;
@@ -134,6 +139,8 @@ impl Daemon {
                 self.guest = self.guest_of(origin, plane);
                 self.send_job(plane, ops)
             }
+            Command::ListNamedPlanes => now(Ok(Reply::NamedPlanes(self.named_planes()))),
+            Command::OpenPlane { name } => now(self.open_plane(client, &name)),
         }
     }
 
@@ -210,6 +217,21 @@ impl Daemon {
         })
     }
 
+    /// Plane `id` is being destroyed by its owner: a persistent plane's files go with it.
+    fn forget_file(&mut self, id: PlaneId) {
+        let Some(entry) = self.planes.get(&id) else {
+            return;
+        };
+        if let (true, Some(name), Some(writer)) = (entry.persistent, entry.name, &self.writer) {
+            entry
+                .cell
+                .marks
+                .destroyed
+                .store(true, std::sync::atomic::Ordering::SeqCst);
+            writer.delete(id, name.as_str());
+        }
+    }
+
     fn plane(&self, id: PlaneId) -> Result<&PlaneEntry, CommandError> {
         self.planes.get(&id).ok_or_else(|| unknown_plane(id))
     }
@@ -234,6 +256,10 @@ impl Daemon {
                 owned + 1,
             ));
         }
+        let naming = match self.naming(&props) {
+            Ok(n) => n,
+            Err(e) => return refuse(e),
+        };
         let id = self.next_plane_id;
         let ticket = self.next_ticket;
         let owner_pid = self.clients.get(owner).map_or(0, |c| c.pid);
@@ -244,6 +270,10 @@ impl Daemon {
         let cell = Arc::new(PlaneCell::default());
         let (jobs, receiver) = mpsc::channel();
         let shared = PlaneProp::shared_in(&props);
+        let file = match (&self.writer, naming.name, naming.persistent) {
+            (Some(w), Some(name), true) => w.plane_file(id, name.as_str(), &cell.marks, None),
+            _ => None,
+        };
         let setup = worker::Setup {
             id,
             kind,
@@ -255,6 +285,8 @@ impl Daemon {
             events: self.events_tx.clone(),
             waker: self.waker.clone(),
             panic_on_step_dt: self.options.panic_on_step_dt,
+            file,
+            restore: None,
         };
         let spawned = worker::spawn(setup, receiver);
         match spawned {
@@ -276,6 +308,10 @@ impl Daemon {
                 jobs,
                 cell,
                 usage,
+                kind,
+                name: naming.name,
+                persistent: naming.persistent,
+                recovered: None,
             },
         );
         if let Some(c) = self.clients.get_mut(owner) {

@@ -27,7 +27,9 @@ pub mod fair;
 pub mod files;
 pub mod heartbeat;
 pub mod limits;
+mod named;
 mod origin;
+pub mod persist;
 pub mod quota;
 mod request_bytes;
 pub mod resources;
@@ -65,6 +67,9 @@ pub struct Options {
     /// Fault injection for tests: a `Step` with exactly this dt panics inside the plane.
     #[doc(hidden)]
     pub panic_on_step_dt: Option<f32>,
+    /// Where persistent planes are written (`--state-dir`, `--snapshot-every`); `None`:
+    /// `Persistent = true` is refused.
+    pub persistence: Option<persist::Persistence>,
 }
 
 /// How often dead clients are looked for while clients are connected (and, for a daemon
@@ -90,6 +95,14 @@ struct PlaneEntry {
     cell: Arc<PlaneCell>,
     /// What the plane holds, as its worker last saw it (for the owner's other quotas).
     usage: Arc<SharedUsage>,
+    /// Its kind.
+    kind: shm_layout::PlaneKind,
+    /// Its `Name`, unique in the domain (`named`).
+    name: Option<shm_layout::PlaneName>,
+    /// Written to the state directory and kept when its owner leaves (`persist`).
+    persistent: bool,
+    /// Restored from a file and not opened yet: the ticks it lost (`Recovered`).
+    recovered: Option<u64>,
 }
 
 /// A request being served: its commands run in order; the loop parks it while one of its
@@ -139,6 +152,8 @@ pub struct Daemon {
     guest: Option<Arc<quota::OwnerUsage>>,
     /// What the resource guard thread needs to know (who said Hello, which planes exist).
     watch: Arc<resources::Watch>,
+    /// The writer of persistent planes (`--state-dir`).
+    writer: Option<persist::Writer>,
 }
 
 /// Wakes the loop of the daemon of `domain` (e.g. from a signal handler thread after setting
@@ -302,6 +317,15 @@ fn serve(
     let (events_tx, events) = mpsc::channel();
 
     let memory_limit = options.limits.memory_bytes();
+    let writer = match &options.persistence {
+        Some(p) => Some(persist::Writer::start(p, domain).map_err(|e| {
+            DaemonError::Ipc(format!(
+                "cannot use the state directory {}: {e}",
+                persist::domain_dir(&p.dir, domain).display()
+            ))
+        })?),
+        None => None,
+    };
     let mut daemon = Daemon {
         domain: domain.to_string(),
         config: config.clone(),
@@ -324,7 +348,10 @@ fn serve(
         origins: origin::Origins::default(),
         guest: None,
         watch,
+        writer,
     };
+    // Persistent planes of the last daemon come back before the first request.
+    daemon.restore_saved();
     // iceoryx2 creates its node-counter segment world-writable: narrow it to this user.
     files::restrict(domain);
     tracing::info!(domain, pid = std::process::id(), "physics daemon ready");
@@ -388,6 +415,9 @@ fn serve(
     }
     tracing::info!(domain = daemon.domain, "shutting down");
     daemon.stop_workers();
+    if let Some(writer) = &mut daemon.writer {
+        writer.finish();
+    }
     Ok(())
 }
 
@@ -629,6 +659,7 @@ impl Daemon {
             .filter(|(_, p)| p.owner == client)
             .map(|(id, _)| *id)
             .collect();
+        let owned = self.orphan_persistent(owned);
         for id in &owned {
             self.remove_plane(*id);
         }

@@ -48,6 +48,8 @@ pub(super) enum Job {
     Reschedule,
     /// Finish the queued jobs, then drop the plane and end.
     Stop,
+    /// Write the (persistent) plane's file now; answer with `ticket` once it is on disk.
+    Save { ticket: u64 },
 }
 
 /// What a worker tells the request loop.
@@ -86,6 +88,8 @@ pub(super) struct PlaneCell {
     /// Runs handed to the worker that it has not finished applying. While any is, the loop
     /// never applies a run inline (it would overtake them).
     queued: AtomicUsize,
+    /// Its tick, whether it changed since its last write, held or destroyed (`persist`).
+    pub marks: super::persist::Marks,
 }
 
 /// What [`PlaneCell::try_apply`] did.
@@ -116,6 +120,7 @@ impl PlaneCell {
                 | PlaneOp::Snapshot
                 | PlaneOp::Restore { .. }
                 | PlaneOp::Rewind(_)
+                | PlaneOp::Save
         ) && op.cost().mesh_vertices == 0
     }
 
@@ -151,6 +156,7 @@ impl PlaneCell {
             return Inline::HandOver(ops);
         };
         let before = schedule_of(plane.as_ref());
+        self.note_changes(&ops);
         let (results, failed) = run_ops(id, plane.as_mut(), ops, budget, usage, None, None);
         if failed {
             *guard = None;
@@ -167,6 +173,14 @@ impl PlaneCell {
             results,
             failed,
             reschedule,
+        }
+    }
+
+    /// Notes that a run with ops that are not reads changes the plane (it is written again
+    /// at the next period, when persistent).
+    fn note_changes(&self, ops: &[PlaneOp]) {
+        if ops.iter().any(|op| !op.is_read_only()) {
+            self.marks.changed.store(true, Ordering::SeqCst);
         }
     }
 
@@ -222,11 +236,15 @@ pub(super) struct Setup {
     pub events: Sender<Event>,
     pub waker: Arc<Waker>,
     pub panic_on_step_dt: Option<f32>,
+    /// The plane's file, when it is persistent.
+    pub file: Option<super::persist::PlaneFile>,
+    /// A snapshot the plane starts from (a persistent plane restored at start).
+    pub restore: Option<Vec<u8>>,
 }
 
 /// Starts the worker of a plane: a thread that is the only thread of a rayon pool of its
 /// own (so the plane's parallel work runs on it), running [`run`]. Returns the thread.
-pub(super) fn spawn(setup: Setup, jobs: Receiver<Job>) -> std::io::Result<JoinHandle<()>> {
+pub(super) fn spawn(mut setup: Setup, jobs: Receiver<Job>) -> std::io::Result<JoinHandle<()>> {
     let id = setup.id;
     let mut thread = None;
     let pool = rayon::ThreadPoolBuilder::new()
@@ -247,14 +265,15 @@ pub(super) fn spawn(setup: Setup, jobs: Receiver<Job>) -> std::io::Result<JoinHa
         })
         .build()
         .map_err(std::io::Error::other)?;
+    let file = setup.file.take();
     // The job keeps the pool alive until it returns; the pool's thread ends after it.
-    pool.spawn(move || run(setup, jobs));
+    pool.spawn(move || run(setup, file, jobs));
     drop(pool);
     thread.ok_or_else(|| std::io::Error::other("the pool started no thread"))
 }
 
 /// The worker thread's body.
-fn run(setup: Setup, jobs: Receiver<Job>) {
+fn run(setup: Setup, file: Option<super::persist::PlaneFile>, jobs: Receiver<Job>) {
     let Setup {
         id,
         ticket,
@@ -295,9 +314,14 @@ fn run(setup: Setup, jobs: Receiver<Job>) {
             return drain(id, jobs, &report);
         }
     };
+    worker.file = file;
     worker.reschedule(Instant::now());
     loop {
-        let job = match worker.next_tick {
+        let wake = match (worker.next_tick, worker.file.as_ref().map(|f| f.due())) {
+            (Some(a), Some(b)) => Some(a.min(b)),
+            (a, b) => a.or(b),
+        };
+        let job = match wake {
             Some(due) => match jobs.recv_timeout(due.saturating_duration_since(Instant::now())) {
                 Ok(job) => Some(job),
                 Err(RecvTimeoutError::Timeout) => None,
@@ -309,8 +333,20 @@ fn run(setup: Setup, jobs: Receiver<Job>) {
             },
         };
         match job {
-            Some(Job::Stop) => return,
+            Some(Job::Stop) => {
+                worker.finish_file();
+                return;
+            }
             Some(Job::Reschedule) => worker.reschedule(Instant::now()),
+            Some(Job::Save { ticket }) => {
+                let result = worker.save_now();
+                report(Event::Done {
+                    ticket,
+                    plane: id,
+                    results: vec![result],
+                    failed: false,
+                });
+            }
             Some(Job::Run {
                 ticket,
                 ops,
@@ -333,6 +369,7 @@ fn run(setup: Setup, jobs: Receiver<Job>) {
             report(Event::Failed { plane: id });
             return drain(id, jobs, &report);
         }
+        worker.save_if_due(Instant::now());
     }
 }
 
@@ -348,6 +385,12 @@ fn drain(id: PlaneId, jobs: Receiver<Job>, report: &dyn Fn(Event)) {
                 failed: true,
             }),
             Ok(Job::Reschedule) => {}
+            Ok(Job::Save { ticket }) => report(Event::Done {
+                ticket,
+                plane: id,
+                results: vec![Err(unknown_plane(id))],
+                failed: true,
+            }),
             Ok(Job::Stop) | Err(_) => return,
         }
     }
@@ -363,6 +406,8 @@ struct Worker {
     period: Option<Duration>,
     /// When the next automatic tick is due; `None` for manual or disabled planes.
     next_tick: Option<Instant>,
+    /// The plane's file, when it is persistent.
+    file: Option<super::persist::PlaneFile>,
     // The node goes last: the ports above are dropped before it.
     _node: Node<ipc::Service>,
 }
@@ -379,6 +424,20 @@ fn create(setup: &Setup) -> Result<(Worker, Reply), CommandError> {
     let id = setup.id;
     let internal = |e: DaemonError| CommandError::new(ErrorKind::Internal, e.to_string());
     let mut plane = crate::kinds::create(setup.kind, id, &setup.props)?;
+    if let Some(bytes) = &setup.restore {
+        plane.apply(PlaneOp::Restore {
+            bytes: bytes.clone(),
+            overrides: Vec::new(),
+        })?;
+    }
+    setup.cell.marks.tick.store(plane.tick(), Ordering::SeqCst);
+    // A new plane is written at once; a restored one only once it changes (its file holds
+    // it already, and a daemon killed again before anyone opens it keeps that file as is).
+    setup
+        .cell
+        .marks
+        .changed
+        .store(setup.restore.is_none(), Ordering::SeqCst);
     let node = NodeBuilder::new()
         .config(&setup.config)
         .signal_handling_mode(SignalHandlingMode::Disabled)
@@ -409,6 +468,7 @@ fn create(setup: &Setup) -> Result<(Worker, Reply), CommandError> {
             panic_on_step_dt: setup.panic_on_step_dt,
             period: None,
             next_tick: None,
+            file: None,
             _node: node,
         },
         info,
@@ -418,7 +478,11 @@ fn create(setup: &Setup) -> Result<(Worker, Reply), CommandError> {
 impl Worker {
     /// Restarts the schedule when the plane's rate or Enabled changed.
     fn reschedule(&mut self, now: Instant) {
-        let period = self.cell.lock().as_deref().and_then(wanted_period);
+        let period = match self.cell.marks.held.load(Ordering::SeqCst) {
+            // A restored plane waits for its first Open.
+            true => None,
+            false => self.cell.lock().as_deref().and_then(wanted_period),
+        };
         if period != self.period {
             self.period = period;
             self.next_tick = period.and_then(|p| now.checked_add(p));
@@ -467,6 +531,8 @@ impl Worker {
             }
         }
         self.usage.update(plane.as_ref());
+        self.cell.marks.tick.store(plane.tick(), Ordering::SeqCst);
+        self.cell.marks.changed.store(true, Ordering::SeqCst);
         drop(guard);
         // Keep the cadence; after a stall, restart from now instead of catching up.
         let now = Instant::now();
@@ -485,6 +551,7 @@ impl Worker {
     /// Applies a run handed over by the loop, under the plane's lock.
     fn run_job(&mut self, ops: Vec<PlaneOp>, budget: Budget) -> (Vec<CommandResult>, bool) {
         let mut guard = self.cell.lock();
+        self.cell.note_changes(&ops);
         let outcome = match guard.as_mut() {
             Some(plane) => {
                 let (results, failed) = run_ops(
@@ -501,6 +568,7 @@ impl Worker {
                     self.usage.release();
                 } else {
                     self.usage.update(plane.as_ref());
+                    self.cell.marks.tick.store(plane.tick(), Ordering::SeqCst);
                 }
                 (results, failed)
             }
@@ -516,6 +584,56 @@ impl Worker {
             self.reschedule(Instant::now());
         }
         outcome
+    }
+}
+
+impl Worker {
+    /// The periodic write of a persistent plane (see `persist`).
+    fn save_if_due(&mut self, now: Instant) {
+        let Some(file) = self.file.as_mut() else {
+            return;
+        };
+        if now < file.due() {
+            return;
+        }
+        let mut guard = self.cell.lock();
+        if let Some(plane) = guard.as_mut() {
+            file.save_if_due(plane.as_mut(), &self.cell.marks, now);
+        }
+    }
+
+    /// `Save`: the plane's file written now (after the runs handed over before it).
+    fn save_now(&mut self) -> CommandResult {
+        let mut guard = self.cell.lock();
+        let result = match (self.file.as_mut(), guard.as_mut()) {
+            (Some(file), Some(plane)) => file.save_now(plane.as_mut(), &self.cell.marks),
+            (None, _) => Err(CommandError::invalid_field(
+                "Persistent",
+                format!(
+                    "plane {} is not persistent: only planes created with a Name and \
+                     Persistent = true are written to the state directory (use Snapshot to \
+                     keep any plane's state)",
+                    self.id
+                ),
+            )),
+            (_, None) => Err(unknown_plane(self.id)),
+        };
+        // Finished before the lock goes: the loop may apply the next run inline.
+        self.cell.queued.fetch_sub(1, Ordering::SeqCst);
+        drop(guard);
+        result
+    }
+
+    /// The worker ends: a persistent plane is written one last time (or its files removed
+    /// when its owner destroyed it).
+    fn finish_file(&mut self) {
+        if let Some(mut file) = self.file.take() {
+            let mut guard = self.cell.lock();
+            file.finish(
+                guard.as_mut().map(|p| p.as_mut() as &mut dyn Backend),
+                &self.cell.marks,
+            );
+        }
     }
 }
 

@@ -5,6 +5,7 @@ use serde::{Deserialize, Serialize};
 
 use super::gui_plane::GuiPlaneProp;
 use super::table::Range;
+use crate::plane_name::PlaneName;
 use crate::validate::{MAX_SOLVER_ITERATIONS, MAX_THREADS, MAX_TICK_RATE, MIN_TICK_RATE};
 use crate::{CommandError, Vec3};
 
@@ -80,6 +81,13 @@ crate::settings_table! {
         RollbackTicks(u32) "RollbackTicks" = 0,
             range: Range::Within(0.0, MAX_ROLLBACK_TICKS as f64), field: rollback_ticks,
             flags: [lua];
+        /// The plane's name: unique within the domain, so any process of the same user can
+        /// `Open` it (see [`crate::plane_name`]). Creation only. Default: none.
+        Name(PlaneName) "Name" = PlaneName::NONE, field: name, flags: [creation_only];
+        /// Written to the daemon's `--state-dir` (every `--snapshot-every` seconds, on
+        /// `Save` and at shutdown), kept when its owner leaves, and restored by the next
+        /// daemon of the domain. Needs a `Name`. Creation only. Default false.
+        Persistent(bool) "Persistent" = false, field: persistent, flags: [creation_only, lua];
     }
     options: {
         /// Options of a new plane: the backend, then one field per plane option (`None`

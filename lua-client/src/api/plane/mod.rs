@@ -244,6 +244,15 @@ impl Context {
         self.stalled.listeners() > 0 || self.resumed.listeners() > 0
     }
 
+    /// The script's plane `id`, if it holds it (`Open` of a plane it already has).
+    pub(crate) fn plane_state(&self, id: client_sdk::PlaneId) -> Option<Rc<PlaneState>> {
+        self.planes
+            .borrow()
+            .iter()
+            .find(|p| p.plane.id() == id)
+            .cloned()
+    }
+
     /// Remembers `part`, just put in a group other than "Default".
     pub(crate) fn note_group_member(&self, part: &Rc<PartState>) {
         if !part.mark_grouped() {
@@ -339,6 +348,7 @@ impl UserData for PhysicsPlane {
         super::joint::add_methods(methods);
         super::ragdoll::add_methods(methods);
         super::probe::add_methods(methods);
+        super::named_plane::add_methods(methods);
         methods.add_meta_method(MetaMethod::Index, |lua, p, key: Value| {
             PLANE.get(lua, &p.0, &key)
         });
@@ -478,5 +488,7 @@ pub fn module(lua: &Lua) -> mlua::Result<Table> {
     super::collision_groups::install(lua, &m)?;
     m.set("NewGUI", lua.create_function(super::gui_plane::new_gui)?)?;
     super::snapshot::install(lua, &m)?;
+    super::named_plane::install(lua, &m)?;
+    super::start_plane::install(lua, &m)?;
     Ok(m)
 }

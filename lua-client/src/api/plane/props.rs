@@ -46,6 +46,31 @@ pub static PLANE: Props<PlaneState> = Props {
             }),
             set: Set::ReadOnly,
         },
+        // The plane's Name (nil: unnamed); an option of New only.
+        Row {
+            name: "Name",
+            kind: Kind::String,
+            get: Get::Fn(|lua, p| {
+                let name = p.info("Name")?.settings.name;
+                Ok(match name.is_none() {
+                    true => Value::Nil,
+                    false => Value::String(lua.create_string(name.as_str())?),
+                })
+            }),
+            set: Set::CreationOnly(|arg| {
+                let text = arg.string()?;
+                client_sdk::PlaneName::new(&text)
+                    .map(PlaneProp::Name)
+                    .map_err(|e| LuaError::runtime(e.message))
+            }),
+        },
+        // Fired once (lost ticks) after Open of a plane restored from its file.
+        Row {
+            name: "Recovered",
+            kind: Kind::String,
+            get: Get::Fn(crate::api::named_plane::recovered_signal),
+            set: Set::ReadOnly,
+        },
     ],
 };
 
