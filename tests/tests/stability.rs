@@ -3,7 +3,7 @@
 //! The full sweeps (tallest stack, largest mass ratio, highest speed) are in
 //! `physics-bench stability`.
 
-use client_sdk::{BodyState, Object, ObjectProp, Pin, PlaneOptions, Pose};
+use client_sdk::{BodyState, Object, ObjectProp, Pin, PlaneOptions, PlaneProp, Pose};
 use integration_tests::Scene;
 use physics_scenes::{
     ball, column, floor, launched_box, overlapping_pile, pair_gap, pyramid, stack_and_ball,
@@ -113,7 +113,12 @@ fn pyramid_of_base_twenty_stands_ten_seconds() {
 /// How far a box of `ratio` times the mass of the `light` boxes under it sinks below its
 /// rest height in 3 s.
 fn heavy_box_sink(ratio: f32, light: usize, quality: u32) -> f32 {
-    let scene = Scene::new("ratio", PlaneOptions::default());
+    heavy_box_sink_on(PlaneOptions::default(), ratio, light, quality)
+}
+
+/// [`heavy_box_sink`] on a plane made with `options`.
+fn heavy_box_sink_on(options: PlaneOptions, ratio: f32, light: usize, quality: u32) -> f32 {
+    let scene = Scene::new("ratio", options);
     quality_floor(&scene, quality);
     let boxes = quality_column(&scene, light + 1, 0.0, quality, |i| {
         if i == light {
@@ -141,6 +146,52 @@ fn a_hundred_to_one_mass_ratio_holds_at_every_quality() {
             "{light} light box(es), q{quality}: sank {sink}"
         );
     }
+}
+
+#[test]
+fn a_thousand_to_one_mass_ratio_holds_at_the_defaults() {
+    // Criterion: the heavy box sinks at most 0.05, on one light box and on a column of four.
+    // Adaptive solving does it (extra substeps and stiffer contacts for the island holding a
+    // pair of masses 100 times apart or more): without it the soft contact lets the heavy box
+    // sink by ratio·g/ω², and it sank 0.73 and 1.98 here (bound: ≥ 0.2).
+    for light in [1, 4] {
+        let sink = heavy_box_sink(1000.0, light, 1);
+        assert!(sink <= 0.05, "{light} light box(es): sank {sink}");
+        let without = PlaneOptions::default().with(PlaneProp::AdaptiveSolving(false));
+        let sink = heavy_box_sink_on(without, 1000.0, light, 1);
+        assert!(
+            sink >= 0.2,
+            "{light} light box(es) without adaptive solving: sank only {sink}"
+        );
+    }
+}
+
+#[test]
+fn a_boosted_island_restores_bit_for_bit() {
+    // The boosts live in the plane's state: a snapshot taken while a 1,000:1 column is
+    // boosted, made into a new plane, replays the original's state hashes tick for tick.
+    let scene = Scene::new("ratio-restore", PlaneOptions::default());
+    quality_floor(&scene, 1);
+    quality_column(&scene, 5, 0.01, 1, |i| {
+        if i == 4 {
+            vec![ObjectProp::Weight(1000.0)]
+        } else {
+            vec![]
+        }
+    });
+    run_finite(&scene, DT, 20);
+    let snapshot = scene.plane.take_snapshot().unwrap();
+    let run = |plane: &client_sdk::Plane| -> Vec<u64> {
+        (0..40)
+            .map(|_| {
+                plane.step(DT).unwrap();
+                plane.state_hash().unwrap()
+            })
+            .collect()
+    };
+    let original = run(&scene.plane);
+    let copy = scene.client.plane_from_snapshot(&snapshot, &[]).unwrap();
+    assert_eq!(run(&copy), original);
 }
 
 /// A 0.5 box at `speed` toward an anchored wall 0.1 thick whose front face is x = 0.

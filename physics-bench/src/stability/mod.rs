@@ -1,6 +1,7 @@
 //! `physics-bench stability`: stress scenes with automatic pass criteria, and sweeps for the
 //! critical values. In process, through the daemon's own plane code, like `accuracy`.
 
+mod adaptive_cost;
 mod before;
 mod markdown;
 pub mod scenes;
@@ -213,6 +214,20 @@ pub fn run(args: &StabilityArgs) -> BenchResult<()> {
     progress.finish();
     let md = markdown::render(&entries);
     let (json, md_path) = report::write(&args.out, "stability", &entries, &md)?;
+    println!("wrote {}, {}", json.display(), md_path.display());
+    let cost = adaptive_cost::measure(args.quick)?;
+    let (json, md_path) = report::write(
+        &args.out,
+        "adaptive",
+        &cost,
+        &adaptive_cost::markdown(&cost),
+    )?;
+    for row in &cost.rows {
+        println!(
+            "adaptive solving, {}: {:.3} vs {:.3} ms per step ({:.3}×)",
+            row.scene, row.on_ms, row.off_ms, row.ratio
+        );
+    }
     println!("wrote {}, {}", json.display(), md_path.display());
     let failed = entries.iter().filter(|e| !e.pass).count();
     println!(

@@ -246,9 +246,11 @@ pub fn pyramid_100(c: Config) -> BenchResult<Check> {
     )
 }
 
-/// Seconds `pyramid-100` watches its settled pyramid for (after 1 s of settling), shortened
-/// from 9 s: 9 s took longer than the whole run's 10-minute budget on a 2-core machine.
-pub const PYRAMID_100_WINDOW: f32 = 2.0;
+/// Seconds `pyramid-100` watches its settled pyramid for (after 1 s of settling): Box2D's
+/// 10 s in all. (It was shortened to 2 s while the pyramid crept at the defaults and the
+/// remedy search over the whole grid made the run take longer than 10 minutes; adaptive
+/// solving holds it at the defaults.)
+pub const PYRAMID_100_WINDOW: f32 = 9.0;
 
 /// Stepped on 2 threads (the plane's own pool: rapier's results are bitwise the same for
 /// any pool size), which is what the run's 10-minute budget on a 2-core machine needs.

@@ -24,6 +24,7 @@ mod held {
     //! Held objects: see `crate::backend::held`.
     crate::backend::held::held_bodies!(rapier3d);
 }
+mod adaptive;
 mod articulations;
 mod axis_motors;
 mod capsule_contact;
@@ -100,6 +101,10 @@ pub struct Plane {
     last_dt: f32,
     max_penetration: f32,
     contact_pairs: u32,
+    /// Bodies the last adaptive pass gave extra substeps (see `adaptive`).
+    boosted: u32,
+    /// Whether the last adaptive pass found a pair of a high mass ratio (see `adaptive`).
+    stiffened: bool,
     /// Objects asking for contact events; the event collector runs only when > 0.
     reporting: u32,
     collision_tx: mpsc::Sender<CollisionEvent>,
@@ -161,6 +166,8 @@ impl Plane {
             last_step_us: 0.0,
             last_dt: 0.0,
             max_penetration: 0.0,
+            boosted: 0,
+            stiffened: false,
             contact_pairs: 0,
             reporting: 0,
             collision_tx,
@@ -358,6 +365,7 @@ impl Plane {
         if let Some(hash) = hash {
             self.state_hash = hash;
         }
+        self.adapt_solving();
         self.last_step_us = started.elapsed().as_secs_f32() * 1e6;
         self.keep_for_rollback()?;
         Ok(true)

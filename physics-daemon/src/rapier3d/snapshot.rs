@@ -19,7 +19,7 @@ use super::{held, joints, Body, Plane, MAX_SLOTS};
 use crate::backend::SlotTable;
 
 /// The engine named in the snapshot header: only a daemon of the same engine reads it.
-pub const ENGINE: &str = "rapier3d 0.36 / physics-daemon state 2";
+pub const ENGINE: &str = "rapier3d 0.36 / physics-daemon state 3";
 
 /// The plane's state, field list written once: `StateRef` borrows it to encode, `State`
 /// owns it decoded, `clone_state` copies it (Rewind). The engine's world comes first; the
@@ -101,6 +101,8 @@ plane_state! {
     last_dt: f32,
     max_penetration: f32,
     contact_pairs: u32,
+    boosted: u32,
+    stiffened: bool,
     reporting: u32,
     event_seq: u64,
     removed: Vec<(ColliderHandle, shm_layout::Handle)>,

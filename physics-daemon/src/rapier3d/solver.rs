@@ -107,6 +107,16 @@ impl Plane {
 
     pub(super) fn tune_solver(&mut self, dt: f32) {
         let s = self.solver_settings(dt);
+        // A pair of a high mass ratio: contacts as stiff as its islands' substeps allow.
+        let s = if self.contacts_stiffened() {
+            let rate = (s.iterations + super::adaptive::RATIO_EXTRA) as f32 / dt;
+            SolverSettings {
+                contact_frequency: s.contact_frequency.max(rate / SUBSTEPS_PER_CONTACT_PERIOD),
+                ..s
+            }
+        } else {
+            s
+        };
         let p = &mut self.world.integration_parameters;
         p.num_solver_iterations = s.iterations;
         p.num_internal_pgs_iterations = s.pgs_iterations;

@@ -88,6 +88,10 @@ crate::settings_table! {
         /// `Save` and at shutdown), kept when its owner leaves, and restored by the next
         /// daemon of the domain. Needs a `Name`. Creation only. Default false.
         Persistent(bool) "Persistent" = false, field: persistent, flags: [creation_only, lua];
+        /// Islands whose contacts need it (a tall stack's deep contacts, a pair of bodies
+        /// whose masses differ 100 times or more) get extra substeps after each step; the
+        /// others pay nothing. Default true.
+        AdaptiveSolving(bool) "AdaptiveSolving" = true, field: adaptive_solving, flags: [lua];
     }
     options: {
         /// Options of a new plane: the backend, then one field per plane option (`None`

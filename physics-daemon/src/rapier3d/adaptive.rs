@@ -1,0 +1,163 @@
+//! Adaptive solving (`AdaptiveSolving`, on by default): the islands that need more substeps
+//! get them, the others pay nothing.
+//!
+//! The plane's solver runs `SolverIterations` substeps (see `solver`): enough for contacts
+//! between bodies of similar mass under a modest load. Two things defeat it, and both are
+//! found in the contacts after each step:
+//!
+//! - **Load.** The lower contacts of a tall stack carry many bodies' weight and sink deeper
+//!   than the solver can recover in one tick (a base-100 pyramid crept 0.76 in 2 s). A pair
+//!   deeper than [`TRIGGER_DEPTH`] gives both its bodies [`LOAD_EXTRA`] more substeps; the
+//!   pyramid then holds within 0.01.
+//! - **Mass ratio.** A heavy body on a light one: the light body sets the contact's effective
+//!   mass, so the soft contact (a spring of rapier's natural frequency) lets the heavy one
+//!   sink by ratio · g / ω² (1,000:1 sank 0.73). A touching pair of dynamic bodies whose
+//!   masses differ [`RATIO`] times or more gets [`RATIO_EXTRA`] more substeps, and while any
+//!   such pair exists the plane's contacts follow the faster substep rate in stiffness (as
+//!   `solver` does for a plane-wide SolverIterations of 32, the setting that held 1,000:1).
+//!
+//! Rapier runs each connected group of awake bodies (contacts and joints) at the largest
+//! request inside it (`additional_solver_iterations`), so only the islands holding such a
+//! pair pay. A plane with an articulation does not adapt: rapier would run every awake body
+//! at the largest request (it does not split multibody scenes into groups), and an
+//! articulated ragdoll hit at 1,000 units/s went non-finite with extra substeps. A boost stays while its pair is
+//! deeper than [`RELEASE_DEPTH`] or keeps its mass ratio, and ends otherwise: every pass
+//! reads the contacts of that tick, and a pass runs when some contact is deeper than
+//! [`RELEASE_DEPTH`] and every 32nd tick (so boosts of pairs that came apart end).
+//!
+//! The decision reads only the contacts, each body's current boost and the plane's tick, all
+//! part of a snapshot: a restored plane boosts exactly as the original would.
+
+use rapier3d::prelude::*;
+
+use super::Plane;
+
+/// Depth (units at HitBoxQuality 1, scaled with the plane's allowed error) past which a
+/// contact asks for more substeps: six times rapier's allowed error.
+const TRIGGER_DEPTH: f32 = 0.03;
+/// Depth under which a boosted pair lets its boost go (unless its mass ratio keeps it).
+const RELEASE_DEPTH: f32 = 0.01;
+/// The allowed error the depths above are written for (HitBoxQuality 1).
+const BASE_ALLOWED_ERROR: f32 = 0.005;
+/// Mass ratio from which a touching pair is boosted whatever its depth (the defaults hold
+/// 100:1; 1,000:1 needs the boost).
+const RATIO: f32 = 100.0;
+/// Extra substeps for a deep pair: 16 in all at the defaults (a base-100 pyramid holds).
+const LOAD_EXTRA: usize = 12;
+/// Extra substeps for a pair of a high mass ratio: 32 in all at the defaults, 1,920 substeps
+/// a second (a 1,000:1 column of four holds).
+pub(super) const RATIO_EXTRA: usize = 28;
+/// A pass runs at least every this many ticks.
+const PASS_EVERY: u64 = 32;
+
+impl Plane {
+    /// After a step: boosts the bodies of the pairs that need more substeps and lets the
+    /// others' boosts go (see the module doc).
+    pub(super) fn adapt_solving(&mut self) {
+        let articulated = self.world.multibody_joints.iter().next().is_some();
+        if !self.settings.adaptive_solving || articulated {
+            if self.boosted > 0 || self.stiffened {
+                self.unboost_all();
+            }
+            return;
+        }
+        let scale = self
+            .world
+            .integration_parameters
+            .normalized_allowed_linear_error
+            / BASE_ALLOWED_ERROR;
+        let (trigger, release) = (TRIGGER_DEPTH * scale, RELEASE_DEPTH * scale);
+        if self.max_penetration <= release && !self.tick.is_multiple_of(PASS_EVERY) {
+            return;
+        }
+        let bodies = &self.world.bodies;
+        // (body, extra substeps) for the bodies some pair asks for; bodies to let go.
+        let (mut wanted, mut unwanted) = (Vec::new(), Vec::new());
+        let mut stiffened = false;
+        for pair in self.world.narrow_phase.contact_pairs() {
+            let Some((manifold, contact)) = pair.find_deepest_contact() else {
+                continue;
+            };
+            let (Some(h1), Some(h2)) = (manifold.data.rigid_body1, manifold.data.rigid_body2)
+            else {
+                continue;
+            };
+            let (Some(b1), Some(b2)) = (bodies.get(h1), bodies.get(h2)) else {
+                continue;
+            };
+            let depth = -contact.dist;
+            let boosted =
+                b1.additional_solver_iterations() > 0 || b2.additional_solver_iterations() > 0;
+            let heavy = b1.is_dynamic() && b2.is_dynamic() && {
+                let (m1, m2) = (b1.mass(), b2.mass());
+                m1.max(m2) >= RATIO * m1.min(m2)
+            };
+            let extra = if heavy {
+                stiffened = true;
+                RATIO_EXTRA
+            } else if depth > trigger || (boosted && depth > release) {
+                LOAD_EXTRA
+            } else {
+                0
+            };
+            for (h, b) in [(h1, b1), (h2, b2)] {
+                if !b.is_dynamic() {
+                    continue;
+                }
+                if extra > 0 {
+                    wanted.push((h.into_raw_parts(), extra));
+                } else if b.additional_solver_iterations() > 0 {
+                    unwanted.push(h.into_raw_parts());
+                }
+            }
+        }
+        self.stiffened = stiffened;
+        // Each body takes the largest request of its pairs.
+        wanted.sort_unstable_by(|a, b| a.0.cmp(&b.0).then(b.1.cmp(&a.1)));
+        wanted.dedup_by_key(|w| w.0);
+        self.boosted = wanted.len() as u32;
+        let bodies = &mut self.world.bodies;
+        for raw in unwanted {
+            if wanted.binary_search_by(|w| w.0.cmp(&raw)).is_err() {
+                set_extra(bodies, raw, 0);
+            }
+        }
+        for (raw, extra) in wanted {
+            set_extra(bodies, raw, extra);
+        }
+    }
+
+    /// Every body back to the plane's own substeps (AdaptiveSolving turned off, or an
+    /// articulation made).
+    fn unboost_all(&mut self) {
+        let boosted: Vec<RigidBodyHandle> = self
+            .world
+            .bodies
+            .iter()
+            .filter(|(_, b)| b.additional_solver_iterations() > 0)
+            .map(|(h, _)| h)
+            .collect();
+        for h in boosted {
+            set_extra(&mut self.world.bodies, h.into_raw_parts(), 0);
+        }
+        (self.boosted, self.stiffened) = (0, false);
+    }
+
+    /// Whether the plane's contacts follow the boosted substep rate in stiffness this step.
+    pub(super) fn contacts_stiffened(&self) -> bool {
+        self.stiffened && self.settings.adaptive_solving
+    }
+}
+
+/// Sets a body's extra substeps, touching it only when that changes something.
+fn set_extra(bodies: &mut RigidBodySet, raw: (u32, u32), extra: usize) {
+    let h = RigidBodyHandle::from_raw_parts(raw.0, raw.1);
+    if bodies
+        .get(h)
+        .is_some_and(|b| b.additional_solver_iterations() != extra)
+    {
+        if let Some(b) = bodies.get_mut(h) {
+            b.set_additional_solver_iterations(extra);
+        }
+    }
+}
