@@ -31,6 +31,7 @@ mod overlay;
 mod plane;
 mod plane_shared;
 mod plane_snapshot;
+mod snapshot_transfer;
 mod probe;
 mod query;
 pub mod ragdoll;

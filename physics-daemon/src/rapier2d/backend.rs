@@ -101,7 +101,10 @@ impl Backend for Plane {
             // Collision groups do not apply (ZIndex is the layer); a client sends its table to
             // every plane it owns, so a GUI plane takes it and ignores it.
             PlaneOp::CollisionGroups(_) => Ok(Reply::Done),
-            PlaneOp::Step { .. } | PlaneOp::Destroy | PlaneOp::Save => Err(CommandError::new(
+            PlaneOp::Step { .. }
+            | PlaneOp::Destroy
+            | PlaneOp::Save
+            | PlaneOp::RestoreUploaded { .. } => Err(CommandError::new(
                 ErrorKind::Internal,
                 format!("{op:?} is handled by the server, not the plane"),
             )),

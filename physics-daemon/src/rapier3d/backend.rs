@@ -49,7 +49,10 @@ impl Plane {
             )),
             PlaneOp::Joint(op) => self.joint_op(op),
             PlaneOp::Map(op) => self.map_op(op),
-            PlaneOp::Step { .. } | PlaneOp::Destroy | PlaneOp::Save => Err(CommandError::new(
+            PlaneOp::Step { .. }
+            | PlaneOp::Destroy
+            | PlaneOp::Save
+            | PlaneOp::RestoreUploaded { .. } => Err(CommandError::new(
                 ErrorKind::Internal,
                 format!("{op:?} is handled by the server, not the plane"),
             )),

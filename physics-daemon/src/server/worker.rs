@@ -75,6 +75,9 @@ pub(super) struct Budget {
     /// The requesting process's total when it is not the plane owner's (a `Shared` plane):
     /// the objects it adds count against it.
     pub guest: Option<Arc<super::quota::OwnerUsage>>,
+    /// The requesting connection's snapshot transfers: a snapshot too large for the reply
+    /// waits there as a download.
+    pub transfers: Option<Arc<super::transfers::ClientTransfers>>,
 }
 
 /// A plane's usage, counted in its owner's total.
@@ -679,6 +682,7 @@ fn run_ops(
         }));
         match outcome {
             Ok(result) => {
+                let result = stage_large(result, reply_left, budget);
                 let result = count_reply(result, &mut reply_left, &budget.limits);
                 results.push(result)
             }
@@ -811,6 +815,20 @@ fn op_name(op: &PlaneOp) -> &'static str {
         PlaneOp::Restore { .. } => "Restore",
         PlaneOp::Rewind(_) => "Rewind",
         _ => "this op",
+    }
+}
+
+/// A snapshot larger than [`shm_layout::snapshot_transfer::STAGE_ABOVE`] (or than what the
+/// reply may still hold) is kept as a download of the requester's and answered with its
+/// number; everything else passes unchanged.
+fn stage_large(result: CommandResult, reply_left: usize, budget: &Budget) -> CommandResult {
+    match (result, &budget.transfers) {
+        (Ok(Reply::Snapshot(bytes)), Some(transfers))
+            if bytes.len() > shm_layout::snapshot_transfer::STAGE_ABOVE.min(reply_left) =>
+        {
+            transfers.stage(bytes)
+        }
+        (result, _) => result,
     }
 }
 
