@@ -31,10 +31,10 @@ mod overlay;
 mod plane;
 mod plane_shared;
 mod plane_snapshot;
-mod snapshot_transfer;
 mod probe;
 mod query;
 pub mod ragdoll;
+mod snapshot_transfer;
 mod spawn;
 mod transport;
 

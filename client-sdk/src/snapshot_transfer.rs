@@ -16,11 +16,10 @@ impl Client {
             while (bytes.len() as u64) < len {
                 let offset = bytes.len() as u64;
                 match self.call(Command::Transfer(TransferOp::Get { transfer, offset }))? {
-                    Reply::Transfer(TransferReply::Piece { offset: at, bytes: piece })
-                        if at == offset && !piece.is_empty() =>
-                    {
-                        bytes.extend_from_slice(&piece)
-                    }
+                    Reply::Transfer(TransferReply::Piece {
+                        offset: at,
+                        bytes: piece,
+                    }) if at == offset && !piece.is_empty() => bytes.extend_from_slice(&piece),
                     other => {
                         return Err(Error::Protocol(format!(
                             "snapshot transfer {transfer}: unexpected reply {other:?} at offset \

@@ -147,7 +147,9 @@ impl<'a> Gen<'a> {
                 transfer,
                 total,
                 offset,
-                bytes: (0..self.rng.range(0, 200)).map(|_| self.rng.u32() as u8).collect(),
+                bytes: (0..self.rng.range(0, 200))
+                    .map(|_| self.rng.u32() as u8)
+                    .collect(),
             },
             2 => TransferOp::Get { transfer, offset },
             _ => TransferOp::Close { transfer },

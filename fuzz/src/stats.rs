@@ -5,7 +5,8 @@ use std::collections::BTreeMap;
 
 use shm_layout::{
     Command, CommandResult, ControllerOp, ErrorKind, GuiControllerOp, GuiObjectOp, GuiOp, GuiShape,
-    JointOp, MapOp, ObjectOp, ObjectProp, PlaneOp, PlaneProp, QueryOp, Reply, Response, Shape, TransferOp,
+    JointOp, MapOp, ObjectOp, ObjectProp, PlaneOp, PlaneProp, QueryOp, Reply, Response, Shape,
+    TransferOp,
 };
 
 /// How many failures a run keeps in full (the counters count all of them).

@@ -92,7 +92,8 @@ pub enum Command {
     OpenPlane {
         /// The plane's name.
         name: String,
-    },    /// An op on a snapshot transfer of this connection (snapshots in pieces,
+    },
+    /// An op on a snapshot transfer of this connection (snapshots in pieces,
     /// [`crate::snapshot_transfer`]). Replies [`Reply::Transfer`].
     Transfer(crate::snapshot_transfer::TransferOp),
 }
@@ -264,7 +265,8 @@ pub enum Reply {
     Saved {
         /// The tick the file holds.
         tick: u64,
-    },    /// A snapshot transfer's answer ([`Command::Transfer`], or a snapshot too large for one
+    },
+    /// A snapshot transfer's answer ([`Command::Transfer`], or a snapshot too large for one
     /// reply).
     Transfer(crate::snapshot_transfer::TransferReply),
 }

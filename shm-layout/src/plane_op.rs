@@ -89,7 +89,8 @@ pub enum PlaneOp {
     Rewind(u32),
     /// Writes a persistent plane to its file in the daemon's state directory now (atomically)
     /// and replies [`crate::Reply::Saved`] once the file is on disk. Owner only.
-    Save,    /// [`PlaneOp::Restore`] from the bytes of upload `transfer` of the sending connection
+    Save,
+    /// [`PlaneOp::Restore`] from the bytes of upload `transfer` of the sending connection
     /// ([`crate::snapshot_transfer`]): the daemon takes the finished upload and restores
     /// from it as from `Restore` (the transfer is gone after, refused or not).
     RestoreUploaded {

@@ -33,8 +33,8 @@ pub mod persist;
 pub mod quota;
 mod request_bytes;
 pub mod resources;
-pub mod trim;
 mod transfers;
+pub mod trim;
 mod worker;
 
 use std::collections::{BTreeMap, HashMap, VecDeque};
@@ -154,7 +154,8 @@ pub struct Daemon {
     /// What the resource guard thread needs to know (who said Hello, which planes exist).
     watch: Arc<resources::Watch>,
     /// The writer of persistent planes (`--state-dir`).
-    writer: Option<persist::Writer>,    /// Each connection's open snapshot transfers (snapshots in pieces).
+    writer: Option<persist::Writer>,
+    /// Each connection's open snapshot transfers (snapshots in pieces).
     transfers: HashMap<u128, Arc<transfers::ClientTransfers>>,
     /// Where a large snapshot of the command being routed is staged (its sender's transfers).
     stage_to: Option<Arc<transfers::ClientTransfers>>,
