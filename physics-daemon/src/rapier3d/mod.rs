@@ -32,6 +32,7 @@ mod contact_points;
 mod gpu;
 mod joints;
 mod limits;
+mod map_store;
 mod maps;
 mod objects;
 mod part;

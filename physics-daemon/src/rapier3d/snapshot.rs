@@ -19,7 +19,7 @@ use super::{held, joints, Body, Plane, MAX_SLOTS};
 use crate::backend::SlotTable;
 
 /// The engine named in the snapshot header: only a daemon of the same engine reads it.
-pub const ENGINE: &str = "rapier3d 0.36 / physics-daemon state 2";
+pub const ENGINE: &str = "rapier3d 0.36 / physics-daemon state 3";
 
 /// The plane's state, field list written once: `StateRef` borrows it to encode, `State`
 /// owns it decoded, `clone_state` copies it (Rewind). The engine's world comes first; the
@@ -177,6 +177,7 @@ impl Plane {
         }
         let (header, body) = snapshot::decode(bytes, PlaneKind::Rapier3d, ENGINE)?;
         let mut state = crate::backend::snapshot_decode::decode(body, refused, check)?;
+        take_map_meshes(&mut state)?;
         // The overrides are checked on the decoded settings before anything changes.
         for prop in overrides {
             if let PlaneProp::DeferGpu(_) = prop {
@@ -257,6 +258,41 @@ impl Plane {
         self.dirty.mark_all();
         Ok(())
     }
+}
+
+/// Gives each decoded map object the mesh its collider carries (a snapshot writes it once),
+/// checked against the content hash the object names, and tells the daemon's map store
+/// about it (a later build of the same mesh shares it).
+fn take_map_meshes(state: &mut State) -> Result<(), CommandError> {
+    let w = &state.world;
+    for (handle, body) in state.bodies.iter_mut() {
+        let Some(map) = body.part.map.as_mut() else {
+            continue;
+        };
+        let shape = w
+            .bodies
+            .get(body.handle)
+            .and_then(|b| b.colliders().first())
+            .and_then(|c| w.colliders.get(*c))
+            .map(|c| c.shared_shape().clone())
+            .ok_or_else(|| refused(format!("map object {} has no collider", handle.slot)))?;
+        let Some(mesh) = shape.as_trimesh() else {
+            return Err(refused(format!(
+                "map object {}'s collider is not a triangle mesh",
+                handle.slot
+            )));
+        };
+        let hash = super::map_store::content_hash(mesh);
+        if hash != map.hash {
+            return Err(refused(format!(
+                "map object {}'s mesh has content hash {hash:016x}, the object names {:016x}",
+                handle.slot, map.hash
+            )));
+        }
+        super::map_store::register(&shape);
+        map.shape = shape;
+    }
+    Ok(())
 }
 
 /// Cross-references a decoded state must satisfy before the plane takes it: every object's
