@@ -71,10 +71,7 @@ impl Backend for Plane {
             PlaneOp::Set(prop) => self.set(prop).map(|_| Reply::Done),
             PlaneOp::Gui(op) => self.gui(op),
             PlaneOp::Snapshot => self.snapshot().map(Reply::Snapshot),
-            PlaneOp::Rewind(_) => Err(CommandError::invalid_field(
-                "Rewind",
-                "GUI planes do not keep ticks for Rewind (3D planes do, with RollbackTicks)",
-            )),
+            PlaneOp::Rewind(n) => self.rewind(n),
             PlaneOp::Restore { bytes, overrides } => self
                 .restore(&bytes, &overrides)
                 .map(|_| Reply::Applied { tick: self.tick }),
