@@ -63,9 +63,9 @@ fn gui_planes_rewind_bit_for_bit() {
     assert_eq!(plane.plane().rewind(3).unwrap(), 7);
     assert_eq!(plane.plane().state_hash().unwrap(), hashes[7]);
     assert_eq!(objects[3].position().unwrap(), poses[7]);
-    for t in 8..=10 {
+    for (t, expected) in hashes.iter().enumerate().skip(8) {
         plane.step(DT).unwrap();
-        assert_eq!(plane.plane().state_hash().unwrap(), hashes[t], "tick {t}");
+        assert_eq!(plane.plane().state_hash().unwrap(), *expected, "tick {t}");
     }
     // A corrected input after a rewind takes effect from its tick on.
     assert_eq!(plane.plane().rewind(2).unwrap(), 8);

@@ -11,8 +11,11 @@ use std::sync::{Arc, Mutex, Weak};
 use rapier3d::parry::shape::{Shape, TriMesh};
 use rapier3d::prelude::*;
 
-/// The daemon's maps by content hash (weak: the planes own them).
-static STORE: Mutex<Option<HashMap<u64, Vec<Weak<dyn Shape>>>>> = Mutex::new(None);
+/// Copies of meshes by content hash (weak: the planes own them).
+type Copies = HashMap<u64, Vec<Weak<dyn Shape>>>;
+
+/// The daemon's maps by content hash.
+static STORE: Mutex<Option<Copies>> = Mutex::new(None);
 
 /// The content hash of a triangle mesh: its vertices' bits, its triangles and its flags.
 pub(super) fn content_hash(mesh: &TriMesh) -> u64 {
@@ -42,11 +45,7 @@ fn same(a: &TriMesh, b: &TriMesh) -> bool {
 }
 
 /// The stored copy equal to `mesh` (hash `hash`), if the daemon holds one.
-fn find(
-    store: &mut HashMap<u64, Vec<Weak<dyn Shape>>>,
-    hash: u64,
-    mesh: &TriMesh,
-) -> Option<SharedShape> {
+fn find(store: &mut Copies, hash: u64, mesh: &TriMesh) -> Option<SharedShape> {
     let copies = store.get_mut(&hash)?;
     copies.retain(|w| w.strong_count() > 0);
     copies
