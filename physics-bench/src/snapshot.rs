@@ -31,6 +31,19 @@ pub struct SnapshotArgs {
     /// Folder receiving snapshot.json and snapshot.md.
     #[arg(long, default_value = "bench-out")]
     pub out: PathBuf,
+    /// Instead of timing: snapshot, run a command log, restore and replay it, and name the
+    /// first field that differs if the replay diverges (`snapshot-validate.json` / `.md`).
+    #[arg(long)]
+    pub validate: bool,
+    /// Bodies of the validated plane.
+    #[arg(long, default_value_t = 1_000)]
+    pub validate_bodies: usize,
+    /// Ticks of the validated log.
+    #[arg(long, default_value_t = 60)]
+    pub validate_ticks: u32,
+    /// Flips one bit of the replay's input at this tick (to see the report name it).
+    #[arg(long)]
+    pub inject_tick: Option<u32>,
 }
 
 /// One pile's figures.
@@ -164,6 +177,14 @@ fn keep_ratio(client: &Client, n: usize, repeats: usize) -> BenchResult<f64> {
 }
 
 pub fn run(args: &SnapshotArgs) -> BenchResult<()> {
+    if args.validate {
+        return super::validate::run(
+            args.validate_bodies,
+            args.validate_ticks,
+            args.inject_tick,
+            &args.out,
+        );
+    }
     // Snapshots of large planes pass the default 8 MiB reply limit, and 8 kept ticks of
     // 10,000 bodies the default 64 MiB of state bytes.
     let daemon = DaemonProcess::start_with(
