@@ -295,6 +295,8 @@ impl Plane {
 
     /// Advances by `dt`. Returns false (and does nothing) when the plane is disabled.
     pub fn step(&mut self, dt: f32) -> Result<bool, CommandError> {
+        // The last tick is kept before this one changes anything.
+        self.finish_keep()?;
         let dt = validate::positive("dt", dt)?;
         if dt > MAX_DT {
             return Err(CommandError::invalid(format!(
@@ -360,7 +362,8 @@ impl Plane {
             self.state_hash = hash;
         }
         self.last_step_us = started.elapsed().as_secs_f32() * 1e6;
-        self.keep_for_rollback()?;
+        // Kept for Rewind off the tick's path (see `rollback`).
+        self.rollback.note_step();
         Ok(true)
     }
 

@@ -158,6 +158,10 @@ impl PlaneCell {
         let Some(plane) = guard.as_mut() else {
             return Inline::HandOver(ops);
         };
+        // Work the worker put off its tick (a copy for Rewind) is the worker's to do.
+        if plane.has_idle_work() {
+            return Inline::HandOver(ops);
+        }
         let before = schedule_of(plane.as_ref());
         self.note_changes(&ops);
         let (results, failed) = run_ops(id, plane.as_mut(), ops, budget, usage, None, None);
@@ -368,7 +372,7 @@ fn run(setup: Setup, file: Option<super::persist::PlaneFile>, jobs: Receiver<Job
             }
             None => {}
         }
-        if !worker.tick_if_due(Instant::now()) {
+        if !worker.tick_if_due(Instant::now()) || !worker.idle_work() {
             report(Event::Failed { plane: id });
             return drain(id, jobs, &report);
         }
@@ -549,6 +553,32 @@ impl Worker {
         let ready = self.usage.owner().cpu.charge(now - started, now);
         self.next_tick = Some(ready.map_or(next, |r| r.max(next)));
         true
+    }
+
+    /// What the plane put off its tick's path (`Backend::idle_work`), now that the tick is
+    /// answered. False when the plane panicked.
+    fn idle_work(&mut self) -> bool {
+        let mut guard = self.cell.lock();
+        let Some(plane) = guard.as_mut() else {
+            return true;
+        };
+        match catch_unwind(AssertUnwindSafe(|| plane.idle_work())) {
+            Ok(Ok(())) => {
+                self.usage.update(plane.as_ref());
+                true
+            }
+            Ok(Err(e)) => {
+                tracing::warn!(plane = self.id, "keeping the tick failed: {e}");
+                true
+            }
+            Err(panic) => {
+                let message = super::dispatch::panic_message(panic.as_ref());
+                tracing::error!(plane = self.id, "plane failed and was removed: {message}");
+                *guard = None;
+                self.usage.release();
+                false
+            }
+        }
     }
 
     /// Applies a run handed over by the loop, under the plane's lock.
