@@ -299,7 +299,7 @@ impl GpuWorld {
         figures: (f32, u32),
     ) -> Result<GpuWorld, String> {
         let size = std::mem::size_of::<State>();
-        if states.len() % size != 0 || states.len() != params.len() {
+        if !states.len().is_multiple_of(size) || states.len() != params.len() {
             return Err(format!(
                 "GPU bodies of {} and {} bytes (64 bytes a slot each, as many of both)",
                 states.len(),

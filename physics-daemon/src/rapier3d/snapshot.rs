@@ -141,7 +141,7 @@ struct Decoded {
 fn check_decoded(d: &Decoded) -> Result<(), CommandError> {
     check(&d.state)?;
     if let Some(g) = &d.gpu {
-        if g.states.len() % 64 != 0
+        if !g.states.len().is_multiple_of(64)
             || g.states.len() != g.params.len()
             || g.states.len() / 64 > d.state.bodies.slot_count()
         {
