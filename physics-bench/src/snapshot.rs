@@ -164,17 +164,21 @@ fn rewind_ratio(client: &Client, n: usize, repeats: usize) -> BenchResult<f64> {
     Ok(median(again) / median(plain))
 }
 
-/// A tick of an awake plane keeping 8 ticks against one keeping none: alternated (each
-/// plane's worker has the other's tick to do its idle work in, as a plane ticking at its
-/// rate has the rest of its period), and back to back (each step waits for the copy the
-/// last one put off: the CPU the copies cost).
+/// A tick of an awake plane keeping 8 ticks against one keeping none: at a game's cadence
+/// (alternated, each step followed by a 20 ms pause, so a worker has the rest of its
+/// period for the copy it puts off, as a plane ticking at 60 Hz does: the tick's latency),
+/// and back to back (each step waits for the copy the last one put off: the CPU the copies
+/// cost).
 fn keep_ratio(client: &Client, n: usize, repeats: usize) -> BenchResult<(f64, f64)> {
     let keeping = pile(client, n, true, &[PlaneProp::RollbackTicks(8)])?;
     let plain = pile(client, n, true, &[])?;
     let (mut k, mut p) = (Vec::new(), Vec::new());
+    let pause = std::time::Duration::from_millis(20);
     for _ in 0..repeats.max(3) * 4 {
         k.push(timed(|| Ok(keeping.step(DT)?))?.1);
+        std::thread::sleep(pause);
         p.push(timed(|| Ok(plain.step(DT)?))?.1);
+        std::thread::sleep(pause);
     }
     let (mut ks, mut ps) = (Vec::new(), Vec::new());
     for _ in 0..repeats.max(3) {
@@ -236,7 +240,8 @@ pub fn run(args: &SnapshotArgs) -> BenchResult<()> {
         ),
         Goal::new(
             format!(
-                "keeping RollbackTicks = 8 costs ≤ 10 % of a tick ({} awake bodies)",
+                "keeping RollbackTicks = 8 costs ≤ 10 % of a tick's latency at 20 ms a tick \
+                 ({} awake bodies)",
                 args.keep_bodies
             ),
             format!("{:+.0} %", (keep_ratio - 1.0) * 100.0),
@@ -244,12 +249,12 @@ pub fn run(args: &SnapshotArgs) -> BenchResult<()> {
         ),
         Goal::new(
             format!(
-                "keeping RollbackTicks = 8, steps back to back: the copies' CPU ({} awake \
-                 bodies; reported, no goal)",
+                "keeping RollbackTicks = 8 costs ≤ 10 % of a tick's CPU (steps back to back, \
+                 {} awake bodies)",
                 args.keep_bodies
             ),
             format!("{:+.0} %", (keep_ratio_back_to_back - 1.0) * 100.0),
-            None,
+            Some(keep_ratio_back_to_back <= 1.10),
         ),
     ];
     let report = SnapshotReport {
