@@ -43,6 +43,12 @@ pub struct GuiPlaneOptions {
     pub never_sleep: Option<bool>,
     /// `BoundsMin` / `BoundsMax` (creation only).
     pub bounds: Option<(Vec2, Vec2)>,
+    /// `Name`: unique in the domain, for `Open` (creation only).
+    pub name: Option<shm_layout::PlaneName>,
+    /// `Persistent`: written to the daemon's state directory (creation only; needs a name).
+    pub persistent: Option<bool>,
+    /// `RollbackTicks`: ticks kept for [`Plane::rewind`].
+    pub rollback_ticks: Option<u32>,
 }
 
 impl GuiPlaneOptions {
@@ -72,6 +78,9 @@ impl GuiPlaneOptions {
             o.tick_rate.map(PlaneProp::TickRate),
             o.enabled.map(PlaneProp::Enabled),
             o.shared.map(PlaneProp::Shared),
+            o.name.map(PlaneProp::Name),
+            o.persistent.map(PlaneProp::Persistent),
+            o.rollback_ticks.map(PlaneProp::RollbackTicks),
         ]
         .into_iter()
         .flatten()
@@ -308,6 +317,15 @@ pub struct GuiObject {
 }
 
 impl GuiObject {
+    /// The object `handle` of `plane` (one a snapshot, a restore or an opened named plane
+    /// holds); stale handles are reported when used.
+    pub fn from_handle(plane: &GuiPlane, handle: Handle) -> GuiObject {
+        GuiObject {
+            plane: plane.clone(),
+            handle,
+        }
+    }
+
     /// The object's handle.
     pub fn handle(&self) -> Handle {
         self.handle

@@ -34,6 +34,8 @@ mod plane_snapshot;
 mod probe;
 mod query;
 pub mod ragdoll;
+mod replay_check;
+mod snapshot_transfer;
 mod spawn;
 mod transport;
 
@@ -54,6 +56,7 @@ pub use plane_snapshot::PlaneSnapshot;
 pub use probe::{Explosion, Falloff, ProbeHit, DEFAULT_MAX_SLOPE};
 pub use query::{Found, QueryParams};
 pub use ragdoll::{Bone, Ragdoll, RagdollDesc};
+pub use replay_check::{first_difference, FieldDifference};
 /// The collision group every object starts in ("Default").
 pub use shm_layout::collision_groups::DEFAULT_GROUP;
 pub use shm_layout::gui_op::{GuiControllerInfo, GuiObjectInfo, GuiPlaneInfo};

@@ -5,14 +5,16 @@
 //!
 //! The bytes are checked (magic, format, layout version, checksum) when made into a
 //! snapshot and again by the daemon, which refuses a snapshot of another engine or kind
-//! with an error naming what is wrong.
+//! with an error naming what is wrong. Snapshots larger than one reply or request travel
+//! in pieces (`snapshot_transfer`), unseen by the caller.
 
 use std::io::Write as _;
 use std::path::Path;
 use std::sync::Arc;
 
 use shm_layout::snapshot::{self, SnapshotHeader};
-use shm_layout::{Command, PlaneKind, PlaneOp, PlaneProp, Reply};
+use shm_layout::snapshot_transfer::STAGE_ABOVE;
+use shm_layout::{Command, PlaneKind, PlaneOp, PlaneProp, Reply, TransferReply};
 
 use crate::{Client, Error, Plane};
 
@@ -120,6 +122,11 @@ impl Plane {
             .call(Command::plane(self.id(), PlaneOp::Snapshot))?
         {
             Reply::Snapshot(bytes) => PlaneSnapshot::from_bytes(bytes),
+            Reply::Transfer(TransferReply::Staged {
+                transfer,
+                len,
+                checksum,
+            }) => PlaneSnapshot::from_bytes(self.client().download(transfer, len, checksum)?),
             other => Err(Error::Protocol(format!("unexpected reply {other:?}"))),
         }
     }
@@ -143,13 +150,18 @@ impl Plane {
             .map(|p| p.checked())
             .collect::<Result<Vec<_>, _>>()
             .map_err(Error::invalid_value)?;
-        let reply = self.client().call(Command::plane(
-            self.id(),
+        let op = if snapshot.bytes.len() > STAGE_ABOVE {
+            PlaneOp::RestoreUploaded {
+                transfer: self.client().upload(&snapshot.bytes)?,
+                overrides,
+            }
+        } else {
             PlaneOp::Restore {
                 bytes: snapshot.bytes.to_vec(),
                 overrides,
-            },
-        ));
+            }
+        };
+        let reply = self.client().call(Command::plane(self.id(), op));
         self.forget_local_state();
         match reply? {
             Reply::Applied { tick } => Ok(tick),

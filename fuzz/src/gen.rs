@@ -9,7 +9,8 @@ use shm_layout::{
     AxisMode, CollisionGroups, Command, ControllerOp, ControllerProp, FilterType, GuiControllerOp,
     GuiControllerProp, GuiObjectOp, GuiObjectProp, GuiOp, GuiPlaneProp, GuiShape, Handle,
     JointKind, JointOp, JointProp, MapOp, ObjectOp, ObjectProp, Pin, PlaneId, PlaneKind, PlaneOp,
-    PlaneProp, Pose, QueryFilter, QueryOp, Ray, Restraint, RotateTo, Shape, Vec3, CRATE_VERSION,
+    PlaneProp, Pose, QueryFilter, QueryOp, Ray, Restraint, RotateTo, Shape, TransferOp, Vec3,
+    CRATE_VERSION,
 };
 
 use super::rng::Rng;
@@ -126,9 +127,33 @@ impl<'a> Gen<'a> {
             }
             return self.create_plane(wild);
         }
+        if u < 0.045 {
+            return Command::Transfer(self.transfer_op());
+        }
         let plane = self.plane_id(wild, &own);
         let op = self.plane_op(wild, plane);
         Command::Plane { plane, op }
+    }
+
+    /// A snapshot transfer op: opens of any size, pieces with made-up numbers, offsets and
+    /// totals (the daemon must refuse each by name and hold nothing for long).
+    fn transfer_op(&mut self) -> TransferOp {
+        let transfer = self.rng.range(0, 64) as u32;
+        let total = *self.rng.pick(&[0, 1, 100, 5 << 20, u64::MAX]);
+        let offset = *self.rng.pick(&[0, 1, 100, u64::MAX]);
+        match self.rng.range(0, 4) {
+            0 => TransferOp::Open { total },
+            1 => TransferOp::Put {
+                transfer,
+                total,
+                offset,
+                bytes: (0..self.rng.range(0, 200))
+                    .map(|_| self.rng.u32() as u8)
+                    .collect(),
+            },
+            2 => TransferOp::Get { transfer, offset },
+            _ => TransferOp::Close { transfer },
+        }
     }
 
     fn create_plane(&mut self, wild: bool) -> Command {
@@ -234,6 +259,12 @@ impl<'a> Gen<'a> {
         }
         for _ in 0..self.rng.range(0, 256) {
             bytes.push(self.rng.u32() as u8);
+        }
+        if self.rng.chance(0.2) {
+            return PlaneOp::RestoreUploaded {
+                transfer: self.rng.range(0, 64) as u32,
+                overrides: Vec::new(),
+            };
         }
         PlaneOp::Restore {
             bytes,

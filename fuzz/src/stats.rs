@@ -6,6 +6,7 @@ use std::collections::BTreeMap;
 use shm_layout::{
     Command, CommandResult, ControllerOp, ErrorKind, GuiControllerOp, GuiObjectOp, GuiOp, GuiShape,
     JointOp, MapOp, ObjectOp, ObjectProp, PlaneOp, PlaneProp, QueryOp, Reply, Response, Shape,
+    TransferOp,
 };
 
 /// How many failures a run keeps in full (the counters count all of them).
@@ -342,6 +343,7 @@ pub fn reply_name(reply: &Reply) -> &'static str {
         Reply::NamedPlanes(_) => "NamedPlanes",
         Reply::Opened(_) => "Opened",
         Reply::Saved { .. } => "Saved",
+        Reply::Transfer(_) => "Transfer",
     }
 }
 
@@ -399,6 +401,13 @@ pub fn op_name(command: &Command) -> String {
             PlaneOp::Restore { .. } => "Plane.Restore".into(),
             PlaneOp::Rewind(_) => "Plane.Rewind".into(),
             PlaneOp::Save => "Plane.Save".into(),
+            PlaneOp::RestoreUploaded { .. } => "Plane.RestoreUploaded".into(),
+        },
+        Command::Transfer(op) => match op {
+            TransferOp::Open { .. } => "Transfer.Open".into(),
+            TransferOp::Put { .. } => "Transfer.Put".into(),
+            TransferOp::Get { .. } => "Transfer.Get".into(),
+            TransferOp::Close { .. } => "Transfer.Close".into(),
         },
     }
 }

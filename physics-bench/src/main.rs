@@ -45,6 +45,7 @@ mod snapshot;
 mod soak;
 mod stability;
 mod stats;
+mod validate;
 
 use std::process::ExitCode;
 

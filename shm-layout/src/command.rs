@@ -93,6 +93,9 @@ pub enum Command {
         /// The plane's name.
         name: String,
     },
+    /// An op on a snapshot transfer of this connection (snapshots in pieces,
+    /// [`crate::snapshot_transfer`]). Replies [`Reply::Transfer`].
+    Transfer(crate::snapshot_transfer::TransferOp),
 }
 
 impl Command {
@@ -263,6 +266,9 @@ pub enum Reply {
         /// The tick the file holds.
         tick: u64,
     },
+    /// A snapshot transfer's answer ([`Command::Transfer`], or a snapshot too large for one
+    /// reply).
+    Transfer(crate::snapshot_transfer::TransferReply),
 }
 
 /// The result of one command.

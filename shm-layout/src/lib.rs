@@ -37,6 +37,7 @@ pub mod records;
 pub mod settings;
 pub mod shape;
 pub mod snapshot;
+pub mod snapshot_transfer;
 pub mod validate;
 
 pub use axis_motor::AxisMotor;
@@ -61,6 +62,7 @@ pub use settings::{
 };
 pub use shape::{Shape, ShapeKind};
 pub use snapshot::SnapshotHeader;
+pub use snapshot_transfer::{TransferOp, TransferReply};
 
 /// Bumped whenever a record layout or the command encoding changes. Client and daemon must
 /// agree on it; the handshake reports both values when they differ.

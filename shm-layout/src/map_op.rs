@@ -39,6 +39,12 @@ pub struct MapReport {
     pub welded_edges: u64,
     /// Edges of one triangle only (the map's border, holes).
     pub open_edges: u64,
+    /// The built mesh's content hash: the daemon keeps one copy of each, shared by every
+    /// plane that builds (or restores) the same mesh.
+    pub content_hash: u64,
+    /// The daemon held this mesh already (another plane's map, or one a restore brought):
+    /// this map shares that copy.
+    pub shared: bool,
 }
 
 /// A built map.

@@ -90,6 +90,15 @@ pub enum PlaneOp {
     /// Writes a persistent plane to its file in the daemon's state directory now (atomically)
     /// and replies [`crate::Reply::Saved`] once the file is on disk. Owner only.
     Save,
+    /// [`PlaneOp::Restore`] from the bytes of upload `transfer` of the sending connection
+    /// ([`crate::snapshot_transfer`]): the daemon takes the finished upload and restores
+    /// from it as from `Restore` (the transfer is gone after, refused or not).
+    RestoreUploaded {
+        /// The upload.
+        transfer: u32,
+        /// Options applied after the state, as for `Restore`.
+        overrides: Vec<PlaneProp>,
+    },
 }
 
 /// What an op may add to a plane, for the daemon's per-client quotas.

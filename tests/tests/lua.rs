@@ -655,6 +655,18 @@ fn rollback_rewinds_and_replays_bit_for_bit() {
 }
 
 #[test]
+fn a_snapshot_planes_objects_come_to_luau() {
+    let daemon = TestDaemon::start("lua-get-objects");
+    run_ok(&daemon, "tests/lua/get_objects.luau", "get objects ok");
+}
+
+#[test]
+fn gui_planes_are_named_opened_and_rewound_from_luau() {
+    let daemon = TestDaemon::start("lua-gui-rollback");
+    run_ok(&daemon, "tests/lua/gui_rollback.luau", "gui rollback ok");
+}
+
+#[test]
 fn persistent_planes_come_back_to_luau_after_a_sigkill() {
     let state = std::env::temp_dir().join(unique_domain("lua-state"));
     std::fs::create_dir_all(&state).unwrap();

@@ -20,6 +20,7 @@ pub mod named_plane;
 pub mod object;
 pub mod part;
 pub mod plane;
+pub mod plane_objects;
 pub mod probe;
 pub mod query;
 pub mod ragdoll;

@@ -10,9 +10,10 @@ use std::cell::{Cell, RefCell};
 use std::collections::HashMap;
 use std::rc::Rc;
 
-use client_sdk::{PlaneId, PlaneKind};
+use client_sdk::{GuiPlane, PlaneId, PlaneKind};
 use mlua::{Lua, MultiValue, Table, UserDataMethods, Value};
 
+use super::gui_plane::{held_gui_plane, wrap_gui_plane, GuiPhysicsPlane, GuiPlaneState};
 use super::plane::{context, plane_ud, wrap_plane, PhysicsPlane, PlaneState};
 use crate::host::scheduler::scheduler;
 use crate::host::signal::Signal;
@@ -75,6 +76,13 @@ pub fn recovered_signal(lua: &Lua, p: &PlaneState) -> mlua::Result<Value> {
     ))
 }
 
+/// `plane.Recovered` of a GUI plane: the signal (the same value on every read).
+pub fn gui_recovered_signal(lua: &Lua, p: &GuiPlaneState) -> mlua::Result<Value> {
+    Ok(Value::UserData(
+        recovery(lua, p.plane.plane().id()).signal.userdata(lua)?,
+    ))
+}
+
 fn kind_name(kind: PlaneKind) -> &'static str {
     match kind {
         PlaneKind::Rapier3d => "3D",
@@ -110,8 +118,8 @@ fn list_planes(lua: &Lua, (): ()) -> mlua::Result<Table> {
     Ok(out)
 }
 
-/// `PhysicsService.Open(name)`: the named plane as a `PhysicsPlane` (the script's own value
-/// when it already holds the plane).
+/// `PhysicsService.Open(name)`: the named plane as a `PhysicsPlane`, or a `GuiPhysicsPlane`
+/// for a GUI plane (the script's own value when it already holds the plane).
 fn open(lua: &Lua, name: Value) -> mlua::Result<mlua::AnyUserData> {
     const WHAT: &str = "PhysicsService.Open";
     let text = name_arg(WHAT, &name)?;
@@ -123,6 +131,18 @@ fn open(lua: &Lua, name: Value) -> mlua::Result<mlua::AnyUserData> {
     let id = opened.plane.id();
     if let Some(lost) = opened.recovered {
         recovery(lua, id).lost.set(Some(lost));
+    }
+    let kind = opened
+        .plane
+        .info()
+        .map_err(|e| sdk_error(&format!("{WHAT}({text:?})"), e))?
+        .kind;
+    if kind == PlaneKind::Gui2d {
+        let plane = match held_gui_plane(lua, id) {
+            Some(held) => held,
+            None => wrap_gui_plane(lua, GuiPlane::from_plane(opened.plane)),
+        };
+        return lua.create_userdata(plane);
     }
     match ctx.plane_state(id) {
         Some(state) => plane_ud(lua, &state),
@@ -142,6 +162,36 @@ pub fn add_methods<M: UserDataMethods<PhysicsPlane>>(methods: &mut M) {
         p.0.plane
             .save()
             .map(|tick| tick as f64)
+            .map_err(|e| sdk_error(WHAT, e))
+    });
+}
+
+/// `Save` and `Rewind` on `GuiPhysicsPlane`: the persistent plane's file written now
+/// (returns its tick); back `ticks` ticks (at most its RollbackTicks).
+pub fn add_gui_methods<M: UserDataMethods<GuiPhysicsPlane>>(methods: &mut M) {
+    methods.add_method("Save", |_, p, ()| {
+        const WHAT: &str = "GuiPhysicsPlane:Save";
+        p.0.check_alive(WHAT)?;
+        p.0.plane
+            .plane()
+            .save()
+            .map(|tick| tick as f64)
+            .map_err(|e| sdk_error(WHAT, e))
+    });
+    methods.add_method("Rewind", |_, p, ticks: Value| {
+        const WHAT: &str = "GuiPhysicsPlane:Rewind";
+        p.0.check_alive(WHAT)?;
+        let n = match ticks {
+            Value::Integer(n) if (0..=u32::MAX as i64).contains(&n) => n as u32,
+            Value::Number(n) if n.fract() == 0.0 && (0.0..=u32::MAX as f64).contains(&n) => {
+                n as u32
+            }
+            other => return Err(expected(WHAT, "a whole number of ticks >= 0", &other)),
+        };
+        p.0.plane
+            .plane()
+            .rewind(n)
+            .map(|_| ())
             .map_err(|e| sdk_error(WHAT, e))
     });
 }

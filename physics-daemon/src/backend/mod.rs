@@ -128,6 +128,18 @@ pub trait Backend: Send {
     fn snapshot_later(&self) -> Option<Result<SnapshotJob, CommandError>> {
         None
     }
+
+    /// Work the plane put off its tick's path (a copy kept for Rewind), done by its worker
+    /// once the tick is published and answered; any op or step does it first as well.
+    fn idle_work(&mut self) -> Result<(), CommandError> {
+        Ok(())
+    }
+
+    /// Whether [`Backend::idle_work`] has something to do (runs then go to the worker, so
+    /// the request loop never does it).
+    fn has_idle_work(&self) -> bool {
+        false
+    }
 }
 
 /// The encoding half of [`Backend::snapshot_later`]: gives the snapshot's bytes.

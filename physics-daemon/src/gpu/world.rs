@@ -278,6 +278,42 @@ impl GpuWorld {
         self.states.len()
     }
 
+    /// Everything a later step reads, as bytes: each slot's state (64 bytes) and parameters
+    /// (64 bytes) as the shaders hold them, and the pair mode (a snapshot of a DeferGpu
+    /// plane; the grid is derived from the parameters at the next upload).
+    pub fn save(&self) -> (Vec<u8>, Vec<u8>, PairMode) {
+        (
+            bytemuck::cast_slice(&self.states).to_vec(),
+            bytemuck::cast_slice(&self.params).to_vec(),
+            self.mode,
+        )
+    }
+
+    /// A world holding what [`GpuWorld::save`] gave (uploaded whole at its first step), with
+    /// the last tick's contact figures.
+    pub fn load(
+        ctx: Arc<Context>,
+        states: &[u8],
+        params: &[u8],
+        mode: PairMode,
+        figures: (f32, u32),
+    ) -> Result<GpuWorld, String> {
+        let size = std::mem::size_of::<State>();
+        if !states.len().is_multiple_of(size) || states.len() != params.len() {
+            return Err(format!(
+                "GPU bodies of {} and {} bytes (64 bytes a slot each, as many of both)",
+                states.len(),
+                params.len()
+            ));
+        }
+        let mut world = GpuWorld::new(ctx);
+        world.states = bytemuck::pod_collect_to_vec(states);
+        world.params = bytemuck::pod_collect_to_vec(params);
+        world.mode = mode;
+        (world.max_penetration, world.contact_pairs) = figures;
+        Ok(world)
+    }
+
     fn extents(&self) -> impl Iterator<Item = (u32, f32, bool)> + Clone + '_ {
         self.params.iter().enumerate().filter_map(|(i, p)| {
             let f = p.bits[0];

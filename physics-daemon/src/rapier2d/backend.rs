@@ -71,10 +71,7 @@ impl Backend for Plane {
             PlaneOp::Set(prop) => self.set(prop).map(|_| Reply::Done),
             PlaneOp::Gui(op) => self.gui(op),
             PlaneOp::Snapshot => self.snapshot().map(Reply::Snapshot),
-            PlaneOp::Rewind(_) => Err(CommandError::invalid_field(
-                "Rewind",
-                "GUI planes do not keep ticks for Rewind (3D planes do, with RollbackTicks)",
-            )),
+            PlaneOp::Rewind(n) => self.rewind(n),
             PlaneOp::Restore { bytes, overrides } => self
                 .restore(&bytes, &overrides)
                 .map(|_| Reply::Applied { tick: self.tick }),
@@ -101,7 +98,10 @@ impl Backend for Plane {
             // Collision groups do not apply (ZIndex is the layer); a client sends its table to
             // every plane it owns, so a GUI plane takes it and ignores it.
             PlaneOp::CollisionGroups(_) => Ok(Reply::Done),
-            PlaneOp::Step { .. } | PlaneOp::Destroy | PlaneOp::Save => Err(CommandError::new(
+            PlaneOp::Step { .. }
+            | PlaneOp::Destroy
+            | PlaneOp::Save
+            | PlaneOp::RestoreUploaded { .. } => Err(CommandError::new(
                 ErrorKind::Internal,
                 format!("{op:?} is handled by the server, not the plane"),
             )),

@@ -23,6 +23,7 @@ mod held {
 mod hooks;
 mod objects;
 mod queries;
+mod rollback;
 mod snapshot;
 
 use std::time::Instant;
@@ -48,7 +49,7 @@ pub const MAX_SLOTS: usize = 1 << 20;
 pub const LENGTH_UNIT: f32 = 100.0;
 
 /// One object: its rapier body and collider and what the API says about it.
-#[derive(Debug, serde::Serialize, serde::Deserialize)]
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 struct Body {
     handle: RigidBodyHandle,
     collider: ColliderHandle,
@@ -81,8 +82,16 @@ pub struct Plane {
     contact_pairs: u32,
     events: Vec<EventRecord>,
     event_seq: u64,
-    /// Bytes of controller paths (counted against the owner's quota).
+    /// Bytes of controller paths and kept ticks (counted against the owner's quota).
     state_bytes: crate::backend::counted::Counter,
+    /// Its `Name`, unique in the domain (creation only; not part of its state).
+    name: shm_layout::PlaneName,
+    /// Written to the daemon's state directory (creation only; not part of its state).
+    persistent: bool,
+    /// `RollbackTicks`: ticks kept for `Rewind`.
+    rollback_ticks: u32,
+    /// The kept ticks (see `rollback`).
+    rollback: rollback::Ring,
 }
 
 impl Plane {
@@ -113,6 +122,10 @@ impl Plane {
             events: Vec::new(),
             event_seq: 0,
             state_bytes: Default::default(),
+            name: shm_layout::PlaneName::NONE,
+            persistent: false,
+            rollback_ticks: 0,
+            rollback: Default::default(),
         };
         for prop in props {
             plane.apply_prop(*prop, true)?;
@@ -139,6 +152,20 @@ impl Plane {
                     format!("Shared is read-only after creation (tried to set {on})"),
                 ))
             }
+            PlaneProp::Name(n) if creating => self.name = n,
+            PlaneProp::Persistent(on) if creating => self.persistent = on,
+            prop @ (PlaneProp::Name(_) | PlaneProp::Persistent(_)) => {
+                return Err(CommandError::invalid_field(
+                    prop.name(),
+                    format!("{} can only be given at creation", prop.name()),
+                ))
+            }
+            PlaneProp::RollbackTicks(k) => {
+                self.rollback_ticks = k;
+                if k == 0 {
+                    self.rollback.clear();
+                }
+            }
             PlaneProp::Gui(g) => {
                 let g = self.settings.apply(g, creating)?;
                 match g {
@@ -158,8 +185,8 @@ impl Plane {
                     format!(
                         "{} is an option of 3D planes; a GUI plane takes Gravity, \
                          LinearDamping, AngularDamping, Drag, ConstantForce, RestThreshold, \
-                         SolverIterations, NeverSleep, BoundsMin/BoundsMax, TickRate, Enabled \
-                         and Shared",
+                         SolverIterations, NeverSleep, BoundsMin/BoundsMax, TickRate, Enabled, \
+                         Shared, Name, Persistent and RollbackTicks",
                         other.name()
                     ),
                 ))
@@ -234,6 +261,9 @@ impl Plane {
                 rest_threshold: s.rest_threshold,
                 solver_iterations: s.solver_iterations,
                 never_sleep: s.never_sleep,
+                name: self.name,
+                persistent: self.persistent,
+                rollback_ticks: self.rollback_ticks,
                 ..PlaneSettings::default()
             },
             tick: self.tick,
@@ -272,6 +302,7 @@ impl Plane {
         self.after_step_controllers();
         (self.max_penetration, self.contact_pairs) = self.contact_figures();
         self.last_step_us = started.elapsed().as_secs_f32() * 1e6;
+        self.keep_for_rollback();
         Ok(true)
     }
 

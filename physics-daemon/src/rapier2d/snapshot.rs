@@ -11,35 +11,70 @@ use crate::backend::counted::Counter;
 use crate::backend::{Backend, SlotTable};
 
 /// The engine named in the snapshot header.
-pub const ENGINE: &str = "rapier2d 0.36 / physics-daemon gui state 1";
+pub const ENGINE: &str = "rapier2d 0.36 / physics-daemon gui state 2";
 
 macro_rules! plane_state {
-    ($($field:ident: $ty:ty,)*) => {
+    (world, $($field:ident: $ty:ty,)*) => {
         #[derive(serde::Serialize)]
         struct StateRef<'a> {
+            world: &'a PhysicsWorld,
             $($field: &'a $ty,)*
         }
 
         #[derive(serde::Deserialize)]
-        struct State {
+        pub(super) struct State {
+            world: PhysicsWorld,
             $($field: $ty,)*
         }
 
         impl Plane {
             fn state_ref(&self) -> StateRef<'_> {
-                StateRef { $($field: &self.$field,)* }
+                StateRef { world: &self.world, $($field: &self.$field,)* }
             }
 
             fn take_state(&mut self, state: State) {
+                self.world = state.world;
                 $(self.$field = state.$field;)*
+            }
+
+            /// The state as an owned copy (what Rewind keeps): the engine's sets cloned,
+            /// its per-step workspaces fresh.
+            pub(super) fn clone_state(&self) -> State {
+                State { world: copy_world(&self.world), $($field: self.$field.clone(),)* }
+            }
+        }
+
+        impl State {
+            /// Another copy of a kept state (a second rewind to the same tick).
+            pub(super) fn duplicate(&self) -> State {
+                State { world: copy_world(&self.world), $($field: self.$field.clone(),)* }
             }
         }
     };
 }
 
+/// A copy of `w`: the engine's sets cloned (shapes shared), its per-step workspaces fresh.
+fn copy_world(w: &PhysicsWorld) -> PhysicsWorld {
+    PhysicsWorld {
+        gravity: w.gravity,
+        integration_parameters: w.integration_parameters,
+        physics_pipeline: PhysicsPipeline::new(),
+        collision_pipeline: CollisionPipeline::new(),
+        islands: w.islands.clone(),
+        broad_phase: w.broad_phase.clone(),
+        narrow_phase: w.narrow_phase.clone(),
+        bodies: w.bodies.clone(),
+        colliders: w.colliders.clone(),
+        impulse_joints: w.impulse_joints.clone(),
+        multibody_joints: w.multibody_joints.clone(),
+        soft_bodies: w.soft_bodies.clone(),
+        ccd_solver: CCDSolver::new(),
+    }
+}
+
 plane_state! {
+    world,
     settings: GuiPlaneSettings,
-    world: PhysicsWorld,
     bodies: SlotTable<Body>,
     controlled: Vec<u32>,
     driven: u32,
@@ -52,6 +87,7 @@ plane_state! {
     max_penetration: f32,
     contact_pairs: u32,
     event_seq: u64,
+    rollback_ticks: u32,
 }
 
 fn refused(what: String) -> CommandError {
@@ -85,7 +121,7 @@ impl Plane {
         let mut checked = state.settings;
         for prop in overrides {
             match prop.checked()? {
-                PlaneProp::TickRate(_) | PlaneProp::Enabled(_) => {}
+                PlaneProp::TickRate(_) | PlaneProp::Enabled(_) | PlaneProp::RollbackTicks(_) => {}
                 PlaneProp::Gui(GuiPlaneProp::Bounds { .. }) | PlaneProp::Shared(_) => {
                     return Err(refused(format!(
                         "{} cannot be set by a restore (it is the snapshot's)",
@@ -126,9 +162,26 @@ impl Plane {
         self.take_state(state);
         self.events.clear();
         self.dirty.mark_all();
+        // Another timeline: the ticks kept for Rewind no longer lead here.
+        self.rollback.clear();
         for prop in overrides {
             self.apply_prop(*prop, true)?;
         }
+        Ok(())
+    }
+
+    /// Becomes `state` (a copy this plane made with [`Plane::clone_state`]).
+    pub(super) fn adopt_copy(&mut self, mut state: State) -> Result<(), CommandError> {
+        state.bodies.adopt_limits(&self.bodies)?;
+        for (_, b) in state.bodies.iter_mut() {
+            if let Some(c) = &mut b.controller {
+                c.count_in(&self.state_bytes);
+            }
+        }
+        state.world.physics_pipeline = std::mem::take(&mut self.world.physics_pipeline);
+        self.take_state(state);
+        self.events.clear();
+        self.dirty.mark_all();
         Ok(())
     }
 }

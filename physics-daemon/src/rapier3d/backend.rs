@@ -49,7 +49,10 @@ impl Plane {
             )),
             PlaneOp::Joint(op) => self.joint_op(op),
             PlaneOp::Map(op) => self.map_op(op),
-            PlaneOp::Step { .. } | PlaneOp::Destroy | PlaneOp::Save => Err(CommandError::new(
+            PlaneOp::Step { .. }
+            | PlaneOp::Destroy
+            | PlaneOp::Save
+            | PlaneOp::RestoreUploaded { .. } => Err(CommandError::new(
                 ErrorKind::Internal,
                 format!("{op:?} is handled by the server, not the plane"),
             )),
@@ -72,7 +75,17 @@ impl Backend for Plane {
         Some(Plane::snapshot_later(self))
     }
 
+    fn idle_work(&mut self) -> Result<(), CommandError> {
+        self.finish_keep()
+    }
+
+    fn has_idle_work(&self) -> bool {
+        self.keep_pending()
+    }
+
     fn apply(&mut self, op: PlaneOp) -> CommandResult {
+        // The last tick is kept for Rewind before an op changes anything (see `rollback`).
+        self.finish_keep()?;
         #[cfg(feature = "gpu")]
         if self.on_gpu() {
             return self.apply_on_gpu(op);

@@ -214,7 +214,15 @@ impl Plane {
         let size = extent
             .min(Vector::splat(shm_layout::validate::MAX_SIZE))
             .into();
-        let part = Part::map(shape, size, pending.cost());
+        // One copy of each mesh in the daemon: a map another plane built (or a restore
+        // brought) is shared.
+        let (shape, hash, shared) = super::map_store::share(shape);
+        let report = MapReport {
+            content_hash: hash,
+            shared,
+            ..report
+        };
+        let part = Part::map(shape, hash, size, pending.cost());
         let mut collider = ColliderBuilder::new(part.collider_shape()?).build();
         part.configure_collider(&mut collider, &self.groups)?;
         let slot = self.bodies.next_slot().ok_or_else(|| {

@@ -33,6 +33,7 @@ mod contact_points;
 mod gpu;
 mod joints;
 mod limits;
+mod map_store;
 mod maps;
 mod objects;
 mod part;
@@ -301,6 +302,8 @@ impl Plane {
 
     /// Advances by `dt`. Returns false (and does nothing) when the plane is disabled.
     pub fn step(&mut self, dt: f32) -> Result<bool, CommandError> {
+        // The last tick is kept before this one changes anything.
+        self.finish_keep()?;
         let dt = validate::positive("dt", dt)?;
         if dt > MAX_DT {
             return Err(CommandError::invalid(format!(
@@ -367,7 +370,8 @@ impl Plane {
         }
         self.adapt_solving();
         self.last_step_us = started.elapsed().as_secs_f32() * 1e6;
-        self.keep_for_rollback()?;
+        // Kept for Rewind off the tick's path (see `rollback`).
+        self.rollback.note_step();
         Ok(true)
     }
 

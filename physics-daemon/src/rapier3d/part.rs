@@ -47,11 +47,21 @@ pub(super) struct Part {
     pub joints: u32,
 }
 
-/// A built map's collider shape and what it counts against the mesh quota.
+/// A built map's collider shape and what it counts against the mesh quota. A snapshot
+/// writes the mesh once, with the map's collider, and this only by its content hash
+/// (`map_store`): a restore takes the shape back from the collider.
 #[derive(Clone, serde::Serialize, serde::Deserialize)]
 pub(super) struct MapShape {
+    #[serde(skip, default = "unrestored_map")]
     pub shape: SharedShape,
     pub cost: u64,
+    /// The mesh's content hash (`map_store::content_hash`).
+    pub hash: u64,
+}
+
+/// What a decoded map holds until the restore takes its collider's mesh (never stepped).
+fn unrestored_map() -> SharedShape {
+    SharedShape::ball(0.5)
 }
 
 impl std::fmt::Debug for MapShape {
@@ -136,10 +146,10 @@ impl Part {
 
     /// A map object: an anchored triangle mesh spanning `size`; `cost` counts against the
     /// mesh quota while it lives.
-    pub fn map(shape: SharedShape, size: Vec3, cost: u64) -> Part {
+    pub fn map(shape: SharedShape, hash: u64, size: Vec3, cost: u64) -> Part {
         let mut part = Part::new(&Shape::Cube { size });
         part.shape = ShapeKind::TriMesh;
-        part.map = Some(MapShape { shape, cost });
+        part.map = Some(MapShape { shape, cost, hash });
         part
     }
 

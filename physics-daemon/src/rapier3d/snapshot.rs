@@ -113,6 +113,51 @@ plane_state! {
     state_hash: u64,
 }
 
+/// A DeferGpu plane's GPU world as the snapshot holds it: each slot's state and parameters
+/// as the shaders hold them (64 bytes each), so a restore on the same adapter continues bit
+/// for bit.
+#[derive(Clone, serde::Serialize, serde::Deserialize)]
+struct GpuSaved {
+    states: Vec<u8>,
+    params: Vec<u8>,
+    brute_force: bool,
+    max_penetration: f32,
+    contact_pairs: u32,
+}
+
+/// A snapshot body: the state, then the GPU world of a DeferGpu plane.
+#[derive(serde::Serialize)]
+struct Encoded<'a> {
+    state: StateRef<'a>,
+    gpu: Option<GpuSaved>,
+}
+
+/// [`Encoded`], decoded.
+#[derive(serde::Deserialize)]
+struct Decoded {
+    state: State,
+    gpu: Option<GpuSaved>,
+}
+
+/// [`check`], and GPU bodies in whole slots, one per object slot at most.
+fn check_decoded(d: &Decoded) -> Result<(), CommandError> {
+    check(&d.state)?;
+    if let Some(g) = &d.gpu {
+        if !g.states.len().is_multiple_of(64)
+            || g.states.len() != g.params.len()
+            || g.states.len() / 64 > d.state.bodies.slot_count()
+        {
+            return Err(refused(format!(
+                "GPU bodies of {} and {} bytes for {} object slots",
+                g.states.len(),
+                g.params.len(),
+                d.state.bodies.slot_count()
+            )));
+        }
+    }
+    Ok(())
+}
+
 fn refused(what: String) -> CommandError {
     CommandError::new(ErrorKind::InvalidValue, format!("snapshot refused: {what}"))
 }
@@ -120,16 +165,28 @@ fn refused(what: String) -> CommandError {
 impl Plane {
     /// The plane's whole state as snapshot bytes (see `shm_layout::snapshot`).
     pub fn snapshot(&self) -> Result<Vec<u8>, CommandError> {
-        #[cfg(feature = "gpu")]
-        if self.on_gpu() {
-            return Err(CommandError::invalid_field(
-                "DeferGpu",
-                "a DeferGpu plane cannot be snapshotted yet: set DeferGpu = false first",
-            ));
-        }
-        let body = postcard::to_allocvec(&self.state_ref())
-            .map_err(|e| CommandError::new(ErrorKind::Internal, format!("snapshot failed: {e}")))?;
+        let body = postcard::to_allocvec(&Encoded {
+            state: self.state_ref(),
+            gpu: self.gpu_saved(),
+        })
+        .map_err(|e| CommandError::new(ErrorKind::Internal, format!("snapshot failed: {e}")))?;
         Ok(snapshot::encode(self.snapshot_header(), &body))
+    }
+
+    /// A DeferGpu plane's GPU bodies (`None` on the CPU path).
+    fn gpu_saved(&self) -> Option<GpuSaved> {
+        #[cfg(feature = "gpu")]
+        if let Some(gpu) = &self.gpu {
+            let (states, params, mode) = gpu.save();
+            return Some(GpuSaved {
+                states,
+                params,
+                brute_force: mode == crate::gpu::PairMode::BruteForce,
+                max_penetration: gpu.max_penetration,
+                contact_pairs: gpu.contact_pairs,
+            });
+        }
+        None
     }
 
     fn snapshot_header(&self) -> SnapshotHeader {
@@ -150,17 +207,15 @@ impl Plane {
     /// than the encode) and encoded by the returned job, on any thread, to the same bytes a
     /// snapshot of this tick gives.
     pub fn snapshot_later(&self) -> Result<crate::backend::SnapshotJob, CommandError> {
-        #[cfg(feature = "gpu")]
-        if self.on_gpu() {
-            return Err(CommandError::invalid_field(
-                "DeferGpu",
-                "a DeferGpu plane cannot be snapshotted yet: set DeferGpu = false first",
-            ));
-        }
         let header = self.snapshot_header();
         let state = self.clone_state();
+        let gpu = self.gpu_saved();
         Ok(Box::new(move || {
-            let body = postcard::to_allocvec(&state.as_ref()).map_err(|e| {
+            let encoded = Encoded {
+                state: state.as_ref(),
+                gpu,
+            };
+            let body = postcard::to_allocvec(&encoded).map_err(|e| {
                 CommandError::new(ErrorKind::Internal, format!("snapshot failed: {e}"))
             })?;
             Ok(snapshot::encode(header, &body))
@@ -170,15 +225,12 @@ impl Plane {
     /// Becomes exactly the state of `bytes` (same objects under the same handles). The
     /// plane keeps its id. Nothing changes when the snapshot is refused.
     pub fn restore(&mut self, bytes: &[u8], overrides: &[PlaneProp]) -> Result<(), CommandError> {
-        #[cfg(feature = "gpu")]
-        if self.on_gpu() {
-            return Err(CommandError::invalid_field(
-                "DeferGpu",
-                "a DeferGpu plane cannot be restored yet: set DeferGpu = false first",
-            ));
-        }
         let (header, body) = snapshot::decode(bytes, PlaneKind::Rapier3d, ENGINE)?;
-        let mut state = crate::backend::snapshot_decode::decode(body, refused, check)?;
+        let Decoded { mut state, gpu } =
+            crate::backend::snapshot_decode::decode(body, refused, check_decoded)?;
+        // A DeferGpu plane's GPU world, made before anything changes (no adapter: refused).
+        let gpu = self.gpu_from_saved(gpu, state.settings.defer_gpu)?;
+        take_map_meshes(&mut state)?;
         // The overrides are checked on the decoded settings before anything changes.
         for prop in overrides {
             if let PlaneProp::DeferGpu(_) = prop {
@@ -224,9 +276,69 @@ impl Plane {
             )));
         }
         self.adopt(state, overrides)?;
+        #[cfg(feature = "gpu")]
+        {
+            self.gpu = gpu;
+        }
+        #[cfg(not(feature = "gpu"))]
+        let () = gpu;
         // Another timeline: the ticks kept for Rewind no longer lead here.
         self.rollback.clear();
         Ok(())
+    }
+
+    /// The GPU world a snapshot's GPU bodies make (`None` for a CPU snapshot). A snapshot
+    /// of a DeferGpu plane restores only where a GPU adapter is (the same adapter for bit
+    /// for bit).
+    #[cfg(feature = "gpu")]
+    fn gpu_from_saved(
+        &self,
+        saved: Option<GpuSaved>,
+        defer_gpu: bool,
+    ) -> Result<Option<crate::gpu::GpuWorld>, CommandError> {
+        let Some(saved) = saved else {
+            return match defer_gpu {
+                true => Err(refused("its DeferGpu plane holds no GPU bodies".into())),
+                false => Ok(None),
+            };
+        };
+        if !defer_gpu {
+            return Err(refused(
+                "it holds GPU bodies for a plane not on the GPU".into(),
+            ));
+        }
+        let ctx = crate::gpu::context().map_err(|e| {
+            CommandError::invalid_field(
+                "DeferGpu",
+                format!("the snapshot is of a DeferGpu plane and this daemon cannot run it: {e}"),
+            )
+        })?;
+        let mode = match saved.brute_force {
+            true => crate::gpu::PairMode::BruteForce,
+            false => crate::gpu::PairMode::Hash,
+        };
+        crate::gpu::GpuWorld::load(
+            ctx,
+            &saved.states,
+            &saved.params,
+            mode,
+            (saved.max_penetration, saved.contact_pairs),
+        )
+        .map(Some)
+        .map_err(refused)
+    }
+
+    /// Without the GPU path, a DeferGpu snapshot is refused by name.
+    #[cfg(not(feature = "gpu"))]
+    fn gpu_from_saved(&self, saved: Option<GpuSaved>, defer_gpu: bool) -> Result<(), CommandError> {
+        match saved.is_some() || defer_gpu {
+            true => Err(CommandError::invalid_field(
+                "DeferGpu",
+                "the snapshot is of a DeferGpu plane and this daemon was built without the GPU \
+                 path (feature \"gpu\")",
+            )),
+            false => Ok(()),
+        }
     }
 
     /// Becomes `state` (a copy this plane made with [`Plane::clone_state`]).
@@ -259,6 +371,41 @@ impl Plane {
         self.dirty.mark_all();
         Ok(())
     }
+}
+
+/// Gives each decoded map object the mesh its collider carries (a snapshot writes it once),
+/// checked against the content hash the object names, and tells the daemon's map store
+/// about it (a later build of the same mesh shares it).
+fn take_map_meshes(state: &mut State) -> Result<(), CommandError> {
+    let w = &state.world;
+    for (handle, body) in state.bodies.iter_mut() {
+        let Some(map) = body.part.map.as_mut() else {
+            continue;
+        };
+        let shape = w
+            .bodies
+            .get(body.handle)
+            .and_then(|b| b.colliders().first())
+            .and_then(|c| w.colliders.get(*c))
+            .map(|c| c.shared_shape().clone())
+            .ok_or_else(|| refused(format!("map object {} has no collider", handle.slot)))?;
+        let Some(mesh) = shape.as_trimesh() else {
+            return Err(refused(format!(
+                "map object {}'s collider is not a triangle mesh",
+                handle.slot
+            )));
+        };
+        let hash = super::map_store::content_hash(mesh);
+        if hash != map.hash {
+            return Err(refused(format!(
+                "map object {}'s mesh has content hash {hash:016x}, the object names {:016x}",
+                handle.slot, map.hash
+            )));
+        }
+        super::map_store::register(&shape);
+        map.shape = shape;
+    }
+    Ok(())
 }
 
 /// Cross-references a decoded state must satisfy before the plane takes it: every object's

@@ -110,6 +110,17 @@ impl Daemon {
             }
             Command::CreatePlane { kind, props } => self.create_plane(client, kind, props),
             Command::Plane { plane, op } => {
+                // An upload becomes the restore it carries (`transfers`).
+                let op = match op {
+                    PlaneOp::RestoreUploaded {
+                        transfer,
+                        overrides,
+                    } => match self.transfers_of(origin).take_upload(transfer) {
+                        Ok(bytes) => PlaneOp::Restore { bytes, overrides },
+                        Err(e) => return now(Err(e)),
+                    },
+                    op => op,
+                };
                 if let Err(e) = self.check_access(client, plane, &op) {
                     return now(Err(e));
                 }
@@ -127,6 +138,7 @@ impl Daemon {
                     if *next != plane
                         || *op == PlaneOp::Destroy
                         || *op == PlaneOp::Save
+                        || matches!(op, PlaneOp::RestoreUploaded { .. })
                         || self.check_access(client, plane, op).is_err()
                     {
                         break;
@@ -137,11 +149,26 @@ impl Daemon {
                     ops.push(op);
                 }
                 self.guest = self.guest_of(origin, plane);
-                self.send_job(plane, ops)
+                self.stage_to = Some(self.transfers_of(origin));
+                let routed = self.send_job(plane, ops);
+                self.stage_to = None;
+                routed
             }
             Command::ListNamedPlanes => now(Ok(Reply::NamedPlanes(self.named_planes()))),
             Command::OpenPlane { name } => now(self.open_plane(client, &name)),
+            Command::Transfer(op) => now(self.transfers_of(origin).apply(op, self.reply_left)),
         }
+    }
+
+    /// The snapshot transfers of the connection `origin` (made on first use; its process
+    /// pays for what they hold).
+    fn transfers_of(&mut self, origin: Origin) -> Arc<super::transfers::ClientTransfers> {
+        let limits = self.options.limits;
+        let owner = self.owners.of(origin.pid);
+        self.transfers
+            .entry(origin.id)
+            .or_insert_with(|| Arc::new(super::transfers::ClientTransfers::new(owner, limits)))
+            .clone()
     }
 
     /// Any client may read any plane; only the owner changes it unless the owner shared
@@ -187,6 +214,7 @@ impl Daemon {
             limits: self.options.limits,
             reply_left: self.reply_left,
             guest: self.guest.clone(),
+            transfers: self.stage_to.clone(),
         }
     }
 

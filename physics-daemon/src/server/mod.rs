@@ -33,6 +33,7 @@ pub mod persist;
 pub mod quota;
 mod request_bytes;
 pub mod resources;
+mod transfers;
 pub mod trim;
 mod worker;
 
@@ -154,6 +155,10 @@ pub struct Daemon {
     watch: Arc<resources::Watch>,
     /// The writer of persistent planes (`--state-dir`).
     writer: Option<persist::Writer>,
+    /// Each connection's open snapshot transfers (snapshots in pieces).
+    transfers: HashMap<u128, Arc<transfers::ClientTransfers>>,
+    /// Where a large snapshot of the command being routed is staged (its sender's transfers).
+    stage_to: Option<Arc<transfers::ClientTransfers>>,
 }
 
 /// Wakes the loop of the daemon of `domain` (e.g. from a signal handler thread after setting
@@ -349,6 +354,8 @@ fn serve(
         guest: None,
         watch,
         writer,
+        transfers: HashMap::new(),
+        stage_to: None,
     };
     // Persistent planes of the last daemon come back before the first request.
     daemon.restore_saved();
@@ -664,6 +671,8 @@ impl Daemon {
             self.remove_plane(*id);
         }
         self.clients.disconnect(client);
+        // Its snapshot transfers (a half-sent restore, an unread download) go with it.
+        self.transfers.remove(&client);
         tracing::info!(
             client = format!("{client:032x}"),
             planes_released = owned.len(),

@@ -13,8 +13,8 @@ use std::sync::atomic::Ordering;
 use std::sync::{mpsc, Arc};
 
 use shm_layout::{
-    CommandError, CommandResult, ErrorKind, NamedPlane, OpenedPlane, PlaneId, PlaneKind, PlaneName,
-    PlaneProp, Reply,
+    CommandError, CommandResult, ErrorKind, NamedPlane, OpenedPlane, PlaneId, PlaneName, PlaneProp,
+    Reply,
 };
 
 use super::limits::exceeded;
@@ -278,7 +278,7 @@ impl Daemon {
         let (jobs, receiver) = mpsc::channel();
         let setup = worker::Setup {
             id,
-            kind: PlaneKind::Rapier3d,
+            kind: loaded.kind,
             props: vec![PlaneProp::Name(loaded.name), PlaneProp::Persistent(true)],
             ticket,
             config: self.config.clone(),
@@ -307,7 +307,7 @@ impl Daemon {
                 jobs,
                 cell,
                 usage,
-                kind: PlaneKind::Rapier3d,
+                kind: loaded.kind,
                 name: Some(loaded.name),
                 persistent: true,
                 recovered: Some(loaded.lost_ticks),

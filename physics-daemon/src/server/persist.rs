@@ -508,6 +508,8 @@ pub struct Loaded {
     pub name: PlaneName,
     /// The snapshot bytes.
     pub bytes: Vec<u8>,
+    /// The kind of plane it holds (3D or GUI).
+    pub kind: PlaneKind,
     /// The snapshot's tick.
     pub tick: u64,
     /// The ticks the old daemon reached past the snapshot (its tick record), 0 without one.
@@ -515,7 +517,7 @@ pub struct Loaded {
 }
 
 /// Loads every plane file of the domain folder `dir`, in name order: temporary files left
-/// by a crash are removed; a file that is not a valid snapshot of a 3D plane is skipped with
+/// by a crash are removed; a file that is not a valid snapshot is skipped with
 /// an error naming it and why (the daemon starts all the same).
 pub fn load(dir: &Path) -> Vec<Loaded> {
     let entries = match std::fs::read_dir(dir) {
@@ -569,18 +571,14 @@ fn load_one(dir: &Path, path: &Path, stem: &str) -> Result<Loaded, String> {
         PlaneName::new(stem).map_err(|e| format!("its name is not a plane name: {}", e.message))?;
     let bytes = std::fs::read(path).map_err(|e| format!("cannot read it: {e}"))?;
     let (header, _) = snapshot::verify(&bytes).map_err(|e| e.message)?;
-    if header.kind != PlaneKind::Rapier3d {
-        return Err(format!(
-            "it holds a {:?} plane; persistent planes are 3D planes",
-            header.kind
-        ));
-    }
+
     let recorded = std::fs::read(tick_file_of(dir, stem))
         .ok()
         .and_then(|b| <[u8; 8]>::try_from(b.get(..8)?).ok())
         .map(u64::from_le_bytes);
     Ok(Loaded {
         name,
+        kind: header.kind,
         tick: header.tick,
         lost_ticks: recorded.map_or(0, |r| r.saturating_sub(header.tick)),
         bytes,

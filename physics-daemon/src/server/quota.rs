@@ -403,6 +403,49 @@ impl Owners {
     }
 }
 
+/// State bytes held for as long as this value lives (a snapshot transfer's buffer), counted
+/// in a process's total like a plane's; given back when dropped.
+#[derive(Debug)]
+pub struct HeldBytes {
+    owner: Arc<OwnerUsage>,
+    bytes: u64,
+}
+
+impl HeldBytes {
+    /// Reserves `bytes` of state against `owner`'s quota (and the daemon's memory), or the
+    /// `Quota` error naming the quota and its flag.
+    pub fn reserve(
+        owner: &Arc<OwnerUsage>,
+        limits: &Limits,
+        bytes: u64,
+    ) -> Result<HeldBytes, CommandError> {
+        owner
+            .reserve(
+                limits,
+                OpCost {
+                    state_bytes: bytes,
+                    ..OpCost::default()
+                },
+            )?
+            .keep();
+        Ok(HeldBytes {
+            owner: owner.clone(),
+            bytes,
+        })
+    }
+}
+
+impl Drop for HeldBytes {
+    fn drop(&mut self) {
+        drop(Reserved {
+            owner: &self.owner,
+            objects: 0,
+            mesh_vertices: 0,
+            state_bytes: self.bytes,
+        });
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

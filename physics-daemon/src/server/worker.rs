@@ -75,6 +75,9 @@ pub(super) struct Budget {
     /// The requesting process's total when it is not the plane owner's (a `Shared` plane):
     /// the objects it adds count against it.
     pub guest: Option<Arc<super::quota::OwnerUsage>>,
+    /// The requesting connection's snapshot transfers: a snapshot too large for the reply
+    /// waits there as a download.
+    pub transfers: Option<Arc<super::transfers::ClientTransfers>>,
 }
 
 /// A plane's usage, counted in its owner's total.
@@ -155,6 +158,10 @@ impl PlaneCell {
         let Some(plane) = guard.as_mut() else {
             return Inline::HandOver(ops);
         };
+        // Work the worker put off its tick (a copy for Rewind) is the worker's to do.
+        if plane.has_idle_work() {
+            return Inline::HandOver(ops);
+        }
         let before = schedule_of(plane.as_ref());
         self.note_changes(&ops);
         let (results, failed) = run_ops(id, plane.as_mut(), ops, budget, usage, None, None);
@@ -365,7 +372,7 @@ fn run(setup: Setup, file: Option<super::persist::PlaneFile>, jobs: Receiver<Job
             }
             None => {}
         }
-        if !worker.tick_if_due(Instant::now()) {
+        if !worker.tick_if_due(Instant::now()) || !worker.idle_work() {
             report(Event::Failed { plane: id });
             return drain(id, jobs, &report);
         }
@@ -548,6 +555,32 @@ impl Worker {
         true
     }
 
+    /// What the plane put off its tick's path (`Backend::idle_work`), now that the tick is
+    /// answered. False when the plane panicked.
+    fn idle_work(&mut self) -> bool {
+        let mut guard = self.cell.lock();
+        let Some(plane) = guard.as_mut() else {
+            return true;
+        };
+        match catch_unwind(AssertUnwindSafe(|| plane.idle_work())) {
+            Ok(Ok(())) => {
+                self.usage.update(plane.as_ref());
+                true
+            }
+            Ok(Err(e)) => {
+                tracing::warn!(plane = self.id, "keeping the tick failed: {e}");
+                true
+            }
+            Err(panic) => {
+                let message = super::dispatch::panic_message(panic.as_ref());
+                tracing::error!(plane = self.id, "plane failed and was removed: {message}");
+                *guard = None;
+                self.usage.release();
+                false
+            }
+        }
+    }
+
     /// Applies a run handed over by the loop, under the plane's lock.
     fn run_job(&mut self, ops: Vec<PlaneOp>, budget: Budget) -> (Vec<CommandResult>, bool) {
         let mut guard = self.cell.lock();
@@ -679,6 +712,7 @@ fn run_ops(
         }));
         match outcome {
             Ok(result) => {
+                let result = stage_large(result, reply_left, budget);
                 let result = count_reply(result, &mut reply_left, &budget.limits);
                 results.push(result)
             }
@@ -811,6 +845,20 @@ fn op_name(op: &PlaneOp) -> &'static str {
         PlaneOp::Restore { .. } => "Restore",
         PlaneOp::Rewind(_) => "Rewind",
         _ => "this op",
+    }
+}
+
+/// A snapshot larger than [`shm_layout::snapshot_transfer::STAGE_ABOVE`] (or than what the
+/// reply may still hold) is kept as a download of the requester's and answered with its
+/// number; everything else passes unchanged.
+fn stage_large(result: CommandResult, reply_left: usize, budget: &Budget) -> CommandResult {
+    match (result, &budget.transfers) {
+        (Ok(Reply::Snapshot(bytes)), Some(transfers))
+            if bytes.len() > shm_layout::snapshot_transfer::STAGE_ABOVE.min(reply_left) =>
+        {
+            transfers.stage(bytes)
+        }
+        (result, _) => result,
     }
 }
 

@@ -201,6 +201,7 @@ impl UserData for GuiPhysicsPlane {
             super::gui_object::gui_object_ud(lua, p.0.add("GuiPhysicsPlane:Add", &prim)?)
         });
         super::snapshot::add_gui_plane_methods(methods);
+        super::named_plane::add_gui_methods(methods);
         methods.add_method("NewController", |_, p, (prim, opts): (Value, Value)| {
             p.0.new_controller("GuiPhysicsPlane:NewController", &prim, opts, false)
         });
@@ -266,6 +267,16 @@ impl UserData for GuiPhysicsPlane {
             MetaMethod::NewIndex,
             |lua, p, (key, value): (Value, Value)| props::GUI_PLANE.set(lua, &p.0, &key, &value),
         );
+        // Two handles on one plane are equal (`Open` of a plane the script holds).
+        methods.add_meta_function(
+            MetaMethod::Eq,
+            |_, (a, b): (mlua::AnyUserData, mlua::AnyUserData)| {
+                let (Ok(a), Ok(b)) = (a.borrow::<Self>(), b.borrow::<Self>()) else {
+                    return Ok(false);
+                };
+                Ok(Rc::ptr_eq(&a.0, &b.0))
+            },
+        );
     }
 }
 
@@ -310,6 +321,9 @@ pub fn new_gui(lua: &Lua, opts: Value) -> mlua::Result<GuiPhysicsPlane> {
             _ => match props::GUI_PLANE.option(WHAT, &key, &value)? {
                 PlaneProp::TickRate(v) => o.tick_rate = Some(v),
                 PlaneProp::Enabled(v) => o.enabled = Some(v),
+                PlaneProp::Name(v) => o.name = Some(v),
+                PlaneProp::Persistent(v) => o.persistent = Some(v),
+                PlaneProp::RollbackTicks(v) => o.rollback_ticks = Some(v),
                 PlaneProp::Gui(g) => match g {
                     GuiPlaneProp::Gravity(v) => o.gravity = Some(v),
                     GuiPlaneProp::LinearDamping(v) => o.linear_damping = Some(v),
@@ -359,6 +373,18 @@ pub(crate) fn wrap_gui_plane(lua: &Lua, plane: GuiPlane) -> GuiPhysicsPlane {
         planes.0.borrow_mut().push(state.clone());
     }
     GuiPhysicsPlane(state)
+}
+
+/// The script's handle on GUI plane `id` when it holds one (`Open` of a plane it has).
+pub(crate) fn held_gui_plane(lua: &Lua, id: client_sdk::PlaneId) -> Option<GuiPhysicsPlane> {
+    let planes = lua.app_data_ref::<GuiPlanes>()?;
+    let found = planes
+        .0
+        .borrow()
+        .iter()
+        .find(|s| s.alive() && s.plane.plane().id() == id)
+        .cloned();
+    found.map(GuiPhysicsPlane)
 }
 
 /// Fires `signal` with `args` (used by controllers).

@@ -3,6 +3,7 @@
 //! daemon's info (one round trip); every write is one `PlaneProp` (`PlaneProp::Gui` for the
 //! 2D settings). `BoundsMin` / `BoundsMax` are options of `NewGUI` only (given as a pair).
 
+use client_sdk::settings::plane::MAX_ROLLBACK_TICKS;
 use client_sdk::validate::MAX_TICK_RATE;
 use client_sdk::{GuiPlaneInfo, GuiPlaneProp, PlaneProp};
 use mlua::{Error as LuaError, Lua, Value};
@@ -167,5 +168,62 @@ pub static GUI_PLANE: Props<GuiPlaneState> = Props {
             get: Get::Fn(|_, p| Ok(Value::Boolean(p.alive()))),
             set: Set::ReadOnly,
         },
+        // The plane's Name (nil: unnamed); an option of NewGUI only.
+        Row {
+            name: "Name",
+            kind: Kind::String,
+            get: Get::Fn(|lua, p| {
+                let name = common(p, "Name")?.name;
+                Ok(match name.is_none() {
+                    true => Value::Nil,
+                    false => Value::String(lua.create_string(name.as_str())?),
+                })
+            }),
+            set: Set::CreationOnly(|arg| {
+                let text = arg.string()?;
+                client_sdk::PlaneName::new(&text)
+                    .map(PlaneProp::Name)
+                    .map_err(|e| LuaError::runtime(e.message))
+            }),
+        },
+        // Written to the daemon's state directory; an option of NewGUI only.
+        Row {
+            name: "Persistent",
+            kind: Kind::Boolean,
+            get: Get::Fn(|_, p| Ok(Value::Boolean(common(p, "Persistent")?.persistent))),
+            set: Set::CreationOnly(|a| Ok(PlaneProp::Persistent(a.bool()?))),
+        },
+        // Ticks kept for Rewind.
+        Row {
+            name: "RollbackTicks",
+            kind: Kind::Number {
+                min: 0.0,
+                max: MAX_ROLLBACK_TICKS as f64,
+            },
+            get: Get::Fn(|_, p| {
+                Ok(Value::Integer(
+                    common(p, "RollbackTicks")?.rollback_ticks as i64,
+                ))
+            }),
+            set: Set::Prop(|a| Ok(PlaneProp::RollbackTicks(a.number()? as u32))),
+        },
+        // Fired once (lost ticks) after Open of a plane restored from its file.
+        Row {
+            name: "Recovered",
+            kind: Kind::String,
+            get: Get::Fn(crate::api::named_plane::gui_recovered_signal),
+            set: Set::ReadOnly,
+        },
     ],
 };
+
+/// The options every plane kind has, as the daemon reports them for this GUI plane
+/// (`Name`, `Persistent`, `RollbackTicks`).
+fn common(p: &GuiPlaneState, what: &str) -> Result<client_sdk::PlaneSettings, LuaError> {
+    p.check_alive(what)?;
+    p.plane
+        .plane()
+        .info()
+        .map(|i| i.settings)
+        .map_err(|e| sdk_error(&format!("GuiPhysicsPlane.{what}"), e))
+}

@@ -400,6 +400,12 @@ impl PartState {
         self.changed(lua, "Size", new_vector(size))
     }
 
+    /// Takes the Size its body already has (a part made for an existing object: nothing is
+    /// sent, nothing fires).
+    pub fn set_size_as_simulated(&self, size: [f32; 3]) {
+        self.size.set(size);
+    }
+
     /// Whether `:Destroy()` was called.
     pub fn is_destroyed(&self) -> bool {
         self.destroyed.get()

@@ -108,6 +108,15 @@ impl PlaneState {
         self.parts.borrow().iter().any(|p| f(p))
     }
 
+    /// The parts this host simulates in the plane, with their bodies' handles.
+    pub fn parts_by_handle(&self) -> Vec<(Handle, Rc<PartState>)> {
+        self.by_handle
+            .borrow()
+            .iter()
+            .map(|(h, p)| (*h, p.clone()))
+            .collect()
+    }
+
     /// The part whose body is `handle`, if this host added it.
     pub fn part_of(&self, handle: Handle) -> Option<Rc<PartState>> {
         self.by_handle.borrow().get(&handle).cloned()
@@ -349,6 +358,7 @@ impl UserData for PhysicsPlane {
         super::ragdoll::add_methods(methods);
         super::probe::add_methods(methods);
         super::named_plane::add_methods(methods);
+        super::plane_objects::add_methods(methods);
         methods.add_meta_method(MetaMethod::Index, |lua, p, key: Value| {
             PLANE.get(lua, &p.0, &key)
         });
