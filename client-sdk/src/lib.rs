@@ -35,6 +35,7 @@ mod probe;
 mod query;
 pub mod ragdoll;
 mod spawn;
+pub mod spin;
 mod transport;
 
 pub use client::{
