@@ -299,7 +299,8 @@ impl Plane {
             }
             let left = deadline.saturating_duration_since(Instant::now());
             match crate::spin::phase(shm_layout::monotonic_ns(), due) {
-                crate::spin::Phase::Poll if !left.is_zero() => std::hint::spin_loop(),
+                // Yield rather than spin: the daemon may need this core to publish.
+                crate::spin::Phase::Poll if !left.is_zero() => std::thread::yield_now(),
                 crate::spin::Phase::Doze(d) if !left.is_zero() => {
                     self.tick_listener()
                         .map_err(|e| self.client.check_daemon().err().unwrap_or(e))?;

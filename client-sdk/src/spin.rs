@@ -6,9 +6,10 @@
 //! through the daemon costs over one in process. Two waits here know when their answer is
 //! due: a `Step`'s reply (about the plane's last step time after the request) and the next
 //! tick of a timer-driven plane (the last tick's end plus its dt). They sleep until shortly
-//! before, poll until a bounded time after, and only then sleep on the event. The polling
-//! is bounded so an idle reader costs nothing and a late answer costs at most [`MAX_SPIN`]
-//! of one core.
+//! before, poll (yielding the core between looks: on a machine with few cores the daemon's
+//! threads that produce the answer may need it) until a bounded time after, and only then
+//! sleep on the event. The polling is bounded so an idle reader costs nothing and a late
+//! answer costs at most [`MAX_SPIN`] of one core.
 
 use std::time::Duration;
 

@@ -180,7 +180,9 @@ impl Transport {
                     // The reply event stays set: the next wait consumes it and looks again.
                     return Ok(response.payload().to_vec());
                 }
-                std::hint::spin_loop();
+                // Yield rather than spin: on a machine with few cores the daemon's threads
+                // that produce the reply may need this one.
+                std::thread::yield_now();
             }
         }
         loop {

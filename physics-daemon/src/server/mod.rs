@@ -35,6 +35,7 @@ mod request_bytes;
 pub mod resources;
 pub mod trim;
 mod worker;
+pub mod liveness;
 
 use std::collections::{BTreeMap, HashMap, VecDeque};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -154,6 +155,8 @@ pub struct Daemon {
     watch: Arc<resources::Watch>,
     /// The writer of persistent planes (`--state-dir`).
     writer: Option<persist::Writer>,
+    /// When to list nodes to find gone clients (`liveness`).
+    liveness: liveness::Schedule,
 }
 
 /// Wakes the loop of the daemon of `domain` (e.g. from a signal handler thread after setting
@@ -349,6 +352,7 @@ fn serve(
         guest: None,
         watch,
         writer,
+        liveness: liveness::Schedule::default(),
     };
     // Persistent planes of the last daemon come back before the first request.
     daemon.restore_saved();
@@ -693,6 +697,17 @@ impl Daemon {
     }
 
     fn release_gone_clients(&mut self) {
+        // Listing nodes reads every node on the machine: only when a client's process looks
+        // dead, or once a `liveness::FULL_CHECK`.
+        let clients = &self.clients;
+        let all_alive = || {
+            clients
+                .ids()
+                .all(|id| clients.get(id).is_some_and(|c| liveness::process_alive(c.pid)))
+        };
+        if !self.liveness.list_now(all_alive) {
+            return;
+        }
         for client in self.clients.reap(&self.config) {
             tracing::warn!(client = format!("{client:032x}"), "client process is gone");
             // Its requests go unanswered: nobody waits for them.
