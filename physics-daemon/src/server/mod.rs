@@ -27,6 +27,7 @@ pub mod fair;
 pub mod files;
 pub mod heartbeat;
 pub mod limits;
+pub mod liveness;
 mod named;
 mod origin;
 pub mod persist;
@@ -35,7 +36,6 @@ mod request_bytes;
 pub mod resources;
 pub mod trim;
 mod worker;
-pub mod liveness;
 
 use std::collections::{BTreeMap, HashMap, VecDeque};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -701,9 +701,11 @@ impl Daemon {
         // dead, or once a `liveness::FULL_CHECK`.
         let clients = &self.clients;
         let all_alive = || {
-            clients
-                .ids()
-                .all(|id| clients.get(id).is_some_and(|c| liveness::process_alive(c.pid)))
+            clients.ids().all(|id| {
+                clients
+                    .get(id)
+                    .is_some_and(|c| liveness::process_alive(c.pid))
+            })
         };
         if !self.liveness.list_now(all_alive) {
             return;
