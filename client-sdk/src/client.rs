@@ -135,6 +135,8 @@ struct Inner {
     last_beat: std::cell::Cell<Instant>,
     /// When [`Client::watch_daemon`] last read the node list.
     last_node_check: std::cell::Cell<Instant>,
+    /// How long the next request polls for its reply before sleeping ([`crate::spin`]).
+    reply_spin: std::cell::Cell<std::time::Duration>,
 }
 
 /// A connection to the physics daemon of one domain. Cheap to clone; not `Send` (shared
@@ -165,6 +167,7 @@ impl Client {
             frame: std::cell::Cell::new(0),
             origin: RefCell::new(None),
             last_beat: std::cell::Cell::new(Instant::now()),
+            reply_spin: std::cell::Cell::new(std::time::Duration::ZERO),
             last_node_check: std::cell::Cell::new(Instant::now()),
         };
         let hello = Command::Hello {
@@ -291,6 +294,12 @@ impl Client {
     }
 
     /// The frame of [`Client::begin_frame`] (0 before the first).
+    /// Lets the next request poll for its reply for up to `spin` before sleeping (a `Step`,
+    /// whose reply is due after about the plane's last step time: see [`crate::spin`]).
+    pub(crate) fn spin_next_reply(&self, spin: std::time::Duration) {
+        self.inner.reply_spin.set(spin);
+    }
+
     pub(crate) fn frame(&self) -> u64 {
         self.inner.frame.get()
     }
@@ -675,8 +684,9 @@ impl Inner {
         let started = Instant::now();
         let mut last_check = started;
         let mut last_beat = started;
+        let spin = self.reply_spin.take();
         self.transport
-            .exchange(bytes, header, LIVENESS_PERIOD, |connected| {
+            .exchange(bytes, header, LIVENESS_PERIOD, spin, |connected| {
                 if !connected {
                     self.check_daemon()?;
                 }

@@ -37,6 +37,7 @@ pub mod ragdoll;
 mod replay_check;
 mod snapshot_transfer;
 mod spawn;
+pub mod spin;
 mod transport;
 
 pub use client::{

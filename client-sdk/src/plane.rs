@@ -247,10 +247,21 @@ impl Plane {
     /// Advances a plane by `dt` seconds (with the queue sent first) and returns once the
     /// new tick is visible in [`Plane::snapshot`]. Returns the tick number.
     pub fn step(&self, dt: f32) -> Result<u64, Error> {
-        match self
+        // The reply is due after about the last step's time: poll for it that long rather
+        // than pay the scheduler's wake-up on top of a small step (`crate::spin`).
+        let last = self
+            .shared
+            .latest
+            .borrow()
+            .as_ref()
+            .map(|s| *s.user_header());
+        self.client
+            .spin_next_reply(crate::spin::step_reply(last.as_ref()));
+        let reply = self
             .client
-            .call(Command::plane(self.id(), PlaneOp::Step { dt }))?
-        {
+            .call(Command::plane(self.id(), PlaneOp::Step { dt }));
+        self.client.spin_next_reply(Duration::ZERO);
+        match reply? {
             Reply::Stepped { tick } => {
                 // The daemon sends the sample before the reply, so it is already here.
                 self.shared.refresh()?;
@@ -261,8 +272,47 @@ impl Plane {
     }
 
     /// Waits until a tick newer than the one visible now is published. Returns its number.
+    ///
+    /// On a timer-driven plane the next tick is due a period after the last one ended: the
+    /// wait sleeps until [`crate::spin::LEAD`] before that, polls shared memory until
+    /// [`crate::spin::TAIL`] after it, and only then sleeps on the tick event, so a tick on
+    /// time reaches the reader without the scheduler's wake-up (about 1 ms of one core per
+    /// tick at most). [`Plane::wait_tick_spin`] with no spin only ever sleeps on the event.
     pub fn wait_tick(&self, timeout: Duration) -> Result<u64, Error> {
-        self.wait_tick_spin(timeout, Duration::ZERO)
+        self.shared.refresh()?;
+        let seen = self.shared.current_tick();
+        let due = self
+            .shared
+            .latest
+            .borrow()
+            .as_ref()
+            .and_then(|s| crate::spin::next_tick_ns(s.user_header()));
+        let Some(due) = due else {
+            return self.wait_tick_after(seen, timeout, Duration::ZERO);
+        };
+        let deadline = Instant::now() + timeout;
+        loop {
+            self.shared.refresh()?;
+            match self.shared.current_tick() {
+                Some(t) if Some(t) != seen => return Ok(t),
+                _ => {}
+            }
+            let left = deadline.saturating_duration_since(Instant::now());
+            match crate::spin::phase(shm_layout::monotonic_ns(), due) {
+                // Yield rather than spin: the daemon may need this core to publish.
+                crate::spin::Phase::Poll if !left.is_zero() => std::thread::yield_now(),
+                crate::spin::Phase::Doze(d) if !left.is_zero() => {
+                    self.tick_listener()
+                        .map_err(|e| self.client.check_daemon().err().unwrap_or(e))?;
+                    if let Some(l) = self.shared.ticks.borrow().as_ref() {
+                        let _ = l.timed_wait(|_| {}, d.min(left).min(LIVENESS_PERIOD));
+                    }
+                }
+                // Past the window (or the time is up): the plain wait, which also watches
+                // the daemon's liveness and reports the timeout.
+                _ => return self.wait_tick_after(seen, left, Duration::ZERO),
+            }
+        }
     }
 
     /// Like [`Plane::wait_tick`], but first polls the shared-memory queue for up to `spin`
@@ -272,6 +322,16 @@ impl Plane {
     pub fn wait_tick_spin(&self, timeout: Duration, spin: Duration) -> Result<u64, Error> {
         self.shared.refresh()?;
         let seen = self.shared.current_tick();
+        self.wait_tick_after(seen, timeout, spin)
+    }
+
+    /// [`Plane::wait_tick_spin`] for a tick other than `seen`.
+    fn wait_tick_after(
+        &self,
+        seen: Option<u64>,
+        timeout: Duration,
+        spin: Duration,
+    ) -> Result<u64, Error> {
         let started = Instant::now();
         let deadline = started + timeout;
         let spin_until = started + spin.min(timeout);

@@ -130,14 +130,16 @@ impl Transport {
         })
     }
 
-    /// Sends request bytes and wakes the daemon; then polls for the reply, sleeping on our
-    /// reply event up to `period` at a time and calling `check` between sleeps (liveness,
-    /// timeouts): a dead daemon is an error within a bounded time, not a hang.
+    /// Sends request bytes and wakes the daemon; then polls for the reply, first without
+    /// sleeping for up to `spin` (see [`crate::spin`]), then sleeping on our reply event up to
+    /// `period` at a time and calling `check` between sleeps (liveness, timeouts): a dead
+    /// daemon is an error within a bounded time, not a hang.
     pub(crate) fn exchange(
         &self,
         bytes: &[u8],
         header: u128,
         period: Duration,
+        spin: Duration,
         mut check: impl FnMut(bool) -> Result<(), Error>,
     ) -> Result<Vec<u8>, Error> {
         let loaned = self.port.borrow().loan_slice_uninit(bytes.len());
@@ -168,6 +170,21 @@ impl Transport {
         self.daemon_wake
             .notify()
             .map_err(|e| Error::ipc("wake daemon", e))?;
+        if !spin.is_zero() {
+            let until = std::time::Instant::now() + spin;
+            while std::time::Instant::now() < until {
+                if let Some(response) = pending
+                    .receive()
+                    .map_err(|e| Error::ipc("receive reply", e))?
+                {
+                    // The reply event stays set: the next wait consumes it and looks again.
+                    return Ok(response.payload().to_vec());
+                }
+                // Yield rather than spin: on a machine with few cores the daemon's threads
+                // that produce the reply may need this one.
+                std::thread::yield_now();
+            }
+        }
         loop {
             if let Some(response) = pending
                 .receive()

@@ -793,3 +793,9 @@ fn physics_lua_starts_from_a_snapshot_file() {
         bad.stderr()
     );
 }
+
+#[test]
+fn cframe_values_are_tagged_userdata_that_refuse_forgeries() {
+    let daemon = TestDaemon::start("lua-cframe-values");
+    run_ok(&daemon, "tests/lua/cframe_values.luau", "cframe values ok");
+}

@@ -85,7 +85,7 @@ pub fn install(lua: &Lua, doll: &Table) -> mlua::Result<()> {
             };
             let bones: Table = this.raw_get("Bones")?;
             let o = bone(what, &bones, &name)?;
-            let ok = matches!(&cframe, Value::UserData(ud) if ud.is::<CFrame>());
+            let ok = CFrame::from_value(&cframe).is_some();
             if !ok {
                 return Err(expected(&format!("{what} cframe"), "a CFrame", &cframe));
             }

@@ -110,8 +110,10 @@ impl UserData for DynMesh {
                 Value::Nil => CFrame::IDENTITY,
                 Value::Table(t) => match t.get::<Value>("Offset")? {
                     Value::Nil => CFrame::IDENTITY,
-                    Value::UserData(ud) if ud.is::<CFrame>() => *ud.borrow::<CFrame>()?,
-                    other => return Err(expected(&format!("{W} Offset"), "a CFrame", &other)),
+                    other => match CFrame::from_value(&other) {
+                        Some(cf) => cf,
+                        None => return Err(expected(&format!("{W} Offset"), "a CFrame", &other)),
+                    },
                 },
                 other => {
                     return Err(expected(

@@ -351,11 +351,8 @@ fn load_prop(
     (path, cframe, opts): (String, Value, Value),
 ) -> mlua::Result<(mlua::AnyUserData, Table)> {
     let what = "PhysicsPlane:LoadProp";
-    let cf = match &cframe {
-        Value::UserData(ud) => ud.borrow::<CFrame>().map(|c| *c).ok(),
-        _ => None,
-    }
-    .ok_or_else(|| expected(&format!("{what} cframe"), "a CFrame", &cframe))?;
+    let cf = CFrame::from_value(&cframe)
+        .ok_or_else(|| expected(&format!("{what} cframe"), "a CFrame", &cframe))?;
     let (mut scale, mut decompose) = ([1.0f32; 3], false);
     for (k, v) in options(what, &opts)? {
         match k.as_str() {

@@ -198,7 +198,7 @@ pub static MAP: Props<MapState> = Props {
                     position: s.position,
                     rotation: s.rotation,
                 });
-                Ok(Value::UserData(lua.create_userdata(cf)?))
+                cf.into_value(lua)
             }),
             set: Set::Prop(|a| Ok(ObjectProp::Pose(a.cframe()?.pose()))),
         },

@@ -67,6 +67,7 @@ pub fn modules(lua: &Lua, client: Client) -> mlua::Result<Table> {
         part: part::methods(lua)?,
         object: object::methods(lua)?,
     }));
+    part::pose_index::install(lua)?;
     let modules = lua.create_table()?;
     modules.set("PhysicsService", plane::module(lua)?)?;
     modules.set("Renderable", part::module(lua)?)?;

@@ -42,11 +42,7 @@ pub(super) fn vector_arg(what: &str, v: &Value) -> mlua::Result<[f32; 3]> {
 }
 
 pub(super) fn cframe_arg(what: &str, v: &Value) -> mlua::Result<CFrame> {
-    match v {
-        Value::UserData(ud) => ud.borrow::<CFrame>().map(|c| *c).ok(),
-        _ => None,
-    }
-    .ok_or_else(|| expected(what, "a CFrame", v))
+    CFrame::from_value(v).ok_or_else(|| expected(what, "a CFrame", v))
 }
 
 pub(super) fn positive_arg(what: &str, v: &Value) -> mlua::Result<f32> {

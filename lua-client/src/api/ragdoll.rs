@@ -21,11 +21,7 @@ use crate::values::{describe, expected, finite_number, finite_vector, sdk_error,
 const WHAT: &str = "PhysicsPlane:NewRagdoll";
 
 fn cframe_of(what: &str, v: &Value) -> mlua::Result<CFrame> {
-    match v {
-        Value::UserData(ud) => ud.borrow::<CFrame>().map(|c| *c).ok(),
-        _ => None,
-    }
-    .ok_or_else(|| expected(what, "a CFrame", v))
+    CFrame::from_value(v).ok_or_else(|| expected(what, "a CFrame", v))
 }
 
 fn bone_of(i: usize, v: Value) -> mlua::Result<Bone> {

@@ -11,7 +11,7 @@
 
 use mlua::{Lua, Table, Value};
 
-use super::part::{BasePart, PartShape, PartState};
+use super::part::{PartShape, PartState};
 use crate::values::rotation::{Quat, V3};
 use crate::values::{expected, finite_number, finite_vector, CFrame};
 
@@ -252,15 +252,13 @@ pub fn add_constructors(lua: &Lua, renderable: &Table) -> mlua::Result<()> {
     renderable.set(
         "Plane",
         lua.create_function(|lua, (normal, offset): (Value, Value)| {
-            Ok(BasePart(std::rc::Rc::new(plane_part(
-                lua, &normal, &offset,
-            )?)))
+            super::part::part_ud(lua, &std::rc::Rc::new(plane_part(lua, &normal, &offset)?))
         })?,
     )?;
     renderable.set(
         "Brush",
-        lua.create_function(|_, planes: Value| {
-            Ok(BasePart(std::rc::Rc::new(brush_part(&planes)?)))
+        lua.create_function(|lua, planes: Value| {
+            super::part::part_ud(lua, &std::rc::Rc::new(brush_part(&planes)?))
         })?,
     )?;
     Ok(())

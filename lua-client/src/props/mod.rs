@@ -169,13 +169,7 @@ impl Kind {
                 Some(v) if v.iter().all(|c| c.is_finite() && *c > 0.0) => Ok(Arg::Vector(v)),
                 _ => Err(bad()),
             },
-            Kind::CFrame => match value {
-                Value::UserData(ud) => ud
-                    .borrow::<CFrame>()
-                    .map(|cf| Arg::CFrame(*cf))
-                    .map_err(|_| bad()),
-                _ => Err(bad()),
-            },
+            Kind::CFrame => CFrame::from_value(value).map(Arg::CFrame).ok_or_else(bad),
             Kind::String => match value {
                 Value::String(s) => Ok(Arg::String(s.to_string_lossy())),
                 _ => Err(bad()),

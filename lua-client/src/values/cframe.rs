@@ -5,15 +5,15 @@ use std::cell::RefCell;
 use std::fmt;
 
 use client_sdk::Pose;
-use mlua::{
-    AnyUserData, Lua, MetaMethod, UserData, UserDataFields, UserDataMethods, Value, Variadic,
-};
+use mlua::{AnyUserData, Lua, Table, Value, Variadic};
 
+use super::cframe_ud::cframe_of_userdata;
 use super::convert::{describe, expected, finite_vector, new_vector, number, vector};
 use super::rotation::{self, Quat, V3};
 
-/// A pose: position and rotation.
+/// A pose: position and rotation. `repr(C)`: the bytes of its Lua value (see `cframe_ud`).
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[repr(C)]
 pub struct CFrame {
     /// World-space position.
     pub position: V3,
@@ -89,20 +89,28 @@ impl CFrameCache {
     /// `cf` as a Lua value: the cached one when it is the same pose, else a new one (which
     /// the cache keeps).
     pub fn value(&self, lua: &Lua, cf: CFrame) -> mlua::Result<Value> {
-        if let Some((cached, ud)) = &*self.0.borrow() {
-            if cached.same_bits(&cf) {
-                return Ok(Value::UserData(ud.clone()));
-            }
+        if let Some(ud) = self.cached(&cf) {
+            return Ok(Value::UserData(ud));
         }
-        let ud = cf.new_userdata(lua)?;
+        let Value::UserData(ud) = cf.into_value(lua)? else {
+            unreachable!("a CFrame is a userdata")
+        };
         *self.0.borrow_mut() = Some((cf, ud.clone()));
         Ok(Value::UserData(ud))
+    }
+
+    /// The value handed out last, if it holds `cf` bit for bit.
+    pub fn cached(&self, cf: &CFrame) -> Option<AnyUserData> {
+        match &*self.0.borrow() {
+            Some((cached, ud)) if cached.same_bits(cf) => Some(ud.clone()),
+            _ => None,
+        }
     }
 }
 
 impl CFrame {
     /// Whether both hold the same bits (unlike `==`, tells -0 from 0, as `tostring` does).
-    fn same_bits(&self, other: &CFrame) -> bool {
+    pub fn same_bits(&self, other: &CFrame) -> bool {
         let bits = |cf: &CFrame| {
             let mut b = [0u32; 7];
             for (i, c) in cf.position.iter().chain(&cf.rotation).enumerate() {
@@ -113,21 +121,11 @@ impl CFrame {
         bits(self) == bits(other)
     }
 
-    /// A new CFrame userdata. While the Lua state has a memory limit, mlua makes every
-    /// userdata in a protected call (a closure allocated and called per value), which costs
-    /// more than the value itself; a CFrame is a few dozen bytes, so the limit is lifted for
-    /// this one allocation and restored at once: the next allocation past the limit still
-    /// fails with Lua's memory error.
-    pub fn new_userdata(self, lua: &Lua) -> mlua::Result<AnyUserData> {
-        match lua.set_memory_limit(0) {
-            Ok(0) => lua.create_userdata(self),
-            Ok(limit) => {
-                let ud = lua.create_userdata(self);
-                lua.set_memory_limit(limit)?;
-                ud
-            }
-            // No memory control (a module's Lua state): nothing to lift.
-            Err(_) => lua.create_userdata(self),
+    /// The CFrame `value` holds, if it is one.
+    pub fn from_value(value: &Value) -> Option<CFrame> {
+        match value {
+            Value::UserData(ud) => cframe_of_userdata(ud),
+            _ => None,
         }
     }
 }
@@ -142,77 +140,138 @@ impl fmt::Display for CFrame {
 
 /// A CFrame argument of a method, or an error naming the method.
 fn cframe_arg(what: &str, value: &Value) -> mlua::Result<CFrame> {
-    match value {
-        Value::UserData(ud) => match ud.borrow::<CFrame>() {
-            Ok(cf) => Ok(*cf),
-            Err(_) => Err(expected(what, "a CFrame", value)),
-        },
-        _ => Err(expected(what, "a CFrame", value)),
-    }
+    CFrame::from_value(value).ok_or_else(|| expected(what, "a CFrame", value))
 }
 
-impl UserData for CFrame {
-    fn add_fields<F: UserDataFields<Self>>(fields: &mut F) {
-        fields.add_field_method_get("Position", |_, cf| Ok(new_vector(cf.position)));
-        fields.add_field_method_get("Rotation", |_, cf| {
-            Ok(new_vector(rotation::to_euler(cf.rotation)))
-        });
-        fields.add_field_method_get("X", |_, cf| Ok(cf.position[0]));
-        fields.add_field_method_get("Y", |_, cf| Ok(cf.position[1]));
-        fields.add_field_method_get("Z", |_, cf| Ok(cf.position[2]));
-        fields.add_field_method_get("LookVector", |_, cf| Ok(cf.axis([0.0, 0.0, -1.0])));
-        fields.add_field_method_get("RightVector", |_, cf| Ok(cf.axis([1.0, 0.0, 0.0])));
-        fields.add_field_method_get("UpVector", |_, cf| Ok(cf.axis([0.0, 1.0, 0.0])));
-    }
+/// The members of a CFrame value, in the order error messages list them.
+const MEMBERS: &str = "Position, Rotation, X, Y, Z, LookVector, RightVector, UpVector, \
+                       ToWorldSpace, ToObjectSpace, PointToWorldSpace, PointToObjectSpace, Inverse";
 
-    fn add_methods<M: UserDataMethods<Self>>(methods: &mut M) {
-        // With no argument the frame itself is the world-space pose (as `Right:ToWorldSpace()`).
-        methods.add_method("ToWorldSpace", |_, cf, other: Value| match other {
-            Value::Nil => Ok(*cf),
-            v => Ok(cf.compose(&cframe_arg("CFrame:ToWorldSpace", &v)?)),
-        });
-        methods.add_method("ToObjectSpace", |_, cf, other: Value| {
+/// The metatable of CFrame values (see `cframe_ud`): `__index` answers the members and the
+/// methods (its C front answers Position and the components), and the operators.
+pub fn metatable(lua: &Lua) -> mlua::Result<Table> {
+    let methods = lua.create_table()?;
+    // With no argument the frame itself is the world-space pose (as `Right:ToWorldSpace()`).
+    methods.raw_set(
+        "ToWorldSpace",
+        lua.create_function(|_, (this, other): (Value, Value)| {
+            let cf = cframe_arg("CFrame:ToWorldSpace self", &this)?;
+            match other {
+                Value::Nil => Ok(cf),
+                v => Ok(cf.compose(&cframe_arg("CFrame:ToWorldSpace", &v)?)),
+            }
+        })?,
+    )?;
+    methods.raw_set(
+        "ToObjectSpace",
+        lua.create_function(|_, (this, other): (Value, Value)| {
+            let cf = cframe_arg("CFrame:ToObjectSpace self", &this)?;
             Ok(cf
                 .inverse()
                 .compose(&cframe_arg("CFrame:ToObjectSpace", &other)?))
-        });
-        methods.add_method("PointToWorldSpace", |_, cf, v: Value| {
+        })?,
+    )?;
+    methods.raw_set(
+        "PointToWorldSpace",
+        lua.create_function(|_, (this, v): (Value, Value)| {
+            let cf = cframe_arg("CFrame:PointToWorldSpace self", &this)?;
             let v = finite_vector("CFrame:PointToWorldSpace", &v)?;
             Ok(new_vector(cf.point_to_world(v)))
-        });
-        methods.add_method("PointToObjectSpace", |_, cf, v: Value| {
+        })?,
+    )?;
+    methods.raw_set(
+        "PointToObjectSpace",
+        lua.create_function(|_, (this, v): (Value, Value)| {
+            let cf = cframe_arg("CFrame:PointToObjectSpace self", &this)?;
             let v = finite_vector("CFrame:PointToObjectSpace", &v)?;
             Ok(new_vector(cf.inverse().point_to_world(v)))
-        });
-        methods.add_method("Inverse", |_, cf, ()| Ok(cf.inverse()));
-        methods.add_meta_function(MetaMethod::Mul, |lua, (a, b): (Value, Value)| {
+        })?,
+    )?;
+    methods.raw_set(
+        "Inverse",
+        lua.create_function(|_, this: Value| {
+            Ok(cframe_arg("CFrame:Inverse self", &this)?.inverse())
+        })?,
+    )?;
+    methods.set_readonly(true);
+
+    let mt = lua.create_table()?;
+    mt.raw_set(
+        "__index",
+        lua.create_function(move |_, (this, key): (Value, Value)| {
+            let cf = cframe_arg("CFrame member read", &this)?;
+            let name = match &key {
+                Value::String(s) => s.as_bytes().to_vec(),
+                _ => Vec::new(),
+            };
+            match name.as_slice() {
+                b"Position" => Ok(new_vector(cf.position)),
+                b"Rotation" => Ok(new_vector(rotation::to_euler(cf.rotation))),
+                b"X" => Ok(Value::Number(f64::from(cf.position[0]))),
+                b"Y" => Ok(Value::Number(f64::from(cf.position[1]))),
+                b"Z" => Ok(Value::Number(f64::from(cf.position[2]))),
+                b"LookVector" => Ok(cf.axis([0.0, 0.0, -1.0])),
+                b"RightVector" => Ok(cf.axis([1.0, 0.0, 0.0])),
+                b"UpVector" => Ok(cf.axis([0.0, 1.0, 0.0])),
+                _ => match methods.raw_get::<Value>(key.clone())? {
+                    f @ Value::Function(_) => Ok(f),
+                    _ => Err(mlua::Error::runtime(format!(
+                        "CFrame has no member {} (members: {MEMBERS})",
+                        describe(&key)
+                    ))),
+                },
+            }
+        })?,
+    )?;
+    mt.raw_set(
+        "__mul",
+        lua.create_function(|lua, (a, b): (Value, Value)| {
             let lhs = cframe_arg("CFrame * ...", &a)?;
             match &b {
                 Value::Vector(_) => Ok(new_vector(
                     lhs.point_to_world(finite_vector("CFrame * Vector", &b)?),
                 )),
-                _ => lua
-                    .create_userdata(lhs.compose(&cframe_arg("CFrame * CFrame", &b)?))
-                    .map(Value::UserData),
+                _ => lhs
+                    .compose(&cframe_arg("CFrame * CFrame", &b)?)
+                    .into_value(lua),
             }
-        });
-        methods.add_meta_function(MetaMethod::Add, |_, (a, b): (Value, Value)| {
+        })?,
+    )?;
+    mt.raw_set(
+        "__add",
+        lua.create_function(|_, (a, b): (Value, Value)| {
             let mut cf = cframe_arg("CFrame + Vector", &a)?;
             let v = finite_vector("CFrame + Vector", &b)?;
             cf.position = [0, 1, 2].map(|i| cf.position[i] + v[i]);
             Ok(cf)
-        });
-        methods.add_meta_function(MetaMethod::Sub, |_, (a, b): (Value, Value)| {
+        })?,
+    )?;
+    mt.raw_set(
+        "__sub",
+        lua.create_function(|_, (a, b): (Value, Value)| {
             let mut cf = cframe_arg("CFrame - Vector", &a)?;
             let v = finite_vector("CFrame - Vector", &b)?;
             cf.position = [0, 1, 2].map(|i| cf.position[i] - v[i]);
             Ok(cf)
-        });
-        methods.add_meta_method(MetaMethod::Eq, |_, cf, other: Value| {
-            Ok(cframe_arg("==", &other).is_ok_and(|o| o == *cf))
-        });
-        methods.add_meta_method(MetaMethod::ToString, |_, cf, ()| Ok(cf.to_string()));
-    }
+        })?,
+    )?;
+    mt.raw_set(
+        "__eq",
+        lua.create_function(|_, (a, b): (Value, Value)| {
+            Ok(matches!(
+                (CFrame::from_value(&a), CFrame::from_value(&b)),
+                (Some(a), Some(b)) if a == b
+            ))
+        })?,
+    )?;
+    mt.raw_set(
+        "__tostring",
+        lua.create_function(|_, this: Value| {
+            Ok(cframe_arg("tostring(CFrame)", &this)?.to_string())
+        })?,
+    )?;
+    mt.raw_set("__type", "CFrame")?;
+    Ok(mt)
 }
 
 /// Components of `args` as numbers, or None when any is not a number.

@@ -3,7 +3,7 @@
 
 use mlua::{AnyUserData, Error as LuaError, Function, Value};
 
-use super::{CFrame, Dim};
+use super::Dim;
 
 /// The metatable field of a userdata type that describes its values in error messages: a
 /// function of the value returning a string (e.g. `BasePart "Ball"`). Types without one are
@@ -41,7 +41,7 @@ pub fn describe(value: &Value) -> String {
         Value::Function(_) => "function".into(),
         Value::Thread(_) => "thread".into(),
         Value::UserData(ud) => {
-            if let Ok(cf) = ud.borrow::<CFrame>() {
+            if let Some(cf) = super::cframe_ud::cframe_of_userdata(ud) {
                 cf.to_string()
             } else if let Ok(d) = ud.borrow::<Dim>() {
                 d.to_string()

@@ -6,6 +6,7 @@
 //! messages than its type name opts in through its metatable (see [`DESCRIBE`]).
 
 mod cframe;
+pub mod cframe_ud;
 mod convert;
 mod dim;
 pub mod rotation;
@@ -23,6 +24,7 @@ use mlua::{Lua, Table};
 /// Builds the `Primitives` module (`Vector`, `CFrame`, `Dim`) and gives every vector its
 /// methods.
 pub fn module(lua: &Lua) -> mlua::Result<Table> {
+    cframe_ud::install(lua, &cframe::metatable(lua)?)?;
     let cframe_mod = lua.create_table()?;
     cframe_mod.set("new", lua.create_function(cframe::new)?)?;
     cframe_mod.set("Angles", lua.create_function(cframe::angles)?)?;

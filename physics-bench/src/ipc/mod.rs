@@ -414,5 +414,15 @@ fn goals(r: &IpcReport) -> Vec<Goal> {
         ),
         met: Some(l.object_count_read_us.max(l.sleeping_read_us) <= 1.0),
     });
+    // Side by side in one frame of one script: the part reads against plain table reads.
+    let ratio = l.cframe_x1000_us / l.table_x1000_us;
+    goals.push(Goal {
+        goal: "Lua: 1,000 part.CFrame reads ≤ 5× 1,000 plain table-field reads (same frame)".into(),
+        value: format!(
+            "{ratio:.1}× ({:.1} µs against {:.1} µs; second read {:.1} µs)",
+            l.cframe_x1000_us, l.table_x1000_us, l.cframe_x1000_second_read_us
+        ),
+        met: Some(ratio <= 5.0),
+    });
     goals
 }

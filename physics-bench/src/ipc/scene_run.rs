@@ -217,12 +217,13 @@ fn delivery(
     local: &mut LocalPlane,
 ) -> BenchResult<Delivery> {
     // Zero-copy: the plane ticks on its own timer; we wait for each tick like a game would,
-    // sleeping on the tick event, then again polling the queue.
+    // with `wait_tick` (it sleeps, and polls only around the moment the tick is due), then
+    // again polling the queue all the time.
     remote.set(PlaneProp::TickRate(60.0))?;
     client.flush()?;
     let mut read_all = Vec::new();
-    let zero_copy = zero_copy_us(plan, remote, Duration::ZERO, &mut read_all)?;
-    let zero_copy_poll = zero_copy_us(plan, remote, POLL_SPIN, &mut read_all)?;
+    let zero_copy = zero_copy_us(plan, remote, None, &mut read_all)?;
+    let zero_copy_poll = zero_copy_us(plan, remote, Some(POLL_SPIN), &mut read_all)?;
     remote.set(PlaneProp::TickRate(0.0))?;
     client.flush()?;
 
@@ -260,14 +261,17 @@ const POLL_SPIN: Duration = Duration::from_micros(33_333);
 fn zero_copy_us(
     plan: &Plan,
     remote: &client_sdk::Plane,
-    spin: Duration,
+    spin: Option<Duration>,
     read_all: &mut Vec<f64>,
 ) -> BenchResult<Vec<f64>> {
     let mut times = Vec::new();
     let deadline = Instant::now() + plan.delivery_time_cap;
     let mut seen = 0;
     while times.len() < plan.delivery_ticks && Instant::now() < deadline {
-        remote.wait_tick_spin(Duration::from_secs(10), spin)?;
+        match spin {
+            None => remote.wait_tick(Duration::from_secs(10))?,
+            Some(spin) => remote.wait_tick_spin(Duration::from_secs(10), spin)?,
+        };
         let snap: Snapshot = remote.snapshot()?;
         // Holding the sample is holding every pose: they are read in place from here on.
         let held = monotonic_ns();

@@ -27,6 +27,7 @@ pub mod fair;
 pub mod files;
 pub mod heartbeat;
 pub mod limits;
+pub mod liveness;
 mod named;
 mod origin;
 pub mod persist;
@@ -159,6 +160,8 @@ pub struct Daemon {
     transfers: HashMap<u128, Arc<transfers::ClientTransfers>>,
     /// Where a large snapshot of the command being routed is staged (its sender's transfers).
     stage_to: Option<Arc<transfers::ClientTransfers>>,
+    /// When to list nodes to find gone clients (`liveness`).
+    liveness: liveness::Schedule,
 }
 
 /// Wakes the loop of the daemon of `domain` (e.g. from a signal handler thread after setting
@@ -356,6 +359,7 @@ fn serve(
         writer,
         transfers: HashMap::new(),
         stage_to: None,
+        liveness: liveness::Schedule::default(),
     };
     // Persistent planes of the last daemon come back before the first request.
     daemon.restore_saved();
@@ -702,6 +706,19 @@ impl Daemon {
     }
 
     fn release_gone_clients(&mut self) {
+        // Listing nodes reads every node on the machine: only when a client's process looks
+        // dead, or once a `liveness::FULL_CHECK`.
+        let clients = &self.clients;
+        let all_alive = || {
+            clients.ids().all(|id| {
+                clients
+                    .get(id)
+                    .is_some_and(|c| liveness::process_alive(c.pid))
+            })
+        };
+        if !self.liveness.list_now(all_alive) {
+            return;
+        }
         for client in self.clients.reap(&self.config) {
             tracing::warn!(client = format!("{client:032x}"), "client process is gone");
             // Its requests go unanswered: nobody waits for them.

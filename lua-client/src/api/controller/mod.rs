@@ -184,10 +184,8 @@ fn point(what: &str, v: &Value) -> mlua::Result<Vec3> {
             return Ok(p);
         }
     }
-    if let Value::UserData(ud) = v {
-        if let Ok(cf) = ud.borrow::<CFrame>() {
-            return Ok(cf.pose().position);
-        }
+    if let Some(cf) = CFrame::from_value(v) {
+        return Ok(cf.pose().position);
     }
     Err(expected(what, "a Vector or a CFrame", v))
 }
@@ -245,9 +243,9 @@ impl UserData for LuaController {
         });
         methods.add_method("Teleport", |_, c, target: Value| {
             const W: &str = "Controller:Teleport";
-            let pose = match &target {
-                Value::UserData(ud) if ud.is::<CFrame>() => ud.borrow::<CFrame>()?.pose(),
-                other => Pose::at(point(W, other)?),
+            let pose = match CFrame::from_value(&target) {
+                Some(cf) => cf.pose(),
+                None => Pose::at(point(W, &target)?),
             };
             c.live("Teleport")?
                 .teleport(pose)

@@ -1,6 +1,7 @@
 //! `Renderable.BasePart`: the host stand-in for a visual part. Once a plane simulates it,
 //! reading `part.CFrame` returns the pose of the newest tick, read from shared memory.
 
+pub(crate) mod pose_index;
 pub(crate) mod props;
 
 use client_sdk::DEFAULT_GROUP;
@@ -243,6 +244,8 @@ pub struct PartState {
     mesh: RefCell<Option<Rc<MeshData>>>,
     /// The CFrame value last handed to scripts (reads of an unmoved pose reuse it).
     cframe_value: CFrameCache,
+    /// The pose of the value `part.CFrame` last handed out (see `pose_index`).
+    handed_out: Cell<Option<CFrame>>,
     /// Added anchored (`Renderable.Plane`, `Renderable.Brush`: static shapes).
     anchor_on_add: Cell<bool>,
     /// The ragdoll bone the part is (hits on it name the bone).
@@ -266,6 +269,7 @@ impl PartState {
             grouped: Cell::new(false),
             mesh: RefCell::new(None),
             cframe_value: CFrameCache::default(),
+            handed_out: Cell::new(None),
             anchor_on_add: Cell::new(false),
             bone: RefCell::new(None),
         }
@@ -505,6 +509,16 @@ impl PartState {
         self.cframe_value.value(lua, cf)
     }
 
+    /// Whether `part.CFrame` last handed out a value of exactly `cf` (see `pose_index`).
+    pub(crate) fn handed_out_same(&self, cf: &CFrame) -> bool {
+        self.handed_out.get().is_some_and(|h| h.same_bits(cf))
+    }
+
+    /// `part.CFrame` handed out a value of `cf`.
+    pub(crate) fn handed_out(&self, cf: CFrame) {
+        self.handed_out.set(Some(cf));
+    }
+
     /// Stores a pose for a part that is not simulated.
     pub fn store_cframe(&self, cf: CFrame) {
         self.cframe.set(cf);
@@ -713,10 +727,12 @@ pub fn module(lua: &Lua) -> mlua::Result<Table> {
 
 /// The script's `BasePart` value of `part` (one per part: see `identity.rs`).
 pub(crate) fn part_ud(lua: &Lua, part: &Rc<PartState>) -> mlua::Result<mlua::AnyUserData> {
-    crate::host::identity::userdata(
+    let ud = crate::host::identity::userdata(
         lua,
         Rc::as_ptr(part).cast(),
         crate::host::identity::tag::PART,
         || BasePart(part.clone()),
-    )
+    )?;
+    pose_index::register(lua, &ud, part)?;
+    Ok(ud)
 }
