@@ -38,6 +38,7 @@ pub mod settings;
 pub mod shape;
 pub mod snapshot;
 pub mod validate;
+pub mod cluster;
 
 pub use axis_motor::AxisMotor;
 pub use codec::{DecodeError, Frame};

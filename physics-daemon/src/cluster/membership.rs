@@ -1,0 +1,51 @@
+//! Membership: each daemon holds a liveliness token `physics/<cluster>/daemon/<name>` for as
+//! long as its session lives. Zenoh withdraws the token when the session closes, when the
+//! process dies (the kernel closes its links) or when its links stay silent past the lease
+//! ([`shm_layout::cluster::LEASE_MS`]), so every member and client sees who is alive without
+//! a protocol of ours.
+//!
+//! A name already alive is refused: before declaring its token the daemon asks the cluster
+//! for tokens of its name. Two daemons that start with the same name in the same instant can
+//! both pass that check; the name is advisory for people, the session id stays unique.
+
+use std::time::Duration;
+
+use shm_layout::cluster as keys;
+use zenoh::Wait;
+
+use super::ClusterError;
+
+/// How long the name check waits for answers from the members already connected.
+const NAME_CHECK: Duration = Duration::from_millis(1500);
+
+/// A daemon's token: alive while this value lives.
+pub struct Member {
+    _token: zenoh::liveliness::LivelinessToken,
+}
+
+impl Member {
+    /// Checks that `name` is free in `cluster`, then declares its token.
+    pub fn join(session: &zenoh::Session, cluster: &str, name: &str) -> Result<Member, ClusterError> {
+        let key = keys::daemon_key(cluster, name);
+        let replies = session
+            .liveliness()
+            .get(&key)
+            .timeout(NAME_CHECK)
+            .wait()
+            .map_err(|e| ClusterError::Zenoh(format!("cannot ask who is alive: {e}")))?;
+        while let Ok(reply) = replies.recv() {
+            if reply.result().is_ok() {
+                return Err(ClusterError::NameTaken {
+                    cluster: cluster.to_string(),
+                    name: name.to_string(),
+                });
+            }
+        }
+        let token = session
+            .liveliness()
+            .declare_token(&key)
+            .wait()
+            .map_err(|e| ClusterError::Zenoh(format!("cannot declare the token {key}: {e}")))?;
+        Ok(Member { _token: token })
+    }
+}
