@@ -174,6 +174,8 @@ fn client_config(options: &ClusterOptions) -> Result<zenoh::Config, Error> {
         set("transport/link/tls/root_ca_certificate", path(ca))?;
         set("transport/link/tls/connect_certificate", path(cert))?;
         set("transport/link/tls/connect_private_key", path(key))?;
+        // Zenoh presents the client certificate only with mTLS on.
+        set("transport/link/tls/enable_mtls", "true".into())?;
     }
     Ok(c)
 }

@@ -29,7 +29,7 @@ pub fn note_step(used: Duration) {
 }
 
 /// What the server loop tells the reporter: the usage records of its planes.
-#[derive(Default)]
+#[derive(Debug, Default)]
 pub struct Gauge {
     planes: Mutex<Vec<Arc<PlaneUsage>>>,
     /// The (plane count, next plane id) the list was taken at.
