@@ -9,8 +9,8 @@
 use std::path::PathBuf;
 use std::time::Duration;
 
-use shm_layout::cluster::{self as keys, Endpoint};
 pub use shm_layout::cluster::LoadReport;
+use shm_layout::cluster::{self as keys, Endpoint};
 use zenoh::Wait;
 
 use crate::Error;
@@ -108,8 +108,8 @@ impl Cluster {
             let Ok(sample) = reply.result() else { continue };
             let name = keys::last_segment(sample.key_expr().as_str());
             // A report counts only under its own name (no daemon speaks for another).
-            let Some(report) = LoadReport::decode(&sample.payload().to_bytes())
-                .filter(|r| r.name == name)
+            let Some(report) =
+                LoadReport::decode(&sample.payload().to_bytes()).filter(|r| r.name == name)
             else {
                 continue;
             };
@@ -166,11 +166,11 @@ fn client_config(options: &ClusterOptions) -> Result<zenoh::Config, Error> {
             (&options.tls_ca, &options.tls_cert, &options.tls_key)
         else {
             return Err(Error::Cluster(
-                "a tls endpoint needs tls_ca, tls_cert and tls_key (members use mutual TLS)"
-                    .into(),
+                "a tls endpoint needs tls_ca, tls_cert and tls_key (members use mutual TLS)".into(),
             ));
         };
-        let path = |p: &PathBuf| serde_json::to_string(&p.display().to_string()).unwrap_or_default();
+        let path =
+            |p: &PathBuf| serde_json::to_string(&p.display().to_string()).unwrap_or_default();
         set("transport/link/tls/root_ca_certificate", path(ca))?;
         set("transport/link/tls/connect_certificate", path(cert))?;
         set("transport/link/tls/connect_private_key", path(key))?;
@@ -203,7 +203,10 @@ mod tests {
             cluster: "c".into(),
             ..Default::default()
         };
-        assert!(client_config(&none).unwrap_err().to_string().contains("endpoint"));
+        assert!(client_config(&none)
+            .unwrap_err()
+            .to_string()
+            .contains("endpoint"));
         let bad = ClusterOptions {
             cluster: "a/b".into(),
             endpoints: vec!["tcp/127.0.0.1:1".into()],

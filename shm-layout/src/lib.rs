@@ -18,6 +18,7 @@
 #![deny(missing_docs)]
 
 pub mod axis_motor;
+pub mod cluster;
 pub mod codec;
 pub mod collision_groups;
 pub mod command;
@@ -38,7 +39,6 @@ pub mod settings;
 pub mod shape;
 pub mod snapshot;
 pub mod validate;
-pub mod cluster;
 
 pub use axis_motor::AxisMotor;
 pub use codec::{DecodeError, Frame};

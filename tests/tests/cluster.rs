@@ -106,11 +106,18 @@ fn three_daemons_see_each_other_and_a_killed_one_leaves() {
     .expect("b reports 1 plane, 41 bodies and some tick budget used");
     for d in &loaded {
         let load = d.load.as_ref().unwrap();
-        assert!(load.budget_used.is_finite() && load.budget_used <= 1.0, "{load:?}");
+        assert!(
+            load.budget_used.is_finite() && load.budget_used <= 1.0,
+            "{load:?}"
+        );
         assert!(load.cpu.is_finite() && load.cpu >= 0.0, "{load:?}");
         if d.name != "b" {
             // No plane, no step: exactly nothing of the budget.
-            assert_eq!((load.planes, load.bodies, load.budget_used), (0, 0, 0.0), "{load:?}");
+            assert_eq!(
+                (load.planes, load.bodies, load.budget_used),
+                (0, 0, 0.0),
+                "{load:?}"
+            );
         } else {
             assert!(load.cpu > 0.0, "b steps a plane yet used no CPU: {load:?}");
         }
@@ -150,20 +157,42 @@ fn unsafe_or_malformed_cluster_flags_are_refused_by_name() {
     let port = free_port().to_string();
     let any = format!("tcp/0.0.0.0:{port}");
     let (ok, err) = refused(&["--cluster", "x", "--name", "a", "--listen", &any]);
-    assert!(!ok, "listening on every interface in plain tcp must be refused");
-    for flag in ["--listen", "--tls-cert", "--tls-key", "--tls-ca", "--allow-peer"] {
+    assert!(
+        !ok,
+        "listening on every interface in plain tcp must be refused"
+    );
+    for flag in [
+        "--listen",
+        "--tls-cert",
+        "--tls-key",
+        "--tls-ca",
+        "--allow-peer",
+    ] {
         assert!(err.contains(flag), "{flag} not named in: {err}");
     }
     let tls = format!("tls/10.9.9.9:{port}");
     let (ok, err) = refused(&["--cluster", "x", "--name", "a", "--listen", &tls]);
-    assert!(!ok && err.contains("--tls-cert") && err.contains("--allow-peer"), "{err}");
+    assert!(
+        !ok && err.contains("--tls-cert") && err.contains("--allow-peer"),
+        "{err}"
+    );
     let (ok, err) = refused(&["--cluster", "x/y", "--name", "a"]);
-    assert!(!ok && err.contains("--cluster") && err.contains("x/y"), "{err}");
+    assert!(
+        !ok && err.contains("--cluster") && err.contains("x/y"),
+        "{err}"
+    );
     let (ok, err) = refused(&["--cluster", "x"]);
     assert!(!ok && err.contains("--name"), "{err}");
     let (ok, err) = refused(&["--name", "a"]);
     assert!(!ok && err.contains("--cluster"), "{err}");
-    let (ok, err) = refused(&["--cluster", "x", "--name", "a", "--listen", "udp/127.0.0.1:1"]);
+    let (ok, err) = refused(&[
+        "--cluster",
+        "x",
+        "--name",
+        "a",
+        "--listen",
+        "udp/127.0.0.1:1",
+    ]);
     assert!(!ok && err.contains("udp/127.0.0.1:1"), "{err}");
 }
 
@@ -179,9 +208,24 @@ impl Certs {
         std::fs::create_dir_all(&dir).expect("cert dir");
         let certs = Certs { dir };
         certs.openssl(&[
-            "req", "-x509", "-newkey", "ec", "-pkeyopt", "ec_paramgen_curve:prime256v1",
-            "-nodes", "-keyout", "ca.key", "-out", "ca.pem", "-days", "2", "-subj",
-            "/CN=physics-test-ca", "-addext", "basicConstraints=critical,CA:TRUE", "-addext",
+            "req",
+            "-x509",
+            "-newkey",
+            "ec",
+            "-pkeyopt",
+            "ec_paramgen_curve:prime256v1",
+            "-nodes",
+            "-keyout",
+            "ca.key",
+            "-out",
+            "ca.pem",
+            "-days",
+            "2",
+            "-subj",
+            "/CN=physics-test-ca",
+            "-addext",
+            "basicConstraints=critical,CA:TRUE",
+            "-addext",
             "keyUsage=critical,keyCertSign,cRLSign",
         ]);
         std::fs::write(
@@ -208,14 +252,41 @@ impl Certs {
 
     /// A certificate and key for common name `cn`: (cert, key) paths.
     fn leaf(&self, cn: &str) -> (String, String) {
-        let (key, csr, pem) = (format!("{cn}.key"), format!("{cn}.csr"), format!("{cn}.pem"));
+        let (key, csr, pem) = (
+            format!("{cn}.key"),
+            format!("{cn}.csr"),
+            format!("{cn}.pem"),
+        );
         self.openssl(&[
-            "req", "-newkey", "ec", "-pkeyopt", "ec_paramgen_curve:prime256v1", "-nodes",
-            "-keyout", &key, "-out", &csr, "-subj", &format!("/CN={cn}"),
+            "req",
+            "-newkey",
+            "ec",
+            "-pkeyopt",
+            "ec_paramgen_curve:prime256v1",
+            "-nodes",
+            "-keyout",
+            &key,
+            "-out",
+            &csr,
+            "-subj",
+            &format!("/CN={cn}"),
         ]);
         self.openssl(&[
-            "x509", "-req", "-in", &csr, "-CA", "ca.pem", "-CAkey", "ca.key",
-            "-CAcreateserial", "-out", &pem, "-days", "2", "-extfile", "leaf.ext",
+            "x509",
+            "-req",
+            "-in",
+            &csr,
+            "-CA",
+            "ca.pem",
+            "-CAkey",
+            "ca.key",
+            "-CAcreateserial",
+            "-out",
+            &pem,
+            "-days",
+            "2",
+            "-extfile",
+            "leaf.ext",
         ]);
         (self.path(&pem), self.path(&key))
     }

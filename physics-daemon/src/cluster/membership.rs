@@ -25,7 +25,11 @@ pub struct Member {
 
 impl Member {
     /// Checks that `name` is free in `cluster`, then declares its token.
-    pub fn join(session: &zenoh::Session, cluster: &str, name: &str) -> Result<Member, ClusterError> {
+    pub fn join(
+        session: &zenoh::Session,
+        cluster: &str,
+        name: &str,
+    ) -> Result<Member, ClusterError> {
         let key = keys::daemon_key(cluster, name);
         let replies = session
             .liveliness()

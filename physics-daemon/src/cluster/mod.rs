@@ -56,7 +56,10 @@ pub struct Cluster {
 impl Cluster {
     /// Joins the cluster `args` name, or returns `None` when no `--cluster` is given.
     /// `gauge` is what the server loop feeds (see [`load::Gauge`]).
-    pub fn join(args: &ClusterArgs, gauge: Arc<load::Gauge>) -> Result<Option<Cluster>, ClusterError> {
+    pub fn join(
+        args: &ClusterArgs,
+        gauge: Arc<load::Gauge>,
+    ) -> Result<Option<Cluster>, ClusterError> {
         let Some(plan) = session::Plan::from_args(args)? else {
             return Ok(None);
         };

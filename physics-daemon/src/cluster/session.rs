@@ -236,9 +236,16 @@ mod tests {
 
     #[test]
     fn beyond_loopback_needs_tls_and_an_allow_list() {
-        let e = Plan::from_args(&args(&["tcp/0.0.0.0:7447"])).unwrap_err().to_string();
-        assert!(e.contains("--listen tcp/0.0.0.0:7447") && e.contains("--tls-cert"), "{e}");
-        let e = Plan::from_args(&args(&["tls/10.1.2.3:7447"])).unwrap_err().to_string();
+        let e = Plan::from_args(&args(&["tcp/0.0.0.0:7447"]))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("--listen tcp/0.0.0.0:7447") && e.contains("--tls-cert"),
+            "{e}"
+        );
+        let e = Plan::from_args(&args(&["tls/10.1.2.3:7447"]))
+            .unwrap_err()
+            .to_string();
         for flag in ["--tls-cert", "--tls-key", "--tls-ca", "--allow-peer"] {
             assert!(e.contains(flag), "{e}");
         }
@@ -249,7 +256,8 @@ mod tests {
         a.allow_peer = vec!["b.example".into()];
         let plan = Plan::from_args(&a).unwrap().unwrap();
         assert!(plan.tls.is_some());
-        plan.config().expect("a valid zenoh configuration with access control");
+        plan.config()
+            .expect("a valid zenoh configuration with access control");
         let mut c = args(&[]);
         c.connect = vec!["tcp/192.168.1.4:7447".into()];
         let e = Plan::from_args(&c).unwrap_err().to_string();
