@@ -2,7 +2,7 @@
 //! long as its session lives. Zenoh withdraws the token when the session closes, when the
 //! process dies (the kernel closes its links) or when its links stay silent past the lease
 //! ([`shm_layout::cluster::LEASE_MS`]), so every member and client sees who is alive without
-//! a protocol of ours.
+//! a protocol of ours. The daemon logs each other member's arrival and departure.
 //!
 //! A name already alive is refused: before declaring its token the daemon asks the cluster
 //! for tokens of its name. Two daemons that start with the same name in the same instant can
@@ -18,9 +18,11 @@ use super::ClusterError;
 /// How long the name check waits for answers from the members already connected.
 const NAME_CHECK: Duration = Duration::from_millis(1500);
 
-/// A daemon's token: alive while this value lives.
+/// A daemon's token, and its watch on the others (each arrival and departure is logged):
+/// alive while this value lives.
 pub struct Member {
     _token: zenoh::liveliness::LivelinessToken,
+    _watch: zenoh::pubsub::Subscriber<()>,
 }
 
 impl Member {
@@ -50,6 +52,30 @@ impl Member {
             .declare_token(&key)
             .wait()
             .map_err(|e| ClusterError::Zenoh(format!("cannot declare the token {key}: {e}")))?;
-        Ok(Member { _token: token })
+        let me = name.to_string();
+        let watch = session
+            .liveliness()
+            .declare_subscriber(keys::daemons_key(cluster))
+            .history(true)
+            .callback(move |sample| {
+                let other = keys::last_segment(sample.key_expr().as_str());
+                if other == me {
+                    return;
+                }
+                match sample.kind() {
+                    zenoh::sample::SampleKind::Put => {
+                        tracing::info!(name = other, "cluster member alive")
+                    }
+                    zenoh::sample::SampleKind::Delete => {
+                        tracing::info!(name = other, "cluster member left")
+                    }
+                }
+            })
+            .wait()
+            .map_err(|e| ClusterError::Zenoh(format!("cannot watch the members: {e}")))?;
+        Ok(Member {
+            _token: token,
+            _watch: watch,
+        })
     }
 }
