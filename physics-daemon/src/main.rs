@@ -77,7 +77,11 @@ fn main() -> ExitCode {
         Ok(cluster) => cluster,
         Err(e) => {
             tracing::error!("{e}");
-            return ExitCode::FAILURE;
+            // Nothing of the domain exists yet. Zenoh's exit handlers can wait on a session
+            // still closing, so leave without running them.
+            // SAFETY: _exit ends the process; no state of ours needs flushing (the log
+            // writer is unbuffered stderr).
+            unsafe { libc::_exit(1) }
         }
     };
     let options = physics_daemon::server::Options {

@@ -46,18 +46,44 @@ fn member(cluster: &str, name: &str, listen: u16, connect: &[u16]) -> TestDaemon
     TestDaemon::start_with(&format!("cl-{name}"), &args, &[])
 }
 
-/// Runs a daemon expected to refuse its flags: its exit status and stderr.
+/// Runs a daemon expected to refuse its flags: its exit status and stderr. A daemon that
+/// has not exited within 15 s fails the test (and is killed).
 fn refused(args: &[&str]) -> (bool, String) {
-    let out = Command::new(client_sdk::daemon_executable())
+    let mut child = Command::new(client_sdk::daemon_executable())
         .args(["--domain", &unique_domain("cl-refused")])
         .args(args)
+        .env("PHYSICS_LOG", "warn")
         .stdin(Stdio::null())
-        .output()
+        .stderr(Stdio::piped())
+        .spawn()
         .expect("run physics-daemon");
-    (
-        out.status.success(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
+    let deadline = Instant::now() + Duration::from_secs(15);
+    let status = loop {
+        if let Some(status) = child.try_wait().expect("wait physics-daemon") {
+            break status;
+        }
+        if Instant::now() > deadline {
+            let _ = child.kill();
+            let _ = child.wait();
+            let mut err = String::new();
+            use std::io::Read;
+            let _ = child
+                .stderr
+                .take()
+                .expect("stderr")
+                .read_to_string(&mut err);
+            panic!("physics-daemon {args:?} did not exit within 15 s of refusing: {err}");
+        }
+        std::thread::sleep(Duration::from_millis(10));
+    };
+    let mut err = String::new();
+    use std::io::Read;
+    let _ = child
+        .stderr
+        .take()
+        .expect("stderr")
+        .read_to_string(&mut err);
+    (status.success(), err)
 }
 
 fn names(daemons: &[DaemonInfo]) -> Vec<&str> {
@@ -123,19 +149,6 @@ fn three_daemons_see_each_other_and_a_killed_one_leaves() {
         }
     }
 
-    // A name alive in the cluster is refused, naming it.
-    let (ok, err) = refused(&[
-        "--cluster",
-        &cluster,
-        "--name",
-        "b",
-        "--listen",
-        &endpoint(free_port()),
-        "--connect",
-        &endpoint(pa),
-    ]);
-    assert!(!ok && err.contains("\"b\" is already alive"), "{err}");
-
     // SIGKILL c: the kernel closes its sockets, so its links (and token) end at once; the
     // bound is the lease (a host that vanishes without closing anything) plus one query.
     let bound = Duration::from_millis(shm_layout::cluster::LEASE_MS)
@@ -150,6 +163,26 @@ fn three_daemons_see_each_other_and_a_killed_one_leaves() {
     .unwrap_or_else(|| panic!("c still listed {bound:?} after SIGKILL"));
     eprintln!("SIGKILLed daemon left the cluster view after {gone:?} (bound {bound:?})");
     drop((a, b, plane, client));
+}
+
+#[test]
+fn a_name_alive_is_refused() {
+    let cluster = unique_cluster("dup");
+    let (pa, pb) = (free_port(), free_port());
+    let _a = member(&cluster, "a", pa, &[]);
+    let _b = member(&cluster, "b", pb, &[pa]);
+    // A name alive in the cluster is refused, naming it.
+    let (ok, err) = refused(&[
+        "--cluster",
+        &cluster,
+        "--name",
+        "b",
+        "--listen",
+        "tcp/127.0.0.1:0",
+        "--connect",
+        &endpoint(pa),
+    ]);
+    assert!(!ok && err.contains("\"b\" is already alive"), "{err}");
 }
 
 #[test]

@@ -64,8 +64,23 @@ impl Cluster {
             return Ok(None);
         };
         let session = session::open(&plan)?;
-        let member = membership::Member::join(&session, &plan.cluster, &plan.name)?;
-        let reporter = load::Reporter::start(&session, &plan.cluster, &plan.name, gauge)?;
+        let joined = membership::Member::join(&session, &plan.cluster, &plan.name).and_then(|m| {
+            Ok((
+                m,
+                load::Reporter::start(&session, &plan.cluster, &plan.name, gauge)?,
+            ))
+        });
+        let (member, reporter) = match joined {
+            Ok(parts) => parts,
+            Err(e) => {
+                // Closing waits on the peers: do it aside, the caller reports the error now.
+                std::thread::spawn(move || {
+                    use zenoh::Wait;
+                    let _ = session.close().wait();
+                });
+                return Err(e);
+            }
+        };
         tracing::info!(
             cluster = plan.cluster,
             name = plan.name,
