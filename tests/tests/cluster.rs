@@ -168,9 +168,11 @@ fn three_daemons_see_each_other_and_a_killed_one_leaves() {
 #[test]
 fn a_name_alive_is_refused() {
     let cluster = unique_cluster("dup");
-    let (pa, pb) = (free_port(), free_port());
+    let (pa, pb, pc) = (free_port(), free_port(), free_port());
     let _a = member(&cluster, "a", pa, &[]);
     let _b = member(&cluster, "b", pb, &[pa]);
+    let _c = member(&cluster, "c", pc, &[pa, pb]);
+    // The newcomer connects to a only: it must learn of b through gossip before it checks.
     // A name alive in the cluster is refused, naming it.
     let (ok, err) = refused(&[
         "--cluster",

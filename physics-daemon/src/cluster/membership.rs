@@ -18,6 +18,30 @@ use super::ClusterError;
 /// How long the name check waits for answers from the members already connected.
 const NAME_CHECK: Duration = Duration::from_millis(1500);
 
+/// Waits until the links to the cluster's members stop growing (bounded by
+/// [`SETTLE_MAX`]): peers route only their own declarations, so a member's token is seen
+/// only once Zenoh's gossip has connected this daemon to that member directly.
+fn settle(session: &zenoh::Session) {
+    let started = std::time::Instant::now();
+    let mut last = usize::MAX;
+    let mut stable_since = started;
+    while started.elapsed() < SETTLE_MAX {
+        let peers = session.info().peers_zid().wait().count();
+        if peers != last {
+            last = peers;
+            stable_since = std::time::Instant::now();
+        } else if stable_since.elapsed() >= SETTLE_QUIET {
+            return;
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    }
+}
+
+/// The longest wait for the links to settle.
+const SETTLE_MAX: Duration = Duration::from_secs(3);
+/// How long the link count must hold still to count as settled.
+const SETTLE_QUIET: Duration = Duration::from_millis(500);
+
 /// A daemon's token, and its watch on the others (each arrival and departure is logged):
 /// alive while this value lives.
 pub struct Member {
@@ -33,6 +57,7 @@ impl Member {
         name: &str,
     ) -> Result<Member, ClusterError> {
         let key = keys::daemon_key(cluster, name);
+        settle(session);
         let replies = session
             .liveliness()
             .get(&key)
