@@ -69,6 +69,10 @@ pub enum Error {
     /// The daemon's reply could not be decoded or was not the one expected.
     #[error("protocol: {0}")]
     Protocol(String),
+    /// The cluster transport (Zenoh) failed or was given unusable settings; the message
+    /// names the setting.
+    #[error("cluster: {0}")]
+    Cluster(String),
 }
 
 fn refused_text(errors: &[CommandError]) -> String {

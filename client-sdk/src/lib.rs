@@ -3,6 +3,7 @@
 //! - [`Client`]: the connection (handshake, batched commands, daemon liveness).
 //! - [`Plane`]: one simulation plane; zero-copy [`Snapshot`]s of its newest tick.
 //! - [`Object`]: one body; reads index into the newest sample, writes join the batch.
+//! - [`cluster`]: the daemons of a physics cluster on Zenoh and their load.
 //!
 //! Writes are queued and sent as one request per [`Client::flush`] (or when a call needs an
 //! answer); reads see your own writes until the daemon's samples reflect them.
@@ -14,6 +15,7 @@
 
 pub mod axis_motor;
 mod client;
+pub mod cluster;
 mod collision_groups;
 mod contact_points;
 mod controller;

@@ -7,10 +7,12 @@
 //! - `rapier2d`: the 2D GUI plane kind (`PhysicsService.NewGUI`), behind the `gui` feature.
 //! - `gpu`: the GPU path of 3D planes (`DeferGpu`, wgpu compute), behind the `gpu` feature.
 //! - [`publish`]: writing a plane's tick into loaned shared-memory samples.
+//! - [`cluster`]: joining a physics cluster over Zenoh (`--cluster`).
 
 #![deny(missing_docs)]
 
 pub mod backend;
+pub mod cluster;
 #[cfg(feature = "gpu")]
 pub mod gpu;
 pub mod kinds;

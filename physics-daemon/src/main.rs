@@ -1,4 +1,6 @@
 //! `physics-daemon [--domain NAME]`: serves every physics plane of one domain.
+//! `physics-daemon --cluster NAME --name DAEMON [--listen ...] [--connect ...]`: the same, as
+//! a member of a physics cluster (docs/cluster.md).
 //! `physics-daemon --cleanup [--domain NAME]`: removes what dead processes of the domain
 //! left behind (a killed daemon's or client's shared memory and files), then exits.
 
@@ -25,6 +27,8 @@ struct Args {
     limits: physics_daemon::server::Limits,
     #[command(flatten)]
     persist: physics_daemon::server::persist::PersistArgs,
+    #[command(flatten)]
+    cluster: physics_daemon::cluster::ClusterArgs,
     /// Remove what dead processes of the domain left behind (shared memory, node records),
     /// print what was removed, and exit. Live processes keep everything of theirs.
     #[arg(long)]
@@ -67,6 +71,19 @@ fn main() -> ExitCode {
         .num_threads(1)
         .build_global();
 
+    // A cluster member joins before serving: a refused name or flag stops the daemon here.
+    let gauge = Arc::new(physics_daemon::cluster::load::Gauge::default());
+    let cluster = match physics_daemon::cluster::Cluster::join(&args.cluster, gauge.clone()) {
+        Ok(cluster) => cluster,
+        Err(e) => {
+            tracing::error!("{e}");
+            // Nothing of the domain exists yet. Zenoh's exit handlers can wait on a session
+            // still closing, so leave without running them.
+            // SAFETY: _exit ends the process; no state of ours needs flushing (the log
+            // writer is unbuffered stderr).
+            unsafe { libc::_exit(1) }
+        }
+    };
     let options = physics_daemon::server::Options {
         limits: args.limits,
         starter_pid: args.starter_pid,
@@ -75,8 +92,13 @@ fn main() -> ExitCode {
             .ok()
             .and_then(|v| v.parse().ok()),
         persistence: args.persist.persistence(),
+        load: cluster.as_ref().map(|_| gauge),
     };
-    match physics_daemon::server::run_with(&args.domain, &shutdown, options) {
+    let served = physics_daemon::server::run_with(&args.domain, &shutdown, options);
+    if let Some(cluster) = cluster {
+        cluster.leave();
+    }
+    match served {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             tracing::error!("{e}");

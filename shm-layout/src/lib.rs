@@ -18,6 +18,7 @@
 #![deny(missing_docs)]
 
 pub mod axis_motor;
+pub mod cluster;
 pub mod codec;
 pub mod collision_groups;
 pub mod command;

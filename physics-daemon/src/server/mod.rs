@@ -72,6 +72,9 @@ pub struct Options {
     /// Where persistent planes are written (`--state-dir`, `--snapshot-every`); `None`:
     /// `Persistent = true` is refused.
     pub persistence: Option<persist::Persistence>,
+    /// Fed the planes' usage for the cluster's load report (`--cluster`); `None` outside a
+    /// cluster.
+    pub load: Option<Arc<crate::cluster::load::Gauge>>,
 }
 
 /// How often dead clients are looked for while clients are connected (and, for a daemon
@@ -390,6 +393,11 @@ fn serve(
         daemon.waker.disarm();
         daemon.handle_events();
         daemon.serve_requests();
+        if let Some(gauge) = &daemon.options.load {
+            gauge.track(daemon.planes.len(), daemon.next_plane_id, || {
+                daemon.planes.values().map(|p| p.usage.clone()).collect()
+            });
+        }
         beats.beat(!daemon.clients.is_empty());
         if daemon.clients.is_empty() {
             if Instant::now() >= next_housekeeping {

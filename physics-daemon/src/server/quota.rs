@@ -326,6 +326,11 @@ impl PlaneUsage {
         }
     }
 
+    /// The plane's objects at its last update (the cluster's load report counts them).
+    pub fn objects(&self) -> u64 {
+        self.lock().objects
+    }
+
     /// The plane is gone: it holds nothing, and nobody pays for it any more.
     pub fn release(&self) {
         let mut st = self.lock();

@@ -1,0 +1,117 @@
+//! Joining a physics cluster (`--cluster NAME --name DAEMON`): a Zenoh session of the daemon's
+//! own, opened only when `--cluster` is given, so a daemon outside a cluster has no socket,
+//! no thread and no cost of it.
+//!
+//! - [`session`]: the flags, their checks (loopback unless TLS and an allow-list), and the
+//!   Zenoh configuration they make (peer mode, no multicast scouting, explicit endpoints).
+//! - [`membership`]: the daemon's liveliness token, and refusing a name already alive.
+//! - [`load`]: the load report each second (planes, bodies, tick budget used, CPU) and the
+//!   gauge the server loop feeds it through (its one hook).
+//!
+//! Local clients keep iceoryx2 zero-copy: Zenoh carries only what crosses hosts.
+
+pub mod load;
+pub mod membership;
+pub mod session;
+
+use std::sync::Arc;
+
+pub use session::ClusterArgs;
+
+/// Why the daemon cannot join its cluster.
+#[derive(Debug, thiserror::Error)]
+pub enum ClusterError {
+    /// A flag is missing, malformed or unsafe; the message names it.
+    #[error("{0}")]
+    Flags(String),
+    /// A name is unusable.
+    #[error(transparent)]
+    Name(#[from] shm_layout::cluster::NameError),
+    /// An endpoint is malformed.
+    #[error(transparent)]
+    Endpoint(#[from] shm_layout::cluster::EndpointError),
+    /// Another daemon of the cluster already has the name.
+    #[error(
+        "a daemon named {name:?} is already alive in cluster {cluster:?}: choose another --name"
+    )]
+    NameTaken {
+        /// The cluster.
+        cluster: String,
+        /// The name.
+        name: String,
+    },
+    /// Zenoh failed (a port in use, a certificate that does not load, ...).
+    #[error("cluster transport: {0}")]
+    Zenoh(String),
+}
+
+/// A daemon's membership of its cluster: alive while this value lives (its token is
+/// undeclared and its reports stop when it is dropped or the process dies).
+pub struct Cluster {
+    reporter: load::Reporter,
+    _member: membership::Member,
+    session: zenoh::Session,
+}
+
+impl Cluster {
+    /// Joins the cluster `args` name, or returns `None` when no `--cluster` is given.
+    /// `gauge` is what the server loop feeds (see [`load::Gauge`]).
+    pub fn join(
+        args: &ClusterArgs,
+        gauge: Arc<load::Gauge>,
+    ) -> Result<Option<Cluster>, ClusterError> {
+        let Some(plan) = session::Plan::from_args(args)? else {
+            return Ok(None);
+        };
+        let session = session::open(&plan)?;
+        let joined = membership::Member::join(&session, &plan.cluster, &plan.name).and_then(|m| {
+            Ok((
+                m,
+                load::Reporter::start(&session, &plan.cluster, &plan.name, gauge)?,
+            ))
+        });
+        let (member, reporter) = match joined {
+            Ok(parts) => parts,
+            Err(e) => {
+                // Closing waits on the peers: do it aside, the caller reports the error now.
+                std::thread::spawn(move || {
+                    use zenoh::Wait;
+                    let _ = session.close().wait();
+                });
+                return Err(e);
+            }
+        };
+        tracing::info!(
+            cluster = plan.cluster,
+            name = plan.name,
+            zid = %session.zid(),
+            listen = ?plan.listen,
+            "joined the physics cluster"
+        );
+        Ok(Some(Cluster {
+            reporter,
+            _member: member,
+            session,
+        }))
+    }
+
+    /// The Zenoh session (for the parts of the cluster built on it).
+    pub fn session(&self) -> &zenoh::Session {
+        &self.session
+    }
+
+    /// Leaves the cluster: stops the reports, undeclares the token, closes the session.
+    pub fn leave(self) {
+        let Cluster {
+            reporter,
+            _member,
+            session,
+        } = self;
+        reporter.stop();
+        drop(_member);
+        use zenoh::Wait;
+        if let Err(e) = session.close().wait() {
+            tracing::debug!("closing the cluster session: {e}");
+        }
+    }
+}
