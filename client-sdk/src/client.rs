@@ -13,6 +13,7 @@ use shm_layout::{
 };
 
 use crate::plane_shared::PlaneShared;
+use crate::remote::{RemoteOptions, RemoteTransport};
 use crate::transport::{Transport, LIVENESS_PERIOD};
 use crate::Error;
 
@@ -158,6 +159,37 @@ impl Client {
     /// Connects with explicit options.
     pub fn connect_with(options: ConnectOptions) -> Result<Client, Error> {
         let transport = Transport::open(&options.domain)?;
+        Self::handshake(options, transport)
+    }
+
+    /// Connects to a daemon of a physics cluster, on this host or another (docs/cluster.md):
+    /// the same API as [`Client::connect`], carried by Zenoh to the daemon's relay. With
+    /// `remote.daemon` unset, the live daemon with the smallest share of its tick budget
+    /// used is chosen. [`Client::domain`] reads `cluster/daemon`.
+    pub fn connect_cluster(remote: &RemoteOptions) -> Result<Client, Error> {
+        Self::connect_cluster_with(remote, ConnectOptions::new(""))
+    }
+
+    /// [`Client::connect_cluster`] with explicit options (`options.domain` is replaced).
+    pub fn connect_cluster_with(
+        remote: &RemoteOptions,
+        mut options: ConnectOptions,
+    ) -> Result<Client, Error> {
+        let transport = RemoteTransport::open(remote)?;
+        options.domain = format!("{}/{}", transport.cluster(), transport.daemon());
+        Self::handshake(options, Transport::Remote(Box::new(transport)))
+    }
+
+    /// The cluster daemon this client uses (`None`: this host's daemon, not through a
+    /// cluster).
+    pub fn cluster_daemon(&self) -> Option<&str> {
+        match &self.inner.transport {
+            Transport::Remote(t) => Some(t.daemon()),
+            Transport::Local(_) => None,
+        }
+    }
+
+    fn handshake(options: ConnectOptions, transport: Transport) -> Result<Client, Error> {
         let mut inner = Inner {
             options,
             transport,
@@ -182,7 +214,7 @@ impl Client {
         inner.options.request_timeout = timeout.min(HELLO_RETRY);
         let welcome = loop {
             match inner.round_trip(vec![hello.clone()]) {
-                Err(Error::Timeout(_)) if Instant::now() < deadline => {
+                Err(Error::Timeout(_)) if Instant::now() < deadline && inner.transport.is_local() => {
                     tracing::debug!("no answer to Hello: asking again with new ports");
                     inner.transport = Transport::open(&inner.options.domain)?;
                 }
@@ -514,6 +546,8 @@ impl Client {
         let now = Instant::now();
         match inner.transport.heartbeat_arrived() {
             Some(true) => inner.last_beat.set(now),
+            // A remote daemon: its liveliness token says whether it lives.
+            None if inner.check_daemon().is_err() => return DaemonHealth::Gone,
             None => return DaemonHealth::Live,
             Some(false) => {}
         }

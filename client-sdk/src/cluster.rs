@@ -125,6 +125,11 @@ impl Cluster {
     pub fn session(&self) -> &zenoh::Session {
         &self.session
     }
+
+    /// The session itself (a remote client keeps it).
+    pub(crate) fn into_session(self) -> zenoh::Session {
+        self.session
+    }
 }
 
 /// The client-mode configuration of `options`, after the same checks the daemons make:

@@ -73,11 +73,7 @@ impl Contact {
 impl EventReader {
     /// Drains the queue into `out`, counting the events missing between samples.
     pub(crate) fn drain(&self, out: &mut Events) -> Result<(), Error> {
-        while let Some(sample) = self
-            .subscriber
-            .receive()
-            .map_err(|e| Error::ipc("receive events", e))?
-        {
+        while let Some(sample) = self.subscriber.receive()? {
             let records = sample.payload();
             let Some(first) = records.first() else {
                 continue;
@@ -105,7 +101,10 @@ impl Plane {
         // Subscribe first, then read where the stream stands: every event after that point
         // reaches the subscriber, so a gap is a real loss.
         let sub = self.client().transport().plane_events(self.id())?;
-        let start = self.snapshot().map_or(0, |s| s.header().event_count);
+        let start = match sub.start() {
+            Some(start) => start,
+            None => self.snapshot().map_or(0, |s| s.header().event_count),
+        };
         *self.shared.events.borrow_mut() = Some(EventReader::new(sub, start));
         Ok(())
     }

@@ -35,6 +35,8 @@ mod plane_shared;
 mod plane_snapshot;
 mod probe;
 mod query;
+pub mod relay;
+pub mod remote;
 pub mod ragdoll;
 mod replay_check;
 mod snapshot_transfer;

@@ -305,7 +305,7 @@ impl Plane {
                     self.tick_listener()
                         .map_err(|e| self.client.check_daemon().err().unwrap_or(e))?;
                     if let Some(l) = self.shared.ticks.borrow().as_ref() {
-                        let _ = l.timed_wait(|_| {}, d.min(left).min(LIVENESS_PERIOD));
+                        l.timed_wait(d.min(left).min(LIVENESS_PERIOD));
                     }
                 }
                 // Past the window (or the time is up): the plain wait, which also watches
@@ -361,7 +361,7 @@ impl Plane {
                 .map_err(|e| self.client.check_daemon().err().unwrap_or(e))?;
             let wait = (deadline - now).min(LIVENESS_PERIOD);
             if let Some(l) = self.shared.ticks.borrow().as_ref() {
-                let _ = l.timed_wait(|_| {}, wait);
+                l.timed_wait(wait);
             }
         }
     }

@@ -67,15 +67,10 @@ impl PlaneShared {
 
     /// Takes the newest sample if one arrived: a check of a shared-memory queue, no syscall.
     pub(crate) fn refresh(&self) -> Result<(), Error> {
-        loop {
-            match self.bodies.receive() {
-                Ok(Some(sample)) => *self.latest.borrow_mut() = Some(Rc::new(sample)),
-                Ok(None) => return Ok(()),
-                // Every borrow slot is held by snapshots the caller keeps: keep the newest we have.
-                Err(iceoryx2::port::ReceiveError::ExceedsMaxBorrows) => return Ok(()),
-                Err(e) => return Err(Error::ipc("receive tick", e)),
-            }
+        while let Some(sample) = self.bodies.receive()? {
+            *self.latest.borrow_mut() = Some(Rc::new(sample));
         }
+        Ok(())
     }
 
     pub(crate) fn latest(&self) -> Result<Option<Rc<BodySample>>, Error> {

@@ -28,17 +28,216 @@ pub(crate) const LIVENESS_PERIOD: Duration = Duration::from_millis(100);
 /// How long `open` waits for a starting daemon to open its request server.
 const SERVER_WAIT: Duration = Duration::from_secs(2);
 
-/// A plane's body states: the newest tick's sample.
-pub(crate) type BodySample = Sample<ipc::Service, [BodyState], TickHeader>;
-/// Subscriber of a plane's body states.
-pub(crate) type BodySubscriber = Subscriber<ipc::Service, [BodyState], TickHeader>;
+/// A shared-memory sample of a plane's body states.
+type ShmBodySample = Sample<ipc::Service, [BodyState], TickHeader>;
+/// Subscriber of a plane's body states in shared memory.
+pub(crate) type ShmBodySubscriber = Subscriber<ipc::Service, [BodyState], TickHeader>;
+/// Subscriber of a plane's per-tick events in shared memory.
+pub(crate) type ShmEventSubscriber = Subscriber<ipc::Service, [EventRecord], TickHeader>;
+
+/// A plane's body states of one tick: read in place from shared memory, or rebuilt from a
+/// remote daemon's frames.
+pub(crate) enum BodySample {
+    /// This host's daemon's sample, in place.
+    Shm(ShmBodySample),
+    /// A remote daemon's tick, rebuilt bit for bit ([`shm_layout::remote::BodyMirror`]).
+    Owned(Box<(TickHeader, Vec<BodyState>)>),
+}
+
+impl BodySample {
+    /// Every slot of the tick.
+    pub(crate) fn payload(&self) -> &[BodyState] {
+        match self {
+            BodySample::Shm(s) => s.payload(),
+            BodySample::Owned(o) => &o.1,
+        }
+    }
+
+    /// The tick's header.
+    pub(crate) fn user_header(&self) -> &TickHeader {
+        match self {
+            BodySample::Shm(s) => s.user_header(),
+            BodySample::Owned(o) => &o.0,
+        }
+    }
+}
+
+/// Subscriber of a plane's body states (newest tick only).
+pub(crate) enum BodySubscriber {
+    /// Shared memory of this host's daemon.
+    Shm(ShmBodySubscriber),
+    /// Frames of a remote daemon's relay.
+    Remote(crate::remote::Bodies),
+}
+
+impl BodySubscriber {
+    /// The next tick waiting, if any (`None` also when every borrow slot is held by
+    /// snapshots the caller keeps: the caller keeps the newest it has).
+    pub(crate) fn receive(&self) -> Result<Option<BodySample>, Error> {
+        match self {
+            BodySubscriber::Shm(s) => match s.receive() {
+                Ok(sample) => Ok(sample.map(BodySample::Shm)),
+                Err(iceoryx2::port::ReceiveError::ExceedsMaxBorrows) => Ok(None),
+                Err(e) => Err(Error::ipc("receive tick", e)),
+            },
+            BodySubscriber::Remote(r) => Ok(r.receive().map(|o| BodySample::Owned(Box::new(o)))),
+        }
+    }
+}
+
+/// One tick's events.
+pub(crate) enum EventSample {
+    /// In place in shared memory.
+    Shm(Sample<ipc::Service, [EventRecord], TickHeader>),
+    /// From a remote daemon's relay.
+    Owned(Vec<EventRecord>),
+}
+
+impl EventSample {
+    /// The tick's events, in order.
+    pub(crate) fn payload(&self) -> &[EventRecord] {
+        match self {
+            EventSample::Shm(s) => s.payload(),
+            EventSample::Owned(r) => r,
+        }
+    }
+}
+
 /// Subscriber of a plane's per-tick events.
-pub(crate) type EventSubscriber = Subscriber<ipc::Service, [EventRecord], TickHeader>;
-/// Listener woken on every tick of a plane.
-pub(crate) type TickListener = Listener<ipc::Service>;
+pub(crate) enum EventSubscriber {
+    /// Shared memory of this host's daemon.
+    Shm(ShmEventSubscriber),
+    /// Frames of a remote daemon's relay, and the event number its stream starts at.
+    Remote(crate::remote::Events),
+}
+
+impl EventSubscriber {
+    /// The next tick's events waiting, if any.
+    pub(crate) fn receive(&self) -> Result<Option<EventSample>, Error> {
+        match self {
+            EventSubscriber::Shm(s) => s
+                .receive()
+                .map(|o| o.map(EventSample::Shm))
+                .map_err(|e| Error::ipc("receive events", e)),
+            EventSubscriber::Remote(r) => Ok(r.receive().map(EventSample::Owned)),
+        }
+    }
+
+    /// Where a remote stream starts (the relay subscribed then); `None` for shared memory.
+    pub(crate) fn start(&self) -> Option<u32> {
+        match self {
+            EventSubscriber::Shm(_) => None,
+            EventSubscriber::Remote(r) => Some(r.start),
+        }
+    }
+}
+
+/// Woken on every tick of a plane.
+pub(crate) enum TickListener {
+    /// The plane's tick event on this host.
+    Shm(Listener<ipc::Service>),
+    /// A remote plane's frames arriving.
+    Remote(crate::remote::Ticks),
+}
+
+impl TickListener {
+    /// Waits up to `wait` for a tick.
+    pub(crate) fn timed_wait(&self, wait: Duration) {
+        match self {
+            TickListener::Shm(l) => {
+                let _ = l.timed_wait(|_| {}, wait);
+            }
+            TickListener::Remote(t) => t.timed_wait(wait),
+        }
+    }
+}
+
+/// How a client reaches its daemon: this host's shared memory, or a cluster member's relay.
+pub(crate) enum Transport {
+    /// The daemon of this host's domain.
+    Local(LocalTransport),
+    /// A daemon of a cluster, through Zenoh.
+    Remote(Box<crate::remote::RemoteTransport>),
+}
+
+impl Transport {
+    /// Opens the ports of a client of `domain`'s daemon on this host.
+    pub(crate) fn open(domain: &str) -> Result<Transport, Error> {
+        LocalTransport::open(domain).map(Transport::Local)
+    }
+
+    /// Sends request bytes and returns the reply bytes ([`LocalTransport::exchange`]).
+    pub(crate) fn exchange(
+        &self,
+        bytes: &[u8],
+        header: u128,
+        period: Duration,
+        spin: Duration,
+        check: impl FnMut(bool) -> Result<(), Error>,
+    ) -> Result<Vec<u8>, Error> {
+        match self {
+            Transport::Local(t) => t.exchange(bytes, header, period, spin, check),
+            Transport::Remote(t) => t.exchange(bytes, period, check),
+        }
+    }
+
+    /// What the daemon knows this client by.
+    pub(crate) fn id(&self) -> u128 {
+        match self {
+            Transport::Local(t) => t.id(),
+            Transport::Remote(t) => t.id(),
+        }
+    }
+
+    /// Whether a heartbeat of the daemon arrived since the last call; `None` when nothing
+    /// can be said (a remote daemon: its liveliness token speaks for it instead).
+    pub(crate) fn heartbeat_arrived(&self) -> Option<bool> {
+        match self {
+            Transport::Local(t) => t.heartbeat_arrived(),
+            Transport::Remote(_) => None,
+        }
+    }
+
+    /// Whether the daemon is alive; `None` when that cannot be read.
+    pub(crate) fn daemon_alive(&self, daemon_node: u128) -> Option<bool> {
+        match self {
+            Transport::Local(t) => t.daemon_alive(daemon_node),
+            Transport::Remote(t) => t.daemon_alive(),
+        }
+    }
+
+    /// Whether the daemon runs on this host (its pid means something here).
+    pub(crate) fn is_local(&self) -> bool {
+        matches!(self, Transport::Local(_))
+    }
+
+    /// Subscribes to plane `id`'s body states (newest tick only).
+    pub(crate) fn plane_bodies(&self, id: PlaneId) -> Result<BodySubscriber, Error> {
+        match self {
+            Transport::Local(t) => t.plane_bodies(id).map(BodySubscriber::Shm),
+            Transport::Remote(t) => t.plane_bodies(id).map(BodySubscriber::Remote),
+        }
+    }
+
+    /// A listener woken by every tick of plane `id`.
+    pub(crate) fn plane_ticks(&self, id: PlaneId) -> Result<TickListener, Error> {
+        match self {
+            Transport::Local(t) => t.plane_ticks(id).map(TickListener::Shm),
+            Transport::Remote(t) => t.plane_ticks(id).map(TickListener::Remote),
+        }
+    }
+
+    /// Subscribes to plane `id`'s per-tick events.
+    pub(crate) fn plane_events(&self, id: PlaneId) -> Result<EventSubscriber, Error> {
+        match self {
+            Transport::Local(t) => t.plane_events(id).map(EventSubscriber::Shm),
+            Transport::Remote(t) => t.plane_events(id).map(EventSubscriber::Remote),
+        }
+    }
+}
 
 /// The ports of one client process.
-pub(crate) struct Transport {
+pub(crate) struct LocalTransport {
     config: Config,
     node: Node<ipc::Service>,
     control: ControlFactory,
@@ -51,10 +250,10 @@ pub(crate) struct Transport {
     heartbeat: RefCell<Option<Subscriber<ipc::Service, u64, ()>>>,
 }
 
-impl Transport {
+impl LocalTransport {
     /// Opens the ports of a client of `domain`'s daemon (waiting, bounded, for a starting
     /// daemon's request server).
-    pub(crate) fn open(domain: &str) -> Result<Transport, Error> {
+    pub(crate) fn open(domain: &str) -> Result<LocalTransport, Error> {
         let config = names::config(domain).map_err(|e| Error::Invalid {
             field: "domain".into(),
             message: e.to_string(),
@@ -118,7 +317,7 @@ impl Transport {
             .listener_builder()
             .create()
             .map_err(|e| Error::ipc("cannot create reply listener", e))?;
-        Ok(Transport {
+        Ok(LocalTransport {
             control,
             config,
             node,
@@ -231,7 +430,7 @@ impl Transport {
     }
 
     /// Subscribes to plane `id`'s body states (newest tick only).
-    pub(crate) fn plane_bodies(&self, id: PlaneId) -> Result<BodySubscriber, Error> {
+    pub(crate) fn plane_bodies(&self, id: PlaneId) -> Result<ShmBodySubscriber, Error> {
         self.node
             .service_builder(&names::plane_bodies(id))
             .publish_subscribe::<[BodyState]>()
@@ -245,7 +444,7 @@ impl Transport {
     }
 
     /// A listener woken by every tick of plane `id`.
-    pub(crate) fn plane_ticks(&self, id: PlaneId) -> Result<TickListener, Error> {
+    pub(crate) fn plane_ticks(&self, id: PlaneId) -> Result<Listener<ipc::Service>, Error> {
         self.node
             .service_builder(&names::plane_tick(id))
             .event()
@@ -257,7 +456,7 @@ impl Transport {
     }
 
     /// Subscribes to plane `id`'s per-tick events.
-    pub(crate) fn plane_events(&self, id: PlaneId) -> Result<EventSubscriber, Error> {
+    pub(crate) fn plane_events(&self, id: PlaneId) -> Result<ShmEventSubscriber, Error> {
         self.node
             .service_builder(&names::plane_events(id))
             .publish_subscribe::<[EventRecord]>()

@@ -84,6 +84,13 @@ fn main() -> ExitCode {
             unsafe { libc::_exit(1) }
         }
     };
+    let mut cluster = cluster;
+    if let Some(c) = cluster.as_mut() {
+        if let Err(e) = c.serve_remote(&args.domain, args.limits.max_clients) {
+            tracing::error!("{e}");
+            return ExitCode::FAILURE;
+        }
+    }
     let options = physics_daemon::server::Options {
         limits: args.limits,
         starter_pid: args.starter_pid,

@@ -35,6 +35,7 @@ pub mod plane_op;
 pub mod probe;
 pub mod query;
 pub mod records;
+pub mod remote;
 pub mod settings;
 pub mod shape;
 pub mod snapshot;

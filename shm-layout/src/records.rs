@@ -35,7 +35,9 @@ impl core::fmt::Display for Handle {
 }
 
 /// The state of one slot after a tick. 64 bytes: one cache line per body.
-#[derive(Debug, Clone, Copy, PartialEq, Default, ZeroCopySend)]
+#[derive(
+    Debug, Clone, Copy, PartialEq, Default, ZeroCopySend, serde::Serialize, serde::Deserialize,
+)]
 #[type_name("physics::BodyState")]
 #[repr(C)]
 pub struct BodyState {
@@ -84,7 +86,9 @@ impl BodyState {
 }
 
 /// User header of every body sample: which tick this is and what it cost.
-#[derive(Debug, Clone, Copy, PartialEq, Default, ZeroCopySend)]
+#[derive(
+    Debug, Clone, Copy, PartialEq, Default, ZeroCopySend, serde::Serialize, serde::Deserialize,
+)]
 #[type_name("physics::TickHeader")]
 #[repr(C)]
 pub struct TickHeader {
@@ -222,7 +226,9 @@ pub const EVENT_JOINT_BROKE: u32 = 3;
 /// `position` is the world-space contact point and `impulse` the total normal impulse the
 /// solver applied in the tick the contact started (all zero for `EVENT_CONTACT_STOPPED`);
 /// `points` holds the pair's contact manifold then (its first `point_count` entries).
-#[derive(Debug, Clone, Copy, PartialEq, Default, ZeroCopySend)]
+#[derive(
+    Debug, Clone, Copy, PartialEq, Default, ZeroCopySend, serde::Serialize, serde::Deserialize,
+)]
 #[type_name("physics::EventRecord")]
 #[repr(C)]
 pub struct EventRecord {

@@ -65,6 +65,26 @@ struct Args {
     /// gets that plane with `PhysicsService.GetStartPlane()`.
     #[arg(long)]
     snapshot: Option<PathBuf>,
+    /// Run against a daemon of this physics cluster, on this host or another, instead of
+    /// this host's domain (docs/cluster.md); no daemon is started. Needs `--connect`.
+    #[arg(long, requires = "connect")]
+    cluster: Option<String>,
+    /// A cluster member's endpoint (`tcp/127.0.0.1:7447`; `tls/HOST:PORT` with the TLS
+    /// flags beyond loopback); repeatable.
+    #[arg(long, requires = "cluster")]
+    connect: Vec<String>,
+    /// The cluster daemon to use, by name (default: the least loaded).
+    #[arg(long = "daemon", requires = "cluster")]
+    cluster_daemon: Option<String>,
+    /// For `tls/` endpoints: the authority that signed the members' certificates.
+    #[arg(long, requires = "cluster")]
+    tls_ca: Option<PathBuf>,
+    /// For `tls/` endpoints: this client's certificate.
+    #[arg(long, requires = "cluster")]
+    tls_cert: Option<PathBuf>,
+    /// For `tls/` endpoints: its key.
+    #[arg(long, requires = "cluster")]
+    tls_key: Option<PathBuf>,
 }
 
 /// The asset roots of a run: `--asset-root`, or the script's directory and the current one.
@@ -225,9 +245,10 @@ fn install_print(lua: &Lua) -> mlua::Result<()> {
     lua.globals().set("print", print)
 }
 
-/// Connects to the domain's daemon, starting one when none answers, with `timeout` as the
-/// longest wait for a reply.
-fn connect(domain: &str, timeout: Duration) -> Result<Session, client_sdk::Error> {
+/// Connects to the domain's daemon, starting one when none answers, or with `--cluster` to
+/// a daemon of the cluster, with `timeout` as the longest wait for a reply.
+fn connect(args: &Args, timeout: Duration) -> Result<Session, client_sdk::Error> {
+    let domain = args.domain.as_str();
     let mut options = ConnectOptions::new(domain);
     // The host flushes every frame: writes right after an Add apply before its first step.
     options.hold_adds_until_flush = true;
@@ -235,6 +256,22 @@ fn connect(domain: &str, timeout: Duration) -> Result<Session, client_sdk::Error
     // script can catch), never the end of the run.
     options.refusals_at_next_call = true;
     options.request_timeout = timeout;
+    if let Some(cluster) = &args.cluster {
+        let remote = client_sdk::remote::RemoteOptions {
+            cluster: client_sdk::cluster::ClusterOptions {
+                cluster: cluster.clone(),
+                endpoints: args.connect.clone(),
+                tls_ca: args.tls_ca.clone(),
+                tls_cert: args.tls_cert.clone(),
+                tls_key: args.tls_key.clone(),
+            },
+            daemon: args.cluster_daemon.clone(),
+        };
+        return Ok(Session {
+            client: Client::connect_cluster_with(&remote, options)?,
+            daemon: None,
+        });
+    }
     match Client::connect_with(options.clone()) {
         Ok(client) => Ok(Session {
             client,
@@ -295,7 +332,7 @@ fn run(args: &Args, signals: &Signals) -> Result<Ended, String> {
     if std::env::var_os("PHYSICS_LOG").is_none() {
         std::env::set_var("PHYSICS_LOG", "warn");
     }
-    let session = connect(&args.domain, Duration::from_secs_f64(args.request_timeout))
+    let session = connect(args, Duration::from_secs_f64(args.request_timeout))
         .map_err(|e| e.to_string())?;
     if let Some(daemon) = &session.daemon {
         signals

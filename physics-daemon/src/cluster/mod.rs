@@ -8,6 +8,9 @@
 //! - [`load`]: the load report each second (planes, bodies, tick budget used, CPU) and the
 //!   gauge the server loop feeds it through (its one hook).
 //!
+//! - remote clients: [`client_sdk::relay`] answers them as local clients of this daemon,
+//!   one per remote session (started by [`Cluster::serve_remote`]).
+//!
 //! Local clients keep iceoryx2 zero-copy: Zenoh carries only what crosses hosts.
 
 pub mod load;
@@ -51,6 +54,9 @@ pub struct Cluster {
     reporter: load::Reporter,
     _member: membership::Member,
     session: zenoh::Session,
+    cluster: String,
+    name: String,
+    relay: Option<client_sdk::relay::Relay>,
 }
 
 impl Cluster {
@@ -92,7 +98,27 @@ impl Cluster {
             reporter,
             _member: member,
             session,
+            cluster: plan.cluster,
+            name: plan.name,
+            relay: None,
         }))
+    }
+
+    /// Starts serving remote clients of this daemon ([`client_sdk::relay`]): they reach the
+    /// daemon of `domain` as local clients, at most `max_sessions` at once.
+    pub fn serve_remote(&mut self, domain: &str, max_sessions: usize) -> Result<(), ClusterError> {
+        let relay = client_sdk::relay::Relay::start(
+            &self.session,
+            client_sdk::relay::RelayOptions {
+                cluster: self.cluster.clone(),
+                daemon: self.name.clone(),
+                domain: domain.to_string(),
+                max_sessions,
+            },
+        )
+        .map_err(|e| ClusterError::Zenoh(e.to_string()))?;
+        self.relay = Some(relay);
+        Ok(())
     }
 
     /// The Zenoh session (for the parts of the cluster built on it).
@@ -106,7 +132,12 @@ impl Cluster {
             reporter,
             _member,
             session,
+            relay,
+            ..
         } = self;
+        if let Some(relay) = relay {
+            relay.stop();
+        }
         reporter.stop();
         drop(_member);
         use zenoh::Wait;

@@ -81,8 +81,11 @@ impl Clients {
                 format!("{} clients", self.connected.len() + 1),
             ));
         }
+        // The cluster relay (this process) connects once per remote session: each such
+        // session is a client of its own for the per-process bounds (the relay bounds how
+        // many sessions it serves).
         let same_process = self.connected.values().filter(|c| c.pid == pid).count();
-        if same_process >= per_process {
+        if same_process >= per_process && pid != std::process::id() {
             return Err(super::limits::exceeded(
                 "clients per process",
                 per_process,
@@ -103,14 +106,22 @@ impl Clients {
         Ok(())
     }
 
+    /// Who pays for client `id`'s usage (quotas, CPU share): its process, or for a relayed
+    /// remote session (a connection of this process, see `client_sdk::relay`) the session.
+    pub fn owner_key(&self, id: u128) -> u128 {
+        owner_key(self.connected.get(&id).map_or(0, |c| c.pid), id)
+    }
+
     /// Planes owned by the connections of the process of client `id` (quotas count per
     /// process, so opening more connections does not multiply them).
     pub fn planes_of_process(&self, id: u128) -> impl Iterator<Item = shm_layout::PlaneId> + '_ {
         let pid = self.connected.get(&id).map(|c| c.pid);
+        // A relayed remote session (this process's own connection) counts alone.
+        let relayed = pid == Some(std::process::id());
         self.connected
-            .values()
-            .filter(move |c| Some(c.pid) == pid)
-            .flat_map(|c| c.planes.iter().copied())
+            .iter()
+            .filter(move |(other, c)| Some(c.pid) == pid && (!relayed || **other == id))
+            .flat_map(|(_, c)| c.planes.iter().copied())
     }
 
     /// The connected client `id`.
@@ -192,4 +203,15 @@ fn open_notifier(node: &Node<ipc::Service>, id: u128) -> Result<Notifier<ipc::Se
         .notifier_builder()
         .create()
         .map_err(|e| format!("cannot notify client: {e:?}"))
+}
+
+/// Who pays for the connection `id` of process `pid` ([`Clients::owner_key`]): the process,
+/// or for a connection of this process (a relayed remote session) the connection itself
+/// (its id with the top bit set, so it never equals a pid).
+pub fn owner_key(pid: u32, id: u128) -> u128 {
+    if pid == std::process::id() {
+        id | (1 << 127)
+    } else {
+        pid as u128
+    }
 }

@@ -164,7 +164,7 @@ impl Daemon {
     /// pays for what they hold).
     fn transfers_of(&mut self, origin: Origin) -> Arc<super::transfers::ClientTransfers> {
         let limits = self.options.limits;
-        let owner = self.owners.of(origin.pid);
+        let owner = self.owners.of(super::clients::owner_key(origin.pid, origin.id));
         self.transfers
             .entry(origin.id)
             .or_insert_with(|| Arc::new(super::transfers::ClientTransfers::new(owner, limits)))
@@ -204,7 +204,8 @@ impl Daemon {
     fn guest_of(&mut self, origin: Origin, id: PlaneId) -> Option<Arc<super::quota::OwnerUsage>> {
         let owner = self.planes.get(&id)?.owner;
         let owner_pid = self.clients.get(owner).map(|c| c.pid)?;
-        (owner_pid != origin.pid).then(|| self.owners.of(origin.pid))
+        let key = super::clients::owner_key(origin.pid, origin.id);
+        (super::clients::owner_key(owner_pid, owner) != key).then(|| self.owners.of(key))
     }
 
     /// The quotas a run is checked against: the limits (the owner's totals are reserved
@@ -291,7 +292,7 @@ impl Daemon {
         let id = self.next_plane_id;
         let ticket = self.next_ticket;
         let owner_pid = self.clients.get(owner).map_or(0, |c| c.pid);
-        let usage = match SharedUsage::admit(self.owners.of(owner_pid)) {
+        let usage = match SharedUsage::admit(self.owners.of(super::clients::owner_key(owner_pid, owner))) {
             Ok(usage) => Arc::new(usage),
             Err(e) => return refuse(e),
         };

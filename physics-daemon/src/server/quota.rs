@@ -368,7 +368,7 @@ impl Drop for PlaneUsage {
 /// The [`OwnerUsage`] of every client process, by process id, and the daemon's memory.
 #[derive(Default)]
 pub struct Owners {
-    by_pid: HashMap<u32, Arc<OwnerUsage>>,
+    by_pid: HashMap<u128, Arc<OwnerUsage>>,
     memory: Arc<DaemonMemory>,
     shares: Arc<super::fair::CpuShares>,
 }
@@ -384,7 +384,7 @@ impl Owners {
     }
 
     /// The counter of process `pid` (made on first use).
-    pub fn of(&mut self, pid: u32) -> Arc<OwnerUsage> {
+    pub fn of(&mut self, pid: u128) -> Arc<OwnerUsage> {
         let (memory, shares) = (&self.memory, &self.shares);
         let owner = self
             .by_pid
