@@ -3,12 +3,10 @@
 //! budget used, CPU) and answers queries on that key with the latest one, so a newcomer (a
 //! client choosing where to place a plane) reads every member's load at once.
 //!
-//! Its inputs come through two hooks and cost nothing without a cluster: the server loop
-//! hands the [`Gauge`] its planes' usage records when the set of planes changes, and every
-//! step's duration is added to one counter ([`note_step`], called where steps are already
-//! charged to their owner's CPU account).
+//! Its inputs come through two hooks of the server (`server::gauge`) and cost nothing
+//! without a cluster: the server loop hands the [`Gauge`] its planes' usage records when the
+//! set of planes changes, and every step's duration is added to one counter.
 
-use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::mpsc::{self, RecvTimeoutError, Sender};
 use std::sync::{Arc, Mutex};
 use std::thread::JoinHandle;
@@ -18,46 +16,8 @@ use shm_layout::cluster::{self as keys, LoadReport};
 use zenoh::Wait;
 
 use super::ClusterError;
-use crate::server::quota::PlaneUsage;
-
-/// Nanoseconds spent stepping planes since the daemon started.
-static STEP_NANOS: AtomicU64 = AtomicU64::new(0);
-
-/// Counts `used` as time spent stepping a plane.
-pub fn note_step(used: Duration) {
-    STEP_NANOS.fetch_add(used.as_nanos() as u64, Ordering::Relaxed);
-}
-
-/// What the server loop tells the reporter: the usage records of its planes.
-#[derive(Debug, Default)]
-pub struct Gauge {
-    planes: Mutex<Vec<Arc<PlaneUsage>>>,
-    /// The (plane count, next plane id) the list was taken at.
-    seen: AtomicU64,
-}
-
-impl Gauge {
-    /// Called by the server loop after each round: refreshes the list through `planes` only
-    /// when the set of planes changed (a new id was handed out or the count moved).
-    pub fn track<F>(&self, count: usize, next_id: u32, planes: F)
-    where
-        F: FnOnce() -> Vec<Arc<PlaneUsage>>,
-    {
-        let key = ((count as u64) << 32) | u64::from(next_id);
-        if self.seen.swap(key, Ordering::Relaxed) != key {
-            *self.planes.lock().unwrap_or_else(|p| p.into_inner()) = planes();
-        }
-    }
-
-    /// Planes and the objects in them.
-    fn counts(&self) -> (u32, u64) {
-        let planes = self.planes.lock().unwrap_or_else(|p| p.into_inner());
-        (
-            planes.len() as u32,
-            planes.iter().map(|p| p.objects()).sum(),
-        )
-    }
-}
+use crate::server::gauge::stepped_nanos;
+pub use crate::server::gauge::Gauge;
 
 /// CPU time this process used so far (user + system).
 fn process_cpu() -> Duration {
@@ -165,7 +125,7 @@ impl Sampler {
             gauge,
             at: Instant::now(),
             cpu: process_cpu(),
-            stepped: STEP_NANOS.load(Ordering::Relaxed),
+            stepped: stepped_nanos(),
             sequence: 0,
         }
     }
@@ -173,7 +133,7 @@ impl Sampler {
     fn sample(&mut self) -> LoadReport {
         let now = Instant::now();
         let cpu = process_cpu();
-        let stepped = STEP_NANOS.load(Ordering::Relaxed);
+        let stepped = stepped_nanos();
         let wall = (now - self.at).as_secs_f64().max(1e-3);
         let cores = cores();
         let (planes, bodies) = self.gauge.counts();

@@ -72,7 +72,7 @@ impl CpuAccount {
     /// Charges `used` of CPU at `now`. Returns when the process's next automatic tick may
     /// run, when it is past its share (`None`: at once).
     pub fn charge(&self, used: Duration, now: Instant) -> Option<Instant> {
-        crate::cluster::load::note_step(used);
+        super::gauge::note_step(used);
         let start = self.shares.start;
         let now_ns = now.saturating_duration_since(start).as_nanos() as u64;
         let floor = now_ns.saturating_sub(BURST.as_nanos() as u64);

@@ -25,6 +25,7 @@ pub mod clients;
 mod dispatch;
 pub mod fair;
 pub mod files;
+pub mod gauge;
 pub mod heartbeat;
 pub mod limits;
 pub mod liveness;
@@ -74,7 +75,7 @@ pub struct Options {
     pub persistence: Option<persist::Persistence>,
     /// Fed the planes' usage for the cluster's load report (`--cluster`); `None` outside a
     /// cluster.
-    pub load: Option<Arc<crate::cluster::load::Gauge>>,
+    pub load: Option<Arc<gauge::Gauge>>,
 }
 
 /// How often dead clients are looked for while clients are connected (and, for a daemon
