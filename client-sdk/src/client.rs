@@ -214,7 +214,9 @@ impl Client {
         inner.options.request_timeout = timeout.min(HELLO_RETRY);
         let welcome = loop {
             match inner.round_trip(vec![hello.clone()]) {
-                Err(Error::Timeout(_)) if Instant::now() < deadline && inner.transport.is_local() => {
+                Err(Error::Timeout(_))
+                    if Instant::now() < deadline && inner.transport.is_local() =>
+                {
                     tracing::debug!("no answer to Hello: asking again with new ports");
                     inner.transport = Transport::open(&inner.options.domain)?;
                 }

@@ -118,7 +118,12 @@ impl Relay {
 }
 
 /// Hands a query to its session's thread, starting one for a new session's request.
-fn route(sessions: &Sessions, shared: &Arc<(Session, RelayOptions, Arc<AtomicBool>)>, query: Query, request: bool) {
+fn route(
+    sessions: &Sessions,
+    shared: &Arc<(Session, RelayOptions, Arc<AtomicBool>)>,
+    query: Query,
+    request: bool,
+) {
     let key = shm_layout::cluster::last_segment(query.key_expr().as_str()).to_string();
     if let Err(e) = wire::check_session(&key) {
         let _ = query.reply_err(e).wait();
@@ -163,7 +168,11 @@ fn route(sessions: &Sessions, shared: &Arc<(Session, RelayOptions, Arc<AtomicBoo
         }
     };
     drop(map);
-    let _ = tx.send(if request { Job::Request(query) } else { Job::Watch(query) });
+    let _ = tx.send(if request {
+        Job::Request(query)
+    } else {
+        Job::Watch(query)
+    });
 }
 
 /// One watched plane of a session.
@@ -176,7 +185,13 @@ struct Watch {
 }
 
 /// Serves one remote session until its client leaves or the relay stops.
-fn serve(session: &Session, options: &RelayOptions, key: &str, rx: Receiver<Job>, stop: &AtomicBool) {
+fn serve(
+    session: &Session,
+    options: &RelayOptions,
+    key: &str,
+    rx: Receiver<Job>,
+    stop: &AtomicBool,
+) {
     let token = session
         .liveliness()
         .get(wire::client_key(&options.cluster, key))
@@ -213,7 +228,7 @@ fn serve(session: &Session, options: &RelayOptions, key: &str, rx: Receiver<Job>
         }
         match rx.recv_timeout(POLL) {
             Ok(Job::Request(q)) => {
-                let (said, ended) = relay_request(&local, &q);
+                let (said, ended) = relay_request(&local, &q, &mut watches);
                 connected |= said;
                 if ended {
                     connected = false;
@@ -234,21 +249,45 @@ fn serve(session: &Session, options: &RelayOptions, key: &str, rx: Receiver<Job>
         let bytes = codec::encode_request(&shm_layout::Request {
             commands: vec![Command::Goodbye],
         });
-        let _ = local.exchange(&bytes, local.id(), Duration::from_millis(100), Duration::ZERO, |_| Ok(()));
+        let _ = local.exchange(
+            &bytes,
+            local.id(),
+            Duration::from_millis(100),
+            Duration::ZERO,
+            |_| Ok(()),
+        );
     }
 }
 
-/// Relays one request; returns (whether it said Hello, whether it said Goodbye).
-fn relay_request(local: &LocalTransport, query: &Query) -> (bool, bool) {
-    let bytes = query.payload().map(|p| p.to_bytes().into_owned()).unwrap_or_default();
+/// Relays one request; returns (whether it said Hello, whether it said Goodbye). Ticks the
+/// request published (a Step's) are sent before its reply, as a local client finds them
+/// published when its reply comes.
+fn relay_request(
+    local: &LocalTransport,
+    query: &Query,
+    watches: &mut HashMap<u32, Watch>,
+) -> (bool, bool) {
+    let bytes = query
+        .payload()
+        .map(|p| p.to_bytes().into_owned())
+        .unwrap_or_default();
     let (bytes, hello, goodbye) = own_pid(bytes);
     let started = Instant::now();
-    let reply = local.exchange(&bytes, local.id(), Duration::from_millis(100), Duration::ZERO, |_| {
-        if started.elapsed() > REQUEST_TIMEOUT {
-            return Err(Error::Timeout(REQUEST_TIMEOUT));
-        }
-        Ok(())
-    });
+    let reply = local.exchange(
+        &bytes,
+        local.id(),
+        Duration::from_millis(100),
+        Duration::ZERO,
+        |_| {
+            if started.elapsed() > REQUEST_TIMEOUT {
+                return Err(Error::Timeout(REQUEST_TIMEOUT));
+            }
+            Ok(())
+        },
+    );
+    for (plane, w) in watches.iter_mut() {
+        forward(*plane, w);
+    }
     match reply {
         Ok(reply) => {
             let _ = query.reply(query.key_expr().clone(), reply).wait();
@@ -269,7 +308,10 @@ fn own_pid(bytes: Vec<u8>) -> (Vec<u8>, bool, bool) {
         return (bytes, false, false);
     };
     let mut hello = false;
-    let goodbye = request.commands.iter().any(|c| matches!(c, Command::Goodbye));
+    let goodbye = request
+        .commands
+        .iter()
+        .any(|c| matches!(c, Command::Goodbye));
     for c in &mut request.commands {
         if let Command::Hello { pid, .. } = c {
             *pid = std::process::id();
@@ -284,7 +326,11 @@ fn own_pid(bytes: Vec<u8>) -> (Vec<u8>, bool, bool) {
         .and_then(|v| v.try_into().ok())
         .map(u32::from_le_bytes)
         .unwrap_or(shm_layout::LAYOUT_VERSION);
-    (codec::encode_request_with_version(&request, version), true, goodbye)
+    (
+        codec::encode_request_with_version(&request, version),
+        true,
+        goodbye,
+    )
 }
 
 /// Answers a watch op.
@@ -318,7 +364,9 @@ fn watch(
             WatchReply::Ok
         }
         Some(WatchOp::Events { plane }) => match watches.get_mut(&plane) {
-            None => WatchReply::Refused(format!("plane {plane} is not watched: watch its bodies first")),
+            None => WatchReply::Refused(format!(
+                "plane {plane} is not watched: watch its bodies first"
+            )),
             Some(w) => match open_events(session, options, key, local, plane) {
                 Ok(events) => {
                     w.events = Some(events);
@@ -350,7 +398,12 @@ fn open_watch(
         .plane_bodies(plane)
         .map_err(|e| format!("plane {plane} of daemon {:?}: {e}", options.daemon))?;
     let publisher = session
-        .declare_publisher(wire::bodies_key(&options.cluster, &options.daemon, key, plane))
+        .declare_publisher(wire::bodies_key(
+            &options.cluster,
+            &options.daemon,
+            key,
+            plane,
+        ))
         .wait()
         .map_err(|e| format!("relay: {e}"))?;
     Ok(Watch {
@@ -368,11 +421,19 @@ fn open_events(
     local: &LocalTransport,
     plane: u32,
 ) -> Result<(ShmEventSubscriber, zenoh::pubsub::Publisher<'static>), String> {
-    let events = local
-        .plane_events(plane)
-        .map_err(|e| format!("events of plane {plane} of daemon {:?}: {e}", options.daemon))?;
+    let events = local.plane_events(plane).map_err(|e| {
+        format!(
+            "events of plane {plane} of daemon {:?}: {e}",
+            options.daemon
+        )
+    })?;
     let publisher = session
-        .declare_publisher(wire::events_key(&options.cluster, &options.daemon, key, plane))
+        .declare_publisher(wire::events_key(
+            &options.cluster,
+            &options.daemon,
+            key,
+            plane,
+        ))
         .wait()
         .map_err(|e| format!("relay: {e}"))?;
     Ok((events, publisher))

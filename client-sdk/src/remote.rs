@@ -269,7 +269,11 @@ struct Asker {
 
 impl Asker {
     fn ask(&self) {
-        if self.last.get().is_some_and(|t| t.elapsed() < KEYFRAME_EVERY) {
+        if self
+            .last
+            .get()
+            .is_some_and(|t| t.elapsed() < KEYFRAME_EVERY)
+        {
             return;
         }
         self.last.set(Some(Instant::now()));

@@ -332,8 +332,8 @@ fn run(args: &Args, signals: &Signals) -> Result<Ended, String> {
     if std::env::var_os("PHYSICS_LOG").is_none() {
         std::env::set_var("PHYSICS_LOG", "warn");
     }
-    let session = connect(args, Duration::from_secs_f64(args.request_timeout))
-        .map_err(|e| e.to_string())?;
+    let session =
+        connect(args, Duration::from_secs_f64(args.request_timeout)).map_err(|e| e.to_string())?;
     if let Some(daemon) = &session.daemon {
         signals
             .shared

@@ -164,7 +164,9 @@ impl Daemon {
     /// pays for what they hold).
     fn transfers_of(&mut self, origin: Origin) -> Arc<super::transfers::ClientTransfers> {
         let limits = self.options.limits;
-        let owner = self.owners.of(super::clients::owner_key(origin.pid, origin.id));
+        let owner = self
+            .owners
+            .of(super::clients::owner_key(origin.pid, origin.id));
         self.transfers
             .entry(origin.id)
             .or_insert_with(|| Arc::new(super::transfers::ClientTransfers::new(owner, limits)))
@@ -292,10 +294,11 @@ impl Daemon {
         let id = self.next_plane_id;
         let ticket = self.next_ticket;
         let owner_pid = self.clients.get(owner).map_or(0, |c| c.pid);
-        let usage = match SharedUsage::admit(self.owners.of(super::clients::owner_key(owner_pid, owner))) {
-            Ok(usage) => Arc::new(usage),
-            Err(e) => return refuse(e),
-        };
+        let usage =
+            match SharedUsage::admit(self.owners.of(super::clients::owner_key(owner_pid, owner))) {
+                Ok(usage) => Arc::new(usage),
+                Err(e) => return refuse(e),
+            };
         let cell = Arc::new(PlaneCell::default());
         let (jobs, receiver) = mpsc::channel();
         let shared = PlaneProp::shared_in(&props);
