@@ -177,7 +177,7 @@ impl Client {
     ) -> Result<Client, Error> {
         let transport = RemoteTransport::open(remote)?;
         options.domain = format!("{}/{}", transport.cluster(), transport.daemon());
-        Self::handshake(options, Transport::Remote(Box::new(transport)))
+        Self::handshake(options, Transport::Remote(transport))
     }
 
     /// The cluster daemon this client uses (`None`: this host's daemon, not through a

@@ -26,8 +26,11 @@ use zenoh::{Session, Wait};
 use crate::transport::{LocalTransport, ShmBodySubscriber, ShmEventSubscriber};
 use crate::Error;
 
-/// How often a session thread looks for new ticks while no request arrives.
+/// How often a session thread looks for new ticks while no request arrives (it waits on
+/// its request queue meanwhile; a request wakes it at once).
 const POLL: Duration = Duration::from_millis(1);
+/// How long it waits on its request queue while it watches no plane.
+const IDLE_WAIT: Duration = Duration::from_millis(50);
 /// How long a relayed request may take before the relay answers with an error.
 const REQUEST_TIMEOUT: Duration = Duration::from_secs(120);
 /// How long a new session waits to see its client's liveliness token.
@@ -226,7 +229,8 @@ fn serve(
         if stop.load(Ordering::SeqCst) {
             break;
         }
-        match rx.recv_timeout(POLL) {
+        let wait = if watches.is_empty() { IDLE_WAIT } else { POLL };
+        match rx.recv_timeout(wait) {
             Ok(Job::Request(q)) => {
                 let (said, ended) = relay_request(&local, &q, &mut watches);
                 connected |= said;
@@ -249,12 +253,19 @@ fn serve(
         let bytes = codec::encode_request(&shm_layout::Request {
             commands: vec![Command::Goodbye],
         });
+        let until = Instant::now() + Duration::from_secs(2);
         let _ = local.exchange(
             &bytes,
             local.id(),
             Duration::from_millis(100),
             Duration::ZERO,
-            |_| Ok(()),
+            |_| {
+                // A daemon shutting down may answer no more: do not wait on it.
+                if Instant::now() > until {
+                    return Err(Error::Timeout(Duration::from_secs(2)));
+                }
+                Ok(())
+            },
         );
     }
 }

@@ -135,7 +135,7 @@ impl EventSubscriber {
 /// Woken on every tick of a plane.
 pub(crate) enum TickListener {
     /// The plane's tick event on this host.
-    Shm(Listener<ipc::Service>),
+    Shm(Box<Listener<ipc::Service>>),
     /// A remote plane's frames arriving.
     Remote(crate::remote::Ticks),
 }
@@ -155,15 +155,15 @@ impl TickListener {
 /// How a client reaches its daemon: this host's shared memory, or a cluster member's relay.
 pub(crate) enum Transport {
     /// The daemon of this host's domain.
-    Local(LocalTransport),
+    Local(Box<LocalTransport>),
     /// A daemon of a cluster, through Zenoh.
-    Remote(Box<crate::remote::RemoteTransport>),
+    Remote(crate::remote::RemoteTransport),
 }
 
 impl Transport {
     /// Opens the ports of a client of `domain`'s daemon on this host.
     pub(crate) fn open(domain: &str) -> Result<Transport, Error> {
-        LocalTransport::open(domain).map(Transport::Local)
+        LocalTransport::open(domain).map(|t| Transport::Local(Box::new(t)))
     }
 
     /// Sends request bytes and returns the reply bytes ([`LocalTransport::exchange`]).
@@ -222,7 +222,7 @@ impl Transport {
     /// A listener woken by every tick of plane `id`.
     pub(crate) fn plane_ticks(&self, id: PlaneId) -> Result<TickListener, Error> {
         match self {
-            Transport::Local(t) => t.plane_ticks(id).map(TickListener::Shm),
+            Transport::Local(t) => t.plane_ticks(id).map(|l| TickListener::Shm(Box::new(l))),
             Transport::Remote(t) => t.plane_ticks(id).map(TickListener::Remote),
         }
     }

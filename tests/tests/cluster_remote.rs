@@ -426,8 +426,7 @@ fn each_remote_client_is_its_own_owner_for_quotas() {
 fn an_unknown_daemon_or_a_forged_session_is_refused_by_name() {
     let two = two("rc-bad");
     let e = Client::connect_cluster(&two.options(Some("nobody")))
-        .err()
-        .expect("no daemon named nobody")
+        .expect_err("no daemon named nobody")
         .to_string();
     assert!(e.contains("nobody"), "{e}");
     // A request under a key that is no session key is refused without a session.
@@ -446,7 +445,7 @@ fn an_unknown_daemon_or_a_forged_session_is_refused_by_name() {
         .wait()
         .unwrap();
     let reply = replies.recv().expect("an answer");
-    let err = reply.result().err().expect("refused");
+    let err = reply.result().expect_err("refused");
     let text = err.payload().try_to_string().unwrap().into_owned();
     assert!(text.contains("NOT-HEX") && text.contains("hex"), "{text}");
     // The daemon keeps serving remote clients.
