@@ -37,6 +37,9 @@ const QUERY_TIMEOUT: Duration = Duration::from_secs(600);
 const ALIVE_WAIT: Duration = Duration::from_secs(2);
 /// Frames a body reader keeps before the oldest are dropped (then it asks for a keyframe).
 const BODY_FRAMES: usize = 64;
+/// Ticks of events a reader keeps before the oldest are dropped (and counted as lost), as
+/// a local reader's queue (`EVENT_BUFFER_TICKS`).
+const EVENT_FRAMES: usize = 64;
 /// At most one keyframe request per plane this often.
 const KEYFRAME_EVERY: Duration = Duration::from_millis(100);
 
@@ -248,7 +251,7 @@ impl RemoteTransport {
         let frames = self
             .session
             .declare_subscriber(key)
-            .with(RingChannel::new(crate::EVENT_BUFFER_TICKS))
+            .with(RingChannel::new(EVENT_FRAMES))
             .wait()
             .map_err(|e| Error::Cluster(format!("cannot subscribe to plane {}: {e}", id)))?;
         let start = match self.watch(WatchOp::Events { plane: id })? {

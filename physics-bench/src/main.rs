@@ -25,6 +25,7 @@
 //! - [`stability`]: the `stability` subcommand (stiff and extreme scenes, pass/fail).
 
 mod accuracy;
+mod cluster;
 mod controllers;
 mod daemon;
 mod error;
@@ -100,6 +101,9 @@ enum Bench {
     /// Persistent planes: a plane's tick with its periodic writes (--state-dir,
     /// --snapshot-every) against a plain plane's, side by side.
     Persist(persist::PersistArgs),
+    /// A cluster on loopback: a remote reader beside a local one (delivery latency p50/p99,
+    /// bytes of a tick's frame, same StateHash), 1k and 10k bodies, settled and awake.
+    Cluster(cluster::ClusterArgs),
 }
 
 fn main() -> ExitCode {
@@ -128,6 +132,7 @@ fn main() -> ExitCode {
         Bench::Hostile(args) => hostile::run(args),
         Bench::Snapshot(args) => snapshot::run(args),
         Bench::Persist(args) => persist::run(args),
+        Bench::Cluster(args) => cluster::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

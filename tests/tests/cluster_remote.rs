@@ -452,3 +452,36 @@ fn an_unknown_daemon_or_a_forged_session_is_refused_by_name() {
     let remote = two.remote();
     remote.create_plane(&PlaneOptions::default()).unwrap();
 }
+
+#[test]
+fn the_cluster_bench_finds_remote_reads_exact_and_settled_frames_small() {
+    let bench = client_sdk::daemon_executable().with_file_name("physics-bench");
+    assert!(bench.is_file(), "build the workspace's binaries first");
+    let out = std::env::temp_dir().join(unique_domain("rc-bench"));
+    let output = std::process::Command::new(bench)
+        .args(["cluster", "--bodies", "300", "--seconds", "1", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&output.stdout).to_string()
+        + &String::from_utf8_lossy(&output.stderr);
+    assert!(output.status.success(), "{text}");
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("cluster.json")).unwrap()).unwrap();
+    assert_eq!(json["goals"][0]["met"], true, "{text}");
+    let cases = json["cases"].as_array().unwrap();
+    let bytes = |awake: bool| {
+        cases
+            .iter()
+            .find(|c| c["awake"] == awake)
+            .and_then(|c| c["frame_bytes"].as_f64())
+            .unwrap()
+    };
+    // Awake: every slot each tick (~57 bytes a body); settled: the header and what woke.
+    assert!(bytes(true) > 300.0 * 40.0, "{text}");
+    assert!(bytes(false) < bytes(true) / 10.0, "{text}");
+    for c in cases {
+        assert!(c["remote"]["ticks"].as_u64().unwrap() >= 30, "{text}");
+    }
+    let _ = std::fs::remove_dir_all(out);
+}

@@ -1,0 +1,333 @@
+//! `physics-bench cluster`: what a remote reader pays beside a local one. Two daemons form a
+//! cluster on loopback (each in a domain of its own, as if on two hosts); a plane ticking at
+//! 60 Hz lives on `west`; one reader reads it through the cluster (Zenoh, `east`'s endpoint,
+//! west's relay) and one through west's shared memory, at the same time. For 1k and 10k
+//! bodies, settled (asleep on a floor) and awake (every body moving), it reports delivery
+//! latency (tick end → the reader has the tick, CLOCK_MONOTONIC on one host), p50 and p99,
+//! the bytes of a tick's frame on the wire, and whether every tick both readers saw had the
+//! same `StateHash`.
+
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+use client_sdk::cluster::{Cluster, ClusterOptions};
+use client_sdk::remote::RemoteOptions;
+use client_sdk::{Client, ObjectProp, PlaneOptions, PlaneProp, Pose, Shape};
+use zenoh::Wait;
+
+use super::daemon::DaemonProcess;
+use super::error::{BenchError, BenchResult};
+use super::report::{self, goals_table, num, Goal, Table};
+use super::stats::percentile;
+
+/// Options of the `cluster` subcommand.
+#[derive(Debug, Clone, clap::Args)]
+pub struct ClusterArgs {
+    /// Body counts (comma-separated).
+    #[arg(long, value_delimiter = ',', default_value = "1000,10000")]
+    pub bodies: Vec<usize>,
+    /// Seconds each case is read.
+    #[arg(long, default_value_t = 4.0)]
+    pub seconds: f64,
+    /// Folder receiving cluster.json and cluster.md.
+    #[arg(long, default_value = "bench-out")]
+    pub out: PathBuf,
+}
+
+/// One reader's figures in one case.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct Reader {
+    pub ticks: usize,
+    pub p50_ms: Option<f64>,
+    pub p99_ms: Option<f64>,
+}
+
+/// One case: a body count and a state.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct Case {
+    pub bodies: usize,
+    pub awake: bool,
+    pub local: Reader,
+    pub remote: Reader,
+    /// Mean bytes of a tick's frame on the wire (payload).
+    pub frame_bytes: f64,
+    /// Ticks both readers saw, and how many of them had different hashes.
+    pub compared: usize,
+    pub differed: usize,
+}
+
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct ClusterReport {
+    pub seconds: f64,
+    pub cases: Vec<Case>,
+    pub goals: Vec<Goal>,
+}
+
+fn free_port() -> BenchResult<u16> {
+    std::net::TcpListener::bind("127.0.0.1:0")
+        .and_then(|l| l.local_addr())
+        .map(|a| a.port())
+        .map_err(BenchError::io("find a free loopback port"))
+}
+
+fn member(
+    cluster: &str,
+    name: &str,
+    listen: u16,
+    connect: Option<u16>,
+) -> BenchResult<DaemonProcess> {
+    let mut args = vec![
+        "--cluster".to_string(),
+        cluster.to_string(),
+        "--name".into(),
+        name.into(),
+        "--listen".into(),
+        format!("tcp/127.0.0.1:{listen}"),
+    ];
+    if let Some(port) = connect {
+        args.push("--connect".into());
+        args.push(format!("tcp/127.0.0.1:{port}"));
+    }
+    DaemonProcess::start_with(&format!("cl-{name}"), &args, None)
+}
+
+/// Builds the case's scene on `client`'s plane (60 Hz) and returns the plane's id.
+fn scene(client: &Client, n: usize, awake: bool) -> BenchResult<(client_sdk::Plane, u32)> {
+    let mut options = PlaneOptions::default().with(PlaneProp::TickRate(60.0));
+    if awake {
+        options = options
+            .with(PlaneProp::Gravity([0.0; 3]))
+            .with(PlaneProp::NeverSleep(true))
+            .with(PlaneProp::LinearDamping(0.0));
+    }
+    let plane = client.create_plane(&options)?;
+    let side = (n as f64).sqrt().ceil() as usize;
+    if !awake {
+        let floor = plane.add(
+            Shape::Cube {
+                size: [side as f32 * 2.0 + 10.0, 1.0, side as f32 * 2.0 + 10.0],
+            },
+            Pose::at([0.0, -0.5, 0.0]),
+            &[],
+        )?;
+        floor.set_anchored(true)?;
+    }
+    for k in 0..n {
+        let (i, j) = (k / side, k % side);
+        let at = [
+            (i as f32 - side as f32 / 2.0) * 2.0,
+            0.5,
+            (j as f32 - side as f32 / 2.0) * 2.0,
+        ];
+        let props = if awake {
+            // Apart and drifting apart: every slot changes every tick, nothing collides.
+            vec![ObjectProp::Velocity([at[0] * 0.01, 0.3, at[2] * 0.01])]
+        } else {
+            Vec::new()
+        };
+        plane.add(Shape::Cube { size: [1.0; 3] }, Pose::at(at), &props)?;
+    }
+    client.flush()?;
+    let id = plane.id();
+    Ok((plane, id))
+}
+
+/// Reads plane `id` for `seconds` through the client `connect` makes on this thread: each
+/// new tick's (tick, hash, latency ms).
+fn read(
+    connect: impl FnOnce() -> Result<Client, client_sdk::Error>,
+    id: u32,
+    seconds: f64,
+) -> BenchResult<Vec<(u64, u64, f64)>> {
+    let client = connect()?;
+    let plane = client.attach_plane(id)?;
+    let mut seen = Vec::new();
+    let until = Instant::now() + Duration::from_secs_f64(seconds);
+    let mut last = 0;
+    while Instant::now() < until {
+        plane.wait_tick(Duration::from_secs(1))?;
+        let s = plane.snapshot()?;
+        let now = shm_layout::monotonic_ns();
+        let h = s.header();
+        if h.tick > last {
+            last = h.tick;
+            seen.push((
+                h.tick,
+                h.state_hash,
+                now.saturating_sub(h.tick_end_ns) as f64 / 1e6,
+            ));
+        }
+    }
+    Ok(seen)
+}
+
+fn figures(seen: &[(u64, u64, f64)]) -> Reader {
+    let ms: Vec<f64> = seen.iter().map(|s| s.2).collect();
+    Reader {
+        ticks: seen.len(),
+        p50_ms: percentile(&ms, 0.5),
+        p99_ms: percentile(&ms, 0.99),
+    }
+}
+
+pub fn run(args: &ClusterArgs) -> BenchResult<()> {
+    let cluster = super::daemon::unique_domain("cl").replace('.', "-");
+    let (pe, pw) = (free_port()?, free_port()?);
+    let _east = member(&cluster, "east", pe, None)?;
+    let west = member(&cluster, "west", pw, Some(pe))?;
+    let endpoint = format!("tcp/127.0.0.1:{pe}");
+    let remote = RemoteOptions {
+        cluster: ClusterOptions {
+            cluster: cluster.clone(),
+            endpoints: vec![endpoint.clone()],
+            ..Default::default()
+        },
+        daemon: Some("west".into()),
+    };
+    // Wait until both members see each other.
+    let view = Cluster::connect(&cluster, &[&endpoint])?;
+    let deadline = Instant::now() + Duration::from_secs(10);
+    while view.daemons()?.len() < 2 {
+        if Instant::now() > deadline {
+            return Err(BenchError::Failed(
+                "the two members did not meet in 10 s".into(),
+            ));
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    let owner = Client::connect_cluster(&remote)?;
+    let mut cases = Vec::new();
+    for &n in &args.bodies {
+        for awake in [false, true] {
+            eprintln!(
+                "cluster: {n} bodies, {}",
+                if awake { "awake" } else { "settled" }
+            );
+            let (plane, id) = scene(&owner, n, awake)?;
+            if !awake {
+                // Let the pile fall asleep.
+                std::thread::sleep(Duration::from_secs(3));
+            }
+            let bytes = Arc::new(AtomicU64::new(0));
+            let frames = Arc::new(AtomicU64::new(0));
+            let (b, f) = (bytes.clone(), frames.clone());
+            let counter = view
+                .session()
+                .declare_subscriber(format!("physics/{cluster}/relay/west/bodies/*/{id}"))
+                .callback(move |s| {
+                    b.fetch_add(s.payload().len() as u64, Ordering::Relaxed);
+                    f.fetch_add(1, Ordering::Relaxed);
+                })
+                .wait()
+                .map_err(|e| BenchError::Failed(format!("count frames: {e}")))?;
+            let (r, seconds) = (remote.clone(), args.seconds);
+            let remote_reader = std::thread::spawn(move || {
+                read(|| Client::connect_cluster(&r), id, seconds).map_err(|e| e.to_string())
+            });
+            let domain = west.domain.clone();
+            let local_reader = std::thread::spawn(move || {
+                read(|| Client::connect(&domain), id, seconds).map_err(|e| e.to_string())
+            });
+            let join = |h: std::thread::JoinHandle<Result<Vec<(u64, u64, f64)>, String>>| {
+                h.join()
+                    .map_err(|_| BenchError::Failed("a reader panicked".into()))?
+                    .map_err(BenchError::Failed)
+            };
+            let (rs, ls) = (join(remote_reader)?, join(local_reader)?);
+            drop(counter);
+            // Skip each reader's first tick: its keyframe or its first sample.
+            let local: std::collections::HashMap<u64, u64> =
+                ls.iter().skip(1).map(|s| (s.0, s.1)).collect();
+            let compared: Vec<_> = rs
+                .iter()
+                .skip(1)
+                .filter(|s| local.contains_key(&s.0))
+                .collect();
+            let differed = compared.iter().filter(|s| local[&s.0] != s.1).count();
+            let f = frames.load(Ordering::Relaxed).max(1);
+            cases.push(Case {
+                bodies: n,
+                awake,
+                local: figures(&ls[1.min(ls.len())..]),
+                remote: figures(&rs[1.min(rs.len())..]),
+                frame_bytes: bytes.load(Ordering::Relaxed) as f64 / f as f64,
+                compared: compared.len(),
+                differed,
+            });
+            plane.destroy()?;
+        }
+    }
+    let differed: usize = cases.iter().map(|c| c.differed).sum();
+    let compared: usize = cases.iter().map(|c| c.compared).sum();
+    let mut goals = vec![Goal::new(
+        "every tick both readers saw has the same StateHash (remote reads are exact)",
+        format!("{differed} of {compared} differ"),
+        Some(differed == 0 && compared > 0),
+    )];
+    for c in &cases {
+        let ratio = match (c.remote.p50_ms, c.local.p50_ms) {
+            (Some(r), Some(l)) if l > 0.0 => Some(r / l),
+            _ => None,
+        };
+        goals.push(Goal::new(
+            format!(
+                "remote p50 / local p50, {} bodies {} (reported, not judged)",
+                c.bodies,
+                if c.awake { "awake" } else { "settled" }
+            ),
+            ratio.map_or("-".into(), |r| format!("{r:.1}")),
+            None,
+        ));
+    }
+    let report = ClusterReport {
+        seconds: args.seconds,
+        cases,
+        goals,
+    };
+    let md = markdown(&report);
+    let (json, md_path) = report::write(&args.out, "cluster", &report, &md)?;
+    println!("{md}");
+    println!("wrote {} and {}", json.display(), md_path.display());
+    Ok(())
+}
+
+fn markdown(r: &ClusterReport) -> String {
+    let mut t = Table::new(&[
+        "bodies",
+        "state",
+        "local ticks",
+        "local p50 (ms)",
+        "local p99 (ms)",
+        "remote ticks",
+        "remote p50 (ms)",
+        "remote p99 (ms)",
+        "frame bytes",
+        "same hash",
+    ]);
+    for c in &r.cases {
+        t.row(&[
+            c.bodies.to_string(),
+            if c.awake { "awake" } else { "settled" }.into(),
+            c.local.ticks.to_string(),
+            num(c.local.p50_ms),
+            num(c.local.p99_ms),
+            c.remote.ticks.to_string(),
+            num(c.remote.p50_ms),
+            num(c.remote.p99_ms),
+            format!("{:.0}", c.frame_bytes),
+            format!("{} of {}", c.compared - c.differed, c.compared),
+        ]);
+    }
+    format!(
+        "# Cluster: remote readers beside local ones\n\nA plane at 60 Hz on daemon `west`; one \
+         reader through the cluster (Zenoh on loopback via `east`, west's relay), one through \
+         west's shared memory, both reading for {} s. Latency: the tick's end (daemon) to the \
+         reader holding it (CLOCK_MONOTONIC, one host). Frame bytes: the mean payload of a \
+         tick's frame (changed slots only).\n\n{}\n\n{}",
+        r.seconds,
+        t.finish(),
+        goals_table(&r.goals)
+    )
+}
