@@ -65,6 +65,9 @@ pub struct ClusterReport {
     pub goals: Vec<Goal>,
 }
 
+/// What a reader saw: each new tick's (tick, hash, latency ms).
+type Seen = Vec<(u64, u64, f64)>;
+
 fn free_port() -> BenchResult<u16> {
     std::net::TcpListener::bind("127.0.0.1:0")
         .and_then(|l| l.local_addr())
@@ -140,7 +143,7 @@ fn read(
     connect: impl FnOnce() -> Result<Client, client_sdk::Error>,
     id: u32,
     seconds: f64,
-) -> BenchResult<Vec<(u64, u64, f64)>> {
+) -> BenchResult<Seen> {
     let client = connect()?;
     let plane = client.attach_plane(id)?;
     let mut seen = Vec::new();
@@ -230,7 +233,7 @@ pub fn run(args: &ClusterArgs) -> BenchResult<()> {
             let local_reader = std::thread::spawn(move || {
                 read(|| Client::connect(&domain), id, seconds).map_err(|e| e.to_string())
             });
-            let join = |h: std::thread::JoinHandle<Result<Vec<(u64, u64, f64)>, String>>| {
+            let join = |h: std::thread::JoinHandle<Result<Seen, String>>| {
                 h.join()
                     .map_err(|_| BenchError::Failed("a reader panicked".into()))?
                     .map_err(BenchError::Failed)
