@@ -35,6 +35,23 @@ pub use host::{Host, Stop, WATCH_PERIOD};
 #[doc(hidden)]
 pub use members::property_rows;
 
+/// A write the daemon refuses after its call returned names the line that made it.
+pub(crate) fn set_origin(lua: &Lua, client: &Client) {
+    let weak = lua.weak();
+    client.set_origin(move || {
+        weak.try_upgrade()
+            .and_then(|lua| lua.inspect_stack(1, |d| d.current_line()).flatten())
+            .map_or(0, |line| line as u32)
+    });
+}
+
+/// Lets `PhysicsService.New{ Placement = "auto" | DAEMON }` place planes on the daemons of
+/// `cluster` (a `physics-lua --cluster` run); without it every plane is on the script's own
+/// daemon.
+pub fn set_cluster(lua: &Lua, cluster: client_sdk::remote::RemoteOptions) {
+    api::plane::context(lua).set_cluster(cluster);
+}
+
 /// Installs the API into `lua`, talking to the daemon through `client`: the globals, the
 /// watchdog's interrupt (see [`Host::set_max_run_time`]) and `pcall`, `xpcall` and
 /// `coroutine.resume` wrapped so that they give API errors as `"chunk:line: message"`
@@ -44,13 +61,7 @@ pub fn install(lua: &Lua, client: Client) -> mlua::Result<Host> {
     lua.set_app_data(scheduler.clone());
     scheduler.watchdog.install(lua);
     host::errors::install(lua)?;
-    // A write the daemon refuses after its call returned names the line that made it.
-    let weak = lua.weak();
-    client.set_origin(move || {
-        weak.try_upgrade()
-            .and_then(|lua| lua.inspect_stack(1, |d| d.current_line()).flatten())
-            .map_or(0, |line| line as u32)
-    });
+    set_origin(lua, &client);
     let modules = api::modules(lua, client.clone())?;
     let import = lua.create_function(move |_, name: Value| {
         let found = match &name {

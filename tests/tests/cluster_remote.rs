@@ -485,3 +485,77 @@ fn the_cluster_bench_finds_remote_reads_exact_and_settled_frames_small() {
     }
     let _ = std::fs::remove_dir_all(out);
 }
+
+#[test]
+fn placement_puts_a_scripts_planes_on_the_daemon_it_names() {
+    let two = two("rc-place");
+    let script = std::env::temp_dir().join(format!("{}.luau", unique_domain("rc-place")));
+    std::fs::write(
+        &script,
+        r#"
+local Physics = import("PhysicsService")
+local Renderable = import("Renderable")
+local P = import("Primitives")
+local V, CF = P.Vector.new, P.CFrame.new
+local here = Physics.New({ TickRate = 0 })
+assert(here.Daemon == "east", "own daemon: " .. tostring(here.Daemon))
+local there = Physics.New({ Placement = "west", TickRate = 0, Gravity = V(0, -10, 0), LinearDamping = 0, AngularDamping = 0 })
+assert(there.Daemon == "west", "placed: " .. tostring(there.Daemon))
+local part = Renderable.BasePart("Sphere")
+part.Size = V(1, 1, 1)
+part.CFrame = CF(V(0, 100, 0))
+local ball = there:Add(part)
+for _ = 1, 60 do
+    there:Step(1 / 60)
+end
+local y = ball.CFrame.Position.Y
+local h, m = 1 / 240, 240
+local expect = 100 - 10 * h * h * m * (m + 1) / 2
+assert(math.abs(y - expect) < 1e-3, string.format("y %.5f, expected %.5f", y, expect))
+assert(Physics.New({ Placement = "west" }).Daemon == "west", "a second plane on west")
+assert(Physics.New({ Placement = "local" }).Daemon == "east", "local is the script's daemon")
+local auto = Physics.New({ Placement = "auto" }).Daemon
+assert(auto == "east" or auto == "west", "auto: " .. tostring(auto))
+local ok, err = pcall(function()
+    return Physics.New({ Placement = "nobody" })
+end)
+assert(not ok and string.find(tostring(err), "nobody", 1, true), tostring(err))
+print("PLACED OK")
+"#,
+    )
+    .unwrap();
+    let out = integration_tests::physics_lua(
+        "unused-domain",
+        script.to_str().unwrap(),
+        &[
+            "--cluster",
+            &two.cluster,
+            "--connect",
+            &endpoint(two.east_port),
+            "--daemon",
+            "east",
+        ],
+    )
+    .output()
+    .unwrap();
+    let text =
+        String::from_utf8_lossy(&out.stdout).to_string() + &String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success() && text.contains("PLACED OK"), "{text}");
+
+    // Outside a cluster run, a placement elsewhere is refused naming what it needs.
+    std::fs::write(
+        &script,
+        "local ok, err = pcall(function() return import(\"PhysicsService\").New({ Placement = \"west\" }) end)\n\
+         assert(not ok and string.find(tostring(err), \"--cluster\", 1, true), tostring(err))\n\
+         assert(import(\"PhysicsService\").New({ Placement = \"local\" }).Daemon == nil)\n\
+         print(\"LOCAL OK\")\n",
+    )
+    .unwrap();
+    let out = integration_tests::physics_lua(&two.west.domain, script.to_str().unwrap(), &[])
+        .output()
+        .unwrap();
+    let text =
+        String::from_utf8_lossy(&out.stdout).to_string() + &String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success() && text.contains("LOCAL OK"), "{text}");
+    let _ = std::fs::remove_file(script);
+}

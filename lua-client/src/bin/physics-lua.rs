@@ -256,17 +256,7 @@ fn connect(args: &Args, timeout: Duration) -> Result<Session, client_sdk::Error>
     // script can catch), never the end of the run.
     options.refusals_at_next_call = true;
     options.request_timeout = timeout;
-    if let Some(cluster) = &args.cluster {
-        let remote = client_sdk::remote::RemoteOptions {
-            cluster: client_sdk::cluster::ClusterOptions {
-                cluster: cluster.clone(),
-                endpoints: args.connect.clone(),
-                tls_ca: args.tls_ca.clone(),
-                tls_cert: args.tls_cert.clone(),
-                tls_key: args.tls_key.clone(),
-            },
-            daemon: args.cluster_daemon.clone(),
-        };
+    if let Some(remote) = remote_options(args) {
         return Ok(Session {
             client: Client::connect_cluster_with(&remote, options)?,
             daemon: None,
@@ -287,6 +277,20 @@ fn connect(args: &Args, timeout: Duration) -> Result<Session, client_sdk::Error>
         }
         Err(e) => Err(e),
     }
+}
+
+/// The cluster of a `--cluster` run: where the script's client and its placed planes go.
+fn remote_options(args: &Args) -> Option<client_sdk::remote::RemoteOptions> {
+    Some(client_sdk::remote::RemoteOptions {
+        cluster: client_sdk::cluster::ClusterOptions {
+            cluster: args.cluster.clone()?,
+            endpoints: args.connect.clone(),
+            tls_ca: args.tls_ca.clone(),
+            tls_cert: args.tls_cert.clone(),
+            tls_key: args.tls_key.clone(),
+        },
+        daemon: args.cluster_daemon.clone(),
+    })
 }
 
 /// Whether `e` is (or was caused by) the Lua state running out of memory.
@@ -349,6 +353,9 @@ fn run(args: &Args, signals: &Signals) -> Result<Ended, String> {
     let lua_err = |e: mlua::Error| e.to_string();
     install_print(&lua).map_err(lua_err)?;
     let host = lua_client::install(&lua, session.client.clone()).map_err(lua_err)?;
+    if let Some(remote) = remote_options(args) {
+        lua_client::set_cluster(&lua, remote);
+    }
     asset_roots(args).install(&lua);
     if let Some(file) = &args.snapshot {
         lua_client::start_from_snapshot(&lua, file)?;

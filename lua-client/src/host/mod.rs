@@ -45,6 +45,9 @@ pub trait DaemonWatch {
     fn watch(&self, lua: &Lua) -> mlua::Result<()>;
     /// Whether a script listens (the host then keeps running frames while it only waits).
     fn watching(&self) -> bool;
+    /// Connections to other daemons the script's planes live on (`Placement`): each frame
+    /// begins and flushes on them too.
+    fn placed(&self) -> Vec<Client>;
 }
 
 /// A host's handle on the installed API: drives frames.
@@ -80,6 +83,9 @@ impl Host {
     pub fn frame(&self, dt: f64) -> mlua::Result<()> {
         // Reads in this frame take each plane's newest sample once.
         self.client.begin_frame();
+        for c in self.daemon.placed() {
+            c.begin_frame();
+        }
         self.daemon.watch(&self.lua)?;
         self.scheduler.frame(&self.lua, dt)?;
         self.flush()
@@ -93,9 +99,11 @@ impl Host {
 
     /// Sends the queued writes as one request.
     pub fn flush(&self) -> mlua::Result<()> {
-        self.client
-            .flush()
-            .map_err(|e| sdk_error("the physics daemon rejected a write", e))
+        for c in std::iter::once(self.client.clone()).chain(self.daemon.placed()) {
+            c.flush()
+                .map_err(|e| sdk_error("the physics daemon rejected a write", e))?;
+        }
+        Ok(())
     }
 
     /// Whether frames still have work: `Heart` handlers, pending waits, or change listeners.

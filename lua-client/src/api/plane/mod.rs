@@ -205,6 +205,10 @@ pub struct Context {
     pub resumed: crate::host::signal::Signal,
     /// Whether the last watch found it stalled.
     is_stalled: Cell<bool>,
+    /// The cluster of a `physics-lua --cluster` run (`Placement` reaches its daemons).
+    cluster: RefCell<Option<client_sdk::remote::RemoteOptions>>,
+    /// Connections to the cluster's other daemons, made by `Placement` (one per daemon).
+    placed: RefCell<Vec<Client>>,
 }
 
 impl Context {
@@ -217,6 +221,8 @@ impl Context {
             stalled: crate::host::signal::Signal::new("PhysicsService.Stalled"),
             resumed: crate::host::signal::Signal::new("PhysicsService.Resumed"),
             is_stalled: Cell::new(false),
+            cluster: RefCell::new(None),
+            placed: RefCell::default(),
         }
     }
 
@@ -245,6 +251,71 @@ impl Context {
             }
             _ => self.resumed.fire(lua, mlua::MultiValue::new()),
         }
+    }
+
+    /// Lets `PhysicsService.New{ Placement }` reach the daemons of `cluster`.
+    pub fn set_cluster(&self, cluster: client_sdk::remote::RemoteOptions) {
+        *self.cluster.borrow_mut() = Some(cluster);
+    }
+
+    /// The connections `Placement` made (beside [`Context::client`]).
+    pub fn placed_clients(&self) -> Vec<Client> {
+        self.placed.borrow().clone()
+    }
+
+    /// The client a plane placed by `placement` is created with: `None` or `"local"` the
+    /// script's own daemon; `"auto"` the cluster's least loaded daemon; any other string
+    /// the daemon of that name (a cluster run only).
+    fn client_for(&self, lua: &Lua, placement: Option<&str>) -> mlua::Result<Client> {
+        const WHAT: &str = "PhysicsService.New";
+        let Some(placement) = placement.filter(|p| *p != "local") else {
+            return Ok(self.client.clone());
+        };
+        let Some(cluster) = self.cluster.borrow().clone() else {
+            return Err(mlua::Error::runtime(format!(
+                "{WHAT}: Placement = {placement:?} needs a cluster run (physics-lua --cluster \
+                 NAME --connect ENDPOINT); without one every plane is \"local\""
+            )));
+        };
+        let daemon = match placement {
+            "auto" => None,
+            name => Some(name.to_string()),
+        };
+        let own = self.client.cluster_daemon().map(str::to_string);
+        if daemon.is_some() && daemon == own {
+            return Ok(self.client.clone());
+        }
+        if let Some(d) = &daemon {
+            if let Some(c) = self
+                .placed
+                .borrow()
+                .iter()
+                .find(|c| c.cluster_daemon() == Some(d.as_str()))
+            {
+                return Ok(c.clone());
+            }
+        }
+        let remote = client_sdk::remote::RemoteOptions { daemon, ..cluster };
+        let mut options = client_sdk::ConnectOptions::new("");
+        options.hold_adds_until_flush = true;
+        options.refusals_at_next_call = true;
+        let client = Client::connect_cluster_with(&remote, options)
+            .map_err(|e| mlua::Error::runtime(format!("{WHAT}: Placement = {placement:?}: {e}")))?;
+        // "auto" may land on the script's own daemon or one already reached.
+        if client.cluster_daemon().map(str::to_string) == own {
+            return Ok(self.client.clone());
+        }
+        if let Some(c) = self
+            .placed
+            .borrow()
+            .iter()
+            .find(|c| c.cluster_daemon() == client.cluster_daemon())
+        {
+            return Ok(c.clone());
+        }
+        crate::set_origin(lua, &client);
+        self.placed.borrow_mut().push(client.clone());
+        Ok(client)
     }
 
     /// Whether `Stalled` or `Resumed` has handlers (the host then keeps watching while
@@ -296,6 +367,9 @@ impl crate::host::DaemonWatch for Context {
     }
     fn watching(&self) -> bool {
         self.watching_daemon()
+    }
+    fn placed(&self) -> Vec<Client> {
+        self.placed_clients()
     }
 }
 
@@ -442,14 +516,29 @@ fn new_plane(lua: &Lua, opts: Value) -> mlua::Result<mlua::AnyUserData> {
     // Every option is part of the creation request: the plane never ticks before all of
     // them apply (a manual plane never ticks on its own at all).
     let mut options = PlaneOptions::default();
+    let mut placement: Option<String> = None;
     for pair in opts.iter().flat_map(|t| t.pairs::<Value, Value>()) {
         let (key, value) = pair?;
+        // Where the plane lives: not a plane setting, a choice of daemon.
+        if matches!(&key, Value::String(k) if k.as_bytes() == b"Placement") {
+            placement = match value {
+                Value::String(p) => Some(p.to_str()?.to_string()),
+                other => {
+                    return Err(expected(
+                        "PhysicsService.New: Placement",
+                        "\"local\", \"auto\" or a daemon's name",
+                        &other,
+                    ))
+                }
+            };
+            continue;
+        }
         // No row of PhysicsPlane makes a GUI option (NewGUI has its own rows).
         options.set(PLANE.option(WHAT, &key, &value)?);
     }
     let ctx = context(lua);
     let plane = ctx
-        .client
+        .client_for(lua, placement.as_deref())?
         .create_plane(&options)
         .map_err(|e| sdk_error(WHAT, e))?;
     wrap_plane(lua, plane)

@@ -64,6 +64,18 @@ pub static PLANE: Props<PlaneState> = Props {
                     .map_err(|e| LuaError::runtime(e.message))
             }),
         },
+        // The cluster daemon the plane lives on (nil: this host's daemon, no cluster).
+        Row {
+            name: "Daemon",
+            kind: Kind::String,
+            get: Get::Fn(|lua, p| {
+                Ok(match p.plane.client().cluster_daemon() {
+                    Some(d) => Value::String(lua.create_string(d)?),
+                    None => Value::Nil,
+                })
+            }),
+            set: Set::ReadOnly,
+        },
         // Fired once (lost ticks) after Open of a plane restored from its file.
         Row {
             name: "Recovered",
