@@ -408,14 +408,19 @@ fn nodes_that_never_say_hello_are_evicted() {
         at_start >= 9,
         "held {at_start} ports, expected the victim's and the hoarder's 8"
     );
-    time_until(Duration::from_secs(10), || (held() == 1).then_some(()))
-        .expect("the nodes without Hello were evicted");
+    let mut last = at_start;
+    time_until(Duration::from_secs(30), || {
+        last = held();
+        (last == 1).then_some(())
+    })
+    .unwrap_or_else(|| panic!("the nodes without Hello were evicted: {last} ports still held"));
     // Held when ready (above), gone after the timeout (3 s from when the daemon first saw
     // them, no later than `ready`) plus one guard period (500 ms) and the polling: 3.5 s on
-    // a quiet machine. The bound leaves room for a loaded one; "not at once" is checked
-    // above.
+    // a quiet machine, over 10 s twice in a full suite run beside an hour-long soak on 2
+    // cores. The bound is for "at all" (a daemon that never evicts fails it); "not at once"
+    // is checked above.
     let total = started.elapsed();
-    assert!(total < Duration::from_secs(9), "evicted after {total:?}");
+    assert!(total < Duration::from_secs(30), "evicted after {total:?}");
     serves_on(&mut daemon, &survivor);
 }
 
