@@ -207,17 +207,12 @@ impl BodyFrame {
 
 /// Whether two slot states are the same bit for bit (NaNs and signed zeros included).
 fn same_bits(a: &BodyState, b: &BodyState) -> bool {
-    let words = |s: &BodyState| {
-        let f = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<u32>>();
-        (
-            f(&s.position),
-            f(&s.rotation),
-            f(&s.linear_velocity),
-            f(&s.angular_velocity),
-            (s.flags, s.generation, s._reserved),
-        )
-    };
-    words(a) == words(b)
+    let bits = |v: [f32; 3]| v.map(f32::to_bits);
+    bits(a.position) == bits(b.position)
+        && a.rotation.map(f32::to_bits) == b.rotation.map(f32::to_bits)
+        && bits(a.linear_velocity) == bits(b.linear_velocity)
+        && bits(a.angular_velocity) == bits(b.angular_velocity)
+        && (a.flags, a.generation, a._reserved) == (b.flags, b.generation, b._reserved)
 }
 
 /// What a remote reader rebuilds from [`BodyFrame`]s: the newest tick's header and slots.
@@ -244,18 +239,21 @@ impl BodyMirror {
     /// Applies `frame`.
     pub fn apply(&mut self, frame: BodyFrame) -> Applied {
         let n = frame.header.slot_count as usize;
-        let mut bodies = match (frame.base_tick, &self.current) {
-            (None, _) => vec![BodyState::default(); n],
-            (Some(base), Some((h, old))) if h.tick == base => {
-                let mut b = old.clone();
-                b.resize(n, BodyState::default());
-                b
-            }
-            _ => return Applied::NeedKeyframe,
-        };
         if frame.base_tick.is_none() && frame.changed.len() != n {
             return Applied::Mismatch;
         }
+        let mut bodies = match (frame.base_tick, self.current.take()) {
+            (None, _) => vec![BodyState::default(); n],
+            // The slots are updated in place: a delta costs its changed slots.
+            (Some(base), Some((h, mut old))) if h.tick == base => {
+                old.resize(n, BodyState::default());
+                old
+            }
+            (_, kept) => {
+                self.current = kept;
+                return Applied::NeedKeyframe;
+            }
+        };
         for (slot, state) in frame.changed {
             if let Some(b) = bodies.get_mut(slot as usize) {
                 *b = state;
