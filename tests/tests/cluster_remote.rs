@@ -559,3 +559,36 @@ print("PLACED OK")
     assert!(out.status.success() && text.contains("LOCAL OK"), "{text}");
     let _ = std::fs::remove_file(script);
 }
+
+#[test]
+fn a_remote_client_learns_its_daemon_died_instead_of_hanging() {
+    let mut two = two("rc-dies");
+    let remote = two.remote();
+    let plane = remote
+        .create_plane(&PlaneOptions {
+            tick_rate: Some(0.0),
+            ..Default::default()
+        })
+        .unwrap();
+    plane.step(DT).unwrap();
+    assert_eq!(remote.watch_daemon(), client_sdk::DaemonHealth::Live);
+    two.west.kill9();
+    let started = std::time::Instant::now();
+    let e = plane.step(DT).unwrap_err();
+    let took = started.elapsed();
+    // The killed daemon's links close at once: its token ends (gone) or the query finds no
+    // relay (no answer); either way an error naming it, well within the request timeout.
+    assert!(
+        took < Duration::from_secs(10),
+        "the step failed after {took:?}"
+    );
+    let text = e.to_string();
+    assert!(
+        matches!(e, client_sdk::Error::DaemonGone { .. }) || text.contains("west"),
+        "{text}"
+    );
+    eventually(Duration::from_secs(5), || {
+        (remote.watch_daemon() == client_sdk::DaemonHealth::Gone).then_some(())
+    })
+    .expect("the client's watch reports the daemon gone");
+}
