@@ -403,7 +403,15 @@ impl Client {
             other => return Err(unexpected(other)),
         };
         let id = info.id;
-        let plane = self.attach_plane(id)?;
+        let plane = match self.attach_plane(id) {
+            Ok(plane) => plane,
+            Err(e) => {
+                // A plane nobody can read (a remote session at its streaming bound, say) is
+                // not left behind.
+                let _ = self.call(Command::plane(id, PlaneOp::Destroy));
+                return Err(e);
+            }
+        };
         *plane.shared.mirror.borrow_mut() =
             crate::mirror::Mirror::exclusive(info, options.shared == Some(true));
         self.note_owned(id);

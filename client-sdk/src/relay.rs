@@ -35,6 +35,24 @@ const IDLE_WAIT: Duration = Duration::from_millis(50);
 const REQUEST_TIMEOUT: Duration = Duration::from_secs(120);
 /// How long a new session waits to see its client's liveliness token.
 const TOKEN_WAIT: Duration = Duration::from_secs(2);
+/// Most planes one remote session streams at once.
+pub const MAX_WATCHES_PER_SESSION: usize = 16;
+/// Most remote sessions one plane streams to at once. Each takes one of the plane's reader
+/// places (two with events), and the relay's ports are the daemon's own, which the
+/// per-process port bounds do not evict: this keeps most of a plane's 64 reader places for
+/// local readers.
+pub const MAX_SESSIONS_PER_PLANE: usize = 16;
+
+/// How many sessions stream each plane (relay-wide).
+type Streams = Arc<Mutex<HashMap<u32, usize>>>;
+
+/// What every session thread of a relay shares.
+struct Shared {
+    session: Session,
+    options: RelayOptions,
+    stop: Arc<AtomicBool>,
+    streams: Streams,
+}
 
 /// What the relay serves.
 #[derive(Debug, Clone)]
@@ -73,7 +91,12 @@ impl Relay {
         let stop = Arc::new(AtomicBool::new(false));
         let sessions: Sessions = Arc::default();
         let zerr = |e: zenoh::Error| Error::Cluster(format!("relay: {e}"));
-        let shared = Arc::new((session.clone(), options.clone(), stop.clone()));
+        let shared = Arc::new(Shared {
+            session: session.clone(),
+            options: options.clone(),
+            stop: stop.clone(),
+            streams: Arc::default(),
+        });
         let (s1, sh1) = (sessions.clone(), shared.clone());
         let requests = session
             .declare_queryable(wire::requests_key(&options.cluster, &options.daemon))
@@ -123,7 +146,7 @@ impl Relay {
 /// Hands a query to its session's thread, starting one for a new session's request.
 fn route(
     sessions: &Sessions,
-    shared: &Arc<(Session, RelayOptions, Arc<AtomicBool>)>,
+    shared: &Arc<Shared>,
     query: Query,
     request: bool,
 ) {
@@ -136,7 +159,8 @@ fn route(
     let tx = match map.get(&key) {
         Some(tx) => tx.clone(),
         None if request => {
-            let (session, options, stop) = (shared.0.clone(), shared.1.clone(), shared.2.clone());
+            let shared = shared.clone();
+            let options = &shared.options;
             if map.len() >= options.max_sessions {
                 let _ = query
                     .reply_err(format!(
@@ -152,7 +176,7 @@ fn route(
             let spawned = std::thread::Builder::new()
                 .name("relay-session".into())
                 .spawn(move || {
-                    serve(&session, &options, &key, rx, &stop);
+                    serve(&shared, &key, rx);
                     if let Ok(mut m) = sessions.lock() {
                         m.remove(&key);
                     }
@@ -188,13 +212,8 @@ struct Watch {
 }
 
 /// Serves one remote session until its client leaves or the relay stops.
-fn serve(
-    session: &Session,
-    options: &RelayOptions,
-    key: &str,
-    rx: Receiver<Job>,
-    stop: &AtomicBool,
-) {
+fn serve(shared: &Shared, key: &str, rx: Receiver<Job>) {
+    let (session, options, stop) = (&shared.session, &shared.options, &shared.stop);
     let token = session
         .liveliness()
         .get(wire::client_key(&options.cluster, key))
@@ -239,13 +258,16 @@ fn serve(
                     break;
                 }
             }
-            Ok(Job::Watch(q)) => watch(session, options, key, &local, &mut watches, &q),
+            Ok(Job::Watch(q)) => watch(shared, key, &local, &mut watches, &q),
             Ok(Job::Leave) | Err(RecvTimeoutError::Disconnected) => break,
             Err(RecvTimeoutError::Timeout) => {}
         }
         for (plane, w) in watches.iter_mut() {
             forward(*plane, w);
         }
+    }
+    for plane in watches.keys() {
+        unstream(&shared.streams, *plane);
     }
     if connected {
         // The client left without a word: release what it held, as the daemon would for a
@@ -346,22 +368,42 @@ fn own_pid(bytes: Vec<u8>) -> (Vec<u8>, bool, bool) {
 
 /// Answers a watch op.
 fn watch(
-    session: &Session,
-    options: &RelayOptions,
+    shared: &Shared,
     key: &str,
     local: &LocalTransport,
     watches: &mut HashMap<u32, Watch>,
     query: &Query,
 ) {
+    let (session, options) = (&shared.session, &shared.options);
     let op = query.payload().and_then(|p| WatchOp::decode(&p.to_bytes()));
     let reply = match op {
         None => WatchReply::Refused("malformed watch op".into()),
-        Some(WatchOp::Bodies { plane }) => match open_watch(session, options, key, local, plane) {
-            Ok(w) => {
-                watches.insert(plane, w);
-                WatchReply::Ok
+        Some(WatchOp::Bodies { plane }) if watches.contains_key(&plane) => {
+            // Watched already: start again from a keyframe.
+            if let Some(w) = watches.get_mut(&plane) {
+                w.sent = None;
+                forward(plane, w);
             }
+            WatchReply::Ok
+        }
+        Some(WatchOp::Bodies { .. }) if watches.len() >= MAX_WATCHES_PER_SESSION => {
+            WatchReply::Refused(format!(
+                "this session streams {MAX_WATCHES_PER_SESSION} planes already (the relay's \
+                 limit): destroy or detach one first"
+            ))
+        }
+        Some(WatchOp::Bodies { plane }) => match stream(&shared.streams, plane) {
             Err(e) => WatchReply::Refused(e),
+            Ok(()) => match open_watch(session, options, key, local, plane) {
+                Ok(w) => {
+                    watches.insert(plane, w);
+                    WatchReply::Ok
+                }
+                Err(e) => {
+                    unstream(&shared.streams, plane);
+                    WatchReply::Refused(e)
+                }
+            },
         },
         Some(WatchOp::Keyframe { plane }) => {
             if let Some(w) = watches.get(&plane) {
@@ -391,11 +433,38 @@ fn watch(
             },
         },
         Some(WatchOp::Stop { plane }) => {
-            watches.remove(&plane);
+            if watches.remove(&plane).is_some() {
+                unstream(&shared.streams, plane);
+            }
             WatchReply::Ok
         }
     };
     let _ = query.reply(query.key_expr().clone(), reply.encode()).wait();
+}
+
+/// Counts one more session streaming `plane`, within [`MAX_SESSIONS_PER_PLANE`].
+fn stream(streams: &Streams, plane: u32) -> Result<(), String> {
+    let mut map = streams.lock().unwrap_or_else(|p| p.into_inner());
+    let n = map.entry(plane).or_default();
+    if *n >= MAX_SESSIONS_PER_PLANE {
+        return Err(format!(
+            "plane {plane} streams to {MAX_SESSIONS_PER_PLANE} remote sessions already (the \
+             relay's limit, which keeps its reader places for local readers)"
+        ));
+    }
+    *n += 1;
+    Ok(())
+}
+
+/// Counts one session fewer streaming `plane`.
+fn unstream(streams: &Streams, plane: u32) {
+    let mut map = streams.lock().unwrap_or_else(|p| p.into_inner());
+    if let Some(n) = map.get_mut(&plane) {
+        *n = n.saturating_sub(1);
+        if *n == 0 {
+            map.remove(&plane);
+        }
+    }
 }
 
 fn open_watch(

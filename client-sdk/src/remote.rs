@@ -322,6 +322,20 @@ impl Bodies {
     }
 }
 
+impl Drop for Bodies {
+    fn drop(&mut self) {
+        // The relay stops streaming the plane (and frees its place for other sessions).
+        let _ = self
+            .asker
+            .session
+            .get(&self.asker.key)
+            .payload(WatchOp::Stop { plane: self.asker.plane }.encode())
+            .timeout(WATCH_TIMEOUT)
+            .callback(|_| {})
+            .wait();
+    }
+}
+
 /// Woken by a remote plane's frames.
 pub(crate) struct Ticks {
     frames: Subscriber<RingChannelHandler<Sample>>,

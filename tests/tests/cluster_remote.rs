@@ -423,6 +423,55 @@ fn each_remote_client_is_its_own_owner_for_quotas() {
 }
 
 #[test]
+fn a_session_and_a_plane_stream_within_the_relays_bounds() {
+    use client_sdk::relay::{MAX_SESSIONS_PER_PLANE, MAX_WATCHES_PER_SESSION};
+    let two = two("rc-bounds");
+    let remote = two.remote();
+    let manual = || PlaneOptions {
+        tick_rate: Some(0.0),
+        ..Default::default()
+    };
+    let mut planes: Vec<_> = (0..MAX_WATCHES_PER_SESSION)
+        .map(|_| remote.create_plane(&manual()).unwrap())
+        .collect();
+    let e = remote.create_plane(&manual()).unwrap_err().to_string();
+    assert!(e.contains("streams 16 planes"), "{e}");
+    // Destroying one frees its place.
+    planes.pop().unwrap().destroy().unwrap();
+    planes.push(eventually(Duration::from_secs(5), || remote.create_plane(&manual()).ok()).unwrap());
+
+    // One plane streams to at most MAX_SESSIONS_PER_PLANE sessions; local readers keep the
+    // rest of its reader places.
+    let shared = remote
+        .create_plane(&PlaneOptions {
+            shared: Some(true),
+            tick_rate: Some(0.0),
+            ..Default::default()
+        });
+    // The 17th plane of this session is refused: read it from other sessions.
+    assert!(shared.is_err());
+    planes.pop().unwrap().destroy().unwrap();
+    let target = eventually(Duration::from_secs(5), || remote.create_plane(&manual()).ok()).unwrap();
+    let readers: Vec<Client> = (1..MAX_SESSIONS_PER_PLANE).map(|_| two.remote()).collect();
+    let attached: Vec<_> = readers
+        .iter()
+        .map(|c| c.attach_plane(target.id()).unwrap())
+        .collect();
+    let extra = two.remote();
+    let e = extra.attach_plane(target.id()).unwrap_err().to_string();
+    assert!(e.contains("16 remote sessions"), "{e}");
+    let local = two.west.client();
+    local
+        .attach_plane(target.id())
+        .expect("a local reader still gets in");
+    drop(attached);
+    drop(readers);
+    // The readers' sessions ended: their places came back.
+    eventually(Duration::from_secs(10), || extra.attach_plane(target.id()).ok())
+        .expect("a place freed when the sessions left");
+}
+
+#[test]
 fn an_unknown_daemon_or_a_forged_session_is_refused_by_name() {
     let two = two("rc-bad");
     let e = Client::connect_cluster(&two.options(Some("nobody")))
