@@ -144,12 +144,7 @@ impl Relay {
 }
 
 /// Hands a query to its session's thread, starting one for a new session's request.
-fn route(
-    sessions: &Sessions,
-    shared: &Arc<Shared>,
-    query: Query,
-    request: bool,
-) {
+fn route(sessions: &Sessions, shared: &Arc<Shared>, query: Query, request: bool) {
     let key = shm_layout::cluster::last_segment(query.key_expr().as_str()).to_string();
     if let Err(e) = wire::check_session(&key) {
         let _ = query.reply_err(e).wait();

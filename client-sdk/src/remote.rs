@@ -329,7 +329,12 @@ impl Drop for Bodies {
             .asker
             .session
             .get(&self.asker.key)
-            .payload(WatchOp::Stop { plane: self.asker.plane }.encode())
+            .payload(
+                WatchOp::Stop {
+                    plane: self.asker.plane,
+                }
+                .encode(),
+            )
             .timeout(WATCH_TIMEOUT)
             .callback(|_| {})
             .wait();
