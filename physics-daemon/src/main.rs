@@ -85,10 +85,22 @@ fn main() -> ExitCode {
         }
     };
     let mut cluster = cluster;
+    let persistence = args.persist.persistence();
+    let mut adopt = None;
     if let Some(c) = cluster.as_mut() {
         if let Err(e) = c.serve_remote(&args.domain, args.limits.max_clients) {
             tracing::error!("{e}");
             return ExitCode::FAILURE;
+        }
+        // With a state folder, this member's persistent planes fail over to the others.
+        if let Some(p) = &persistence {
+            let queue = Arc::new(physics_daemon::server::persist::Adoptions::default());
+            let dir = physics_daemon::server::persist::domain_dir(&p.dir, &args.domain);
+            if let Err(e) = c.start_failover(dir, queue.clone(), &args.domain) {
+                tracing::error!("{e}");
+                return ExitCode::FAILURE;
+            }
+            adopt = Some(queue);
         }
     }
     let options = physics_daemon::server::Options {
@@ -98,8 +110,9 @@ fn main() -> ExitCode {
         panic_on_step_dt: std::env::var("PHYSICS_FAULT_PANIC_DT")
             .ok()
             .and_then(|v| v.parse().ok()),
-        persistence: args.persist.persistence(),
+        persistence,
         load: cluster.as_ref().map(|_| gauge),
+        adopt,
     };
     let served = physics_daemon::server::run_with(&args.domain, &shutdown, options);
     if let Some(cluster) = cluster {

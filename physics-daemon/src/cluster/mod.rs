@@ -8,11 +8,14 @@
 //! - [`load`]: the load report each second (planes, bodies, tick budget used, CPU) and the
 //!   gauge the server loop feeds it through (its one hook).
 //!
+//! - [`failover`]: persistent planes replicated to the other members, and restored by one
+//!   of them when their daemon leaves.
 //! - remote clients: [`client_sdk::relay`] answers them as local clients of this daemon,
 //!   one per remote session (started by [`Cluster::serve_remote`]).
 //!
 //! Local clients keep iceoryx2 zero-copy: Zenoh carries only what crosses hosts.
 
+pub mod failover;
 pub mod load;
 pub mod membership;
 pub mod session;
@@ -57,6 +60,7 @@ pub struct Cluster {
     cluster: String,
     name: String,
     relay: Option<client_sdk::relay::Relay>,
+    failover: Option<failover::Failover>,
 }
 
 impl Cluster {
@@ -101,7 +105,29 @@ impl Cluster {
             cluster: plan.cluster,
             name: plan.name,
             relay: None,
+            failover: None,
         }))
+    }
+
+    /// Starts replicating this daemon's persistent planes (the state folder `dir` of its
+    /// domain) to the other members and taking over theirs when they leave
+    /// ([`failover`]); adopted planes reach the server loop through `adopt`.
+    pub fn start_failover(
+        &mut self,
+        dir: std::path::PathBuf,
+        adopt: Arc<crate::server::persist::Adoptions>,
+        domain: &str,
+    ) -> Result<(), ClusterError> {
+        let f = failover::Failover::start(
+            &self.session,
+            &self.cluster,
+            &self.name,
+            dir,
+            adopt,
+            domain,
+        )?;
+        self.failover = Some(f);
+        Ok(())
     }
 
     /// Starts serving remote clients of this daemon ([`client_sdk::relay`]): they reach the
@@ -133,8 +159,10 @@ impl Cluster {
             _member,
             session,
             relay,
+            failover,
             ..
         } = self;
+        drop(failover);
         if let Some(relay) = relay {
             relay.stop();
         }

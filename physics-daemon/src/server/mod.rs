@@ -76,6 +76,9 @@ pub struct Options {
     /// Fed the planes' usage for the cluster's load report (`--cluster`); `None` outside a
     /// cluster.
     pub load: Option<Arc<gauge::Gauge>>,
+    /// Planes a cluster peer hands over at run time (failover, `--cluster` with
+    /// `--state-dir`); `None` outside a cluster.
+    pub adopt: Option<Arc<persist::Adoptions>>,
 }
 
 /// How often dead clients are looked for while clients are connected (and, for a daemon
@@ -393,6 +396,7 @@ fn serve(
         while matches!(worker_wake.try_receive(&mut buf), Ok(n) if n > 0) {}
         daemon.waker.disarm();
         daemon.handle_events();
+        daemon.adopt_planes();
         daemon.serve_requests();
         if let Some(gauge) = &daemon.options.load {
             gauge.track(daemon.planes.len(), daemon.next_plane_id, || {

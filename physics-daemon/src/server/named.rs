@@ -218,8 +218,37 @@ impl Daemon {
         let Some(dir) = self.writer.as_ref().map(|w| w.dir().to_path_buf()) else {
             return;
         };
+        self.restore_loaded(super::persist::load(&dir));
+    }
+
+    /// Takes the planes a cluster peer handed over (`Options::adopt`, failover): each is
+    /// restored like a file of the state directory, orphaned until opened. One whose name
+    /// is in use here, or that arrives on a daemon without `--state-dir`, is refused with
+    /// an error in the log.
+    pub(super) fn adopt_planes(&mut self) {
+        let Some(adopt) = self.options.adopt.clone() else {
+            return;
+        };
+        let planes = adopt.take();
+        if planes.is_empty() {
+            return;
+        }
+        let mut kept = Vec::new();
+        for loaded in planes {
+            if self.writer.is_none() {
+                tracing::error!(plane = %loaded.name, "cannot adopt a plane without --state-dir");
+            } else if self.planes.values().any(|p| p.name == Some(loaded.name)) {
+                tracing::error!(plane = %loaded.name, "cannot adopt a plane: the name is in use here");
+            } else {
+                kept.push(loaded);
+            }
+        }
+        self.restore_loaded(kept);
+    }
+
+    fn restore_loaded(&mut self, planes: Vec<Loaded>) {
         let mut waiting = Vec::new();
-        for loaded in super::persist::load(&dir) {
+        for loaded in planes {
             let name = loaded.name;
             match self.spawn_restored(loaded) {
                 Ok(ticket) => waiting.push((ticket, name)),
@@ -251,10 +280,9 @@ impl Daemon {
                             return true;
                         }
                         if let Some(Err(e)) = results.first() {
-                            let file = super::persist::file_of(&dir, name.as_str());
                             tracing::error!(
-                                file = %file.display(),
-                                "persistent plane file skipped: its state does not restore: {e}"
+                                plane = %name,
+                                "persistent plane skipped: its state does not restore: {e}"
                             );
                         }
                         false

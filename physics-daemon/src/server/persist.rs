@@ -502,6 +502,29 @@ fn write_atomically(dir: &Path, name: &str, bytes: &[u8]) -> std::io::Result<()>
     written
 }
 
+/// Planes handed to this daemon at run time (a cluster peer's, on failover): the cluster
+/// side pushes, the server loop takes them after its next wake-up.
+#[derive(Default)]
+pub struct Adoptions(std::sync::Mutex<Vec<Loaded>>);
+
+impl Adoptions {
+    /// Queues `plane` (wake the loop after: `crate::wake`).
+    pub fn push(&self, plane: Loaded) {
+        self.0.lock().unwrap_or_else(|p| p.into_inner()).push(plane);
+    }
+
+    /// Everything queued.
+    pub fn take(&self) -> Vec<Loaded> {
+        std::mem::take(&mut *self.0.lock().unwrap_or_else(|p| p.into_inner()))
+    }
+}
+
+impl std::fmt::Debug for Adoptions {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("Adoptions")
+    }
+}
+
 /// A plane file found at start, checked.
 pub struct Loaded {
     /// The plane's name (the file's).
@@ -564,6 +587,23 @@ pub fn load(dir: &Path) -> Vec<Loaded> {
         }
     }
     loaded
+}
+
+impl Loaded {
+    /// A plane snapshot from elsewhere (a cluster peer's file): `recorded` is the last tick
+    /// its old daemon recorded (its `.tick`), for the lost ticks.
+    pub fn from_bytes(name: &str, bytes: Vec<u8>, recorded: Option<u64>) -> Result<Loaded, String> {
+        let name = PlaneName::new(name)
+            .map_err(|e| format!("its name is not a plane name: {}", e.message))?;
+        let (header, _) = snapshot::verify(&bytes).map_err(|e| e.message)?;
+        Ok(Loaded {
+            name,
+            kind: header.kind,
+            tick: header.tick,
+            lost_ticks: recorded.map_or(0, |r| r.saturating_sub(header.tick)),
+            bytes,
+        })
+    }
 }
 
 fn load_one(dir: &Path, path: &Path, stem: &str) -> Result<Loaded, String> {
