@@ -85,17 +85,52 @@ fn a_persistent_plane_of_a_killed_member_comes_back_on_another() {
     let ball = plane
         .add(Shape::Sphere { radius: 0.5 }, Pose::at([0.0, y0, 0.0]), &[])
         .unwrap();
+    // What east receives, seen from a session of the test's own: the replica and the
+    // newest tick record of west's plane.
+    use zenoh::Wait;
+    let replicated = std::sync::Arc::new(std::sync::atomic::AtomicU64::new(0));
+    let recorded = std::sync::Arc::new(std::sync::atomic::AtomicU64::new(0));
+    let (r1, r2) = (replicated.clone(), recorded.clone());
+    let _replicas = view
+        .session()
+        .declare_subscriber(format!("physics/{cluster}/replica/west/arena"))
+        .callback(move |s| {
+            r1.store(
+                s.payload().len() as u64,
+                std::sync::atomic::Ordering::SeqCst,
+            )
+        })
+        .wait()
+        .unwrap();
+    let _ticks = view
+        .session()
+        .declare_subscriber(format!("physics/{cluster}/replica-tick/west/arena"))
+        .callback(move |s| {
+            let b = s.payload().to_bytes();
+            let tick = u64::from_le_bytes(b[..8].try_into().unwrap());
+            r2.store(tick, std::sync::atomic::Ordering::SeqCst)
+        })
+        .wait()
+        .unwrap();
     for _ in 0..30 {
         plane.step(DT).unwrap();
     }
     // Written (Save waits for the file), then replicated within a scan.
     assert_eq!(plane.save().unwrap(), 30);
-    std::thread::sleep(Duration::from_millis(800));
+    eventually(Duration::from_secs(10), || {
+        (replicated.load(std::sync::atomic::Ordering::SeqCst) > 0).then_some(())
+    })
+    .expect("the plane file was replicated");
     // Ticks past the last replicated snapshot: recorded (every 100 ms) but not saved.
     for _ in 0..10 {
         plane.step(DT).unwrap();
     }
-    std::thread::sleep(Duration::from_millis(600));
+    eventually(Duration::from_secs(10), || {
+        (recorded.load(std::sync::atomic::Ordering::SeqCst) == 40).then_some(())
+    })
+    .expect("west's tick record of tick 40 was replicated");
+    // East got the same puts (one more scan period of margin for its callback).
+    std::thread::sleep(Duration::from_millis(200));
     assert!((ball.position().unwrap()[1] - fallen(y0, 40)).abs() < 1e-2);
     drop((ball, plane, client));
 
@@ -133,5 +168,7 @@ fn a_persistent_plane_of_a_killed_member_comes_back_on_another() {
     // It goes on.
     assert_eq!(opened.plane.step(DT).unwrap(), tick + 1);
     assert!(took < Duration::from_secs(10));
+    // The daemons go before their state folders.
+    drop((opened, local, east, west));
     let _ = std::fs::remove_dir_all(state);
 }
