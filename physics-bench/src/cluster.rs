@@ -5,7 +5,8 @@
 //! bodies, settled (asleep on a floor) and awake (every body moving), it reports delivery
 //! latency (tick end → the reader has the tick, CLOCK_MONOTONIC on one host), p50 and p99,
 //! the bytes of a tick's frame on the wire, and whether every tick both readers saw had the
-//! same `StateHash`.
+//! same `StateHash`. Then the failover of a persistent plane: its daemon SIGKILLed, the time
+//! until a survivor serves it and ticks again, and the ticks lost.
 
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -44,6 +45,20 @@ pub struct Reader {
     pub p99_ms: Option<f64>,
 }
 
+/// Failover of a persistent plane: its daemon SIGKILLed, the survivor serving it.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct FailoverCase {
+    pub bodies: usize,
+    /// The newest tick read on the plane's first daemon before the kill.
+    pub tick_before: u64,
+    /// The tick the survivor resumed at, and the ticks it reports lost.
+    pub resumed_tick: u64,
+    pub lost_ticks: u64,
+    /// SIGKILL to the plane opened on the survivor, and to its first new tick read there.
+    pub open_ms: f64,
+    pub first_tick_ms: f64,
+}
+
 /// One case: a body count and a state.
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct Case {
@@ -62,6 +77,7 @@ pub struct Case {
 pub struct ClusterReport {
     pub seconds: f64,
     pub cases: Vec<Case>,
+    pub failover: Option<FailoverCase>,
     pub goals: Vec<Goal>,
 }
 
@@ -80,15 +96,17 @@ fn member(
     name: &str,
     listen: u16,
     connect: Option<u16>,
+    extra: &[String],
 ) -> BenchResult<DaemonProcess> {
-    let mut args = vec![
+    let mut args: Vec<String> = extra.to_vec();
+    args.extend([
         "--cluster".to_string(),
         cluster.to_string(),
         "--name".into(),
         name.into(),
         "--listen".into(),
         format!("tcp/127.0.0.1:{listen}"),
-    ];
+    ]);
     if let Some(port) = connect {
         args.push("--connect".into());
         args.push(format!("tcp/127.0.0.1:{port}"));
@@ -166,6 +184,84 @@ fn read(
     Ok(seen)
 }
 
+/// A persistent plane of `n` awake bodies at 60 Hz on `west` (state folder, snapshots every
+/// 0.5 s, replicated to `east`); after 2 s west is SIGKILLed; east opens the plane and reads
+/// its first new tick.
+fn failover(n: usize) -> BenchResult<FailoverCase> {
+    let cluster = super::daemon::unique_domain("fo").replace('.', "-");
+    let state = std::env::temp_dir().join(super::daemon::unique_domain("fo-state"));
+    let flags = |who: &str| {
+        vec![
+            "--state-dir".to_string(),
+            state.join(who).display().to_string(),
+            "--snapshot-every".into(),
+            "0.5".into(),
+        ]
+    };
+    let (pe, pw) = (free_port()?, free_port()?);
+    let east = member(&cluster, "east", pe, None, &flags("east"))?;
+    let west = member(&cluster, "west", pw, Some(pe), &flags("west"))?;
+    let view = Cluster::connect(&cluster, &[&format!("tcp/127.0.0.1:{pe}")])?;
+    let deadline = Instant::now() + Duration::from_secs(10);
+    while view.daemons()?.len() < 2 {
+        if Instant::now() > deadline {
+            return Err(BenchError::Failed(
+                "the failover members did not meet in 10 s".into(),
+            ));
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    let owner = west.connect()?;
+    let options = PlaneOptions::default()
+        .with(PlaneProp::TickRate(60.0))
+        .with(PlaneProp::Gravity([0.0; 3]))
+        .with(PlaneProp::NeverSleep(true))
+        .with(PlaneProp::Name(client_sdk::PlaneName::new("arena")?))
+        .with(PlaneProp::Persistent(true));
+    let plane = owner.create_plane(&options)?;
+    let side = (n as f64).sqrt().ceil() as usize;
+    for k in 0..n {
+        let at = [(k / side) as f32 * 2.0, 0.0, (k % side) as f32 * 2.0];
+        plane.add(
+            Shape::Sphere { radius: 0.5 },
+            Pose::at(at),
+            &[ObjectProp::Velocity([0.0, 0.5, 0.0])],
+        )?;
+    }
+    owner.flush()?;
+    std::thread::sleep(Duration::from_secs(2));
+    let tick_before = plane.snapshot()?.tick();
+    // SAFETY: kill(2) on the pid of a daemon this process started.
+    unsafe { libc::kill(west.pid() as libc::pid_t, libc::SIGKILL) };
+    let killed = Instant::now();
+    let survivor = east.connect()?;
+    let opened = loop {
+        match survivor.open_named("arena") {
+            Ok(o) => break o,
+            Err(_) if killed.elapsed() < Duration::from_secs(20) => {
+                std::thread::sleep(Duration::from_millis(5))
+            }
+            Err(e) => return Err(e.into()),
+        }
+    };
+    let open_ms = killed.elapsed().as_secs_f64() * 1e3;
+    let resumed_tick = opened.plane.snapshot()?.tick();
+    opened.plane.wait_tick(Duration::from_secs(5))?;
+    let first_tick_ms = killed.elapsed().as_secs_f64() * 1e3;
+    let case = FailoverCase {
+        bodies: n,
+        tick_before,
+        resumed_tick,
+        lost_ticks: opened.recovered.unwrap_or(0),
+        open_ms,
+        first_tick_ms,
+    };
+    drop((opened, survivor, plane, owner, view));
+    drop((east, west));
+    let _ = std::fs::remove_dir_all(&state);
+    Ok(case)
+}
+
 fn figures(seen: &[(u64, u64, f64)]) -> Reader {
     let ms: Vec<f64> = seen.iter().map(|s| s.2).collect();
     Reader {
@@ -178,8 +274,8 @@ fn figures(seen: &[(u64, u64, f64)]) -> Reader {
 pub fn run(args: &ClusterArgs) -> BenchResult<()> {
     let cluster = super::daemon::unique_domain("cl").replace('.', "-");
     let (pe, pw) = (free_port()?, free_port()?);
-    let _east = member(&cluster, "east", pe, None)?;
-    let west = member(&cluster, "west", pw, Some(pe))?;
+    let _east = member(&cluster, "east", pe, None, &[])?;
+    let west = member(&cluster, "west", pw, Some(pe), &[])?;
     let endpoint = format!("tcp/127.0.0.1:{pe}");
     let remote = RemoteOptions {
         cluster: ClusterOptions {
@@ -262,6 +358,9 @@ pub fn run(args: &ClusterArgs) -> BenchResult<()> {
             plane.destroy()?;
         }
     }
+    let n = args.bodies.first().copied().unwrap_or(1000);
+    eprintln!("cluster: failover of a persistent plane of {n} bodies");
+    let fo = failover(n)?;
     let differed: usize = cases.iter().map(|c| c.differed).sum();
     let compared: usize = cases.iter().map(|c| c.compared).sum();
     let mut goals = vec![Goal::new(
@@ -269,6 +368,25 @@ pub fn run(args: &ClusterArgs) -> BenchResult<()> {
         format!("{differed} of {compared} differ"),
         Some(differed == 0 && compared > 0),
     )];
+    goals.push(Goal::new(
+        format!(
+            "failover: SIGKILL of a persistent plane's daemon ({} bodies, 60 Hz) to its first \
+             tick on the survivor ≤ 2 s",
+            fo.bodies
+        ),
+        format!(
+            "{:.0} ms (opened after {:.0} ms); resumed at tick {}, Recovered reports {} ticks \
+             lost; tick {} was read before the kill, so at least {} were (the tick record \
+             lags up to ~200 ms)",
+            fo.first_tick_ms,
+            fo.open_ms,
+            fo.resumed_tick,
+            fo.lost_ticks,
+            fo.tick_before,
+            fo.tick_before.saturating_sub(fo.resumed_tick)
+        ),
+        Some(fo.first_tick_ms <= 2000.0),
+    ));
     for c in &cases {
         let ratio = match (c.remote.p50_ms, c.local.p50_ms) {
             (Some(r), Some(l)) if l > 0.0 => Some(r / l),
@@ -287,6 +405,7 @@ pub fn run(args: &ClusterArgs) -> BenchResult<()> {
     let report = ClusterReport {
         seconds: args.seconds,
         cases,
+        failover: Some(fo),
         goals,
     };
     let md = markdown(&report);
@@ -328,7 +447,8 @@ fn markdown(r: &ClusterReport) -> String {
          reader through the cluster (Zenoh on loopback via `east`, west's relay), one through \
          west's shared memory, both reading for {} s. Latency: the tick's end (daemon) to the \
          reader holding it (CLOCK_MONOTONIC, one host). Frame bytes: the mean payload of a \
-         tick's frame (changed slots only).\n\n{}\n\n{}",
+         tick's frame (changed slots only). Failover: a persistent plane on a second pair of \
+         members (state folders, snapshots every 0.5 s), its daemon SIGKILLed after 2 s.\n\n{}\n\n{}",
         r.seconds,
         t.finish(),
         goals_table(&r.goals)

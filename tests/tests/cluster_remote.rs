@@ -530,6 +530,11 @@ fn the_cluster_bench_finds_remote_reads_exact_and_settled_frames_small() {
     for c in cases {
         assert!(c["remote"]["ticks"].as_u64().unwrap() >= 30, "{text}");
     }
+    // The failover case ran: the survivor resumed the plane from a replicated snapshot.
+    assert!(
+        json["failover"]["resumed_tick"].as_u64().unwrap() > 0,
+        "{text}"
+    );
     let _ = std::fs::remove_dir_all(out);
 }
 
