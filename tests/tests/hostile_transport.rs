@@ -408,10 +408,10 @@ fn nodes_that_never_say_hello_are_evicted() {
         at_start >= 9,
         "held {at_start} ports, expected the victim's and the hoarder's 8"
     );
-    // The victim's port stays; the hoarder's 8 must go. One straggler of the first phase
-    // (see above) was seen still listed after 30 s in 2 of 6 full runs on a loaded machine
-    // (cause not found: it is not one of these 8, which are all gone), so up to one more
-    // port is tolerated; a daemon that evicts none of the 8 still fails here.
+    // The victim's port stays; the hoarder's 8 must go. One port besides the victim's was
+    // seen still listed after 30 s in 2 of 6 full runs on a loaded machine (cause not
+    // found; most likely a straggler of the first phase, see above), so one is tolerated:
+    // a daemon that evicts none of the 8 still fails here.
     let mut last = at_start;
     time_until(Duration::from_secs(30), || {
         last = held();
