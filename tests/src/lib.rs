@@ -408,3 +408,53 @@ pub mod assets {
         ]
     }
 }
+
+/// Daemons of a physics cluster on loopback, each in a domain of its own (as if on its own
+/// host) and on a port the OS handed out (`tests/tests/cluster*.rs`).
+pub mod cluster {
+    use super::TestDaemon;
+
+    /// A loopback port nobody listens on now (the OS picks it; closed again at once).
+    pub fn free_port() -> u16 {
+        std::net::TcpListener::bind("127.0.0.1:0")
+            .and_then(|l| l.local_addr())
+            .expect("a free loopback port")
+            .port()
+    }
+
+    /// `tcp/127.0.0.1:PORT`.
+    pub fn endpoint(port: u16) -> String {
+        format!("tcp/127.0.0.1:{port}")
+    }
+
+    /// A cluster name of this test run only (clusters with other names share nothing).
+    pub fn unique_cluster(tag: &str) -> String {
+        super::unique_domain(tag).replace('.', "-")
+    }
+
+    /// Daemon `name` of `cluster`, listening on `listen`, connecting to `connect`, with
+    /// `extra` flags.
+    pub fn member(
+        cluster: &str,
+        name: &str,
+        listen: u16,
+        connect: &[u16],
+        extra: &[&str],
+    ) -> TestDaemon {
+        let mut args: Vec<String> = extra.iter().map(|s| s.to_string()).collect();
+        args.extend([
+            "--cluster".to_string(),
+            cluster.to_string(),
+            "--name".into(),
+            name.into(),
+            "--listen".into(),
+            endpoint(listen),
+        ]);
+        for port in connect {
+            args.push("--connect".into());
+            args.push(endpoint(*port));
+        }
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        TestDaemon::start_with(&format!("cl-{name}"), &args, &[])
+    }
+}

@@ -9,42 +9,8 @@ use std::time::{Duration, Instant};
 
 use client_sdk::cluster::{Cluster, DaemonInfo};
 use client_sdk::PlaneOptions;
+use integration_tests::cluster::{endpoint, free_port, member, unique_cluster};
 use integration_tests::{eventually, unique_domain, TestDaemon};
-
-/// A loopback port nobody listens on now (the OS picks it; closed again at once).
-fn free_port() -> u16 {
-    std::net::TcpListener::bind("127.0.0.1:0")
-        .and_then(|l| l.local_addr())
-        .expect("a free loopback port")
-        .port()
-}
-
-fn endpoint(port: u16) -> String {
-    format!("tcp/127.0.0.1:{port}")
-}
-
-/// A cluster name of this test run only (clusters with other names share nothing).
-fn unique_cluster(tag: &str) -> String {
-    unique_domain(tag).replace('.', "-")
-}
-
-fn member(cluster: &str, name: &str, listen: u16, connect: &[u16]) -> TestDaemon {
-    let listen = endpoint(listen);
-    let mut args = vec![
-        "--cluster".to_string(),
-        cluster.to_string(),
-        "--name".into(),
-        name.into(),
-        "--listen".into(),
-        listen,
-    ];
-    for port in connect {
-        args.push("--connect".into());
-        args.push(endpoint(*port));
-    }
-    let args: Vec<&str> = args.iter().map(String::as_str).collect();
-    TestDaemon::start_with(&format!("cl-{name}"), &args, &[])
-}
 
 /// Runs a daemon expected to refuse its flags: its exit status and stderr. A daemon that
 /// has not exited within 15 s fails the test (and is killed).
@@ -94,9 +60,9 @@ fn names(daemons: &[DaemonInfo]) -> Vec<&str> {
 fn three_daemons_see_each_other_and_a_killed_one_leaves() {
     let cluster = unique_cluster("three");
     let (pa, pb, pc) = (free_port(), free_port(), free_port());
-    let a = member(&cluster, "a", pa, &[]);
-    let b = member(&cluster, "b", pb, &[pa]);
-    let mut c = member(&cluster, "c", pc, &[pa, pb]);
+    let a = member(&cluster, "a", pa, &[], &[]);
+    let b = member(&cluster, "b", pb, &[pa], &[]);
+    let mut c = member(&cluster, "c", pc, &[pa, pb], &[]);
 
     // Through b's endpoint only: the member routes for its client, so all three are seen.
     let view = Cluster::connect(&cluster, &[&endpoint(pb)]).expect("connect to the cluster");
@@ -169,9 +135,9 @@ fn three_daemons_see_each_other_and_a_killed_one_leaves() {
 fn a_name_alive_is_refused() {
     let cluster = unique_cluster("dup");
     let (pa, pb, pc) = (free_port(), free_port(), free_port());
-    let _a = member(&cluster, "a", pa, &[]);
-    let _b = member(&cluster, "b", pb, &[pa]);
-    let _c = member(&cluster, "c", pc, &[pa, pb]);
+    let _a = member(&cluster, "a", pa, &[], &[]);
+    let _b = member(&cluster, "b", pb, &[pa], &[]);
+    let _c = member(&cluster, "c", pc, &[pa, pb], &[]);
     // The newcomer connects to a only: it must learn of b through gossip before it checks.
     // A name alive in the cluster is refused, naming it.
     let (ok, err) = refused(&[

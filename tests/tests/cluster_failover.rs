@@ -8,42 +8,8 @@
 use std::time::{Duration, Instant};
 
 use client_sdk::{PlaneName, PlaneOptions, PlaneProp, Pose, Shape};
-use integration_tests::{eventually, unique_domain, TestDaemon};
-
-fn free_port() -> u16 {
-    std::net::TcpListener::bind("127.0.0.1:0")
-        .and_then(|l| l.local_addr())
-        .expect("a free loopback port")
-        .port()
-}
-
-fn member(
-    cluster: &str,
-    name: &str,
-    listen: u16,
-    connect: Option<u16>,
-    state: &std::path::Path,
-) -> TestDaemon {
-    let mut args = vec![
-        "--cluster".to_string(),
-        cluster.to_string(),
-        "--name".into(),
-        name.into(),
-        "--listen".into(),
-        format!("tcp/127.0.0.1:{listen}"),
-        "--state-dir".into(),
-        state.display().to_string(),
-        // Long enough that the saved snapshot (tick 30) is the newest one west writes.
-        "--snapshot-every".into(),
-        "30".into(),
-    ];
-    if let Some(port) = connect {
-        args.push("--connect".into());
-        args.push(format!("tcp/127.0.0.1:{port}"));
-    }
-    let args: Vec<&str> = args.iter().map(String::as_str).collect();
-    TestDaemon::start_with(&format!("fo-{name}"), &args, &[])
-}
+use integration_tests::cluster::{endpoint, free_port, member, unique_cluster};
+use integration_tests::{eventually, unique_domain};
 
 const DT: f32 = 1.0 / 60.0;
 const G: f32 = 10.0;
@@ -57,13 +23,36 @@ fn fallen(y0: f32, n: u64) -> f32 {
 
 #[test]
 fn a_persistent_plane_of_a_killed_member_comes_back_on_another() {
-    let cluster = unique_domain("fo").replace('.', "-");
+    let cluster = unique_cluster("fo");
     let state = std::env::temp_dir().join(unique_domain("fo-state"));
     let (pe, pw) = (free_port(), free_port());
-    let east = member(&cluster, "east", pe, None, &state.join("east"));
-    let mut west = member(&cluster, "west", pw, Some(pe), &state.join("west"));
-    let view =
-        client_sdk::cluster::Cluster::connect(&cluster, &[&format!("tcp/127.0.0.1:{pe}")]).unwrap();
+    // A snapshot period long enough that the saved snapshot (tick 30) is the newest one
+    // west writes.
+    let flags = |who: &str| {
+        let dir = state.join(who).display().to_string();
+        [
+            "--state-dir".to_string(),
+            dir,
+            "--snapshot-every".into(),
+            "30".into(),
+        ]
+    };
+    let (fe, fw) = (flags("east"), flags("west"));
+    let east = member(
+        &cluster,
+        "east",
+        pe,
+        &[],
+        &fe.each_ref().map(String::as_str),
+    );
+    let mut west = member(
+        &cluster,
+        "west",
+        pw,
+        &[pe],
+        &fw.each_ref().map(String::as_str),
+    );
+    let view = client_sdk::cluster::Cluster::connect(&cluster, &[&endpoint(pe)]).unwrap();
     eventually(Duration::from_secs(10), || {
         (view.daemons().ok()?.len() == 2).then_some(())
     })

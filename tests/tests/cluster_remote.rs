@@ -11,36 +11,8 @@ use std::time::Duration;
 use client_sdk::cluster::ClusterOptions;
 use client_sdk::remote::RemoteOptions;
 use client_sdk::{Client, Contact, ErrorKind, ObjectProp, PlaneOptions, Pose, Shape};
+use integration_tests::cluster::{endpoint, free_port, member, unique_cluster};
 use integration_tests::{eventually, unique_domain, TestDaemon};
-
-fn free_port() -> u16 {
-    std::net::TcpListener::bind("127.0.0.1:0")
-        .and_then(|l| l.local_addr())
-        .expect("a free loopback port")
-        .port()
-}
-
-fn endpoint(port: u16) -> String {
-    format!("tcp/127.0.0.1:{port}")
-}
-
-fn member(cluster: &str, name: &str, listen: u16, connect: &[u16], extra: &[&str]) -> TestDaemon {
-    let mut args: Vec<String> = extra.iter().map(|s| s.to_string()).collect();
-    args.extend([
-        "--cluster".to_string(),
-        cluster.to_string(),
-        "--name".into(),
-        name.into(),
-        "--listen".into(),
-        endpoint(listen),
-    ]);
-    for port in connect {
-        args.push("--connect".into());
-        args.push(endpoint(*port));
-    }
-    let args: Vec<&str> = args.iter().map(String::as_str).collect();
-    TestDaemon::start_with(&format!("rc-{name}"), &args, &[])
-}
 
 /// Two members: `east` (the endpoint clients use) and `west` (where their planes live).
 struct Two {
@@ -56,7 +28,7 @@ fn two(tag: &str) -> Two {
 
 /// [`two`] with `west_args` added to west's command line.
 fn two_with(tag: &str, west_args: &[&str]) -> Two {
-    let cluster = unique_domain(tag).replace('.', "-");
+    let cluster = unique_cluster(tag);
     let (pe, pw) = (free_port(), free_port());
     let east = member(&cluster, "east", pe, &[], &[]);
     let west = member(&cluster, "west", pw, &[pe], west_args);

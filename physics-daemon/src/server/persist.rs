@@ -607,22 +607,12 @@ impl Loaded {
 }
 
 fn load_one(dir: &Path, path: &Path, stem: &str) -> Result<Loaded, String> {
-    let name =
-        PlaneName::new(stem).map_err(|e| format!("its name is not a plane name: {}", e.message))?;
     let bytes = std::fs::read(path).map_err(|e| format!("cannot read it: {e}"))?;
-    let (header, _) = snapshot::verify(&bytes).map_err(|e| e.message)?;
-
     let recorded = std::fs::read(tick_file_of(dir, stem))
         .ok()
         .and_then(|b| <[u8; 8]>::try_from(b.get(..8)?).ok())
         .map(u64::from_le_bytes);
-    Ok(Loaded {
-        name,
-        kind: header.kind,
-        tick: header.tick,
-        lost_ticks: recorded.map_or(0, |r| r.saturating_sub(header.tick)),
-        bytes,
-    })
+    Loaded::from_bytes(stem, bytes, recorded)
 }
 
 #[cfg(test)]
