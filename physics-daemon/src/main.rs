@@ -87,6 +87,7 @@ fn main() -> ExitCode {
     let mut cluster = cluster;
     let persistence = args.persist.persistence();
     let mut adopt = None;
+    let mut migrate = None;
     if let Some(c) = cluster.as_mut() {
         if let Err(e) = c.serve_remote(&args.domain, args.limits.max_clients) {
             tracing::error!("{e}");
@@ -102,6 +103,13 @@ fn main() -> ExitCode {
             }
             adopt = Some(queue);
         }
+        match c.start_migration(&args.domain) {
+            Ok(m) => migrate = Some(m),
+            Err(e) => {
+                tracing::error!("{e}");
+                return ExitCode::FAILURE;
+            }
+        }
     }
     let options = physics_daemon::server::Options {
         limits: args.limits,
@@ -113,6 +121,7 @@ fn main() -> ExitCode {
         persistence,
         load: cluster.as_ref().map(|_| gauge),
         adopt,
+        migrate,
     };
     let served = physics_daemon::server::run_with(&args.domain, &shutdown, options);
     if let Some(cluster) = cluster {

@@ -269,6 +269,16 @@ pub enum Reply {
     /// A snapshot transfer's answer ([`Command::Transfer`], or a snapshot too large for one
     /// reply).
     Transfer(crate::snapshot_transfer::TransferReply),
+    /// The plane moved ([`PlaneOp::MoveTo`]): where it lives now, and the key its owner
+    /// claims it with there ([`PlaneOp::ClaimMoved`]; 0 when it did not move).
+    Moved {
+        /// The daemon it lives on.
+        daemon: String,
+        /// Its id there.
+        plane: PlaneId,
+        /// The claim key.
+        key: u128,
+    },
 }
 
 /// The result of one command.

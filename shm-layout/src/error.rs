@@ -26,6 +26,9 @@ pub enum ErrorKind {
     Quota,
     /// The plane belongs to another client, which did not allow this.
     NotOwner,
+    /// The plane moved to another daemon of the cluster: the command was not applied;
+    /// [`crate::migrate::Moved`] reads where it went.
+    Moved,
 }
 
 /// The failure of one command. `message` is complete on its own ("Friction must be within

@@ -28,6 +28,7 @@ pub mod error;
 pub mod gui_op;
 pub mod joint_op;
 pub mod map_op;
+pub mod migrate;
 pub mod names;
 pub mod object_op;
 pub mod plane_name;

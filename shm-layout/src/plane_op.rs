@@ -99,6 +99,19 @@ pub enum PlaneOp {
         /// Options applied after the state, as for `Restore`.
         overrides: Vec<PlaneProp>,
     },
+    /// Moves the plane to another daemon of the cluster (owner only, 3D planes only): it
+    /// stops at a tick boundary here and goes on from the same tick there, same objects,
+    /// same handles ([`crate::migrate`]). Replies [`crate::Reply::Moved`].
+    MoveTo {
+        /// The target daemon's name (`--name`).
+        daemon: String,
+    },
+    /// Claims a plane that arrived by [`PlaneOp::MoveTo`] with the key its old owner got:
+    /// the sender becomes its owner. Replies [`crate::Reply::Done`].
+    ClaimMoved {
+        /// The key of [`crate::Reply::Moved`].
+        key: u128,
+    },
 }
 
 /// What an op may add to a plane, for the daemon's per-client quotas.

@@ -10,6 +10,7 @@
 //!
 //! - [`failover`]: persistent planes replicated to the other members, and restored by one
 //!   of them when their daemon leaves.
+//! - [`migrate`]: planes moving to and arriving from other members (`MoveTo`).
 //! - remote clients: [`client_sdk::relay`] answers them as local clients of this daemon,
 //!   one per remote session (started by [`Cluster::serve_remote`]).
 //!
@@ -18,6 +19,7 @@
 pub mod failover;
 pub mod load;
 pub mod membership;
+pub mod migrate;
 pub mod session;
 
 use std::sync::Arc;
@@ -61,6 +63,9 @@ pub struct Cluster {
     name: String,
     relay: Option<client_sdk::relay::Relay>,
     failover: Option<failover::Failover>,
+    /// An endpoint clients of a plane that moved away connect through (the first listened).
+    endpoint: String,
+    arrivals: Option<migrate::Arrivals>,
 }
 
 impl Cluster {
@@ -98,7 +103,10 @@ impl Cluster {
             listen = ?plan.listen,
             "joined the physics cluster"
         );
+        let endpoint = plan.listen.first().cloned().unwrap_or_default();
         Ok(Some(Cluster {
+            endpoint,
+            arrivals: None,
             reporter,
             _member: member,
             session,
@@ -147,6 +155,18 @@ impl Cluster {
         Ok(())
     }
 
+    /// Starts taking planes that move here from other members, and returns the hook the
+    /// server loop moves planes away and takes arrivals through ([`migrate`]).
+    pub fn start_migration(
+        &mut self,
+        domain: &str,
+    ) -> Result<Arc<crate::server::moves::Migration>, ClusterError> {
+        let (migration, arrivals) =
+            migrate::start(&self.session, &self.cluster, &self.name, &self.endpoint, domain)?;
+        self.arrivals = Some(arrivals);
+        Ok(migration)
+    }
+
     /// The Zenoh session (for the parts of the cluster built on it).
     pub fn session(&self) -> &zenoh::Session {
         &self.session
@@ -160,8 +180,10 @@ impl Cluster {
             session,
             relay,
             failover,
+            arrivals,
             ..
         } = self;
+        drop(arrivals);
         drop(failover);
         if let Some(relay) = relay {
             relay.stop();

@@ -101,7 +101,9 @@ impl Backend for Plane {
             PlaneOp::Step { .. }
             | PlaneOp::Destroy
             | PlaneOp::Save
-            | PlaneOp::RestoreUploaded { .. } => Err(CommandError::new(
+            | PlaneOp::RestoreUploaded { .. }
+            | PlaneOp::MoveTo { .. }
+            | PlaneOp::ClaimMoved { .. } => Err(CommandError::new(
                 ErrorKind::Internal,
                 format!("{op:?} is handled by the server, not the plane"),
             )),

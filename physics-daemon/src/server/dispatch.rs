@@ -110,6 +110,13 @@ impl Daemon {
             }
             Command::CreatePlane { kind, props } => self.create_plane(client, kind, props),
             Command::Plane { plane, op } => {
+                // A plane that moved away: refused (not applied) naming where it went.
+                if let Some(e) = self.moved_refusal(plane) {
+                    return now(Err(e));
+                }
+                if let PlaneOp::ClaimMoved { key } = op {
+                    return now(self.claim_moved(client, plane, key));
+                }
                 // An upload becomes the restore it carries (`transfers`).
                 let op = match op {
                     PlaneOp::RestoreUploaded {
@@ -127,6 +134,9 @@ impl Daemon {
                 if op == PlaneOp::Save {
                     return self.save_plane(plane);
                 }
+                if let PlaneOp::MoveTo { daemon } = &op {
+                    return now(self.move_plane(plane, daemon));
+                }
                 if op == PlaneOp::Destroy {
                     self.forget_file(plane);
                     self.remove_plane(plane);
@@ -139,6 +149,7 @@ impl Daemon {
                         || *op == PlaneOp::Destroy
                         || *op == PlaneOp::Save
                         || matches!(op, PlaneOp::RestoreUploaded { .. })
+                        || matches!(op, PlaneOp::MoveTo { .. } | PlaneOp::ClaimMoved { .. })
                         || self.check_access(client, plane, op).is_err()
                     {
                         break;
@@ -193,6 +204,7 @@ impl Daemon {
             PlaneOp::Set(PlaneProp::SharedObjectLimit(_)) => {
                 refused("only its owner may set SharedObjectLimit")
             }
+            PlaneOp::MoveTo { .. } => refused("only its owner may move it"),
             _ if entry.shared => Ok(()),
             _ => refused(
                 "it is not shared, so other clients may only read it (its owner can create it \
@@ -249,7 +261,7 @@ impl Daemon {
     }
 
     /// Plane `id` is being destroyed by its owner: a persistent plane's files go with it.
-    fn forget_file(&mut self, id: PlaneId) {
+    pub(super) fn forget_file(&mut self, id: PlaneId) {
         let Some(entry) = self.planes.get(&id) else {
             return;
         };
@@ -263,7 +275,7 @@ impl Daemon {
         }
     }
 
-    fn plane(&self, id: PlaneId) -> Result<&PlaneEntry, CommandError> {
+    pub(super) fn plane(&self, id: PlaneId) -> Result<&PlaneEntry, CommandError> {
         self.planes.get(&id).ok_or_else(|| unknown_plane(id))
     }
 

@@ -29,6 +29,7 @@ pub mod gauge;
 pub mod heartbeat;
 pub mod limits;
 pub mod liveness;
+pub mod moves;
 mod named;
 mod origin;
 pub mod persist;
@@ -79,6 +80,9 @@ pub struct Options {
     /// Planes a cluster peer hands over at run time (failover, `--cluster` with
     /// `--state-dir`); `None` outside a cluster.
     pub adopt: Option<Arc<persist::Adoptions>>,
+    /// How planes move to and arrive from other daemons (`--cluster`; `MoveTo`); `None`
+    /// outside a cluster.
+    pub migrate: Option<Arc<moves::Migration>>,
 }
 
 /// How often dead clients are looked for while clients are connected (and, for a daemon
@@ -169,6 +173,8 @@ pub struct Daemon {
     stage_to: Option<Arc<transfers::ClientTransfers>>,
     /// When to list nodes to find gone clients (`liveness`).
     liveness: liveness::Schedule,
+    /// Planes that moved to other daemons (`moves`).
+    moved: moves::Tombstones,
 }
 
 /// Wakes the loop of the daemon of `domain` (e.g. from a signal handler thread after setting
@@ -367,6 +373,7 @@ fn serve(
         transfers: HashMap::new(),
         stage_to: None,
         liveness: liveness::Schedule::default(),
+        moved: moves::Tombstones::default(),
     };
     // Persistent planes of the last daemon come back before the first request.
     daemon.restore_saved();
@@ -397,6 +404,7 @@ fn serve(
         daemon.waker.disarm();
         daemon.handle_events();
         daemon.adopt_planes();
+        daemon.take_arrivals();
         daemon.serve_requests();
         if let Some(gauge) = &daemon.options.load {
             gauge.track(daemon.planes.len(), daemon.next_plane_id, || {

@@ -194,6 +194,26 @@ impl PlaneCell {
     fn lock(&self) -> MutexGuard<'_, Option<Box<dyn Backend>>> {
         self.plane.lock().unwrap_or_else(|p| p.into_inner())
     }
+
+    /// Locks the plane between two ticks once every run handed to its worker is applied
+    /// (migration: `moves`), waiting up to `wait`; `None` when runs are still queued then.
+    /// While the guard lives the worker neither steps nor applies anything.
+    pub fn lock_idle(&self, wait: Duration) -> Option<MutexGuard<'_, Option<Box<dyn Backend>>>> {
+        let deadline = Instant::now() + wait;
+        loop {
+            if self.queued.load(Ordering::SeqCst) == 0 {
+                let guard = self.lock();
+                // Checked again under the lock: the worker finishes a run before it lets go.
+                if self.queued.load(Ordering::SeqCst) == 0 {
+                    return Some(guard);
+                }
+            }
+            if Instant::now() >= deadline {
+                return None;
+            }
+            std::thread::sleep(Duration::from_micros(200));
+        }
+    }
 }
 
 /// What the tick schedule depends on.
@@ -221,7 +241,7 @@ impl Waker {
         self.armed.store(false, Ordering::SeqCst);
     }
 
-    fn wake(&self) {
+    pub(super) fn wake(&self) {
         if !self.armed.swap(true, Ordering::SeqCst) {
             if let Ok(socket) = self.socket.lock() {
                 let _ = socket.try_send(&[1]);
