@@ -138,6 +138,10 @@ struct Inner {
     last_node_check: std::cell::Cell<Instant>,
     /// How long the next request polls for its reply before sleeping ([`crate::spin`]).
     reply_spin: std::cell::Cell<std::time::Duration>,
+    /// Connections to the daemons this client's planes moved to, by daemon (`moving`).
+    peers: RefCell<HashMap<String, Client>>,
+    /// How this client reached its cluster, when it did ([`Client::connect_cluster`]).
+    remote: Option<RemoteOptions>,
 }
 
 /// A connection to the physics daemon of one domain. Cheap to clone; not `Send` (shared
@@ -177,7 +181,8 @@ impl Client {
     ) -> Result<Client, Error> {
         let transport = RemoteTransport::open(remote)?;
         options.domain = format!("{}/{}", transport.cluster(), transport.daemon());
-        Self::handshake(options, Transport::Remote(transport))
+        let client = Self::handshake(options, Transport::Remote(transport))?;
+        Ok(client.with_remote(remote.clone()))
     }
 
     /// The cluster daemon this client uses (`None`: this host's daemon, not through a
@@ -201,6 +206,8 @@ impl Client {
             last_beat: std::cell::Cell::new(Instant::now()),
             reply_spin: std::cell::Cell::new(std::time::Duration::ZERO),
             last_node_check: std::cell::Cell::new(Instant::now()),
+            peers: RefCell::default(),
+            remote: None,
         };
         let hello = Command::Hello {
             crate_version: inner.options.crate_version.clone(),
@@ -289,7 +296,11 @@ impl Client {
         if self.inner.options.refusals_at_next_call {
             return Ok(());
         }
-        let deferred = self.take_refused(None);
+        let mut deferred = self.take_refused(None);
+        // Refusals of writes to planes that moved to other daemons.
+        for peer in self.inner.peers.borrow().values() {
+            deferred.extend(peer.take_refused(None));
+        }
         if deferred.is_empty() {
             Ok(())
         } else {
@@ -351,6 +362,11 @@ impl Client {
     /// back, after it ran; a creating call keeps them for the next call, so its handle is
     /// never lost.
     pub(crate) fn call(&self, command: Command) -> Result<Reply, Error> {
+        // A plane that moved: its commands go to its new daemon, under its id there.
+        let command = match self.reroute(command) {
+            Ok(command) => command,
+            Err((peer, command)) => return peer.call(command),
+        };
         let plane = match (&command, self.inner.options.refusals_at_next_call) {
             (Command::Plane { plane, op }, true) => {
                 let refused = self.take_refused(Some(*plane));
@@ -401,6 +417,14 @@ impl Client {
         confirms: Option<(PlaneId, Handle)>,
         impulse: Option<u32>,
     ) {
+        let (command, confirms) = match self.reroute(command) {
+            Ok(command) => (command, confirms),
+            Err((peer, command)) => {
+                let confirms = confirms.map(|(_, h)| (command_plane(&command), h));
+                return peer.queue_with(command, confirms, impulse);
+            }
+        };
+        let confirms = confirms.map(|(_, h)| (command_plane(&command), h));
         self.inner.state.borrow_mut().queue.push(Queued {
             command,
             confirms,
@@ -414,11 +438,73 @@ impl Client {
         if !self.inner.state.borrow().queue.is_empty() {
             self.send(Vec::new())?;
         }
+        let peers: Vec<Client> = self.inner.peers.borrow().values().cloned().collect();
+        for peer in peers {
+            peer.send_queue()?;
+        }
         Ok(())
     }
 
+    /// Moves the queued commands for plane `id` to `peer`'s queue under `new_id` (the plane
+    /// moved there before they were sent).
+    pub(crate) fn requeue_to(&self, id: PlaneId, peer: &Client, new_id: PlaneId) {
+        let queue = std::mem::take(&mut self.inner.state.borrow_mut().queue);
+        let (theirs, ours): (Vec<Queued>, Vec<Queued>) = queue
+            .into_iter()
+            .partition(|q| matches!(&q.command, Command::Plane { plane, .. } if *plane == id));
+        self.inner.state.borrow_mut().queue = ours;
+        let mut state = peer.inner.state.borrow_mut();
+        for mut q in theirs {
+            if let Command::Plane { plane, .. } = &mut q.command {
+                *plane = new_id;
+            }
+            if let Some((plane, _)) = &mut q.confirms {
+                *plane = new_id;
+            }
+            state.queue.push(q);
+        }
+    }
+
+    /// This client with the cluster options it was connected with (peers connect alike).
+    fn with_remote(self, remote: RemoteOptions) -> Client {
+        match Rc::try_unwrap(self.inner) {
+            Ok(mut inner) => {
+                inner.remote = Some(remote);
+                Client {
+                    inner: Rc::new(inner),
+                }
+            }
+            Err(inner) => Client { inner },
+        }
+    }
+
+    /// How this client reached its cluster ([`Client::connect_cluster`]), if it did.
+    pub(crate) fn remote_options(&self) -> Option<&RemoteOptions> {
+        self.inner.remote.as_ref()
+    }
+
+    /// The options this client connected with.
+    pub(crate) fn connect_options(&self) -> &ConnectOptions {
+        &self.inner.options
+    }
+
+    /// The connections to the daemons this client's planes moved to, by daemon.
+    pub(crate) fn peers(&self) -> &RefCell<HashMap<String, Client>> {
+        &self.inner.peers
+    }
+
+    /// A handle that does not keep this client alive.
+    pub(crate) fn downgrade(&self) -> WeakClient {
+        WeakClient(Rc::downgrade(&self.inner))
+    }
+
+    /// Whether both are the same connection.
+    pub(crate) fn same(&self, other: &Client) -> bool {
+        Rc::ptr_eq(&self.inner, &other.inner)
+    }
+
     /// One request: the queued commands first, then `extra`. Returns the results of `extra`.
-    fn send(&self, extra: Vec<Command>) -> Result<Vec<CommandResult>, Error> {
+    pub(crate) fn send(&self, extra: Vec<Command>) -> Result<Vec<CommandResult>, Error> {
         let queued = std::mem::take(&mut self.inner.state.borrow_mut().queue);
         let n_queued = queued.len();
         let mut confirms = Vec::with_capacity(n_queued);
@@ -455,9 +541,11 @@ impl Client {
             commands.push(q.command);
         }
         commands.extend(extra);
-        let mut results = self.inner.round_trip(commands)?;
+        let (mut results, commands) = self.inner.round_trip_keeping(commands)?;
         // A reply is a sign of life as good as a beat.
         self.inner.last_beat.set(Instant::now());
+        // Refused because their plane moved (not applied): switch over, send them again.
+        self.resend_moved(&commands, &mut results)?;
         let extra_results = results.split_off(n_queued.min(results.len()));
         let mut state = self.inner.state.borrow_mut();
         let each = results.into_iter().zip(confirms).zip(targets).zip(releases);
@@ -618,6 +706,14 @@ impl Client {
 
 impl Inner {
     fn round_trip(&self, commands: Vec<Command>) -> Result<Vec<CommandResult>, Error> {
+        self.round_trip_keeping(commands).map(|(results, _)| results)
+    }
+
+    /// [`Inner::round_trip`] that gives the commands back with their results.
+    fn round_trip_keeping(
+        &self,
+        commands: Vec<Command>,
+    ) -> Result<(Vec<CommandResult>, Vec<Command>), Error> {
         if self.state.borrow().gone {
             return Err(self.gone());
         }
@@ -626,7 +722,8 @@ impl Inner {
         let bytes = self.encode(&request);
         let reply = self.exchange(&bytes, self.transport.id())?;
         let results = self.results_of(&reply, n)?;
-        self.rejoin_if_forgotten(request.commands, results)
+        let results = self.rejoin_if_forgotten(&request.commands, results)?;
+        Ok((results, request.commands))
     }
 
     /// A daemon that forgot this client (it said Goodbye, or was released) answers
@@ -636,7 +733,7 @@ impl Inner {
     /// with `UnknownPlane`).
     fn rejoin_if_forgotten(
         &self,
-        commands: Vec<Command>,
+        commands: &[Command],
         mut results: Vec<CommandResult>,
     ) -> Result<Vec<CommandResult>, Error> {
         let refused = results
@@ -803,6 +900,26 @@ impl std::fmt::Debug for Client {
             .field("domain", &self.domain())
             .field("daemon_pid", &self.daemon_pid())
             .finish()
+    }
+}
+
+/// The plane a command names (0: none).
+fn command_plane(command: &Command) -> PlaneId {
+    match command {
+        Command::Plane { plane, .. } => *plane,
+        _ => 0,
+    }
+}
+
+/// A [`Client`] that does not keep its connection alive (a moved plane's route: the
+/// connection belongs to the client that switched it, `moving`).
+#[derive(Clone)]
+pub(crate) struct WeakClient(std::rc::Weak<Inner>);
+
+impl WeakClient {
+    /// The client, while it lives.
+    pub(crate) fn upgrade(&self) -> Option<Client> {
+        self.0.upgrade().map(|inner| Client { inner })
     }
 }
 

@@ -100,7 +100,8 @@ impl Plane {
         }
         // Subscribe first, then read where the stream stands: every event after that point
         // reaches the subscriber, so a gap is a real loss.
-        let sub = self.client().transport().plane_events(self.id())?;
+        let (via, id) = self.via();
+        let sub = via.transport().plane_events(id)?;
         let start = match sub.start() {
             Some(start) => start,
             None => self.snapshot().map_or(0, |s| s.header().event_count),

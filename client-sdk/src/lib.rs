@@ -27,6 +27,7 @@ mod joint;
 pub mod map;
 mod members;
 mod mirror;
+mod moving;
 mod named_plane;
 mod object;
 mod overlay;

@@ -303,7 +303,7 @@ impl Plane {
                 crate::spin::Phase::Poll if !left.is_zero() => std::thread::yield_now(),
                 crate::spin::Phase::Doze(d) if !left.is_zero() => {
                     self.tick_listener()
-                        .map_err(|e| self.client.check_daemon().err().unwrap_or(e))?;
+                        .map_err(|e| self.via().0.check_daemon().err().unwrap_or(e))?;
                     if let Some(l) = self.shared.ticks.borrow().as_ref() {
                         l.timed_wait(d.min(left).min(LIVENESS_PERIOD));
                     }
@@ -353,12 +353,13 @@ impl Plane {
             // Listing nodes costs a directory scan: check the daemon's liveness only when a
             // wait brought no tick for a while, never on the hot path of a delivered tick.
             if now.duration_since(last_check) >= LIVENESS_PERIOD {
-                self.client.check_daemon()?;
+                // A plane that moved is switched over here (its ticks come from elsewhere).
+                self.look_for_move()?;
                 last_check = now;
             }
             // A failure to reach the tick event most likely means the daemon is gone.
             self.tick_listener()
-                .map_err(|e| self.client.check_daemon().err().unwrap_or(e))?;
+                .map_err(|e| self.via().0.check_daemon().err().unwrap_or(e))?;
             let wait = (deadline - now).min(LIVENESS_PERIOD);
             if let Some(l) = self.shared.ticks.borrow().as_ref() {
                 l.timed_wait(wait);
@@ -370,7 +371,8 @@ impl Plane {
         if self.shared.ticks.borrow().is_some() {
             return Ok(());
         }
-        let listener = self.client.transport().plane_ticks(self.id())?;
+        let (via, id) = self.via();
+        let listener = via.transport().plane_ticks(id)?;
         *self.shared.ticks.borrow_mut() = Some(listener);
         Ok(())
     }

@@ -16,7 +16,8 @@ use crate::Error;
 /// What a client keeps per plane: the subscriber, the newest sample, the overlay.
 pub(crate) struct PlaneShared {
     pub(crate) id: PlaneId,
-    pub(crate) bodies: BodySubscriber,
+    /// Replaced when the plane moves to another daemon (`moving`).
+    pub(crate) bodies: RefCell<BodySubscriber>,
     pub(crate) latest: RefCell<Option<Rc<BodySample>>>,
     pub(crate) overlay: RefCell<Overlay>,
     /// Created on the first wait: readers that never wait pay nothing for it.
@@ -29,6 +30,8 @@ pub(crate) struct PlaneShared {
     pub(crate) mirror: RefCell<Mirror>,
     /// Adds and removals the newest header may not count yet ([`Plane::object_count`]).
     pub(crate) members: RefCell<Members>,
+    /// Where the plane went when it moved to another daemon (`moving`).
+    pub(crate) route: RefCell<Option<crate::moving::Route>>,
 }
 
 impl PlaneShared {
@@ -36,7 +39,7 @@ impl PlaneShared {
         let bodies = transport.plane_bodies(id)?;
         Ok(PlaneShared {
             id,
-            bodies,
+            bodies: RefCell::new(bodies),
             latest: RefCell::new(None),
             overlay: RefCell::default(),
             ticks: RefCell::new(None),
@@ -45,6 +48,7 @@ impl PlaneShared {
             refreshed_in: Cell::new(0),
             mirror: RefCell::default(),
             members: RefCell::default(),
+            route: RefCell::new(None),
         })
     }
 
@@ -67,7 +71,7 @@ impl PlaneShared {
 
     /// Takes the newest sample if one arrived: a check of a shared-memory queue, no syscall.
     pub(crate) fn refresh(&self) -> Result<(), Error> {
-        while let Some(sample) = self.bodies.receive()? {
+        while let Some(sample) = self.bodies.borrow().receive()? {
             *self.latest.borrow_mut() = Some(Rc::new(sample));
         }
         Ok(())

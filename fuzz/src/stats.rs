@@ -344,6 +344,7 @@ pub fn reply_name(reply: &Reply) -> &'static str {
         Reply::Opened(_) => "Opened",
         Reply::Saved { .. } => "Saved",
         Reply::Transfer(_) => "Transfer",
+        Reply::Moved { .. } => "Moved",
     }
 }
 
@@ -402,6 +403,8 @@ pub fn op_name(command: &Command) -> String {
             PlaneOp::Rewind(_) => "Plane.Rewind".into(),
             PlaneOp::Save => "Plane.Save".into(),
             PlaneOp::RestoreUploaded { .. } => "Plane.RestoreUploaded".into(),
+            PlaneOp::MoveTo { .. } => "Plane.MoveTo".into(),
+            PlaneOp::ClaimMoved { .. } => "Plane.ClaimMoved".into(),
         },
         Command::Transfer(op) => match op {
             TransferOp::Open { .. } => "Transfer.Open".into(),

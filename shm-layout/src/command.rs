@@ -278,6 +278,10 @@ pub enum Reply {
         plane: PlaneId,
         /// The claim key.
         key: u128,
+        /// The cluster.
+        cluster: String,
+        /// An endpoint of the cluster that routes for clients (the old daemon's).
+        endpoint: String,
     },
 }
 

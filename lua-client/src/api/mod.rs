@@ -27,6 +27,7 @@ pub mod ragdoll;
 pub mod snapshot;
 pub mod start_plane;
 pub mod static_shapes;
+pub mod move_to;
 
 use std::rc::Rc;
 

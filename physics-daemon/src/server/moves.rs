@@ -161,6 +161,8 @@ impl Daemon {
                 daemon: daemon.to_string(),
                 plane: id,
                 key: 0,
+                cluster: migration.cluster.clone(),
+                endpoint: migration.endpoint.clone(),
             });
         }
         migration
@@ -233,6 +235,8 @@ impl Daemon {
             daemon: daemon.to_string(),
             plane: new_id,
             key,
+            cluster: migration.cluster.clone(),
+            endpoint: migration.endpoint.clone(),
         })
     }
 

@@ -433,6 +433,7 @@ impl UserData for PhysicsPlane {
         super::probe::add_methods(methods);
         super::named_plane::add_methods(methods);
         super::plane_objects::add_methods(methods);
+        super::move_to::add_methods(methods);
         methods.add_meta_method(MetaMethod::Index, |lua, p, key: Value| {
             PLANE.get(lua, &p.0, &key)
         });

@@ -64,12 +64,13 @@ pub static PLANE: Props<PlaneState> = Props {
                     .map_err(|e| LuaError::runtime(e.message))
             }),
         },
-        // The cluster daemon the plane lives on (nil: this host's daemon, no cluster).
+        // The cluster daemon the plane lives on (nil: this host's daemon, no cluster); follows
+        // MoveTo.
         Row {
             name: "Daemon",
             kind: Kind::String,
             get: Get::Fn(|lua, p| {
-                Ok(match p.plane.client().cluster_daemon() {
+                Ok(match p.plane.daemon() {
                     Some(d) => Value::String(lua.create_string(d)?),
                     None => Value::Nil,
                 })

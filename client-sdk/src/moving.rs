@@ -1,0 +1,217 @@
+//! Planes that move between the daemons of a cluster (`Plane::move_to`, docs/cluster.md
+//! "Migration"). The user keeps the same `Plane` and `Object` values: a moved plane's
+//! per-plane state (`PlaneShared`) gets a [`Route`] to a connection to its new daemon (a
+//! remote client of the cluster, kept by the client that switched it) and its id there;
+//! every command for it is sent there from then on, and its ticks are read from there.
+//!
+//! A client learns of a move from its own `move_to`, or from the old daemon's refusal
+//! ([`shm_layout::migrate::Moved`]) of a command that reached it after the cut: the command
+//! was not applied, so it is sent again to the new daemon once switched (exactly once in
+//! all). A reader that only waits for ticks asks the old daemon when a wait brings none.
+
+use shm_layout::migrate::Moved;
+use shm_layout::{Command, CommandResult, PlaneId, PlaneOp, Reply};
+
+use crate::client::{unexpected, WeakClient};
+use crate::cluster::ClusterOptions;
+use crate::remote::RemoteOptions;
+use crate::{Client, Error, Plane};
+
+/// Where a moved plane's commands go: the connection to its daemon and its id there.
+#[derive(Clone)]
+pub(crate) struct Route {
+    pub(crate) peer: WeakClient,
+    pub(crate) id: PlaneId,
+}
+
+impl Client {
+    /// `Ok`: send `command` on this connection (under the plane's id here, which differs
+    /// when the plane moved onto it); `Err`: send it on the returned connection.
+    pub(crate) fn reroute(&self, command: Command) -> Result<Command, (Client, Command)> {
+        let Command::Plane { plane, op } = command else {
+            return Ok(command);
+        };
+        let route = self
+            .attached(plane)
+            .and_then(|s| s.route.borrow().clone())
+            .and_then(|r| Some((r.peer.upgrade()?, r.id)));
+        match route {
+            None => Ok(Command::Plane { plane, op }),
+            Some((peer, id)) if peer.same(self) => Ok(Command::Plane { plane: id, op }),
+            Some((peer, id)) => Err((peer, Command::Plane { plane: id, op })),
+        }
+    }
+
+    /// Sends again, to the plane's new daemon, every command the old one refused because
+    /// its plane moved (switching this client's plane over first).
+    pub(crate) fn resend_moved(
+        &self,
+        commands: &[Command],
+        results: &mut [CommandResult],
+    ) -> Result<(), Error> {
+        for (command, result) in commands.iter().zip(results.iter_mut()) {
+            let (Command::Plane { plane, .. }, Err(e)) = (command, &*result) else {
+                continue;
+            };
+            let Some(moved) = Moved::from_error(*plane, e) else {
+                continue;
+            };
+            let Some(shared) = self.attached(*plane) else {
+                // Not a plane of this client's: the refusal says where it went.
+                continue;
+            };
+            let switched = shared.route.borrow().as_ref().is_some_and(|r| {
+                r.id == moved.plane
+                    && r.peer
+                        .upgrade()
+                        .is_some_and(|p| p.cluster_daemon() == Some(moved.daemon.as_str()))
+            });
+            if !switched {
+                self.switch_plane(*plane, &moved, 0)?;
+            }
+            let again = match self.reroute(command.clone()) {
+                Ok(c) => self.send(vec![c])?,
+                Err((peer, c)) => peer.send(vec![c])?,
+            };
+            if let Some(r) = again.into_iter().next() {
+                *result = r;
+            }
+        }
+        Ok(())
+    }
+
+    /// Switches this client's plane `id` over to where `moved` says it lives; `key`
+    /// (non-zero for its owner) claims it there.
+    pub(crate) fn switch_plane(&self, id: PlaneId, moved: &Moved, key: u128) -> Result<(), Error> {
+        let Some(shared) = self.attached(id) else {
+            return Ok(());
+        };
+        let peer = self.peer_for(moved)?;
+        let bodies = peer.transport().plane_bodies(moved.plane)?;
+        *shared.bodies.borrow_mut() = bodies;
+        *shared.ticks.borrow_mut() = None;
+        *shared.events.borrow_mut() = None;
+        *shared.route.borrow_mut() = Some(Route {
+            peer: peer.downgrade(),
+            id: moved.plane,
+        });
+        peer.remember_plane(moved.plane, shared.clone());
+        if key != 0 {
+            peer.call(Command::plane(moved.plane, PlaneOp::ClaimMoved { key }))?;
+            peer.note_owned(moved.plane);
+        }
+        if !peer.same(self) || id != moved.plane {
+            self.requeue_to(id, &peer, moved.plane);
+        }
+        // Asking after subscribing makes the daemon hand the newest tick to the new reader.
+        peer.call(Command::plane(moved.plane, PlaneOp::Info))?;
+        tracing::debug!(
+            plane = id,
+            daemon = moved.daemon,
+            id_there = moved.plane,
+            "plane moved: switched over"
+        );
+        Ok(())
+    }
+
+    /// The connection to `moved.daemon`: this one, one made before, or a new remote client
+    /// of the cluster (through this client's own cluster options, or the endpoint the old
+    /// daemon named).
+    fn peer_for(&self, moved: &Moved) -> Result<Client, Error> {
+        if self.cluster_daemon() == Some(moved.daemon.as_str()) {
+            return Ok(self.clone());
+        }
+        if let Some(peer) = self.peers().borrow().get(&moved.daemon) {
+            return Ok(peer.clone());
+        }
+        let remote = match self.remote_options() {
+            Some(r) => RemoteOptions {
+                daemon: Some(moved.daemon.clone()),
+                ..r.clone()
+            },
+            None => RemoteOptions {
+                cluster: ClusterOptions {
+                    cluster: moved.cluster.clone(),
+                    endpoints: vec![moved.endpoint.clone()],
+                    ..Default::default()
+                },
+                daemon: Some(moved.daemon.clone()),
+            },
+        };
+        let peer = Client::connect_cluster_with(&remote, self.connect_options().clone())?;
+        self.peers()
+            .borrow_mut()
+            .insert(moved.daemon.clone(), peer.clone());
+        Ok(peer)
+    }
+}
+
+impl Plane {
+    /// Moves the plane to daemon `daemon` of the cluster (owner only; 3D planes only): the
+    /// queued writes are sent first (they are in the moved state), the plane stops between
+    /// two ticks on its daemon and goes on from the same tick on `daemon` with the same
+    /// objects and handles; this handle, its objects and every other client of the plane
+    /// switch over. Moving to the daemon it is on does nothing.
+    pub fn move_to(&self, daemon: &str) -> Result<(), Error> {
+        let (via, id) = self.via();
+        let reply = via.call(Command::plane(
+            id,
+            PlaneOp::MoveTo {
+                daemon: daemon.to_string(),
+            },
+        ))?;
+        match reply {
+            Reply::Moved { key: 0, .. } => Ok(()),
+            Reply::Moved {
+                daemon,
+                plane,
+                key,
+                cluster,
+                endpoint,
+            } => {
+                let moved = Moved {
+                    from_id: id,
+                    daemon,
+                    plane,
+                    cluster,
+                    endpoint,
+                };
+                via.switch_plane(id, &moved, key)
+            }
+            other => Err(unexpected(other)),
+        }
+    }
+
+    /// The cluster daemon the plane lives on (`None`: this host's daemon, outside a
+    /// cluster connection). Follows moves.
+    pub fn daemon(&self) -> Option<String> {
+        self.via().0.cluster_daemon().map(str::to_string)
+    }
+
+    /// The connection the plane's commands go to now, and its id there.
+    pub(crate) fn via(&self) -> (Client, PlaneId) {
+        let route = self
+            .shared
+            .route
+            .borrow()
+            .as_ref()
+            .and_then(|r| Some((r.peer.upgrade()?, r.id)));
+        route.unwrap_or_else(|| (self.client().clone(), self.id()))
+    }
+
+    /// While a wait brings no tick: fails when the plane's daemon is gone, and otherwise
+    /// asks it about the plane, so a plane that moved is switched over (the refusal does it).
+    pub(crate) fn look_for_move(&self) -> Result<(), Error> {
+        let (via, id) = self.via();
+        via.check_daemon()?;
+        match via.send(vec![Command::plane(id, PlaneOp::Info)]) {
+            Err(
+                e @ (Error::DaemonGone { .. }
+                | Error::NoDaemon { .. }
+                | Error::Stalled { .. }
+                | Error::Timeout(_)),
+            ) => Err(e),
+            _ => Ok(()),
+        }
+    }
+}
