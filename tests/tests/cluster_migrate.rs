@@ -236,3 +236,67 @@ fn moves_that_cannot_happen_are_refused_by_name() {
     let e = alone.move_to("b").unwrap_err();
     assert!(e.to_string().contains("--cluster"), "{e}");
 }
+
+#[test]
+fn a_luau_script_moves_its_plane_and_its_parts_keep_falling() {
+    let pair = pair("mv-lua");
+    let script = std::env::temp_dir().join(format!(
+        "{}.luau",
+        integration_tests::unique_domain("mv-lua")
+    ));
+    std::fs::write(
+        &script,
+        r#"
+local Physics = import("PhysicsService")
+local Renderable = import("Renderable")
+local P = import("Primitives")
+local V, CF = P.Vector.new, P.CFrame.new
+local plane = Physics.New({ TickRate = 0, Gravity = V(0, -10, 0), LinearDamping = 0, AngularDamping = 0 })
+assert(plane.Daemon == "a", "placed on a: " .. tostring(plane.Daemon))
+local part = Renderable.BasePart("Sphere")
+part.Size = V(1, 1, 1)
+part.CFrame = CF(V(0, 100, 0))
+local ball = plane:Add(part)
+for _ = 1, 30 do
+    plane:Step(1 / 60)
+end
+plane:MoveTo("b")
+assert(plane.Daemon == "b", "moved: " .. tostring(plane.Daemon))
+for _ = 1, 30 do
+    plane:Step(1 / 60)
+end
+local y = ball.CFrame.Position.Y
+local h, m = 1 / 240, 240
+local expect = 100 - 10 * h * h * m * (m + 1) / 2
+assert(math.abs(y - expect) < 1e-3, string.format("y %.5f, expected %.5f", y, expect))
+local ok, err = pcall(function()
+    plane:MoveTo(7)
+end)
+assert(not ok and string.find(tostring(err), "must be a string", 1, true), tostring(err))
+ok, err = pcall(function()
+    plane:MoveTo("nowhere")
+end)
+assert(not ok and string.find(tostring(err), "nowhere", 1, true), tostring(err))
+print("MOVED OK")
+"#,
+    )
+    .unwrap();
+    let out = integration_tests::physics_lua(
+        "unused-domain",
+        script.to_str().unwrap(),
+        &[
+            "--cluster",
+            &pair.cluster,
+            "--connect",
+            &endpoint(pair.a_port),
+            "--daemon",
+            "a",
+        ],
+    )
+    .output()
+    .unwrap();
+    let text =
+        String::from_utf8_lossy(&out.stdout).to_string() + &String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success() && text.contains("MOVED OK"), "{text}");
+    let _ = std::fs::remove_file(script);
+}
