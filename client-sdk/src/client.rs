@@ -12,6 +12,7 @@ use shm_layout::{
     LAYOUT_VERSION,
 };
 
+use crate::moving::Rerouted;
 use crate::plane_shared::PlaneShared;
 use crate::remote::{RemoteOptions, RemoteTransport};
 use crate::transport::{Transport, LIVENESS_PERIOD};
@@ -364,8 +365,8 @@ impl Client {
     pub(crate) fn call(&self, command: Command) -> Result<Reply, Error> {
         // A plane that moved: its commands go to its new daemon, under its id there.
         let command = match self.reroute(command) {
-            Ok(command) => command,
-            Err((peer, command)) => return peer.call(command),
+            Rerouted::Here(command) => command,
+            Rerouted::There(peer, command) => return peer.call(command),
         };
         let plane = match (&command, self.inner.options.refusals_at_next_call) {
             (Command::Plane { plane, op }, true) => {
@@ -418,8 +419,8 @@ impl Client {
         impulse: Option<u32>,
     ) {
         let (command, confirms) = match self.reroute(command) {
-            Ok(command) => (command, confirms),
-            Err((peer, command)) => {
+            Rerouted::Here(command) => (command, confirms),
+            Rerouted::There(peer, command) => {
                 let confirms = confirms.map(|(_, h)| (command_plane(&command), h));
                 return peer.queue_with(command, confirms, impulse);
             }
@@ -706,7 +707,8 @@ impl Client {
 
 impl Inner {
     fn round_trip(&self, commands: Vec<Command>) -> Result<Vec<CommandResult>, Error> {
-        self.round_trip_keeping(commands).map(|(results, _)| results)
+        self.round_trip_keeping(commands)
+            .map(|(results, _)| results)
     }
 
     /// [`Inner::round_trip`] that gives the commands back with their results.

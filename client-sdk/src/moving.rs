@@ -24,21 +24,29 @@ pub(crate) struct Route {
     pub(crate) id: PlaneId,
 }
 
+/// Where a command goes ([`Client::reroute`]).
+pub(crate) enum Rerouted {
+    /// On this connection (under the plane's id here, which differs when the plane moved
+    /// onto it).
+    Here(Command),
+    /// On another connection.
+    There(Client, Command),
+}
+
 impl Client {
-    /// `Ok`: send `command` on this connection (under the plane's id here, which differs
-    /// when the plane moved onto it); `Err`: send it on the returned connection.
-    pub(crate) fn reroute(&self, command: Command) -> Result<Command, (Client, Command)> {
+    /// Where `command` goes: this connection, or the one its plane moved to.
+    pub(crate) fn reroute(&self, command: Command) -> Rerouted {
         let Command::Plane { plane, op } = command else {
-            return Ok(command);
+            return Rerouted::Here(command);
         };
         let route = self
             .attached(plane)
             .and_then(|s| s.route.borrow().clone())
             .and_then(|r| Some((r.peer.upgrade()?, r.id)));
         match route {
-            None => Ok(Command::Plane { plane, op }),
-            Some((peer, id)) if peer.same(self) => Ok(Command::Plane { plane: id, op }),
-            Some((peer, id)) => Err((peer, Command::Plane { plane: id, op })),
+            None => Rerouted::Here(Command::Plane { plane, op }),
+            Some((peer, id)) if peer.same(self) => Rerouted::Here(Command::Plane { plane: id, op }),
+            Some((peer, id)) => Rerouted::There(peer, Command::Plane { plane: id, op }),
         }
     }
 
@@ -70,8 +78,8 @@ impl Client {
                 self.switch_plane(*plane, &moved, 0)?;
             }
             let again = match self.reroute(command.clone()) {
-                Ok(c) => self.send(vec![c])?,
-                Err((peer, c)) => peer.send(vec![c])?,
+                Rerouted::Here(c) => self.send(vec![c])?,
+                Rerouted::There(peer, c) => peer.send(vec![c])?,
             };
             if let Some(r) = again.into_iter().next() {
                 *result = r;

@@ -6,10 +6,10 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::command::PlaneId;
 use crate::error::{CommandError, ErrorKind};
 use crate::plane_name::PlaneName;
 use crate::plane_op::PlaneKind;
-use crate::command::PlaneId;
 
 /// The key a daemon answers migrations on: `physics/<cluster>/migrate/<daemon>`.
 pub fn migrate_key(cluster: &str, daemon: &str) -> String {

@@ -99,7 +99,11 @@ fn read_tick(plane: &Plane, tick: u64) -> u64 {
             assert_eq!(now.tick(), tick, "the reader skipped to a later tick");
             return now.header().state_hash;
         }
-        assert!(Instant::now() < deadline, "the reader stays at tick {}", now.tick());
+        assert!(
+            Instant::now() < deadline,
+            "the reader stays at tick {}",
+            now.tick()
+        );
         let _ = plane.wait_tick(Duration::from_millis(500));
     }
 }
@@ -110,7 +114,11 @@ fn a_plane_moves_mid_fall_and_its_readers_writers_and_hashes_carry_on() {
     let owner = pair.a.client();
     let (plane, balls) = falling_plane(&owner);
     let (twin, twin_balls) = falling_plane(&owner);
-    assert_eq!(plane.daemon(), None, "a local client names no cluster daemon");
+    assert_eq!(
+        plane.daemon(),
+        None,
+        "a local client names no cluster daemon"
+    );
 
     // Readers: a local client of a, and a remote client of a through the cluster.
     let local = pair.a.client();
@@ -122,7 +130,11 @@ fn a_plane_moves_mid_fall_and_its_readers_writers_and_hashes_carry_on() {
         assert_eq!(plane.step(DT).unwrap(), tick);
         assert_eq!(twin.step(DT).unwrap(), tick);
         let hash = plane.state_hash().unwrap();
-        assert_eq!(hash, twin.state_hash().unwrap(), "twins agree at tick {tick}");
+        assert_eq!(
+            hash,
+            twin.state_hash().unwrap(),
+            "twins agree at tick {tick}"
+        );
         assert_eq!(read_tick(&local_plane, tick), hash);
         assert_eq!(read_tick(&remote_plane, tick), hash);
     }
@@ -135,7 +147,11 @@ fn a_plane_moves_mid_fall_and_its_readers_writers_and_hashes_carry_on() {
     let moving = Instant::now();
     plane.move_to("b").unwrap();
     let move_took = moving.elapsed();
-    assert_eq!(plane.daemon().as_deref(), Some("b"), "the plane names its new daemon");
+    assert_eq!(
+        plane.daemon().as_deref(),
+        Some("b"),
+        "the plane names its new daemon"
+    );
     assert_eq!(plane.snapshot().unwrap().tick(), 30, "the same tick on b");
     assert_eq!(
         plane.state_hash().unwrap(),
@@ -149,7 +165,11 @@ fn a_plane_moves_mid_fall_and_its_readers_writers_and_hashes_carry_on() {
     local.flush().unwrap();
     twin_balls[1].apply_impulse([0.0, 20.0, 0.0]).unwrap();
     twin.client().flush().unwrap();
-    assert_eq!(local_plane.daemon().as_deref(), Some("b"), "the writer switched over");
+    assert_eq!(
+        local_plane.daemon().as_deref(),
+        Some("b"),
+        "the writer switched over"
+    );
 
     assert_eq!(plane.step(DT).unwrap(), 31, "tick 30 on a, 31 on b");
     let pause = last_on_a.elapsed();
@@ -173,8 +193,16 @@ fn a_plane_moves_mid_fall_and_its_readers_writers_and_hashes_carry_on() {
             "the moved plane computes what its unmoved twin does at tick {tick} (the write \
              after the cut applied exactly once)"
         );
-        assert_eq!(read_tick(&local_plane, tick), hash, "local reader, tick {tick}");
-        assert_eq!(read_tick(&remote_plane, tick), hash, "remote reader, tick {tick}");
+        assert_eq!(
+            read_tick(&local_plane, tick),
+            hash,
+            "local reader, tick {tick}"
+        );
+        assert_eq!(
+            read_tick(&remote_plane, tick),
+            hash,
+            "remote reader, tick {tick}"
+        );
     }
     assert_eq!(remote_plane.daemon().as_deref(), Some("b"));
     // Free fall through the move: ball 0 was never touched.
@@ -201,7 +229,8 @@ fn moves_that_cannot_happen_are_refused_by_name() {
 
     let e = plane.move_to("nowhere").unwrap_err();
     assert!(
-        e.to_string().contains("no live daemon is named \"nowhere\""),
+        e.to_string()
+            .contains("no live daemon is named \"nowhere\""),
         "{e}"
     );
     let e = plane.move_to("b/*").unwrap_err();

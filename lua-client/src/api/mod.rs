@@ -16,6 +16,7 @@ pub mod gui_plane;
 pub mod joint;
 pub(crate) mod lifecycle;
 pub mod map;
+pub mod move_to;
 pub mod named_plane;
 pub mod object;
 pub mod part;
@@ -27,7 +28,6 @@ pub mod ragdoll;
 pub mod snapshot;
 pub mod start_plane;
 pub mod static_shapes;
-pub mod move_to;
 
 use std::rc::Rc;
 

@@ -38,7 +38,9 @@ impl Courier for ZenohCourier {
         let mut live = Vec::new();
         while let Ok(reply) = replies.recv() {
             if let Ok(sample) = reply.result() {
-                live.push(shm_layout::cluster::last_segment(sample.key_expr().as_str()).to_string());
+                live.push(
+                    shm_layout::cluster::last_segment(sample.key_expr().as_str()).to_string(),
+                );
             }
         }
         if live.iter().any(|d| d == daemon) {

@@ -161,8 +161,13 @@ impl Cluster {
         &mut self,
         domain: &str,
     ) -> Result<Arc<crate::server::moves::Migration>, ClusterError> {
-        let (migration, arrivals) =
-            migrate::start(&self.session, &self.cluster, &self.name, &self.endpoint, domain)?;
+        let (migration, arrivals) = migrate::start(
+            &self.session,
+            &self.cluster,
+            &self.name,
+            &self.endpoint,
+            domain,
+        )?;
         self.arrivals = Some(arrivals);
         Ok(migration)
     }

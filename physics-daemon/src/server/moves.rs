@@ -201,15 +201,12 @@ impl Daemon {
             bytes,
         };
         let size = moving.bytes.len();
-        let new_id = migration
-            .courier
-            .deliver(daemon, &moving)
-            .map_err(|e| {
-                CommandError::new(
-                    ErrorKind::Internal,
-                    format!("plane {id} could not move to {daemon:?} (it stays here): {e}"),
-                )
-            })?;
+        let new_id = migration.courier.deliver(daemon, &moving).map_err(|e| {
+            CommandError::new(
+                ErrorKind::Internal,
+                format!("plane {id} could not move to {daemon:?} (it stays here): {e}"),
+            )
+        })?;
         // Gone from here between two ticks: the worker finds no plane and ends.
         *guard = None;
         drop(guard);
@@ -262,7 +259,11 @@ impl Daemon {
         if let Some(c) = self.clients.get_mut(client) {
             c.planes.push(id);
         }
-        tracing::info!(plane = id, client = format!("{client:032x}"), "moved plane claimed");
+        tracing::info!(
+            plane = id,
+            client = format!("{client:032x}"),
+            "moved plane claimed"
+        );
         Ok(Reply::Done)
     }
 
@@ -376,7 +377,10 @@ impl Daemon {
                 }
                 Some(Err(e)) => {
                     self.remove_plane(id);
-                    Err(format!("its snapshot does not restore there: {}", e.message))
+                    Err(format!(
+                        "its snapshot does not restore there: {}",
+                        e.message
+                    ))
                 }
                 other => {
                     self.remove_plane(id);
