@@ -379,7 +379,20 @@ impl Client {
             }
             _ => None,
         };
-        let mut results = self.send(vec![command])?;
+        // A remote client's persistent plane outlives its daemon (`failover_switch`): keep
+        // the command to send it again where the plane was taken over.
+        let again = match &command {
+            Command::Plane { plane, .. } if self.remote_options().is_some() => {
+                Some((*plane, command.clone()))
+            }
+            _ => None,
+        };
+        let mut results = match (self.send(vec![command]), again) {
+            (Err(Error::DaemonGone { .. }), Some((plane, command))) if self.fail_over(plane)? => {
+                return self.call(command);
+            }
+            (results, _) => results?,
+        };
         match results.pop() {
             Some(Ok(reply @ (Reply::Stepped { .. } | Reply::Applied { .. } | Reply::Done)))
                 if plane.is_some() =>

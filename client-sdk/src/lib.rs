@@ -21,6 +21,7 @@ mod contact_points;
 mod controller;
 mod error;
 mod events;
+mod failover_switch;
 mod gui;
 mod inspect;
 mod joint;

@@ -122,34 +122,50 @@ impl Client {
         Ok(())
     }
 
-    /// The connection to `moved.daemon`: this one, one made before, or a new remote client
-    /// of the cluster (through this client's own cluster options, or the endpoint the old
-    /// daemon named).
+    /// The connection to `moved.daemon` (see [`Client::peer_named`]).
     fn peer_for(&self, moved: &Moved) -> Result<Client, Error> {
-        if self.cluster_daemon() == Some(moved.daemon.as_str()) {
+        self.peer_named(&moved.daemon, &moved.cluster, Some(&moved.endpoint))
+    }
+
+    /// The connection to daemon `daemon` of `cluster`: this one, one made before, or a new
+    /// remote client of the cluster (through this client's own cluster options, or
+    /// `endpoint`: one the old daemon named).
+    pub(crate) fn peer_named(
+        &self,
+        daemon: &str,
+        cluster: &str,
+        endpoint: Option<&str>,
+    ) -> Result<Client, Error> {
+        if self.cluster_daemon() == Some(daemon) {
             return Ok(self.clone());
         }
-        if let Some(peer) = self.peers().borrow().get(&moved.daemon) {
+        if let Some(peer) = self.peers().borrow().get(daemon) {
             return Ok(peer.clone());
         }
-        let remote = match self.remote_options() {
-            Some(r) => RemoteOptions {
-                daemon: Some(moved.daemon.clone()),
+        let remote = match (self.remote_options(), endpoint) {
+            (Some(r), _) => RemoteOptions {
+                daemon: Some(daemon.to_string()),
                 ..r.clone()
             },
-            None => RemoteOptions {
+            (None, Some(endpoint)) => RemoteOptions {
                 cluster: ClusterOptions {
-                    cluster: moved.cluster.clone(),
-                    endpoints: vec![moved.endpoint.clone()],
+                    cluster: cluster.to_string(),
+                    endpoints: vec![endpoint.to_string()],
                     ..Default::default()
                 },
-                daemon: Some(moved.daemon.clone()),
+                daemon: Some(daemon.to_string()),
             },
+            (None, None) => {
+                return Err(Error::Cluster(format!(
+                    "cannot reach daemon {daemon:?}: this client knows no endpoint of cluster \
+                     {cluster:?}"
+                )))
+            }
         };
         let peer = Client::connect_cluster_with(&remote, self.connect_options().clone())?;
         self.peers()
             .borrow_mut()
-            .insert(moved.daemon.clone(), peer.clone());
+            .insert(daemon.to_string(), peer.clone());
         Ok(peer)
     }
 }
@@ -211,7 +227,13 @@ impl Plane {
     /// asks it about the plane, so a plane that moved is switched over (the refusal does it).
     pub(crate) fn look_for_move(&self) -> Result<(), Error> {
         let (via, id) = self.via();
-        via.check_daemon()?;
+        if let Err(e) = via.check_daemon() {
+            // A daemon that died: a persistent plane goes on where it was taken over.
+            return match e {
+                Error::DaemonGone { .. } if via.fail_over(id)? => Ok(()),
+                e => Err(e),
+            };
+        }
         match via.send(vec![Command::plane(id, PlaneOp::Info)]) {
             Err(
                 e @ (Error::DaemonGone { .. }

@@ -414,6 +414,7 @@ impl Client {
                 return Err(e);
             }
         };
+        crate::failover_switch::note_info(&plane.shared, &info);
         *plane.shared.mirror.borrow_mut() =
             crate::mirror::Mirror::exclusive(info, options.shared == Some(true));
         self.note_owned(id);
@@ -439,7 +440,9 @@ impl Client {
             }
         };
         // Asking after subscribing makes the daemon hand the newest tick to the new reader.
-        self.call(Command::plane(id, PlaneOp::Info))?;
+        if let Reply::Plane(info) = self.call(Command::plane(id, PlaneOp::Info))? {
+            crate::failover_switch::note_info(&shared, &info);
+        }
         self.remember_plane(id, shared.clone());
         Ok(Plane::new(self.clone(), shared))
     }

@@ -32,6 +32,10 @@ pub(crate) struct PlaneShared {
     pub(crate) members: RefCell<Members>,
     /// Where the plane went when it moved to another daemon (`moving`).
     pub(crate) route: RefCell<Option<crate::moving::Route>>,
+    /// The name of a persistent plane (`failover_switch` opens it by name elsewhere).
+    pub(crate) persistent_name: RefCell<Option<String>>,
+    /// Ticks lost when the plane came back on another member (`Plane::take_recovered`).
+    pub(crate) recovered: Cell<Option<u64>>,
 }
 
 impl PlaneShared {
@@ -49,6 +53,8 @@ impl PlaneShared {
             mirror: RefCell::default(),
             members: RefCell::default(),
             route: RefCell::new(None),
+            persistent_name: RefCell::new(None),
+            recovered: Cell::new(None),
         })
     }
 

@@ -187,6 +187,32 @@ impl RemoteTransport {
         Some(self.alive.load(Ordering::SeqCst))
     }
 
+    /// The members that hold replicas of other members' persistent planes (failover),
+    /// by name; empty when the cluster does not answer.
+    pub(crate) fn holders(&self) -> Vec<String> {
+        let replies = self
+            .session
+            .liveliness()
+            .get(format!(
+                "{}/{}/holder/*",
+                shm_layout::cluster::ROOT,
+                self.cluster
+            ))
+            .timeout(Duration::from_secs(1))
+            .wait();
+        let mut names = Vec::new();
+        if let Ok(replies) = replies {
+            while let Ok(reply) = replies.recv() {
+                if let Ok(sample) = reply.result() {
+                    names.push(
+                        shm_layout::cluster::last_segment(sample.key_expr().as_str()).to_string(),
+                    );
+                }
+            }
+        }
+        names
+    }
+
     fn watch(&self, op: WatchOp) -> Result<WatchReply, Error> {
         let replies = self
             .session

@@ -24,10 +24,23 @@ use crate::values::{expected, sdk_error};
 struct Recovery {
     signal: Signal,
     lost: Cell<Option<u64>>,
+    /// The plane, once the script read its signal: a plane that came back on another
+    /// member after its daemon died announces it through the SDK (`Plane::take_recovered`).
+    plane: RefCell<Option<client_sdk::Plane>>,
 }
 
 impl Watched for Recovery {
     fn listeners(&self) -> usize {
+        if self.lost.get().is_none() {
+            if let Some(lost) = self
+                .plane
+                .borrow()
+                .as_ref()
+                .and_then(|p| p.take_recovered())
+            {
+                self.lost.set(Some(lost));
+            }
+        }
         match self.lost.get() {
             Some(_) => self.signal.listeners(),
             None => 0,
@@ -62,6 +75,7 @@ fn recovery(lua: &Lua, id: PlaneId) -> Rc<Recovery> {
             let r = Rc::new(Recovery {
                 signal: Signal::new(format!("PhysicsPlane {id}.Recovered")),
                 lost: Cell::new(None),
+                plane: RefCell::new(None),
             });
             scheduler(lua).watch(r.clone());
             r
@@ -71,9 +85,9 @@ fn recovery(lua: &Lua, id: PlaneId) -> Rc<Recovery> {
 
 /// `plane.Recovered`: the signal (the same value on every read).
 pub fn recovered_signal(lua: &Lua, p: &PlaneState) -> mlua::Result<Value> {
-    Ok(Value::UserData(
-        recovery(lua, p.plane.id()).signal.userdata(lua)?,
-    ))
+    let r = recovery(lua, p.plane.id());
+    r.plane.borrow_mut().get_or_insert_with(|| p.plane.clone());
+    Ok(Value::UserData(r.signal.userdata(lua)?))
 }
 
 /// `plane.Recovered` of a GUI plane: the signal (the same value on every read).
