@@ -75,7 +75,8 @@ impl Client {
                         .is_some_and(|p| p.cluster_daemon() == Some(moved.daemon.as_str()))
             });
             if !switched {
-                self.switch_plane(*plane, &moved, 0)?;
+                // The owner of a plane moved by `--rebalance` learns its claim key here.
+                self.switch_plane(*plane, &moved, moved.key)?;
             }
             let again = match self.reroute(command.clone()) {
                 Rerouted::Here(c) => self.send(vec![c])?,
@@ -199,11 +200,19 @@ impl Plane {
                     plane,
                     cluster,
                     endpoint,
+                    key,
                 };
                 via.switch_plane(id, &moved, key)
             }
             other => Err(unexpected(other)),
         }
+    }
+
+    /// Pins the plane to its daemon (owner only): `--rebalance` never moves it away (a plane
+    /// placed on a daemon by name). [`Plane::move_to`] still moves it.
+    pub fn pin(&self) -> Result<(), Error> {
+        let (via, id) = self.via();
+        via.call(Command::plane(id, PlaneOp::Pin)).map(|_| ())
     }
 
     /// The cluster daemon the plane lives on (`None`: this host's daemon, outside a

@@ -405,6 +405,7 @@ pub fn op_name(command: &Command) -> String {
             PlaneOp::RestoreUploaded { .. } => "Plane.RestoreUploaded".into(),
             PlaneOp::MoveTo { .. } => "Plane.MoveTo".into(),
             PlaneOp::ClaimMoved { .. } => "Plane.ClaimMoved".into(),
+            PlaneOp::Pin => "Plane.Pin".into(),
         },
         Command::Transfer(op) => match op {
             TransferOp::Open { .. } => "Transfer.Open".into(),

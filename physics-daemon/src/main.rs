@@ -110,6 +110,12 @@ fn main() -> ExitCode {
                 return ExitCode::FAILURE;
             }
         }
+        if let (Some(share), Some(m)) = (args.cluster.rebalance, migrate.clone()) {
+            if let Err(e) = c.start_rebalance(share, m, &args.domain) {
+                tracing::error!("{e}");
+                return ExitCode::FAILURE;
+            }
+        }
     }
     let options = physics_daemon::server::Options {
         limits: args.limits,

@@ -53,6 +53,9 @@ pub struct Moved {
     pub cluster: String,
     /// An endpoint of the cluster that routes for clients (the old daemon's own).
     pub endpoint: String,
+    /// The key the plane's owner claims it with there; 0 in the refusal of anyone else's
+    /// command (a plane moved by `--rebalance` tells its owner this way).
+    pub key: u128,
 }
 
 /// Marks the machine-readable form in [`CommandError::field`].
@@ -65,8 +68,8 @@ impl Moved {
         CommandError {
             kind: ErrorKind::Moved,
             field: Some(format!(
-                "{TAG}\t{}\t{}\t{}\t{}",
-                self.daemon, self.plane, self.cluster, self.endpoint
+                "{TAG}\t{}\t{}\t{}\t{}\t{:x}",
+                self.daemon, self.plane, self.cluster, self.endpoint, self.key
             )),
             message: format!(
                 "plane {} moved to daemon {:?} (plane {} there, cluster {:?}): the command \
@@ -90,6 +93,7 @@ impl Moved {
         let plane = parts.next()?.parse().ok()?;
         let cluster = parts.next()?.to_string();
         let endpoint = parts.next()?.to_string();
+        let key = u128::from_str_radix(parts.next().unwrap_or("0"), 16).ok()?;
         crate::cluster::check_name("daemon", &daemon).ok()?;
         crate::cluster::check_name("cluster", &cluster).ok()?;
         Some(Moved {
@@ -98,6 +102,7 @@ impl Moved {
             plane,
             cluster,
             endpoint,
+            key,
         })
     }
 }
@@ -114,6 +119,7 @@ mod tests {
             plane: 7,
             cluster: "demo".into(),
             endpoint: "tcp/127.0.0.1:7447".into(),
+            key: 0xabc,
         };
         let e = moved.to_error();
         assert!(e.message.contains("moved to daemon \"b\""), "{}", e.message);

@@ -112,6 +112,9 @@ pub enum PlaneOp {
         /// The key of [`crate::Reply::Moved`].
         key: u128,
     },
+    /// Pins the plane to its daemon (owner only): `--rebalance` never moves it (a plane
+    /// placed on a daemon by name). `MoveTo` still does. Replies [`crate::Reply::Done`].
+    Pin,
 }
 
 /// What an op may add to a plane, for the daemon's per-client quotas.

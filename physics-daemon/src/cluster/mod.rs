@@ -11,6 +11,7 @@
 //! - [`failover`]: persistent planes replicated to the other members, and restored by one
 //!   of them when their daemon leaves.
 //! - [`migrate`]: planes moving to and arriving from other members (`MoveTo`).
+//! - [`rebalance`]: `--rebalance`, planes moved off a daemon over its tick budget.
 //! - remote clients: [`client_sdk::relay`] answers them as local clients of this daemon,
 //!   one per remote session (started by [`Cluster::serve_remote`]).
 //!
@@ -20,6 +21,7 @@ pub mod failover;
 pub mod load;
 pub mod membership;
 pub mod migrate;
+pub mod rebalance;
 pub mod session;
 
 use std::sync::Arc;
@@ -66,6 +68,7 @@ pub struct Cluster {
     /// An endpoint clients of a plane that moved away connect through (the first listened).
     endpoint: String,
     arrivals: Option<migrate::Arrivals>,
+    rebalancer: Option<rebalance::Rebalancer>,
 }
 
 impl Cluster {
@@ -107,6 +110,7 @@ impl Cluster {
         Ok(Some(Cluster {
             endpoint,
             arrivals: None,
+            rebalancer: None,
             reporter,
             _member: member,
             session,
@@ -172,6 +176,25 @@ impl Cluster {
         Ok(migration)
     }
 
+    /// Starts `--rebalance SHARE` ([`rebalance`]): planes move through `migration`.
+    pub fn start_rebalance(
+        &mut self,
+        share: f32,
+        migration: Arc<crate::server::moves::Migration>,
+        domain: &str,
+    ) -> Result<(), ClusterError> {
+        let r = rebalance::start(
+            &self.session,
+            &self.cluster,
+            &self.name,
+            share,
+            migration,
+            domain,
+        )?;
+        self.rebalancer = Some(r);
+        Ok(())
+    }
+
     /// The Zenoh session (for the parts of the cluster built on it).
     pub fn session(&self) -> &zenoh::Session {
         &self.session
@@ -186,8 +209,10 @@ impl Cluster {
             relay,
             failover,
             arrivals,
+            rebalancer,
             ..
         } = self;
+        drop(rebalancer);
         drop(arrivals);
         drop(failover);
         if let Some(relay) = relay {

@@ -47,6 +47,10 @@ pub struct ClusterArgs {
     /// Certificate common name of a peer allowed in (repeatable); required with TLS.
     #[arg(long, requires = "cluster")]
     pub allow_peer: Vec<String>,
+    /// Move planes to less loaded members while this daemon uses more than this share of
+    /// its tick budget (0 < SHARE <= 1; the flag alone: 0.8). Off without the flag.
+    #[arg(long, requires = "cluster", num_args = 0..=1, default_missing_value = "0.8", value_name = "SHARE")]
+    pub rebalance: Option<f32>,
 }
 
 /// The checked flags.

@@ -54,7 +54,8 @@ impl Plane {
             | PlaneOp::Save
             | PlaneOp::RestoreUploaded { .. }
             | PlaneOp::MoveTo { .. }
-            | PlaneOp::ClaimMoved { .. } => Err(CommandError::new(
+            | PlaneOp::ClaimMoved { .. }
+            | PlaneOp::Pin => Err(CommandError::new(
                 ErrorKind::Internal,
                 format!("{op:?} is handled by the server, not the plane"),
             )),

@@ -111,7 +111,7 @@ impl Daemon {
             Command::CreatePlane { kind, props } => self.create_plane(client, kind, props),
             Command::Plane { plane, op } => {
                 // A plane that moved away: refused (not applied) naming where it went.
-                if let Some(e) = self.moved_refusal(plane) {
+                if let Some(e) = self.moved_refusal(client, plane) {
                     return now(Err(e));
                 }
                 if let PlaneOp::ClaimMoved { key } = op {
@@ -137,6 +137,9 @@ impl Daemon {
                 if let PlaneOp::MoveTo { daemon } = &op {
                     return now(self.move_plane(plane, daemon));
                 }
+                if op == PlaneOp::Pin {
+                    return now(self.pin_plane(plane));
+                }
                 if op == PlaneOp::Destroy {
                     self.forget_file(plane);
                     self.remove_plane(plane);
@@ -149,7 +152,10 @@ impl Daemon {
                         || *op == PlaneOp::Destroy
                         || *op == PlaneOp::Save
                         || matches!(op, PlaneOp::RestoreUploaded { .. })
-                        || matches!(op, PlaneOp::MoveTo { .. } | PlaneOp::ClaimMoved { .. })
+                        || matches!(
+                            op,
+                            PlaneOp::MoveTo { .. } | PlaneOp::ClaimMoved { .. } | PlaneOp::Pin
+                        )
                         || self.check_access(client, plane, op).is_err()
                     {
                         break;
@@ -205,6 +211,7 @@ impl Daemon {
                 refused("only its owner may set SharedObjectLimit")
             }
             PlaneOp::MoveTo { .. } => refused("only its owner may move it"),
+            PlaneOp::Pin => refused("only its owner may pin it"),
             _ if entry.shared => Ok(()),
             _ => refused(
                 "it is not shared, so other clients may only read it (its owner can create it \

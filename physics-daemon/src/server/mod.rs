@@ -405,6 +405,7 @@ fn serve(
         daemon.handle_events();
         daemon.adopt_planes();
         daemon.take_arrivals();
+        daemon.take_rebalance();
         daemon.serve_requests();
         if let Some(gauge) = &daemon.options.load {
             gauge.track(daemon.planes.len(), daemon.next_plane_id, || {

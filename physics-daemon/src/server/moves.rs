@@ -36,6 +36,16 @@ pub trait Courier: Send + Sync {
     fn deliver(&self, daemon: &str, plane: &MovingPlane) -> MoveAnswer;
 }
 
+/// A plane `--rebalance` wants moved: the largest movable plane goes to `target`.
+#[derive(Debug, Clone)]
+pub struct RebalanceRequest {
+    /// The member with room.
+    pub target: String,
+}
+
+/// Planes that arrived this recently are not moved on by `--rebalance` (no ping-pong).
+pub const SETTLE: Duration = Duration::from_secs(30);
+
 /// A plane arriving from another daemon, and where its answer goes.
 pub struct Arrival {
     plane: MovingPlane,
@@ -52,6 +62,7 @@ pub struct Migration {
     pub endpoint: String,
     courier: Box<dyn Courier>,
     arrivals: Mutex<Vec<Arrival>>,
+    rebalance: Mutex<Vec<RebalanceRequest>>,
 }
 
 impl Migration {
@@ -63,7 +74,17 @@ impl Migration {
             endpoint: endpoint.to_string(),
             courier,
             arrivals: Mutex::default(),
+            rebalance: Mutex::default(),
         }
+    }
+
+    /// Asks the loop to move its largest movable plane to `request.target` (`--rebalance`;
+    /// wake the loop after: `crate::wake`).
+    pub fn rebalance(&self, request: RebalanceRequest) {
+        self.rebalance
+            .lock()
+            .unwrap_or_else(|p| p.into_inner())
+            .push(request);
     }
 
     /// Queues a plane that arrives (wake the loop after: `crate::wake`); its answer comes
@@ -91,22 +112,39 @@ impl std::fmt::Debug for Migration {
     }
 }
 
-/// The planes that left this daemon: old id → where they went.
+/// What the loop keeps about moves: the planes that left (old id → where they went, and
+/// the owner the claim key is for), the planes pinned to this daemon, and when planes
+/// arrived.
 #[derive(Default)]
 pub(super) struct Tombstones {
-    map: HashMap<PlaneId, Moved>,
+    map: HashMap<PlaneId, (Moved, u128)>,
     order: VecDeque<PlaneId>,
+    pinned: std::collections::HashSet<PlaneId>,
+    arrived: HashMap<PlaneId, Instant>,
 }
 
 impl Tombstones {
-    fn insert(&mut self, moved: Moved) {
+    fn insert(&mut self, moved: Moved, owner: u128) {
         if self.order.len() >= MAX_TOMBSTONES {
             if let Some(old) = self.order.pop_front() {
                 self.map.remove(&old);
             }
         }
         self.order.push_back(moved.from_id);
-        self.map.insert(moved.from_id, moved);
+        self.pinned.remove(&moved.from_id);
+        self.arrived.remove(&moved.from_id);
+        self.map.insert(moved.from_id, (moved, owner));
+    }
+
+    /// The refusal `client` gets for plane `id` that left (the claim key only for its
+    /// owner).
+    fn refusal(&self, id: PlaneId, client: u128) -> Option<CommandError> {
+        let (moved, owner) = self.map.get(&id)?;
+        let mut moved = moved.clone();
+        if *owner != client {
+            moved.key = 0;
+        }
+        Some(moved.to_error())
     }
 }
 
@@ -131,12 +169,54 @@ fn move_error(message: String) -> CommandError {
 }
 
 impl Daemon {
-    /// The refusal of a command for plane `id` when it moved away.
-    pub(super) fn moved_refusal(&self, id: PlaneId) -> Option<CommandError> {
+    /// The refusal of `client`'s command for plane `id` when it moved away.
+    pub(super) fn moved_refusal(&self, client: u128, id: PlaneId) -> Option<CommandError> {
         if self.planes.contains_key(&id) {
             return None;
         }
-        self.moved.map.get(&id).map(Moved::to_error)
+        self.moved.refusal(id, client)
+    }
+
+    /// `Pin` of plane `id` (its owner asked): `--rebalance` leaves it here.
+    pub(super) fn pin_plane(&mut self, id: PlaneId) -> CommandResult {
+        self.plane(id)?;
+        self.moved.pinned.insert(id);
+        Ok(Reply::Done)
+    }
+
+    /// Serves `--rebalance`'s requests: the largest 3D plane that is not pinned and did not
+    /// arrive within [`SETTLE`] moves to the target, through the path of `MoveTo`.
+    pub(super) fn take_rebalance(&mut self) {
+        let Some(migration) = self.options.migrate.clone() else {
+            return;
+        };
+        let requests =
+            std::mem::take(&mut *migration.rebalance.lock().unwrap_or_else(|p| p.into_inner()));
+        for request in requests {
+            let now = Instant::now();
+            let candidate = self
+                .planes
+                .iter()
+                .filter(|(id, e)| {
+                    e.kind == PlaneKind::Rapier3d
+                        && !self.moved.pinned.contains(id)
+                        && self
+                            .moved
+                            .arrived
+                            .get(id)
+                            .is_none_or(|t| now.duration_since(*t) >= SETTLE)
+                })
+                .max_by_key(|(id, e)| (e.usage.objects(), std::cmp::Reverse(**id)))
+                .map(|(id, _)| *id);
+            let Some(id) = candidate else {
+                tracing::info!("rebalance: no plane may move (pinned, or arrived lately)");
+                continue;
+            };
+            match self.move_plane(id, &request.target) {
+                Ok(_) => tracing::info!(plane = id, to = request.target, "rebalanced"),
+                Err(e) => tracing::warn!(plane = id, to = request.target, "rebalance: {e}"),
+            }
+        }
     }
 
     /// `MoveTo(daemon)` of plane `id` (its owner asked: `check_access`).
@@ -169,7 +249,8 @@ impl Daemon {
             .courier
             .check_target(daemon)
             .map_err(|e| move_error(format!("MoveTo({daemon:?}): {e}")))?;
-        let (cell, name, persistent) = (entry.cell.clone(), entry.name, entry.persistent);
+        let (cell, name, persistent, owner) =
+            (entry.cell.clone(), entry.name, entry.persistent, entry.owner);
         let started = Instant::now();
         let Some(mut guard) = cell.lock_idle(IDLE_WAIT) else {
             return Err(CommandError::new(
@@ -212,13 +293,17 @@ impl Daemon {
         drop(guard);
         self.forget_file(id);
         self.remove_plane(id);
-        self.moved.insert(Moved {
-            from_id: id,
-            daemon: daemon.to_string(),
-            plane: new_id,
-            cluster: migration.cluster.clone(),
-            endpoint: migration.endpoint.clone(),
-        });
+        self.moved.insert(
+            Moved {
+                from_id: id,
+                daemon: daemon.to_string(),
+                plane: new_id,
+                cluster: migration.cluster.clone(),
+                endpoint: migration.endpoint.clone(),
+                key,
+            },
+            owner,
+        );
         tracing::info!(
             plane = id,
             to = daemon,
@@ -239,13 +324,11 @@ impl Daemon {
 
     /// `ClaimMoved(key)`: the plane that arrived with this key becomes `client`'s.
     pub(super) fn claim_moved(&mut self, client: u128, id: PlaneId, key: u128) -> CommandResult {
-        let entry = self.planes.get_mut(&id).ok_or_else(|| {
-            self.moved
-                .map
-                .get(&id)
-                .map(Moved::to_error)
-                .unwrap_or_else(|| super::dispatch::unknown_plane(id))
-        })?;
+        let refusal = self.moved.refusal(id, client);
+        let entry = self
+            .planes
+            .get_mut(&id)
+            .ok_or_else(|| refusal.unwrap_or_else(|| super::dispatch::unknown_plane(id)))?;
         if entry.owner == client {
             return Ok(Reply::Done);
         }
@@ -366,6 +449,7 @@ impl Daemon {
                     if let Some(e) = self.planes.get_mut(&id) {
                         e.shared = info.settings.shared;
                     }
+                    self.moved.arrived.insert(id, Instant::now());
                     tracing::info!(
                         plane = id,
                         from = moving.from,
