@@ -97,11 +97,7 @@ pub fn start(
 
 /// The latest load report of every member (a report under another name's key is ignored).
 fn loads(session: &Session, cluster: &str) -> Vec<LoadReport> {
-    let Ok(replies) = session
-        .get(keys::loads_key(cluster))
-        .timeout(PERIOD)
-        .wait()
-    else {
+    let Ok(replies) = session.get(keys::loads_key(cluster)).timeout(PERIOD).wait() else {
         return Vec::new();
     };
     let mut reports = Vec::new();
@@ -156,8 +152,16 @@ mod tests {
 
     #[test]
     fn only_an_overloaded_daemon_moves_and_only_to_a_member_with_room() {
-        let r = [report("a", 3, 0.9), report("b", 1, 0.5), report("c", 1, 0.3)];
-        assert_eq!(choose(&r, "a", 0.8).as_deref(), Some("c"), "least loaded with room");
+        let r = [
+            report("a", 3, 0.9),
+            report("b", 1, 0.5),
+            report("c", 1, 0.3),
+        ];
+        assert_eq!(
+            choose(&r, "a", 0.8).as_deref(),
+            Some("c"),
+            "least loaded with room"
+        );
         assert_eq!(choose(&r, "b", 0.8), None, "under its share");
         // Nobody under half the share: no room anywhere (no ping-pong between two busy).
         let r = [report("a", 3, 0.9), report("b", 1, 0.45)];

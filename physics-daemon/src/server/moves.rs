@@ -190,8 +190,12 @@ impl Daemon {
         let Some(migration) = self.options.migrate.clone() else {
             return;
         };
-        let requests =
-            std::mem::take(&mut *migration.rebalance.lock().unwrap_or_else(|p| p.into_inner()));
+        let requests = std::mem::take(
+            &mut *migration
+                .rebalance
+                .lock()
+                .unwrap_or_else(|p| p.into_inner()),
+        );
         for request in requests {
             let now = Instant::now();
             let candidate = self
@@ -249,8 +253,12 @@ impl Daemon {
             .courier
             .check_target(daemon)
             .map_err(|e| move_error(format!("MoveTo({daemon:?}): {e}")))?;
-        let (cell, name, persistent, owner) =
-            (entry.cell.clone(), entry.name, entry.persistent, entry.owner);
+        let (cell, name, persistent, owner) = (
+            entry.cell.clone(),
+            entry.name,
+            entry.persistent,
+            entry.owner,
+        );
         let started = Instant::now();
         let Some(mut guard) = cell.lock_idle(IDLE_WAIT) else {
             return Err(CommandError::new(

@@ -543,7 +543,10 @@ fn new_plane(lua: &Lua, opts: Value) -> mlua::Result<mlua::AnyUserData> {
         .create_plane(&options)
         .map_err(|e| sdk_error(WHAT, e))?;
     // Placed on a daemon by name: `--rebalance` leaves it there.
-    if placement.as_deref().is_some_and(|p| p != "local" && p != "auto") {
+    if placement
+        .as_deref()
+        .is_some_and(|p| p != "local" && p != "auto")
+    {
         plane.pin().map_err(|e| sdk_error(WHAT, e))?;
     }
     wrap_plane(lua, plane)
