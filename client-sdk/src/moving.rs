@@ -178,6 +178,12 @@ impl Plane {
     /// objects and handles; this handle, its objects and every other client of the plane
     /// switch over. Moving to the daemon it is on does nothing.
     pub fn move_to(&self, daemon: &str) -> Result<(), Error> {
+        self.move_to_at(daemon).map(|_| ())
+    }
+
+    /// [`Plane::move_to`] that returns the tick the plane stopped at (its last on the old
+    /// daemon; the new daemon's first is the next).
+    pub fn move_to_at(&self, daemon: &str) -> Result<u64, Error> {
         let (via, id) = self.via();
         let reply = via.call(Command::plane(
             id,
@@ -186,13 +192,14 @@ impl Plane {
             },
         ))?;
         match reply {
-            Reply::Moved { key: 0, .. } => Ok(()),
+            Reply::Moved { key: 0, tick, .. } => Ok(tick),
             Reply::Moved {
                 daemon,
                 plane,
                 key,
                 cluster,
                 endpoint,
+                tick,
             } => {
                 let moved = Moved {
                     from_id: id,
@@ -202,7 +209,7 @@ impl Plane {
                     endpoint,
                     key,
                 };
-                via.switch_plane(id, &moved, key)
+                via.switch_plane(id, &moved, key).map(|_| tick)
             }
             other => Err(unexpected(other)),
         }

@@ -6,7 +6,9 @@
 //! latency (tick end → the reader has the tick, CLOCK_MONOTONIC on one host), p50 and p99,
 //! the bytes of a tick's frame on the wire, and whether every tick both readers saw had the
 //! same `StateHash`. Then the failover of a persistent plane: its daemon SIGKILLed, the time
-//! until a survivor serves it and ticks again, and the ticks lost.
+//! until a survivor serves it and ticks again, and the ticks lost. And the migration of a
+//! plane (`MoveTo`) of 1k and 10k bodies: the pause from its last tick on the old daemon to
+//! its first on the new one.
 
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -59,6 +61,21 @@ pub struct FailoverCase {
     pub first_tick_ms: f64,
 }
 
+/// Migration of a 60 Hz plane between two daemons (`MoveTo`).
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct MigrationCase {
+    pub bodies: usize,
+    /// The tick the plane stopped at on the old daemon.
+    pub tick: u64,
+    /// From the end of that tick to the end of the next, on the new daemon (tick ends,
+    /// CLOCK_MONOTONIC on one host; see [`migration`]). One period (16.7 ms) of it is the
+    /// 60 Hz cadence itself.
+    pub pause_ms: f64,
+    /// The owner's `MoveTo` call: the hand-over and the owner's switch-over (connecting to
+    /// the new daemon).
+    pub call_ms: f64,
+}
+
 /// One case: a body count and a state.
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct Case {
@@ -78,6 +95,7 @@ pub struct ClusterReport {
     pub seconds: f64,
     pub cases: Vec<Case>,
     pub failover: Option<FailoverCase>,
+    pub migrations: Vec<MigrationCase>,
     pub goals: Vec<Goal>,
 }
 
@@ -262,6 +280,68 @@ fn failover(n: usize) -> BenchResult<FailoverCase> {
     Ok(case)
 }
 
+/// A plane of `n` awake bodies at 60 Hz on `a`, moved to `b` after a second. The pause is
+/// read from tick ends: the last tick on `a` (read just before the move, carried forward by
+/// the period to the tick the move stopped at) and the first on `b` (the tick read after the
+/// move, carried back by the period to the first).
+fn migration(n: usize) -> BenchResult<MigrationCase> {
+    let cluster = super::daemon::unique_domain("mv").replace('.', "-");
+    let (pa, pb) = (free_port()?, free_port()?);
+    let a = member(&cluster, "a", pa, None, &[])?;
+    let _b = member(&cluster, "b", pb, Some(pa), &[])?;
+    let view = Cluster::connect(&cluster, &[&format!("tcp/127.0.0.1:{pa}")])?;
+    let deadline = Instant::now() + Duration::from_secs(10);
+    while view.daemons()?.len() < 2 {
+        if Instant::now() > deadline {
+            return Err(BenchError::Failed(
+                "the migration members did not meet in 10 s".into(),
+            ));
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    let owner = a.connect()?;
+    let options = PlaneOptions::default()
+        .with(PlaneProp::TickRate(60.0))
+        .with(PlaneProp::Gravity([0.0; 3]))
+        .with(PlaneProp::NeverSleep(true));
+    let plane = owner.create_plane(&options)?;
+    let side = (n as f64).sqrt().ceil() as usize;
+    for k in 0..n {
+        let at = [(k / side) as f32 * 2.0, 0.0, (k % side) as f32 * 2.0];
+        plane.add(
+            Shape::Sphere { radius: 0.5 },
+            Pose::at(at),
+            &[ObjectProp::Velocity([0.0, 0.5, 0.0])],
+        )?;
+    }
+    owner.flush()?;
+    std::thread::sleep(Duration::from_secs(1));
+    let period_ns = 1e9 / 60.0;
+    plane.wait_tick(Duration::from_secs(2))?;
+    let before = *plane.snapshot()?.header();
+    let started = Instant::now();
+    let tick = plane.move_to_at("b")?;
+    let call_ms = started.elapsed().as_secs_f64() * 1e3;
+    plane.wait_tick(Duration::from_secs(5))?;
+    let after = *plane.snapshot()?.header();
+    if after.tick <= tick || before.tick > tick {
+        return Err(BenchError::Failed(format!(
+            "migration: ticks {} before, stopped at {tick}, {} after",
+            before.tick, after.tick
+        )));
+    }
+    let last_on_a = before.tick_end_ns as f64 + (tick - before.tick) as f64 * period_ns;
+    let first_on_b = after.tick_end_ns as f64 - (after.tick - tick - 1) as f64 * period_ns;
+    let case = MigrationCase {
+        bodies: n,
+        tick,
+        pause_ms: (first_on_b - last_on_a) / 1e6,
+        call_ms,
+    };
+    drop((plane, owner, view));
+    Ok(case)
+}
+
 fn figures(seen: &[(u64, u64, f64)]) -> Reader {
     let ms: Vec<f64> = seen.iter().map(|s| s.2).collect();
     Reader {
@@ -361,6 +441,11 @@ pub fn run(args: &ClusterArgs) -> BenchResult<()> {
     let n = args.bodies.first().copied().unwrap_or(1000);
     eprintln!("cluster: failover of a persistent plane of {n} bodies");
     let fo = failover(n)?;
+    let mut migrations = Vec::new();
+    for &n in &args.bodies {
+        eprintln!("cluster: migration of a plane of {n} bodies");
+        migrations.push(migration(n)?);
+    }
     let differed: usize = cases.iter().map(|c| c.differed).sum();
     let compared: usize = cases.iter().map(|c| c.compared).sum();
     let mut goals = vec![Goal::new(
@@ -387,6 +472,30 @@ pub fn run(args: &ClusterArgs) -> BenchResult<()> {
         ),
         Some(fo.first_tick_ms <= 2000.0),
     ));
+    for m in &migrations {
+        // 100 ms at 1k bodies: six ticks at 60 Hz, a hitch a player sees once but short of
+        // what a game's networking treats as a stall; the hand-over is a snapshot of the
+        // plane (~100 bytes a body) over loopback and its restore.
+        let judged = (m.bodies <= 1000).then_some(m.pause_ms <= 100.0);
+        goals.push(Goal::new(
+            format!(
+                "migration: MoveTo of a 60 Hz plane of {} bodies, last tick on the old daemon \
+                 to the first on the new one{}",
+                m.bodies,
+                if m.bodies <= 1000 {
+                    " ≤ 100 ms"
+                } else {
+                    " (reported, not judged)"
+                }
+            ),
+            format!(
+                "{:.1} ms (one 16.7 ms period of it is the cadence); the owner's MoveTo call \
+                 {:.1} ms; stopped at tick {}",
+                m.pause_ms, m.call_ms, m.tick
+            ),
+            judged,
+        ));
+    }
     for c in &cases {
         let ratio = match (c.remote.p50_ms, c.local.p50_ms) {
             (Some(r), Some(l)) if l > 0.0 => Some(r / l),
@@ -406,6 +515,7 @@ pub fn run(args: &ClusterArgs) -> BenchResult<()> {
         seconds: args.seconds,
         cases,
         failover: Some(fo),
+        migrations,
         goals,
     };
     let md = markdown(&report);
@@ -448,7 +558,9 @@ fn markdown(r: &ClusterReport) -> String {
          west's shared memory, both reading for {} s. Latency: the tick's end (daemon) to the \
          reader holding it (CLOCK_MONOTONIC, one host). Frame bytes: the mean payload of a \
          tick's frame (changed slots only). Failover: a persistent plane on a second pair of \
-         members (state folders, snapshots every 0.5 s), its daemon SIGKILLed after 2 s.\n\n{}\n\n{}",
+         members (state folders, snapshots every 0.5 s), its daemon SIGKILLed after 2 s. \
+         Migration: a 60 Hz plane moved between two members with MoveTo; the pause from \
+         tick ends.\n\n{}\n\n{}",
         r.seconds,
         t.finish(),
         goals_table(&r.goals)

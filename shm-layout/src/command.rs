@@ -282,6 +282,9 @@ pub enum Reply {
         cluster: String,
         /// An endpoint of the cluster that routes for clients (the old daemon's).
         endpoint: String,
+        /// The tick the plane stopped at (its last on the old daemon; the new one steps
+        /// the next).
+        tick: u64,
     },
 }
 

@@ -247,6 +247,7 @@ impl Daemon {
                 key: 0,
                 cluster: migration.cluster.clone(),
                 endpoint: migration.endpoint.clone(),
+                tick: entry.cell.marks.tick.load(std::sync::atomic::Ordering::SeqCst),
             });
         }
         migration
@@ -327,6 +328,7 @@ impl Daemon {
             key,
             cluster: migration.cluster.clone(),
             endpoint: migration.endpoint.clone(),
+            tick,
         })
     }
 
