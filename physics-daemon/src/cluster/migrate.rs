@@ -60,7 +60,7 @@ impl Courier for ZenohCourier {
             .session
             .get(migrate_key(&self.cluster, daemon))
             .payload(bytes)
-            .timeout(RESTORE_WAIT + ASK_TIMEOUT)
+            .timeout(RESTORE_WAIT * 2 + ASK_TIMEOUT)
             .wait()
             .map_err(|e| format!("cannot reach {daemon:?}: {e}"))?;
         let reply = replies
@@ -134,8 +134,8 @@ fn arrive(migration: &Migration, domain: &str, query: Query) {
         let answer = migration.arrive(plane);
         crate::wake(domain).map_err(|e| format!("cannot wake the loop: {e}"))?;
         answer
-            .recv_timeout(RESTORE_WAIT)
-            .map_err(|_| format!("not restored within {RESTORE_WAIT:?}"))?
+            .recv_timeout(RESTORE_WAIT * 2)
+            .map_err(|_| format!("not restored within {:?}", RESTORE_WAIT * 2))?
     })();
     let bytes = postcard::to_allocvec(&answer).unwrap_or_default();
     if let Err(e) = query.reply(query.key_expr().clone(), bytes).wait() {

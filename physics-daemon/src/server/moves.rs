@@ -22,7 +22,11 @@ use super::{Daemon, PlaneEntry, MAX_PLANES};
 
 /// How long a move waits for the plane's queued runs to be applied.
 const IDLE_WAIT: Duration = Duration::from_secs(5);
-/// How long the target takes at most to restore an arriving plane.
+/// How long the target takes at most to restore an arriving plane. An arrival its loop
+/// reaches later than half of this is refused unrestored; the one that brought it waits
+/// twice this for the answer, and the old daemon a little longer: a plane the old daemon
+/// gave up on is never restored after all (two daemons moving planes to each other at
+/// once both wait, then both refuse, and both planes stay).
 pub const RESTORE_WAIT: Duration = Duration::from_secs(10);
 /// Tombstones kept (the oldest go first): a client that has not touched a moved plane for
 /// this many later moves gets `UnknownPlane` instead of the way to it.
@@ -50,6 +54,7 @@ pub const SETTLE: Duration = Duration::from_secs(30);
 pub struct Arrival {
     plane: MovingPlane,
     answer: mpsc::Sender<MoveAnswer>,
+    queued: Instant,
 }
 
 /// The migration hook of a daemon in a cluster ([`super::Options::migrate`]).
@@ -94,7 +99,11 @@ impl Migration {
         self.arrivals
             .lock()
             .unwrap_or_else(|p| p.into_inner())
-            .push(Arrival { plane, answer });
+            .push(Arrival {
+                plane,
+                answer,
+                queued: Instant::now(),
+            });
         receiver
     }
 
@@ -247,7 +256,11 @@ impl Daemon {
                 key: 0,
                 cluster: migration.cluster.clone(),
                 endpoint: migration.endpoint.clone(),
-                tick: entry.cell.marks.tick.load(std::sync::atomic::Ordering::SeqCst),
+                tick: entry
+                    .cell
+                    .marks
+                    .tick
+                    .load(std::sync::atomic::Ordering::SeqCst),
             });
         }
         migration
@@ -366,6 +379,13 @@ impl Daemon {
             return;
         };
         for arrival in migration.take() {
+            let late = arrival.queued.elapsed();
+            if late > RESTORE_WAIT / 2 {
+                let _ = arrival.answer.send(Err(format!(
+                    "the target's loop reached the plane {late:?} after it arrived: refused"
+                )));
+                continue;
+            }
             let answer = self.arrive_plane(arrival.plane);
             let _ = arrival.answer.send(answer);
         }
