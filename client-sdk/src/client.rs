@@ -12,7 +12,6 @@ use shm_layout::{
     LAYOUT_VERSION,
 };
 
-use crate::moving::Rerouted;
 use crate::plane_shared::PlaneShared;
 use crate::remote::{RemoteOptions, RemoteTransport};
 use crate::transport::{Transport, LIVENESS_PERIOD};
@@ -507,9 +506,33 @@ impl Client {
         &self.inner.peers
     }
 
-    /// A handle that does not keep this client alive.
-    pub(crate) fn downgrade(&self) -> WeakClient {
-        WeakClient(Rc::downgrade(&self.inner))
+    /// A handle that does not keep this client alive (a moved plane's route: the
+    /// connection belongs to the client that switched it).
+    pub(crate) fn downgrade(&self) -> std::rc::Weak<dyn std::any::Any> {
+        let inner: Rc<dyn std::any::Any> = self.inner.clone();
+        Rc::downgrade(&inner)
+    }
+
+    /// The client behind [`Client::downgrade`]'s handle, while it lives.
+    pub(crate) fn upgrade(weak: &std::rc::Weak<dyn std::any::Any>) -> Option<Client> {
+        let inner = weak.upgrade()?.downcast::<Inner>().ok()?;
+        Some(Client { inner })
+    }
+
+    /// Where `command` goes: this connection, or the one its plane moved to.
+    pub(crate) fn reroute(&self, command: Command) -> Rerouted {
+        let Command::Plane { plane, op } = command else {
+            return Rerouted::Here(command);
+        };
+        let route = self
+            .attached(plane)
+            .and_then(|s| s.route.borrow().clone())
+            .and_then(|r| Some((Client::upgrade(&r.peer)?, r.id)));
+        match route {
+            None => Rerouted::Here(Command::Plane { plane, op }),
+            Some((peer, id)) if peer.same(self) => Rerouted::Here(Command::Plane { plane: id, op }),
+            Some((peer, id)) => Rerouted::There(peer, Command::Plane { plane: id, op }),
+        }
     }
 
     /// Whether both are the same connection.
@@ -926,16 +949,13 @@ fn command_plane(command: &Command) -> PlaneId {
     }
 }
 
-/// A [`Client`] that does not keep its connection alive (a moved plane's route: the
-/// connection belongs to the client that switched it, `moving`).
-#[derive(Clone)]
-pub(crate) struct WeakClient(std::rc::Weak<Inner>);
-
-impl WeakClient {
-    /// The client, while it lives.
-    pub(crate) fn upgrade(&self) -> Option<Client> {
-        self.0.upgrade().map(|inner| Client { inner })
-    }
+/// Where a command goes ([`Client::reroute`]).
+pub(crate) enum Rerouted {
+    /// On this connection (under the plane's id here, which differs when the plane moved
+    /// onto it).
+    Here(Command),
+    /// On another connection.
+    There(Client, Command),
 }
 
 /// Whether `command` is the release of a held add ([`ConnectOptions::hold_adds_until_flush`]).

@@ -10,9 +10,9 @@
 
 use std::time::{Duration, Instant};
 
-use shm_layout::{Command, ErrorKind, PlaneId, PlaneInfo, PlaneOp, Reply};
+use shm_layout::{Command, ErrorKind, PlaneId, PlaneOp, Reply};
 
-use crate::moving::Route;
+use crate::plane_shared::Route;
 use crate::transport::Transport;
 use crate::{Client, Error, Plane};
 
@@ -95,13 +95,5 @@ impl Plane {
     /// resumed from); `None` otherwise.
     pub fn take_recovered(&self) -> Option<u64> {
         self.shared.recovered.take()
-    }
-}
-
-/// Remembers what the client needs to find a persistent plane again after its daemon died.
-pub(crate) fn note_info(shared: &crate::plane_shared::PlaneShared, info: &PlaneInfo) {
-    let s = &info.settings;
-    if s.persistent && !s.name.is_none() {
-        *shared.persistent_name.borrow_mut() = Some(s.name.as_str().to_string());
     }
 }

@@ -1,6 +1,6 @@
 //! Planes that move between the daemons of a cluster (`Plane::move_to`, docs/cluster.md
 //! "Migration"). The user keeps the same `Plane` and `Object` values: a moved plane's
-//! per-plane state (`PlaneShared`) gets a [`Route`] to a connection to its new daemon (a
+//! per-plane state (`PlaneShared`) gets a `Route` to a connection to its new daemon (a
 //! remote client of the cluster, kept by the client that switched it) and its id there;
 //! every command for it is sent there from then on, and its ticks are read from there.
 //!
@@ -12,44 +12,13 @@
 use shm_layout::migrate::Moved;
 use shm_layout::{Command, CommandResult, PlaneId, PlaneOp, Reply};
 
-use crate::client::{unexpected, WeakClient};
+use crate::client::{unexpected, Rerouted};
 use crate::cluster::ClusterOptions;
+use crate::plane_shared::Route;
 use crate::remote::RemoteOptions;
 use crate::{Client, Error, Plane};
 
-/// Where a moved plane's commands go: the connection to its daemon and its id there.
-#[derive(Clone)]
-pub(crate) struct Route {
-    pub(crate) peer: WeakClient,
-    pub(crate) id: PlaneId,
-}
-
-/// Where a command goes ([`Client::reroute`]).
-pub(crate) enum Rerouted {
-    /// On this connection (under the plane's id here, which differs when the plane moved
-    /// onto it).
-    Here(Command),
-    /// On another connection.
-    There(Client, Command),
-}
-
 impl Client {
-    /// Where `command` goes: this connection, or the one its plane moved to.
-    pub(crate) fn reroute(&self, command: Command) -> Rerouted {
-        let Command::Plane { plane, op } = command else {
-            return Rerouted::Here(command);
-        };
-        let route = self
-            .attached(plane)
-            .and_then(|s| s.route.borrow().clone())
-            .and_then(|r| Some((r.peer.upgrade()?, r.id)));
-        match route {
-            None => Rerouted::Here(Command::Plane { plane, op }),
-            Some((peer, id)) if peer.same(self) => Rerouted::Here(Command::Plane { plane: id, op }),
-            Some((peer, id)) => Rerouted::There(peer, Command::Plane { plane: id, op }),
-        }
-    }
-
     /// Sends again, to the plane's new daemon, every command the old one refused because
     /// its plane moved (switching this client's plane over first).
     pub(crate) fn resend_moved(
@@ -70,8 +39,7 @@ impl Client {
             };
             let switched = shared.route.borrow().as_ref().is_some_and(|r| {
                 r.id == moved.plane
-                    && r.peer
-                        .upgrade()
+                    && Client::upgrade(&r.peer)
                         .is_some_and(|p| p.cluster_daemon() == Some(moved.daemon.as_str()))
             });
             if !switched {
@@ -235,7 +203,7 @@ impl Plane {
             .route
             .borrow()
             .as_ref()
-            .and_then(|r| Some((r.peer.upgrade()?, r.id)));
+            .and_then(|r| Some((Client::upgrade(&r.peer)?, r.id)));
         route.unwrap_or_else(|| (self.client().clone(), self.id()))
     }
 

@@ -414,7 +414,7 @@ impl Client {
                 return Err(e);
             }
         };
-        crate::failover_switch::note_info(&plane.shared, &info);
+        plane.shared.note_info(&info);
         *plane.shared.mirror.borrow_mut() =
             crate::mirror::Mirror::exclusive(info, options.shared == Some(true));
         self.note_owned(id);
@@ -441,7 +441,7 @@ impl Client {
         };
         // Asking after subscribing makes the daemon hand the newest tick to the new reader.
         if let Reply::Plane(info) = self.call(Command::plane(id, PlaneOp::Info))? {
-            crate::failover_switch::note_info(&shared, &info);
+            shared.note_info(&info);
         }
         self.remember_plane(id, shared.clone());
         Ok(Plane::new(self.clone(), shared))

@@ -31,7 +31,7 @@ pub(crate) struct PlaneShared {
     /// Adds and removals the newest header may not count yet ([`Plane::object_count`]).
     pub(crate) members: RefCell<Members>,
     /// Where the plane went when it moved to another daemon (`moving`).
-    pub(crate) route: RefCell<Option<crate::moving::Route>>,
+    pub(crate) route: RefCell<Option<Route>>,
     /// The name of a persistent plane (`failover_switch` opens it by name elsewhere).
     pub(crate) persistent_name: RefCell<Option<String>>,
     /// Ticks lost when the plane came back on another member (`Plane::take_recovered`).
@@ -97,9 +97,27 @@ impl PlaneShared {
         Ok(())
     }
 
+    /// Remembers what the client needs to find a persistent plane again after its daemon
+    /// died (`failover_switch`).
+    pub(crate) fn note_info(&self, info: &shm_layout::PlaneInfo) {
+        let s = &info.settings;
+        if s.persistent && !s.name.is_none() {
+            *self.persistent_name.borrow_mut() = Some(s.name.as_str().to_string());
+        }
+    }
+
     pub(crate) fn current_tick(&self) -> Option<u64> {
         self.latest.borrow().as_ref().map(|s| s.user_header().tick)
     }
+}
+
+/// Where a moved plane's commands go (`moving`, `failover_switch`): the connection to its
+/// daemon now (`Client::downgrade`: held weakly, it belongs to the client that switched
+/// the plane) and the plane's id there.
+#[derive(Clone)]
+pub(crate) struct Route {
+    pub(crate) peer: std::rc::Weak<dyn std::any::Any>,
+    pub(crate) id: PlaneId,
 }
 
 /// A subscription to a plane's events and the number (modulo 2³²) of the next event it
