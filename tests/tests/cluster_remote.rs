@@ -507,6 +507,16 @@ fn the_cluster_bench_finds_remote_reads_exact_and_settled_frames_small() {
         json["failover"]["resumed_tick"].as_u64().unwrap() > 0,
         "{text}"
     );
+    // The migration row ran: the plane stopped at a tick on one daemon and ticked on the
+    // other after a pause.
+    assert!(
+        json["migrations"][0]["tick"].as_u64().unwrap() > 0,
+        "{text}"
+    );
+    assert!(
+        json["migrations"][0]["pause_ms"].as_f64().unwrap() > 0.0,
+        "{text}"
+    );
     let _ = std::fs::remove_dir_all(out);
 }
 
