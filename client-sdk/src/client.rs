@@ -215,10 +215,14 @@ impl Client {
         };
         // A Hello can be lost while the daemon evicts another process's ports from the
         // control service (see the daemon's `server/resources.rs`): ask again with fresh
-        // ports every HELLO_RETRY, within the request timeout.
+        // ports every HELLO_RETRY, within the request timeout. A remote Hello is a Zenoh query
+        // that is not lost that way (the relay opens its session's local connection before it
+        // answers, which can take seconds on a loaded host): it gets the whole timeout.
         let timeout = inner.options.request_timeout;
         let deadline = Instant::now() + timeout;
-        inner.options.request_timeout = timeout.min(HELLO_RETRY);
+        if inner.transport.is_local() {
+            inner.options.request_timeout = timeout.min(HELLO_RETRY);
+        }
         let welcome = loop {
             match inner.round_trip(vec![hello.clone()]) {
                 Err(Error::Timeout(_))
