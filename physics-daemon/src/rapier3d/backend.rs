@@ -9,7 +9,7 @@ use super::Plane;
 use crate::backend::{Backend, Usage};
 
 impl Plane {
-    /// Applies one op to the rapier world (on the GPU path, `gpu.rs` wraps this).
+    /// Applies one op to the rapier world (the GPU path, `crate::gpu::GpuPlane`, wraps this).
     pub(super) fn apply_on_cpu(&mut self, op: PlaneOp) -> CommandResult {
         let applied = |plane: &Plane| Reply::Applied { tick: plane.tick };
         match op {
@@ -86,10 +86,6 @@ impl Backend for Plane {
     fn apply(&mut self, op: PlaneOp) -> CommandResult {
         // The last tick is kept for Rewind before an op changes anything (see `rollback`).
         self.finish_keep()?;
-        #[cfg(feature = "gpu")]
-        if self.on_gpu() {
-            return self.apply_on_gpu(op);
-        }
         self.apply_on_cpu(op)
     }
 
@@ -122,12 +118,6 @@ impl Backend for Plane {
     }
 
     fn for_each_awake(&self, f: &mut dyn FnMut(usize)) {
-        #[cfg(feature = "gpu")]
-        if self.on_gpu() {
-            // Nothing sleeps on the GPU path.
-            (0..self.slot_count()).for_each(f);
-            return;
-        }
         for slot in self.awake_slots() {
             f(slot);
         }

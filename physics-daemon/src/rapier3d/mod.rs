@@ -29,13 +29,12 @@ mod articulations;
 mod axis_motors;
 mod capsule_contact;
 mod contact_points;
-#[cfg(feature = "gpu")]
-mod gpu;
 mod joints;
 mod limits;
 mod map_store;
 mod maps;
 mod objects;
+mod offload;
 mod part;
 mod probes;
 mod properties;
@@ -52,18 +51,18 @@ use std::sync::mpsc;
 use std::time::Instant;
 
 use rapier3d::prelude::*;
-use shm_layout::validate::{self, MAX_DT, MAX_HIT_BOX_QUALITY};
+use shm_layout::validate::MAX_HIT_BOX_QUALITY;
 use shm_layout::{
     BodyState, CollisionGroups, CommandError, EventRecord, PlaneId, PlaneInfo, PlaneKind,
     PlaneProp, PlaneSettings, StateHasher, TickHeader, LAYOUT_VERSION,
 };
-#[cfg(feature = "gpu")]
-use shm_layout::{FLAG_ALIVE, FLAG_ANCHORED};
 
 use crate::backend::{Dirty, SlotTable};
 use part::Part;
 
 pub use objects::MAX_SLOTS;
+pub use offload::{no_other_engine, DeferHook, SimpleBody, SimplePose};
+pub use snapshot::GpuSaved;
 
 /// One object: its rapier body and what the API says about it.
 #[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
@@ -131,9 +130,6 @@ pub struct Plane {
     joints: joints::Joints,
     /// Map pieces uploaded since the last build (see `maps`).
     map_pending: maps::PendingMap,
-    /// The GPU world while `DeferGpu` is on (see `gpu`).
-    #[cfg(feature = "gpu")]
-    gpu: Option<crate::gpu::GpuWorld>,
     /// [`StateHasher`] over every slot as the last step left it (the tick header's).
     state_hash: u64,
     /// Bytes of controller paths (counted against the owner's quota).
@@ -143,15 +139,21 @@ pub struct Plane {
 }
 
 impl Plane {
-    /// A plane with default options, then `props` applied in order.
+    /// A plane with default options, then `props` applied in order (`DeferGpu = true` is
+    /// refused: see [`Plane::new_with`]).
     pub fn new(id: PlaneId, props: &[PlaneProp]) -> Result<Plane, CommandError> {
+        Plane::new_with(id, props, &mut no_other_engine)
+    }
+
+    /// A plane with default options.
+    fn empty(id: PlaneId) -> Plane {
         let settings = PlaneSettings::default();
         let mut world = PhysicsWorld::new();
         world.gravity = Vector::from(settings.gravity);
         let (collision_tx, collision_rx) = mpsc::channel();
         let (force_tx, _) = mpsc::channel();
         let (tear_tx, _) = mpsc::channel();
-        let mut plane = Plane {
+        Plane {
             id,
             settings,
             world,
@@ -184,28 +186,29 @@ impl Plane {
             query_stale: Default::default(),
             joints: joints::Joints::default(),
             map_pending: maps::PendingMap::default(),
-            #[cfg(feature = "gpu")]
-            gpu: None,
             state_hash: 0,
             state_bytes: Default::default(),
             rollback: Default::default(),
-        };
-        for prop in props {
-            plane.apply_prop(*prop, true)?;
         }
-        Ok(plane)
     }
 
-    /// Applies one option; `creating` allows the construction-only ones.
+    /// Applies one option (`DeferGpu = true` is refused: see [`Plane::set_with`]).
     pub fn set(&mut self, prop: PlaneProp) -> Result<(), CommandError> {
-        self.apply_prop(prop, false)
+        self.apply_prop(prop, false, &mut no_other_engine)
     }
 
-    fn apply_prop(&mut self, prop: PlaneProp, creating: bool) -> Result<(), CommandError> {
+    /// Applies one option; `creating` allows the construction-only ones; `defer` takes
+    /// `DeferGpu`.
+    fn apply_prop(
+        &mut self,
+        prop: PlaneProp,
+        creating: bool,
+        defer: &mut DeferHook<'_>,
+    ) -> Result<(), CommandError> {
         let before = self.settings;
         let prop = self.settings.apply(prop, creating)?;
         if let PlaneProp::DeferGpu(on) = prop {
-            if let Err(mut e) = self.set_defer_gpu(on) {
+            if let Err(mut e) = defer(self, on) {
                 self.settings = before;
                 e.message = match creating {
                     true => format!("{}; no plane was created", e.message),
@@ -226,18 +229,6 @@ impl Plane {
             self.world.wake_up_all(true);
         }
         self.dirty.mark_all();
-        Ok(())
-    }
-
-    #[cfg(not(feature = "gpu"))]
-    fn set_defer_gpu(&mut self, on: bool) -> Result<(), CommandError> {
-        if on {
-            return Err(CommandError::invalid_field(
-                "DeferGpu",
-                "DeferGpu = true failed: this daemon was built without the GPU path (cargo \
-                 feature \"gpu\")",
-            ));
-        }
         Ok(())
     }
 
@@ -303,14 +294,7 @@ impl Plane {
     /// Advances by `dt`. Returns false (and does nothing) when the plane is disabled.
     pub fn step(&mut self, dt: f32) -> Result<bool, CommandError> {
         // The last tick is kept before this one changes anything.
-        self.finish_keep()?;
-        let dt = validate::positive("dt", dt)?;
-        if dt > MAX_DT {
-            return Err(CommandError::invalid(format!(
-                "dt must be at most {MAX_DT} s, got {dt}"
-            )));
-        }
-        if !self.settings.enabled {
+        if !self.begin_step(dt)? {
             return Ok(false);
         }
         let started = Instant::now();
@@ -319,18 +303,6 @@ impl Plane {
         let moving = self.tick == 0
             || self.world.islands.num_active_bodies() > 0
             || !self.dirty.since_step().is_empty();
-        #[cfg(feature = "gpu")]
-        if self.gpu.is_some() {
-            self.step_on_gpu(dt)?;
-            self.dirty.stepped(self.bodies.slot_count());
-            self.tick += 1;
-            self.sim_time += dt as f64;
-            self.last_dt = dt;
-            // Nothing sleeps on the GPU path: every step can move every body.
-            self.state_hash = self.state_hash();
-            self.last_step_us = started.elapsed().as_secs_f32() * 1e6;
-            return Ok(true);
-        }
         self.world.integration_parameters.dt = dt;
         self.tune_solver(dt);
         self.tick_controllers(dt);
@@ -446,43 +418,11 @@ impl Plane {
 
     /// Number of bodies in [`Plane::awake_slots`].
     pub fn awake_count(&self) -> usize {
-        #[cfg(feature = "gpu")]
-        if self.gpu.is_some() {
-            return self.bodies.slot_count();
-        }
         self.world.islands.num_active_bodies()
     }
 
     /// The published state of slot `i` (dead slots carry only their generation).
     pub fn body_state(&self, i: usize) -> BodyState {
-        #[cfg(feature = "gpu")]
-        if let Some(gpu) = &self.gpu {
-            let generation = self.bodies.generation(i);
-            let Some((p, b)) = gpu.pose(i).zip(self.bodies.at(i)) else {
-                return BodyState {
-                    generation,
-                    ..BodyState::default()
-                };
-            };
-            let mut flags = FLAG_ALIVE | b.flags;
-            if self
-                .world
-                .bodies
-                .get(b.handle)
-                .is_some_and(|r| r.is_fixed())
-            {
-                flags |= FLAG_ANCHORED;
-            }
-            return BodyState {
-                position: p.position,
-                flags,
-                rotation: p.rotation,
-                linear_velocity: p.velocity,
-                generation,
-                angular_velocity: p.angular_velocity,
-                _reserved: 0,
-            };
-        }
         publish::body_state(&self.bodies, &self.world.bodies, i)
     }
 }
