@@ -144,7 +144,7 @@ impl Backend for Plane {
     }
 
     fn drain_dirty(&mut self, into: &mut Vec<u32>) -> bool {
-        self.dirty.drain(into)
+        self.bodies.drain_marks(into)
     }
 
     fn body_state(&self, i: usize) -> BodyState {

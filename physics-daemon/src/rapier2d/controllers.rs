@@ -144,7 +144,6 @@ impl Plane {
             _ => {}
         }
         self.world.bodies[h].wake_up(true);
-        self.dirty.mark(handle.slot);
         Ok(applied)
     }
 

@@ -38,7 +38,7 @@ use shm_layout::{
     StateHasher, TickHeader, FLAG_ALIVE, FLAG_ANCHORED, FLAG_SLEEPING, LAYOUT_VERSION,
 };
 
-use crate::backend::{Dirty, SlotTable};
+use crate::backend::SlotTable;
 use controllers::Controller;
 
 /// Slots per GUI plane.
@@ -69,7 +69,6 @@ pub struct Plane {
     controlled: Vec<u32>,
     /// Bodies with a force or a pending impulse of their own.
     driven: u32,
-    dirty: Dirty,
     /// An op moved, added or reshaped a body since the last step (queries refresh first).
     query_stale: crate::backend::Marks<RigidBodyHandle>,
     /// Bodies a step must leave where it found them (see `held`).
@@ -107,10 +106,9 @@ impl Plane {
             id,
             settings,
             world,
-            bodies: SlotTable::new("object", MAX_SLOTS),
+            bodies: SlotTable::tracked("object", MAX_SLOTS),
             controlled: Vec::new(),
             driven: 0,
-            dirty: Dirty::default(),
             query_stale: Default::default(),
             held: Vec::new(),
             tick: 0,
@@ -192,7 +190,7 @@ impl Plane {
                 ))
             }
         }
-        self.dirty.mark_all();
+        self.bodies.mark_all();
         Ok(())
     }
 
@@ -295,7 +293,7 @@ impl Plane {
         self.world.step_with_events(&hooks::Hooks, &());
         self.held_after_step();
         self.query_stale.clear();
-        self.dirty.stepped(self.bodies.slot_count());
+        self.bodies.stepped();
         self.tick += 1;
         self.sim_time += dt as f64;
         self.last_dt = dt;

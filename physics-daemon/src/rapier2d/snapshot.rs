@@ -159,9 +159,10 @@ impl Plane {
             }
         }
         state.world.physics_pipeline = std::mem::take(&mut self.world.physics_pipeline);
+        state.bodies.take_marks_of(&mut self.bodies);
         self.take_state(state);
         self.events.clear();
-        self.dirty.mark_all();
+        self.bodies.mark_all();
         // Another timeline: the ticks kept for Rewind no longer lead here.
         self.rollback.clear();
         for prop in overrides {
@@ -179,9 +180,10 @@ impl Plane {
             }
         }
         state.world.physics_pipeline = std::mem::take(&mut self.world.physics_pipeline);
+        state.bodies.take_marks_of(&mut self.bodies);
         self.take_state(state);
         self.events.clear();
-        self.dirty.mark_all();
+        self.bodies.mark_all();
         Ok(())
     }
 }

@@ -57,7 +57,7 @@ use shm_layout::{
     PlaneProp, PlaneSettings, StateHasher, TickHeader, LAYOUT_VERSION,
 };
 
-use crate::backend::{Dirty, SlotTable};
+use crate::backend::SlotTable;
 use part::Part;
 
 pub use objects::MAX_SLOTS;
@@ -88,9 +88,6 @@ pub struct Plane {
     driven: u32,
     /// Mesh vertices of all parts (for quotas).
     mesh_vertices: u64,
-    /// Slots changed by ops: the publisher rewrites them, and the force pass sees them even
-    /// before rapier's island manager lists them as awake.
-    dirty: Dirty,
     /// Buffers of the per-body passes.
     pass: body_pass::Scratch,
     /// Objects a step must leave where it found them (see `held`).
@@ -157,11 +154,10 @@ impl Plane {
             id,
             settings,
             world,
-            bodies: SlotTable::new("object", MAX_SLOTS),
+            bodies: SlotTable::tracked("object", MAX_SLOTS),
             quality_counts: [0; MAX_HIT_BOX_QUALITY as usize + 1],
             driven: 0,
             mesh_vertices: 0,
-            dirty: Dirty::default(),
             pass: body_pass::Scratch::default(),
             held: Vec::new(),
             tick: 0,
@@ -169,9 +165,9 @@ impl Plane {
             last_step_us: 0.0,
             last_dt: 0.0,
             max_penetration: 0.0,
+            contact_pairs: 0,
             boosted: 0,
             stiffened: false,
-            contact_pairs: 0,
             reporting: 0,
             collision_tx,
             collision_rx,
@@ -228,7 +224,7 @@ impl Plane {
         if prop.changes_forces() {
             self.world.wake_up_all(true);
         }
-        self.dirty.mark_all();
+        self.bodies.mark_all();
         Ok(())
     }
 
@@ -302,7 +298,7 @@ impl Plane {
         // last step. A settled plane keeps its hash without rehashing every slot.
         let moving = self.tick == 0
             || self.world.islands.num_active_bodies() > 0
-            || !self.dirty.since_step().is_empty();
+            || !self.bodies.since_step().is_empty();
         self.world.integration_parameters.dt = dt;
         self.tune_solver(dt);
         self.tick_controllers(dt);
@@ -327,7 +323,7 @@ impl Plane {
         self.held_after_step();
         self.query_stale.clear();
         self.limit_speeds_after_step();
-        self.dirty.stepped(self.bodies.slot_count());
+        self.bodies.stepped();
         self.tick += 1;
         self.sim_time += dt as f64;
         self.last_dt = dt;

@@ -240,7 +240,7 @@ impl Plane {
         self.contact_pairs = contact_pairs;
         self.events.clear();
         self.removed.clear();
-        self.dirty.stepped(self.bodies.slot_count());
+        self.bodies.stepped();
         self.tick += 1;
         self.sim_time += dt as f64;
         self.last_dt = dt;

@@ -319,6 +319,7 @@ impl Plane {
     fn adopt(&mut self, mut state: State, overrides: &[PlaneProp]) -> Result<(), CommandError> {
         controllers::count_paths_in(&mut state.controllers, &self.state_bytes);
         let threads = state.settings.threads;
+        state.bodies.take_marks_of(&mut self.bodies);
         self.take_state(state);
         self.events.clear();
         self.pending_events.clear();
@@ -335,7 +336,7 @@ impl Plane {
         for prop in overrides {
             self.apply_prop(*prop, true, &mut super::no_other_engine)?;
         }
-        self.dirty.mark_all();
+        self.bodies.mark_all();
         Ok(())
     }
 }

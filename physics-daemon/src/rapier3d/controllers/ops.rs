@@ -125,7 +125,6 @@ impl Plane {
             part: Box::new(part),
             flags: shm_layout::FLAG_CONTROLLER,
         })?;
-        self.dirty.mark(handle.slot);
         self.query_stale.push(h);
         self.controllers.insert(handle.slot, controller);
         for prop in state {
@@ -154,12 +153,11 @@ impl Plane {
         position: Vector,
         yaw: f32,
     ) -> Result<(), CommandError> {
-        let h = self.body_of(handle)?;
+        let h = self.changing(handle)?;
         let pose = rapier3d::math::Pose::from_parts(position, yaw_rotation(yaw));
         let body = &mut self.world.bodies[h];
         body.set_position(pose, true);
         body.set_next_kinematic_position(pose);
-        self.dirty.mark(handle.slot);
         self.query_stale.push(h);
         Ok(())
     }
