@@ -6,6 +6,7 @@
 //! Adding a plane kind: a folder of its own (like `rapier3d/`) with a type implementing
 //! [`Backend`], a [`PlaneKind`] variant in shm-layout, and one line in `kinds::create`.
 
+pub mod clock;
 pub mod counted;
 mod dirty;
 pub(crate) mod held;
@@ -16,6 +17,7 @@ pub(crate) mod snapshot_decode;
 
 use std::mem::MaybeUninit;
 
+pub use clock::{check_dt, Clock, HeaderFigures};
 pub use dirty::Dirty;
 pub use marks::Marks;
 pub use slot_table::SlotTable;

@@ -10,7 +10,9 @@ use crate::backend::{Backend, Usage};
 
 impl Plane {
     fn gui(&mut self, op: GuiOp) -> CommandResult {
-        let applied = |plane: &Plane| Reply::Applied { tick: plane.tick };
+        let applied = |plane: &Plane| Reply::Applied {
+            tick: plane.clock.tick,
+        };
         match op {
             GuiOp::Info => Ok(Reply::Gui(GuiReply::Plane(self.gui_info()))),
             GuiOp::Add {
@@ -22,14 +24,14 @@ impl Plane {
                 let handle = self.add_object(shape, size, position, &props)?;
                 Ok(Reply::Object {
                     handle,
-                    tick: self.tick,
+                    tick: self.clock.tick,
                 })
             }
             GuiOp::Object { handle, op } => match op {
                 GuiObjectOp::Set(prop) => self.set_object(handle, prop).map(|_| applied(self)),
                 GuiObjectOp::ApplyImpulse(j) => {
                     self.apply_impulse(handle, j).map(|v| Reply::Velocity {
-                        tick: self.tick,
+                        tick: self.clock.tick,
                         linear: [v[0], v[1], 0.0],
                     })
                 }
@@ -72,9 +74,11 @@ impl Backend for Plane {
             PlaneOp::Gui(op) => self.gui(op),
             PlaneOp::Snapshot => self.snapshot().map(Reply::Snapshot),
             PlaneOp::Rewind(n) => self.rewind(n),
-            PlaneOp::Restore { bytes, overrides } => self
-                .restore(&bytes, &overrides)
-                .map(|_| Reply::Applied { tick: self.tick }),
+            PlaneOp::Restore { bytes, overrides } => {
+                self.restore(&bytes, &overrides).map(|_| Reply::Applied {
+                    tick: self.clock.tick,
+                })
+            }
             PlaneOp::Object { handle, op } => match op {
                 ObjectOp::Wake => self.gui(GuiOp::Object {
                     handle,
@@ -122,7 +126,7 @@ impl Backend for Plane {
     }
 
     fn tick(&self) -> u64 {
-        self.tick
+        self.clock.tick
     }
 
     fn header(&self) -> TickHeader {

@@ -11,7 +11,9 @@ use crate::backend::{Backend, Usage};
 impl Plane {
     /// Applies one op to the rapier world (the GPU path, `crate::gpu::GpuPlane`, wraps this).
     pub(super) fn apply_on_cpu(&mut self, op: PlaneOp) -> CommandResult {
-        let applied = |plane: &Plane| Reply::Applied { tick: plane.tick };
+        let applied = |plane: &Plane| Reply::Applied {
+            tick: plane.clock.tick,
+        };
         match op {
             PlaneOp::Info => Ok(Reply::Plane(self.info())),
             PlaneOp::Set(prop) => self.set(prop).map(|_| Reply::Done),
@@ -19,14 +21,14 @@ impl Plane {
                 let handle = self.add_object(&shape, pose, &props)?;
                 Ok(Reply::Object {
                     handle,
-                    tick: self.tick,
+                    tick: self.clock.tick,
                 })
             }
             PlaneOp::Object { handle, op } => match op {
                 ObjectOp::Set(prop) => self.set_object(handle, prop).map(|_| applied(self)),
                 ObjectOp::ApplyImpulse(j) => {
                     self.apply_impulse(handle, j).map(|linear| Reply::Velocity {
-                        tick: self.tick,
+                        tick: self.clock.tick,
                         linear,
                     })
                 }
@@ -102,7 +104,7 @@ impl Backend for Plane {
     }
 
     fn tick(&self) -> u64 {
-        self.tick
+        self.clock.tick
     }
 
     fn header(&self) -> TickHeader {

@@ -54,10 +54,10 @@ use rapier3d::prelude::*;
 use shm_layout::validate::MAX_HIT_BOX_QUALITY;
 use shm_layout::{
     BodyState, CollisionGroups, CommandError, EventRecord, PlaneId, PlaneInfo, PlaneKind,
-    PlaneProp, PlaneSettings, StateHasher, TickHeader, LAYOUT_VERSION,
+    PlaneProp, PlaneSettings, StateHasher, TickHeader,
 };
 
-use crate::backend::SlotTable;
+use crate::backend::{HeaderFigures, SlotTable};
 use part::Part;
 
 pub use objects::MAX_SLOTS;
@@ -92,12 +92,8 @@ pub struct Plane {
     pass: body_pass::Scratch,
     /// Objects a step must leave where it found them (see `held`).
     held: Vec<held::HeldBody>,
-    tick: u64,
-    sim_time: f64,
-    last_step_us: f32,
-    last_dt: f32,
-    max_penetration: f32,
-    contact_pairs: u32,
+    /// The tick clock and the last step's figures (see `backend::clock`).
+    clock: crate::backend::Clock,
     /// Bodies the last adaptive pass gave extra substeps (see `adaptive`).
     boosted: u32,
     /// Whether the last adaptive pass found a pair of a high mass ratio (see `adaptive`).
@@ -160,12 +156,7 @@ impl Plane {
             mesh_vertices: 0,
             pass: body_pass::Scratch::default(),
             held: Vec::new(),
-            tick: 0,
-            sim_time: 0.0,
-            last_step_us: 0.0,
-            last_dt: 0.0,
-            max_penetration: 0.0,
-            contact_pairs: 0,
+            clock: Default::default(),
             boosted: 0,
             stiffened: false,
             reporting: 0,
@@ -271,7 +262,7 @@ impl Plane {
 
     /// Ticks stepped so far.
     pub fn tick(&self) -> u64 {
-        self.tick
+        self.clock.tick
     }
 
     /// Every option and figure of the plane.
@@ -280,7 +271,7 @@ impl Plane {
             id: self.id,
             kind: PlaneKind::Rapier3d,
             settings: self.settings,
-            tick: self.tick,
+            tick: self.clock.tick,
             object_count: self.bodies.live(),
             effective_solver_iterations: self.solver_settings(self.nominal_dt()).iterations as u32,
             max_hit_box_quality: self.max_quality(),
@@ -296,7 +287,7 @@ impl Plane {
         let started = Instant::now();
         // Whether this step can change any published state: bodies awake, or ops since the
         // last step. A settled plane keeps its hash without rehashing every slot.
-        let moving = self.tick == 0
+        let moving = self.clock.tick == 0
             || self.world.islands.num_active_bodies() > 0
             || !self.bodies.since_step().is_empty();
         self.world.integration_parameters.dt = dt;
@@ -324,20 +315,18 @@ impl Plane {
         self.query_stale.clear();
         self.limit_speeds_after_step();
         self.bodies.stepped();
-        self.tick += 1;
-        self.sim_time += dt as f64;
-        self.last_dt = dt;
+        self.clock.advance(dt);
         self.collect_events();
         self.joints_after_step(dt);
         self.removed.clear();
         let rehash = moving || self.awake_count() > 0;
         let (figures, hash) = self.figures_and_hash(rehash);
-        (self.max_penetration, self.contact_pairs) = figures;
+        (self.clock.max_penetration, self.clock.contact_pairs) = figures;
         if let Some(hash) = hash {
             self.state_hash = hash;
         }
         self.adapt_solving();
-        self.last_step_us = started.elapsed().as_secs_f32() * 1e6;
+        self.clock.timed(started);
         // Kept for Rewind off the tick's path (see `rollback`).
         self.rollback.note_step();
         Ok(true)
@@ -350,22 +339,16 @@ impl Plane {
 
     /// The header of the newest tick.
     pub fn header(&self) -> TickHeader {
-        TickHeader {
-            layout_version: LAYOUT_VERSION,
-            plane_id: self.id,
-            tick: self.tick,
-            sim_time: self.sim_time,
-            tick_end_ns: 0,
-            step_time_us: self.last_step_us,
-            dt: self.last_dt,
-            slot_count: self.bodies.slot_count() as u32,
-            body_count: self.bodies.live(),
-            max_penetration: self.max_penetration,
-            max_joint_error: self.joints.max_error,
-            contact_pairs: self.contact_pairs,
-            event_count: self.event_seq as u32,
-            state_hash: self.state_hash,
-        }
+        self.clock.header(
+            self.id,
+            HeaderFigures {
+                slot_count: self.bodies.slot_count() as u32,
+                body_count: self.bodies.live(),
+                max_joint_error: self.joints.max_error,
+                event_count: self.event_seq,
+                state_hash: self.state_hash,
+            },
+        )
     }
 
     /// After a step: the contact figures of the tick header and, when `rehash`, the state

@@ -8,7 +8,6 @@
 use std::time::Instant;
 
 use rapier3d::prelude::*;
-use shm_layout::validate::{self, MAX_DT};
 use shm_layout::{
     BodyState, CommandError, Handle, ObjectProp, PlaneProp, PlaneSettings, ShapeKind, Vec3,
     FLAG_ALIVE, FLAG_ANCHORED,
@@ -217,12 +216,7 @@ impl Plane {
     /// false when the plane is disabled (the step then does nothing).
     pub fn begin_step(&mut self, dt: f32) -> Result<bool, CommandError> {
         self.finish_keep()?;
-        let dt = validate::positive("dt", dt)?;
-        if dt > MAX_DT {
-            return Err(CommandError::invalid(format!(
-                "dt must be at most {MAX_DT} s, got {dt}"
-            )));
-        }
+        crate::backend::check_dt(dt)?;
         Ok(self.settings.enabled)
     }
 
@@ -236,16 +230,14 @@ impl Plane {
         state_hash: u64,
         started: Instant,
     ) {
-        self.max_penetration = max_penetration;
-        self.contact_pairs = contact_pairs;
+        self.clock.max_penetration = max_penetration;
+        self.clock.contact_pairs = contact_pairs;
         self.events.clear();
         self.removed.clear();
         self.bodies.stepped();
-        self.tick += 1;
-        self.sim_time += dt as f64;
-        self.last_dt = dt;
+        self.clock.advance(dt);
         self.state_hash = state_hash;
-        self.last_step_us = started.elapsed().as_secs_f32() * 1e6;
+        self.clock.timed(started);
     }
 
     /// The published state of slot `i` with its pose from the other engine (`pose`: what
