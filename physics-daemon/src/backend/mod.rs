@@ -11,6 +11,7 @@ pub mod counted;
 mod dirty;
 pub(crate) mod held;
 pub mod marks;
+pub mod object_op;
 pub mod pools;
 mod slot_table;
 pub(crate) mod snapshot_decode;
@@ -20,6 +21,7 @@ use std::mem::MaybeUninit;
 pub use clock::{check_dt, Clock, HeaderFigures};
 pub use dirty::Dirty;
 pub use marks::Marks;
+pub use object_op::{object_op, ObjectPlane};
 pub use slot_table::SlotTable;
 
 use shm_layout::{

@@ -1,12 +1,12 @@
 //! The rapier3d plane behind the backend seam: routes each op to the plane's methods.
 
 use shm_layout::{
-    BodyState, CommandError, CommandResult, ErrorKind, EventRecord, ObjectOp, PlaneKind, PlaneOp,
-    Reply, TickHeader,
+    BodyState, CommandError, CommandResult, ErrorKind, EventRecord, Handle, ObjectOp, ObjectProp,
+    PlaneKind, PlaneOp, Reply, TickHeader, Vec3,
 };
 
 use super::Plane;
-use crate::backend::{Backend, Usage};
+use crate::backend::{Backend, ObjectPlane, Usage};
 
 impl Plane {
     /// Applies one op to the rapier world (the GPU path, `crate::gpu::GpuPlane`, wraps this).
@@ -24,21 +24,16 @@ impl Plane {
                     tick: self.clock.tick,
                 })
             }
-            PlaneOp::Object { handle, op } => match op {
-                ObjectOp::Set(prop) => self.set_object(handle, prop).map(|_| applied(self)),
-                ObjectOp::ApplyImpulse(j) => {
-                    self.apply_impulse(handle, j).map(|linear| Reply::Velocity {
-                        tick: self.clock.tick,
-                        linear,
-                    })
-                }
-                ObjectOp::Info => Ok(Reply::ObjectInfo(Box::new(self.object_info(handle)?))),
-                ObjectOp::RecalculateCenterOfMass => self
+            PlaneOp::Object { handle, op } => match op.into_common() {
+                Ok(common) => crate::backend::object_op(self, handle, common),
+                Err(ObjectOp::RecalculateCenterOfMass) => self
                     .recalculate_center_of_mass(handle)
                     .map(Reply::CenterOfMass),
-                ObjectOp::Wake => self.wake(handle).map(|_| applied(self)),
-                ObjectOp::Destroy => self.destroy_object(handle).map(|_| applied(self)),
-                ObjectOp::Contacts => self.object_contacts(handle).map(Reply::Contacts),
+                Err(ObjectOp::Contacts) => self.object_contacts(handle).map(Reply::Contacts),
+                Err(other) => Err(CommandError::new(
+                    ErrorKind::Internal,
+                    format!("ObjectOp::{other:?} is a shared object op"),
+                )),
             },
             PlaneOp::Query(query) => self.query(query),
             PlaneOp::Controller(op) => self.controller_op(op),
@@ -151,5 +146,34 @@ impl Backend for Plane {
             mesh_vertices: self.mesh_vertices + self.map_pending.cost(),
             state_bytes: self.state_bytes.get(),
         }
+    }
+}
+
+impl ObjectPlane for Plane {
+    type Prop = ObjectProp;
+    type Impulse = Vec3;
+
+    fn tick_now(&self) -> u64 {
+        self.clock.tick
+    }
+
+    fn set_prop(&mut self, handle: Handle, prop: ObjectProp) -> Result<(), CommandError> {
+        Plane::set_object(self, handle, prop)
+    }
+
+    fn impulse(&mut self, handle: Handle, impulse: Vec3) -> Result<Vec3, CommandError> {
+        Plane::apply_impulse(self, handle, impulse)
+    }
+
+    fn wake_object(&mut self, handle: Handle) -> Result<(), CommandError> {
+        Plane::wake(self, handle)
+    }
+
+    fn info_reply(&self, handle: Handle) -> CommandResult {
+        Ok(Reply::ObjectInfo(Box::new(self.object_info(handle)?)))
+    }
+
+    fn destroy(&mut self, handle: Handle) -> Result<(), CommandError> {
+        Plane::destroy_object(self, handle)
     }
 }
