@@ -6,6 +6,15 @@ use shm_layout::{CommandError, PlaneId, PlaneKind, PlaneProp};
 
 use crate::backend::Backend;
 
+/// The 3D plane kind as this daemon builds it: with the GPU path (`DeferGpu`) when built
+/// with the `gpu` feature, the rapier3d plane alone without it.
+#[cfg(feature = "gpu")]
+pub type Plane3d = crate::gpu::GpuPlane;
+/// The 3D plane kind as this daemon builds it: with the GPU path (`DeferGpu`) when built
+/// with the `gpu` feature, the rapier3d plane alone without it.
+#[cfg(not(feature = "gpu"))]
+pub type Plane3d = crate::rapier3d::Plane;
+
 /// Creates a plane of `kind` with its defaults, then `props` applied in order.
 pub fn create(
     kind: PlaneKind,
@@ -13,7 +22,7 @@ pub fn create(
     props: &[PlaneProp],
 ) -> Result<Box<dyn Backend>, CommandError> {
     Ok(match kind {
-        PlaneKind::Rapier3d => Box::new(crate::rapier3d::Plane::new(id, props)?),
+        PlaneKind::Rapier3d => Box::new(Plane3d::new(id, props)?),
         #[cfg(feature = "gui")]
         PlaneKind::Gui2d => Box::new(crate::rapier2d::Plane::new(id, props)?),
         #[cfg(not(feature = "gui"))]

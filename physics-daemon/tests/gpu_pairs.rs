@@ -4,8 +4,8 @@
 //! the pairs found by testing every pair, and both equal the overlaps computed here on the
 //! CPU from the same shapes. Runs on the machine's GPU adapter (lavapipe in CI).
 
+use physics_daemon::gpu::GpuPlane as Plane;
 use physics_daemon::gpu::PairMode;
-use physics_daemon::rapier3d::Plane;
 use proptest::prelude::*;
 use shm_layout::{CollisionGroups, ObjectProp, PlaneProp, Pose, Shape};
 

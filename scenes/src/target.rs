@@ -4,11 +4,12 @@
 
 use shm_layout::{CommandError, Handle, ObjectProp, Pose, Shape};
 
-/// The daemon's plane code, stepped in process: exactly what the daemon steps.
+/// The daemon's plane code, stepped in process: exactly what the daemon steps (its 3D plane
+/// kind, with the GPU path when the daemon has it).
 ///
 /// The single place this crate, and `physics-bench` through it, names the daemon's plane
-/// module.
-pub type LocalPlane = physics_daemon::rapier3d::Plane;
+/// type.
+pub type LocalPlane = physics_daemon::kinds::Plane3d;
 
 /// Somewhere a scene builder can add objects.
 pub trait SceneTarget {

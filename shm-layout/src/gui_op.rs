@@ -69,20 +69,12 @@ pub enum GuiOp {
     },
 }
 
-/// An op on one GUI object.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub enum GuiObjectOp {
-    /// Sets one property. Replies `Reply::Applied`.
-    Set(GuiObjectProp),
-    /// `Δv = impulse / Mass` now; wakes the body.
-    ApplyImpulse(Vec2),
-    /// Wakes the body.
-    Wake,
-    /// Every property. Replies [`GuiReply::Object`].
-    Info,
-    /// Removes the body (and its controller).
-    Destroy,
-}
+/// An op on one GUI object: the object op every plane kind shares
+/// ([`ObjectOpOf`](crate::ObjectOpOf)) over the GUI object properties and 2D impulses. `Set`
+/// replies `Reply::Applied`, `ApplyImpulse` (`Δv = impulse / Mass` now; wakes the body)
+/// `Reply::Velocity`, `Info` [`GuiReply::Object`], `Wake` and `Destroy` (the body and its
+/// controller) `Reply::Applied`.
+pub type GuiObjectOp = crate::ObjectOpOf<GuiObjectProp, Vec2>;
 
 /// A tunable of a GUI controller.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]

@@ -31,6 +31,7 @@ pub mod map_op;
 pub mod migrate;
 pub mod names;
 pub mod object_op;
+pub mod object_op_of;
 pub mod plane_name;
 pub mod plane_op;
 pub mod probe;
@@ -54,6 +55,7 @@ pub use gui_op::{GuiControllerOp, GuiControllerProp, GuiHit, GuiObjectOp, GuiOp,
 pub use joint_op::{AxisMode, JointInfo, JointKind, JointOp, JointProp, JointSettings};
 pub use map_op::{MapInfo, MapOp, MapReport};
 pub use object_op::ObjectOp;
+pub use object_op_of::ObjectOpOf;
 pub use plane_name::{NamedPlane, OpenedPlane, PlaneName};
 pub use plane_op::{OpCost, PlaneKind, PlaneOp};
 pub use probe::{Explosion, Falloff, ProbeHit};

@@ -799,3 +799,11 @@ fn cframe_values_are_tagged_userdata_that_refuse_forgeries() {
     let daemon = TestDaemon::start("lua-cframe-values");
     run_ok(&daemon, "tests/lua/cframe_values.luau", "cframe values ok");
 }
+
+/// A GUI plane's 2D settings, rows of its settings table: defaults, writes of each kind,
+/// the documented clamp, refusals naming the property and the value, Bounds at creation.
+#[test]
+fn gui_plane_settings_come_from_their_table() {
+    let daemon = TestDaemon::start("lua-gui-settings");
+    run_ok(&daemon, "tests/lua/gui_settings.luau", "gui settings ok");
+}

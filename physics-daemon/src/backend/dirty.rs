@@ -3,7 +3,7 @@
 //! drains; the plane's force pass reads the slots marked since its last step.
 
 /// Slots changed since the last publish.
-#[derive(Debug, Default)]
+#[derive(Debug, Default, Clone)]
 pub struct Dirty {
     slots: Vec<u32>,
     all: bool,

@@ -6,18 +6,22 @@
 //! Adding a plane kind: a folder of its own (like `rapier3d/`) with a type implementing
 //! [`Backend`], a [`PlaneKind`] variant in shm-layout, and one line in `kinds::create`.
 
+pub mod clock;
 pub mod counted;
 mod dirty;
 pub(crate) mod held;
 pub mod marks;
+pub mod object_op;
 pub mod pools;
 mod slot_table;
 pub(crate) mod snapshot_decode;
 
 use std::mem::MaybeUninit;
 
+pub use clock::{check_dt, Clock, HeaderFigures};
 pub use dirty::Dirty;
 pub use marks::Marks;
+pub use object_op::{object_op, ObjectPlane};
 pub use slot_table::SlotTable;
 
 use shm_layout::{

@@ -2,8 +2,16 @@
 //! time the slot is reused. A handle `(slot, generation)` finds its value only while the
 //! slot still holds that generation, so a handle to a removed value is an error, never
 //! another value. Bodies, and later controllers, joints and GUI bodies, use it alike.
+//!
+//! A table made with [`SlotTable::tracked`] (a plane's bodies) also records which slots
+//! changed ([`Dirty`]): [`SlotTable::insert`], [`SlotTable::get_mut`] and
+//! [`SlotTable::remove`] mark their slot themselves, so an op that changes an object through
+//! its handle cannot forget to; the publisher drains the marks. The engine's own passes
+//! ([`SlotTable::at_mut`], [`SlotTable::iter_mut`]) do not mark.
 
 use shm_layout::{CommandError, ErrorKind, Handle};
+
+use super::Dirty;
 
 #[derive(Clone, serde::Serialize, serde::Deserialize)]
 struct Entry<T> {
@@ -23,6 +31,11 @@ pub struct SlotTable<T> {
     live: u32,
     #[serde(skip)]
     max_slots: usize,
+    /// Slots changed since the last publish, in a tracked table. Not state: a copy or a
+    /// decoded table takes the marks of the live table it replaces
+    /// ([`SlotTable::take_marks_of`]).
+    #[serde(skip)]
+    marks: Option<Dirty>,
 }
 
 impl<T> SlotTable<T> {
@@ -34,7 +47,54 @@ impl<T> SlotTable<T> {
             free: Vec::new(),
             live: 0,
             max_slots,
+            marks: None,
         }
+    }
+
+    /// An empty table of at most `max_slots` slots that marks the slots ops change.
+    pub fn tracked(what: &'static str, max_slots: usize) -> Self {
+        SlotTable {
+            marks: Some(Dirty::default()),
+            ..SlotTable::new(what, max_slots)
+        }
+    }
+
+    fn mark(&mut self, slot: u32) {
+        if let Some(marks) = &mut self.marks {
+            marks.mark(slot);
+        }
+    }
+
+    /// Marks every slot as changed (a plane-wide change).
+    pub fn mark_all(&mut self) {
+        if let Some(marks) = &mut self.marks {
+            marks.mark_all();
+        }
+    }
+
+    /// Slots marked since the last step (possibly repeated; see [`Dirty::since_step`]).
+    pub fn since_step(&self) -> &[u32] {
+        self.marks.as_ref().map_or(&[], |m| m.since_step())
+    }
+
+    /// A step has seen every slot marked so far (see [`Dirty::stepped`]).
+    pub fn stepped(&mut self) {
+        let n = self.entries.len();
+        if let Some(marks) = &mut self.marks {
+            marks.stepped(n);
+        }
+    }
+
+    /// Hands the marked slots to `into` (appended) and forgets them. Returns true when the
+    /// whole table changed.
+    pub fn drain_marks(&mut self, into: &mut Vec<u32>) -> bool {
+        self.marks.as_mut().is_some_and(|m| m.drain(into))
+    }
+
+    /// Takes over the marks of `live`, the table this one replaces (a restore or a rewind:
+    /// what changed since the last publish is still to be published).
+    pub fn take_marks_of(&mut self, live: &mut SlotTable<T>) {
+        self.marks = live.marks.take();
     }
 
     /// Takes the name and slot limit of `like` (a table decoded from a snapshot has
@@ -104,10 +164,9 @@ impl<T> SlotTable<T> {
         entry.generation = entry.generation.wrapping_add(1).max(1);
         entry.value = Some(value);
         self.live += 1;
-        Ok(Handle {
-            slot,
-            generation: entry.generation,
-        })
+        let generation = entry.generation;
+        self.mark(slot);
+        Ok(Handle { slot, generation })
     }
 
     /// The value of `handle`, or a clear error for unknown and stale handles.
@@ -116,16 +175,19 @@ impl<T> SlotTable<T> {
         Ok(entry.value.as_ref().expect("checked by entry"))
     }
 
-    /// The value of `handle`, mutably.
+    /// The value of `handle`, mutably; its slot is marked changed.
     pub fn get_mut(&mut self, handle: Handle) -> Result<&mut T, CommandError> {
         self.entry(handle)?;
+        self.mark(handle.slot);
         let entry = &mut self.entries[handle.slot as usize];
         Ok(entry.value.as_mut().expect("checked by entry"))
     }
 
-    /// Removes the value of `handle`; its slot is reused with a new generation.
+    /// Removes the value of `handle`; its slot is reused with a new generation (and marked
+    /// changed).
     pub fn remove(&mut self, handle: Handle) -> Result<T, CommandError> {
         self.entry(handle)?;
+        self.mark(handle.slot);
         let value = self.entries[handle.slot as usize]
             .value
             .take()
@@ -166,7 +228,8 @@ impl<T> SlotTable<T> {
         self.entries.get(slot)?.value.as_ref()
     }
 
-    /// The value in slot `slot` mutably, if occupied.
+    /// The value in slot `slot` mutably, if occupied (for the engine's own passes: the slot
+    /// is not marked).
     pub fn at_mut(&mut self, slot: usize) -> Option<&mut T> {
         self.entries.get_mut(slot)?.value.as_mut()
     }
@@ -210,7 +273,7 @@ impl<T> SlotTable<T> {
         })
     }
 
-    /// Every occupied slot with its handle and value, mutably.
+    /// Every occupied slot with its handle and value, mutably (not marked).
     pub fn iter_mut(&mut self) -> impl Iterator<Item = (Handle, &mut T)> + '_ {
         self.entries.iter_mut().enumerate().filter_map(|(i, e)| {
             let generation = e.generation;
@@ -256,5 +319,55 @@ mod tests {
             .unwrap_err();
         assert!(e.message.contains("does not exist"), "{e}");
         assert_eq!(t.iter().count(), 2);
+    }
+
+    fn drained(t: &mut SlotTable<&str>) -> (Vec<u32>, bool) {
+        let mut slots = Vec::new();
+        let all = t.drain_marks(&mut slots);
+        slots.sort_unstable();
+        slots.dedup();
+        (slots, all)
+    }
+
+    #[test]
+    fn a_tracked_table_marks_what_handles_change_and_only_that() {
+        let mut t = SlotTable::tracked("thing", 8);
+        let a = t.insert("a").unwrap();
+        let b = t.insert("b").unwrap();
+        let c = t.insert("c").unwrap();
+        assert_eq!(drained(&mut t), (vec![0, 1, 2], false), "inserts mark");
+        t.get(a).unwrap();
+        t.at(1).unwrap();
+        t.at_mut(2).unwrap();
+        t.iter_mut().for_each(|_| {});
+        assert_eq!(
+            drained(&mut t),
+            (vec![], false),
+            "reads and engine passes do not"
+        );
+        *t.get_mut(b).unwrap() = "B";
+        t.remove(c).unwrap();
+        assert!(t.get_mut(c).is_err());
+        assert_eq!(t.since_step(), &[1, 2], "seen by the next step");
+        t.stepped();
+        assert!(t.since_step().is_empty());
+        assert_eq!(
+            drained(&mut t),
+            (vec![1, 2], false),
+            "get_mut and remove mark"
+        );
+        t.mark_all();
+        assert_eq!(drained(&mut t), (vec![], true));
+        // A copy (Rewind) or a decoded table takes the live table's marks when it replaces it.
+        t.get_mut(a).unwrap();
+        let mut copy = t.clone();
+        copy.get_mut(b).unwrap();
+        copy.take_marks_of(&mut t);
+        assert_eq!(drained(&mut copy), (vec![0], false));
+        // An untracked table (joints) keeps no marks.
+        let mut u = SlotTable::new("thing", 2);
+        let x = u.insert("x").unwrap();
+        u.get_mut(x).unwrap();
+        assert_eq!(drained(&mut u), (vec![], false));
     }
 }

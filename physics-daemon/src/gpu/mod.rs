@@ -7,19 +7,21 @@
 //!   time a plane asks for the GPU (no wgpu instance exists before) and shared by planes.
 //! - `world`: [`GpuWorld`], one plane's buffers, uploads, the step and the readback.
 //! - `broadphase`: the hash grid's sizing, the prefix-sum levels and the pair modes.
-//!
-//! The rapier plane owns a `GpuWorld` while `DeferGpu` is true and hands it every body's
-//! pose and velocity when it flips (see `rapier3d/gpu.rs`).
+//! - `plane`: [`GpuPlane`], the 3D plane kind of a daemon with the GPU path: a wrapper
+//!   around the rapier3d plane behind the backend seam that owns a `GpuWorld` while
+//!   `DeferGpu` is true and hands it every body's pose and velocity when it flips.
 //!
 //! `PHYSICS_GPU=off` in the daemon's environment hides every adapter (as on a machine
 //! without one), so the refusal path can be exercised anywhere.
 
 mod broadphase;
+mod plane;
 mod world;
 
 use std::sync::{Arc, OnceLock};
 
 pub use broadphase::PairMode;
+pub use plane::GpuPlane;
 pub use world::{GpuBody, GpuWorld, StepEnv};
 
 /// The shared wgpu device and the compiled step and scan pipelines.

@@ -53,38 +53,8 @@ struct Env {
     mode: [u32; 4],
 }
 
-/// One body handed to the GPU world.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct GpuBody {
-    /// Centre.
-    pub position: [f32; 3],
-    /// Orientation `[x, y, z, w]` (kept as it is for non-spheres).
-    pub rotation: [f32; 4],
-    /// Linear velocity.
-    pub velocity: [f32; 3],
-    /// Angular velocity (spheres only turn; others read back zero).
-    pub angular_velocity: [f32; 3],
-    /// Half extents of its world-aligned box (the rotated Size box's bounds).
-    pub half_extents: [f32; 3],
-    /// `Some(radius)`: a sphere.
-    pub sphere: Option<f32>,
-    /// 1 / mass; 0 for anchored bodies.
-    pub inverse_mass: f32,
-    /// Its own acceleration (ImpulseDirection + ConstantForce / mass).
-    pub acceleration: [f32; 3],
-    /// Restitution (a pair uses the higher).
-    pub bounciness: f32,
-    /// Friction (a pair uses the geometric mean).
-    pub friction: f32,
-    /// CanCollide.
-    pub collide: bool,
-    /// Translation locks X, Y, Z.
-    pub locks: [bool; 3],
-    /// Its collision group's bit.
-    pub group_bit: u32,
-    /// The groups it collides with.
-    pub group_mask: u32,
-}
+/// One body handed to the GPU world (the plane's own description of a simple body).
+pub use crate::rapier3d::SimpleBody as GpuBody;
 
 /// Plane-wide inputs of one tick.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -113,18 +83,8 @@ pub struct StepEnv {
     pub rest_threshold: f32,
 }
 
-/// What one slot reads back.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct GpuPose {
-    /// Centre.
-    pub position: [f32; 3],
-    /// Orientation.
-    pub rotation: [f32; 4],
-    /// Linear velocity.
-    pub velocity: [f32; 3],
-    /// Angular velocity.
-    pub angular_velocity: [f32; 3],
-}
+/// What one slot reads back (handed to the plane as it is).
+pub use crate::rapier3d::SimplePose as GpuPose;
 
 struct Buffers {
     capacity: usize,

@@ -1,16 +1,15 @@
 //! The GUI plane behind the backend seam: routes each op to the plane's methods.
 
 use shm_layout::{
-    BodyState, CommandError, CommandResult, ErrorKind, EventRecord, GuiObjectOp, GuiOp, GuiReply,
-    ObjectOp, PlaneKind, PlaneOp, Reply, TickHeader,
+    BodyState, CommandError, CommandResult, ErrorKind, EventRecord, GuiObjectOp, GuiObjectProp,
+    GuiOp, GuiReply, Handle, ObjectOp, PlaneKind, PlaneOp, Reply, TickHeader, Vec2, Vec3,
 };
 
 use super::Plane;
-use crate::backend::{Backend, Usage};
+use crate::backend::{Backend, ObjectPlane, Usage};
 
 impl Plane {
     fn gui(&mut self, op: GuiOp) -> CommandResult {
-        let applied = |plane: &Plane| Reply::Applied { tick: plane.tick };
         match op {
             GuiOp::Info => Ok(Reply::Gui(GuiReply::Plane(self.gui_info()))),
             GuiOp::Add {
@@ -22,23 +21,10 @@ impl Plane {
                 let handle = self.add_object(shape, size, position, &props)?;
                 Ok(Reply::Object {
                     handle,
-                    tick: self.tick,
+                    tick: self.clock.tick,
                 })
             }
-            GuiOp::Object { handle, op } => match op {
-                GuiObjectOp::Set(prop) => self.set_object(handle, prop).map(|_| applied(self)),
-                GuiObjectOp::ApplyImpulse(j) => {
-                    self.apply_impulse(handle, j).map(|v| Reply::Velocity {
-                        tick: self.tick,
-                        linear: [v[0], v[1], 0.0],
-                    })
-                }
-                GuiObjectOp::Wake => self.wake(handle).map(|_| applied(self)),
-                GuiObjectOp::Info => Ok(Reply::Gui(GuiReply::Object(Box::new(
-                    self.object_info(handle)?,
-                )))),
-                GuiObjectOp::Destroy => self.destroy_object(handle).map(|_| applied(self)),
-            },
+            GuiOp::Object { handle, op } => crate::backend::object_op(self, handle, op),
             GuiOp::Controller { handle, op } => self.controller_op(handle, op),
             GuiOp::Raycast {
                 from,
@@ -72,9 +58,11 @@ impl Backend for Plane {
             PlaneOp::Gui(op) => self.gui(op),
             PlaneOp::Snapshot => self.snapshot().map(Reply::Snapshot),
             PlaneOp::Rewind(n) => self.rewind(n),
-            PlaneOp::Restore { bytes, overrides } => self
-                .restore(&bytes, &overrides)
-                .map(|_| Reply::Applied { tick: self.tick }),
+            PlaneOp::Restore { bytes, overrides } => {
+                self.restore(&bytes, &overrides).map(|_| Reply::Applied {
+                    tick: self.clock.tick,
+                })
+            }
             PlaneOp::Object { handle, op } => match op {
                 ObjectOp::Wake => self.gui(GuiOp::Object {
                     handle,
@@ -125,7 +113,7 @@ impl Backend for Plane {
     }
 
     fn tick(&self) -> u64 {
-        self.tick
+        self.clock.tick
     }
 
     fn header(&self) -> TickHeader {
@@ -147,7 +135,7 @@ impl Backend for Plane {
     }
 
     fn drain_dirty(&mut self, into: &mut Vec<u32>) -> bool {
-        self.dirty.drain(into)
+        self.bodies.drain_marks(into)
     }
 
     fn body_state(&self, i: usize) -> BodyState {
@@ -164,5 +152,36 @@ impl Backend for Plane {
             mesh_vertices: 0,
             state_bytes: self.state_bytes.get(),
         }
+    }
+}
+
+impl ObjectPlane for Plane {
+    type Prop = GuiObjectProp;
+    type Impulse = Vec2;
+
+    fn tick_now(&self) -> u64 {
+        self.clock.tick
+    }
+
+    fn set_prop(&mut self, handle: Handle, prop: GuiObjectProp) -> Result<(), CommandError> {
+        Plane::set_object(self, handle, prop)
+    }
+
+    fn impulse(&mut self, handle: Handle, impulse: Vec2) -> Result<Vec3, CommandError> {
+        Plane::apply_impulse(self, handle, impulse).map(|v| [v[0], v[1], 0.0])
+    }
+
+    fn wake_object(&mut self, handle: Handle) -> Result<(), CommandError> {
+        Plane::wake(self, handle)
+    }
+
+    fn info_reply(&self, handle: Handle) -> CommandResult {
+        Ok(Reply::Gui(GuiReply::Object(Box::new(
+            self.object_info(handle)?,
+        ))))
+    }
+
+    fn destroy(&mut self, handle: Handle) -> Result<(), CommandError> {
+        Plane::destroy_object(self, handle)
     }
 }

@@ -58,7 +58,9 @@ impl Plane {
     ) -> Result<Reply, CommandError> {
         let op = op.checked()?;
         let h = self.body(handle)?.handle;
-        let applied = Reply::Applied { tick: self.tick };
+        let applied = Reply::Applied {
+            tick: self.clock.tick,
+        };
         if let GuiControllerOp::Create {
             uncontrolled,
             props,
@@ -144,7 +146,6 @@ impl Plane {
             _ => {}
         }
         self.world.bodies[h].wake_up(true);
-        self.dirty.mark(handle.slot);
         Ok(applied)
     }
 

@@ -25,7 +25,7 @@ impl Plane {
         let lin = (1.0 - s.linear_damping * dt).max(0.0);
         let ang = (1.0 - s.angular_damping * dt).max(0.0);
         let mut visit: Vec<RigidBodyHandle> = self.world.active_bodies().map(|(h, _)| h).collect();
-        for &slot in self.dirty.since_step() {
+        for &slot in self.bodies.since_step() {
             if let Some(b) = self.bodies.at(slot as usize) {
                 visit.push(b.handle);
             }

@@ -32,13 +32,12 @@ use rapier2d::prelude::*;
 use shm_layout::gui_op::GuiPlaneInfo;
 use shm_layout::settings::gui_plane::GUI_TIME_UNTIL_SLEEP;
 use shm_layout::settings::{GuiObjectSettings, GuiPlaneProp, GuiPlaneSettings, GuiShape};
-use shm_layout::validate::{self, MAX_DT};
 use shm_layout::{
     BodyState, CommandError, EventRecord, PlaneId, PlaneInfo, PlaneKind, PlaneProp, PlaneSettings,
-    StateHasher, TickHeader, FLAG_ALIVE, FLAG_ANCHORED, FLAG_SLEEPING, LAYOUT_VERSION,
+    StateHasher, TickHeader, FLAG_ALIVE, FLAG_ANCHORED, FLAG_SLEEPING,
 };
 
-use crate::backend::{Dirty, SlotTable};
+use crate::backend::{HeaderFigures, SlotTable};
 use controllers::Controller;
 
 /// Slots per GUI plane.
@@ -69,17 +68,12 @@ pub struct Plane {
     controlled: Vec<u32>,
     /// Bodies with a force or a pending impulse of their own.
     driven: u32,
-    dirty: Dirty,
     /// An op moved, added or reshaped a body since the last step (queries refresh first).
     query_stale: crate::backend::Marks<RigidBodyHandle>,
     /// Bodies a step must leave where it found them (see `held`).
     held: Vec<held::HeldBody>,
-    tick: u64,
-    sim_time: f64,
-    last_step_us: f32,
-    last_dt: f32,
-    max_penetration: f32,
-    contact_pairs: u32,
+    /// The tick clock and the last step's figures (see `backend::clock`).
+    clock: crate::backend::Clock,
     events: Vec<EventRecord>,
     event_seq: u64,
     /// Bytes of controller paths and kept ticks (counted against the owner's quota).
@@ -107,18 +101,12 @@ impl Plane {
             id,
             settings,
             world,
-            bodies: SlotTable::new("object", MAX_SLOTS),
+            bodies: SlotTable::tracked("object", MAX_SLOTS),
             controlled: Vec::new(),
             driven: 0,
-            dirty: Dirty::default(),
             query_stale: Default::default(),
             held: Vec::new(),
-            tick: 0,
-            sim_time: 0.0,
-            last_step_us: 0.0,
-            last_dt: 0.0,
-            max_penetration: 0.0,
-            contact_pairs: 0,
+            clock: Default::default(),
             events: Vec::new(),
             event_seq: 0,
             state_bytes: Default::default(),
@@ -192,7 +180,7 @@ impl Plane {
                 ))
             }
         }
-        self.dirty.mark_all();
+        self.bodies.mark_all();
         Ok(())
     }
 
@@ -235,7 +223,7 @@ impl Plane {
         GuiPlaneInfo {
             id: self.id,
             settings: self.settings,
-            tick: self.tick,
+            tick: self.clock.tick,
             object_count: self.bodies.live(),
             controller_count: self.controlled.len() as u32,
         }
@@ -266,7 +254,7 @@ impl Plane {
                 rollback_ticks: self.rollback_ticks,
                 ..PlaneSettings::default()
             },
-            tick: self.tick,
+            tick: self.clock.tick,
             object_count: self.bodies.live(),
             effective_solver_iterations: s.solver_iterations,
             max_hit_box_quality: 1,
@@ -275,12 +263,7 @@ impl Plane {
 
     /// Advances by `dt`. Returns false (and does nothing) when the plane is disabled.
     pub fn step(&mut self, dt: f32) -> Result<bool, CommandError> {
-        let dt = validate::positive("dt", dt)?;
-        if dt > MAX_DT {
-            return Err(CommandError::invalid(format!(
-                "dt must be at most {MAX_DT} s, got {dt}"
-            )));
-        }
+        let dt = crate::backend::check_dt(dt)?;
         if !self.settings.enabled {
             return Ok(false);
         }
@@ -295,13 +278,11 @@ impl Plane {
         self.world.step_with_events(&hooks::Hooks, &());
         self.held_after_step();
         self.query_stale.clear();
-        self.dirty.stepped(self.bodies.slot_count());
-        self.tick += 1;
-        self.sim_time += dt as f64;
-        self.last_dt = dt;
+        self.bodies.stepped();
+        self.clock.advance(dt);
         self.after_step_controllers();
-        (self.max_penetration, self.contact_pairs) = self.contact_figures();
-        self.last_step_us = started.elapsed().as_secs_f32() * 1e6;
+        (self.clock.max_penetration, self.clock.contact_pairs) = self.contact_figures();
+        self.clock.timed(started);
         self.keep_for_rollback();
         Ok(true)
     }
@@ -328,22 +309,16 @@ impl Plane {
 
     /// The header of the newest tick.
     pub fn header(&self) -> TickHeader {
-        TickHeader {
-            layout_version: LAYOUT_VERSION,
-            plane_id: self.id,
-            tick: self.tick,
-            sim_time: self.sim_time,
-            tick_end_ns: 0,
-            step_time_us: self.last_step_us,
-            dt: self.last_dt,
-            slot_count: self.bodies.slot_count() as u32,
-            body_count: self.bodies.live(),
-            max_penetration: self.max_penetration,
-            max_joint_error: 0.0,
-            contact_pairs: self.contact_pairs,
-            event_count: self.event_seq as u32,
-            state_hash: self.state_hash(),
-        }
+        self.clock.header(
+            self.id,
+            HeaderFigures {
+                slot_count: self.bodies.slot_count() as u32,
+                body_count: self.bodies.live(),
+                max_joint_error: 0.0,
+                event_count: self.event_seq,
+                state_hash: self.state_hash(),
+            },
+        )
     }
 
     /// [`StateHasher`] over every slot's published state, in slot order (what the tick
@@ -410,7 +385,7 @@ impl Plane {
 
     /// Appends one event (running number assigned here).
     fn push_event(&mut self, mut record: EventRecord) {
-        record.tick = self.tick;
+        record.tick = self.clock.tick;
         record.seq = self.event_seq;
         self.event_seq += 1;
         self.events.push(record);

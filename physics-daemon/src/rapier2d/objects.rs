@@ -81,7 +81,6 @@ impl Plane {
             settings,
             controller: None,
         })?;
-        self.dirty.mark(handle.slot);
         self.query_stale.push(h);
         for prop in props {
             self.set_object(handle, prop)?;
@@ -93,6 +92,16 @@ impl Plane {
     pub(super) fn body(&self, handle: Handle) -> Result<&Body, CommandError> {
         self.bodies.get(handle).map_err(|mut e| {
             e.message = format!("{} (GUI plane {})", e.message, self.id);
+            e
+        })
+    }
+
+    /// The body of `handle`, which the caller is about to change: its slot is marked
+    /// changed. Errors as [`Plane::body`].
+    fn changing(&mut self, handle: Handle) -> Result<&mut Body, CommandError> {
+        let id = self.id;
+        self.bodies.get_mut(handle).map_err(|mut e| {
+            e.message = format!("{} (GUI plane {id})", e.message);
             e
         })
     }
@@ -191,7 +200,6 @@ impl Plane {
             (true, false) => self.driven -= 1,
             _ => {}
         }
-        self.dirty.mark(handle.slot);
         Ok(())
     }
 
@@ -207,7 +215,7 @@ impl Plane {
     /// Returns the linear velocity right after it.
     pub fn apply_impulse(&mut self, handle: Handle, impulse: Vec2) -> Result<Vec2, CommandError> {
         let impulse = finite2("impulse", impulse)?;
-        let b = self.body(handle)?;
+        let b = self.changing(handle)?;
         let (h, settings) = (b.handle, b.settings);
         let rb = &mut self.world.bodies[h];
         if rb.is_dynamic() {
@@ -215,15 +223,13 @@ impl Plane {
             rb.set_linvel(unlocked(&settings, v), true);
         }
         let v = rb.linvel();
-        self.dirty.mark(handle.slot);
         Ok([v.x, v.y])
     }
 
     /// Wakes the body.
     pub fn wake(&mut self, handle: Handle) -> Result<(), CommandError> {
-        let h = self.body(handle)?.handle;
+        let h = self.changing(handle)?.handle;
         self.world.bodies[h].wake_up(true);
-        self.dirty.mark(handle.slot);
         Ok(())
     }
 
@@ -238,7 +244,6 @@ impl Plane {
             self.controlled.retain(|s| *s != handle.slot);
         }
         self.world.remove_body(body.handle);
-        self.dirty.mark(handle.slot);
         Ok(())
     }
 

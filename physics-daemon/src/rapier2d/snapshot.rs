@@ -80,12 +80,7 @@ plane_state! {
     driven: u32,
     query_stale: crate::backend::Marks<RigidBodyHandle>,
     held: Vec<held::HeldBody>,
-    tick: u64,
-    sim_time: f64,
-    last_step_us: f32,
-    last_dt: f32,
-    max_penetration: f32,
-    contact_pairs: u32,
+    clock: crate::backend::Clock,
     event_seq: u64,
     rollback_ticks: u32,
 }
@@ -103,7 +98,7 @@ impl Plane {
         let header = SnapshotHeader {
             engine: ENGINE.to_string(),
             kind: PlaneKind::Gui2d,
-            tick: self.tick,
+            tick: self.clock.tick,
             state_hash: self.header().state_hash,
             objects: usage.objects,
             mesh_vertices: usage.mesh_vertices,
@@ -159,9 +154,10 @@ impl Plane {
             }
         }
         state.world.physics_pipeline = std::mem::take(&mut self.world.physics_pipeline);
+        state.bodies.take_marks_of(&mut self.bodies);
         self.take_state(state);
         self.events.clear();
-        self.dirty.mark_all();
+        self.bodies.mark_all();
         // Another timeline: the ticks kept for Rewind no longer lead here.
         self.rollback.clear();
         for prop in overrides {
@@ -179,9 +175,10 @@ impl Plane {
             }
         }
         state.world.physics_pipeline = std::mem::take(&mut self.world.physics_pipeline);
+        state.bodies.take_marks_of(&mut self.bodies);
         self.take_state(state);
         self.events.clear();
-        self.dirty.mark_all();
+        self.bodies.mark_all();
         Ok(())
     }
 }

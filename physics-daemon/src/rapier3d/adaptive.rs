@@ -67,7 +67,7 @@ impl Plane {
             .normalized_allowed_linear_error
             / BASE_ALLOWED_ERROR;
         let (trigger, release) = (TRIGGER_DEPTH * scale, RELEASE_DEPTH * scale);
-        if self.max_penetration <= release && !self.tick.is_multiple_of(PASS_EVERY) {
+        if self.clock.max_penetration <= release && !self.clock.tick.is_multiple_of(PASS_EVERY) {
             return;
         }
         let bodies = &self.world.bodies;

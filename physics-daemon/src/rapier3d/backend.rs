@@ -1,17 +1,19 @@
 //! The rapier3d plane behind the backend seam: routes each op to the plane's methods.
 
 use shm_layout::{
-    BodyState, CommandError, CommandResult, ErrorKind, EventRecord, ObjectOp, PlaneKind, PlaneOp,
-    Reply, TickHeader,
+    BodyState, CommandError, CommandResult, ErrorKind, EventRecord, Handle, ObjectOp, ObjectProp,
+    PlaneKind, PlaneOp, Reply, TickHeader, Vec3,
 };
 
 use super::Plane;
-use crate::backend::{Backend, Usage};
+use crate::backend::{Backend, ObjectPlane, Usage};
 
 impl Plane {
-    /// Applies one op to the rapier world (on the GPU path, `gpu.rs` wraps this).
+    /// Applies one op to the rapier world (the GPU path, `crate::gpu::GpuPlane`, wraps this).
     pub(super) fn apply_on_cpu(&mut self, op: PlaneOp) -> CommandResult {
-        let applied = |plane: &Plane| Reply::Applied { tick: plane.tick };
+        let applied = |plane: &Plane| Reply::Applied {
+            tick: plane.clock.tick,
+        };
         match op {
             PlaneOp::Info => Ok(Reply::Plane(self.info())),
             PlaneOp::Set(prop) => self.set(prop).map(|_| Reply::Done),
@@ -19,24 +21,19 @@ impl Plane {
                 let handle = self.add_object(&shape, pose, &props)?;
                 Ok(Reply::Object {
                     handle,
-                    tick: self.tick,
+                    tick: self.clock.tick,
                 })
             }
-            PlaneOp::Object { handle, op } => match op {
-                ObjectOp::Set(prop) => self.set_object(handle, prop).map(|_| applied(self)),
-                ObjectOp::ApplyImpulse(j) => {
-                    self.apply_impulse(handle, j).map(|linear| Reply::Velocity {
-                        tick: self.tick,
-                        linear,
-                    })
-                }
-                ObjectOp::Info => Ok(Reply::ObjectInfo(Box::new(self.object_info(handle)?))),
-                ObjectOp::RecalculateCenterOfMass => self
+            PlaneOp::Object { handle, op } => match op.into_common() {
+                Ok(common) => crate::backend::object_op(self, handle, common),
+                Err(ObjectOp::RecalculateCenterOfMass) => self
                     .recalculate_center_of_mass(handle)
                     .map(Reply::CenterOfMass),
-                ObjectOp::Wake => self.wake(handle).map(|_| applied(self)),
-                ObjectOp::Destroy => self.destroy_object(handle).map(|_| applied(self)),
-                ObjectOp::Contacts => self.object_contacts(handle).map(Reply::Contacts),
+                Err(ObjectOp::Contacts) => self.object_contacts(handle).map(Reply::Contacts),
+                Err(other) => Err(CommandError::new(
+                    ErrorKind::Internal,
+                    format!("ObjectOp::{other:?} is a shared object op"),
+                )),
             },
             PlaneOp::Query(query) => self.query(query),
             PlaneOp::Controller(op) => self.controller_op(op),
@@ -89,10 +86,6 @@ impl Backend for Plane {
     fn apply(&mut self, op: PlaneOp) -> CommandResult {
         // The last tick is kept for Rewind before an op changes anything (see `rollback`).
         self.finish_keep()?;
-        #[cfg(feature = "gpu")]
-        if self.on_gpu() {
-            return self.apply_on_gpu(op);
-        }
         self.apply_on_cpu(op)
     }
 
@@ -109,7 +102,7 @@ impl Backend for Plane {
     }
 
     fn tick(&self) -> u64 {
-        self.tick
+        self.clock.tick
     }
 
     fn header(&self) -> TickHeader {
@@ -125,19 +118,13 @@ impl Backend for Plane {
     }
 
     fn for_each_awake(&self, f: &mut dyn FnMut(usize)) {
-        #[cfg(feature = "gpu")]
-        if self.on_gpu() {
-            // Nothing sleeps on the GPU path.
-            (0..self.slot_count()).for_each(f);
-            return;
-        }
         for slot in self.awake_slots() {
             f(slot);
         }
     }
 
     fn drain_dirty(&mut self, into: &mut Vec<u32>) -> bool {
-        self.dirty.drain(into)
+        self.bodies.drain_marks(into)
     }
 
     fn body_state(&self, i: usize) -> BodyState {
@@ -162,5 +149,34 @@ impl Backend for Plane {
             mesh_vertices: self.mesh_vertices + self.map_pending.cost(),
             state_bytes: self.state_bytes.get(),
         }
+    }
+}
+
+impl ObjectPlane for Plane {
+    type Prop = ObjectProp;
+    type Impulse = Vec3;
+
+    fn tick_now(&self) -> u64 {
+        self.clock.tick
+    }
+
+    fn set_prop(&mut self, handle: Handle, prop: ObjectProp) -> Result<(), CommandError> {
+        Plane::set_object(self, handle, prop)
+    }
+
+    fn impulse(&mut self, handle: Handle, impulse: Vec3) -> Result<Vec3, CommandError> {
+        Plane::apply_impulse(self, handle, impulse)
+    }
+
+    fn wake_object(&mut self, handle: Handle) -> Result<(), CommandError> {
+        Plane::wake(self, handle)
+    }
+
+    fn info_reply(&self, handle: Handle) -> CommandResult {
+        Ok(Reply::ObjectInfo(Box::new(self.object_info(handle)?)))
+    }
+
+    fn destroy(&mut self, handle: Handle) -> Result<(), CommandError> {
+        Plane::destroy_object(self, handle)
     }
 }

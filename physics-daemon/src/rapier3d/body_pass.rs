@@ -131,7 +131,7 @@ impl Plane {
         handles.extend(self.world.islands.active_bodies());
         // Bodies changed by ops since the last step, awake or not yet listed as awake: a
         // body can be listed twice (or more), and gets one update.
-        let dirty = self.dirty.since_step();
+        let dirty = self.bodies.since_step();
         let slots = &self.bodies;
         handles.extend(
             dirty

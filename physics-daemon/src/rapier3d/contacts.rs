@@ -100,7 +100,7 @@ impl Plane {
         self.events.clear();
         // Events the controllers produced before the step come first, in their order.
         for mut record in std::mem::take(&mut self.pending_events) {
-            record.tick = self.tick;
+            record.tick = self.clock.tick;
             record.seq = self.event_seq;
             self.event_seq += 1;
             self.events.push(record);
@@ -117,7 +117,7 @@ impl Plane {
                 a_generation: a.generation,
                 b_slot: b.slot,
                 b_generation: b.generation,
-                tick: self.tick,
+                tick: self.clock.tick,
                 seq: self.event_seq,
                 ..EventRecord::default()
             };

@@ -67,20 +67,19 @@ impl Plane {
             if share <= 0.0 || e.impulse == 0.0 {
                 continue;
             }
-            if controller {
-                let mass: f32 = body
-                    .colliders()
-                    .iter()
-                    .filter_map(|c| self.world.colliders.get(*c))
-                    .map(|co| co.mass())
-                    .sum();
-                if mass > 0.0 {
-                    self.kick_controller(handle.slot, impulse / mass);
-                }
-            } else {
+            let mass: f32 = body
+                .colliders()
+                .iter()
+                .filter_map(|c| self.world.colliders.get(*c))
+                .map(|co| co.mass())
+                .sum();
+            // The object changes: its slot is marked.
+            let h = self.changing(handle)?;
+            if !controller {
                 self.world.bodies[h].apply_impulse(impulse, true);
+            } else if mass > 0.0 {
+                self.kick_controller(handle.slot, impulse / mass);
             }
-            self.dirty.mark(handle.slot);
             affected.push(handle);
         }
         Ok(Reply::Objects(affected))

@@ -302,12 +302,14 @@ impl Plane {
                 let handle = self.create_joint(kind, a, b, &props)?;
                 Ok(Reply::Joint {
                     handle,
-                    tick: self.tick,
+                    tick: self.clock.tick,
                 })
             }
             JointOp::Set { joint, prop } => {
                 self.set_joint(joint, prop)?;
-                Ok(Reply::Applied { tick: self.tick })
+                Ok(Reply::Applied {
+                    tick: self.clock.tick,
+                })
             }
             JointOp::Info { joint } => Ok(Reply::JointInfo(Box::new(self.joint_info(joint)?))),
             JointOp::Destroy { joint } => {
@@ -317,7 +319,9 @@ impl Plane {
                 if let Some(b) = j.b {
                     self.joint_holds(b, -1);
                 }
-                Ok(Reply::Applied { tick: self.tick })
+                Ok(Reply::Applied {
+                    tick: self.clock.tick,
+                })
             }
         }
     }
@@ -726,7 +730,7 @@ impl Plane {
                     b_generation: a.generation,
                     impulse: force,
                     position: anchor.into(),
-                    tick: self.tick,
+                    tick: self.clock.tick,
                     seq: self.event_seq,
                     ..EventRecord::default()
                 });

@@ -244,7 +244,6 @@ impl Plane {
             part: Box::new(part),
             flags: 0,
         })?;
-        self.dirty.mark(handle.slot);
         self.query_stale.push(h);
         Ok((handle, report))
     }

@@ -29,13 +29,12 @@ mod articulations;
 mod axis_motors;
 mod capsule_contact;
 mod contact_points;
-#[cfg(feature = "gpu")]
-mod gpu;
 mod joints;
 mod limits;
 mod map_store;
 mod maps;
 mod objects;
+mod offload;
 mod part;
 mod probes;
 mod properties;
@@ -52,18 +51,18 @@ use std::sync::mpsc;
 use std::time::Instant;
 
 use rapier3d::prelude::*;
-use shm_layout::validate::{self, MAX_DT, MAX_HIT_BOX_QUALITY};
+use shm_layout::validate::MAX_HIT_BOX_QUALITY;
 use shm_layout::{
     BodyState, CollisionGroups, CommandError, EventRecord, PlaneId, PlaneInfo, PlaneKind,
-    PlaneProp, PlaneSettings, StateHasher, TickHeader, LAYOUT_VERSION,
+    PlaneProp, PlaneSettings, StateHasher, TickHeader,
 };
-#[cfg(feature = "gpu")]
-use shm_layout::{FLAG_ALIVE, FLAG_ANCHORED};
 
-use crate::backend::{Dirty, SlotTable};
+use crate::backend::{HeaderFigures, SlotTable};
 use part::Part;
 
 pub use objects::MAX_SLOTS;
+pub use offload::{no_other_engine, DeferHook, SimpleBody, SimplePose};
+pub use snapshot::GpuSaved;
 
 /// One object: its rapier body and what the API says about it.
 #[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
@@ -89,19 +88,12 @@ pub struct Plane {
     driven: u32,
     /// Mesh vertices of all parts (for quotas).
     mesh_vertices: u64,
-    /// Slots changed by ops: the publisher rewrites them, and the force pass sees them even
-    /// before rapier's island manager lists them as awake.
-    dirty: Dirty,
     /// Buffers of the per-body passes.
     pass: body_pass::Scratch,
     /// Objects a step must leave where it found them (see `held`).
     held: Vec<held::HeldBody>,
-    tick: u64,
-    sim_time: f64,
-    last_step_us: f32,
-    last_dt: f32,
-    max_penetration: f32,
-    contact_pairs: u32,
+    /// The tick clock and the last step's figures (see `backend::clock`).
+    clock: crate::backend::Clock,
     /// Bodies the last adaptive pass gave extra substeps (see `adaptive`).
     boosted: u32,
     /// Whether the last adaptive pass found a pair of a high mass ratio (see `adaptive`).
@@ -131,9 +123,6 @@ pub struct Plane {
     joints: joints::Joints,
     /// Map pieces uploaded since the last build (see `maps`).
     map_pending: maps::PendingMap,
-    /// The GPU world while `DeferGpu` is on (see `gpu`).
-    #[cfg(feature = "gpu")]
-    gpu: Option<crate::gpu::GpuWorld>,
     /// [`StateHasher`] over every slot as the last step left it (the tick header's).
     state_hash: u64,
     /// Bytes of controller paths (counted against the owner's quota).
@@ -143,33 +132,33 @@ pub struct Plane {
 }
 
 impl Plane {
-    /// A plane with default options, then `props` applied in order.
+    /// A plane with default options, then `props` applied in order (`DeferGpu = true` is
+    /// refused: see [`Plane::new_with`]).
     pub fn new(id: PlaneId, props: &[PlaneProp]) -> Result<Plane, CommandError> {
+        Plane::new_with(id, props, &mut no_other_engine)
+    }
+
+    /// A plane with default options.
+    fn empty(id: PlaneId) -> Plane {
         let settings = PlaneSettings::default();
         let mut world = PhysicsWorld::new();
         world.gravity = Vector::from(settings.gravity);
         let (collision_tx, collision_rx) = mpsc::channel();
         let (force_tx, _) = mpsc::channel();
         let (tear_tx, _) = mpsc::channel();
-        let mut plane = Plane {
+        Plane {
             id,
             settings,
             world,
-            bodies: SlotTable::new("object", MAX_SLOTS),
+            bodies: SlotTable::tracked("object", MAX_SLOTS),
             quality_counts: [0; MAX_HIT_BOX_QUALITY as usize + 1],
             driven: 0,
             mesh_vertices: 0,
-            dirty: Dirty::default(),
             pass: body_pass::Scratch::default(),
             held: Vec::new(),
-            tick: 0,
-            sim_time: 0.0,
-            last_step_us: 0.0,
-            last_dt: 0.0,
-            max_penetration: 0.0,
+            clock: Default::default(),
             boosted: 0,
             stiffened: false,
-            contact_pairs: 0,
             reporting: 0,
             collision_tx,
             collision_rx,
@@ -184,28 +173,29 @@ impl Plane {
             query_stale: Default::default(),
             joints: joints::Joints::default(),
             map_pending: maps::PendingMap::default(),
-            #[cfg(feature = "gpu")]
-            gpu: None,
             state_hash: 0,
             state_bytes: Default::default(),
             rollback: Default::default(),
-        };
-        for prop in props {
-            plane.apply_prop(*prop, true)?;
         }
-        Ok(plane)
     }
 
-    /// Applies one option; `creating` allows the construction-only ones.
+    /// Applies one option (`DeferGpu = true` is refused: see [`Plane::set_with`]).
     pub fn set(&mut self, prop: PlaneProp) -> Result<(), CommandError> {
-        self.apply_prop(prop, false)
+        self.apply_prop(prop, false, &mut no_other_engine)
     }
 
-    fn apply_prop(&mut self, prop: PlaneProp, creating: bool) -> Result<(), CommandError> {
+    /// Applies one option; `creating` allows the construction-only ones; `defer` takes
+    /// `DeferGpu`.
+    fn apply_prop(
+        &mut self,
+        prop: PlaneProp,
+        creating: bool,
+        defer: &mut DeferHook<'_>,
+    ) -> Result<(), CommandError> {
         let before = self.settings;
         let prop = self.settings.apply(prop, creating)?;
         if let PlaneProp::DeferGpu(on) = prop {
-            if let Err(mut e) = self.set_defer_gpu(on) {
+            if let Err(mut e) = defer(self, on) {
                 self.settings = before;
                 e.message = match creating {
                     true => format!("{}; no plane was created", e.message),
@@ -225,19 +215,7 @@ impl Plane {
         if prop.changes_forces() {
             self.world.wake_up_all(true);
         }
-        self.dirty.mark_all();
-        Ok(())
-    }
-
-    #[cfg(not(feature = "gpu"))]
-    fn set_defer_gpu(&mut self, on: bool) -> Result<(), CommandError> {
-        if on {
-            return Err(CommandError::invalid_field(
-                "DeferGpu",
-                "DeferGpu = true failed: this daemon was built without the GPU path (cargo \
-                 feature \"gpu\")",
-            ));
-        }
+        self.bodies.mark_all();
         Ok(())
     }
 
@@ -284,7 +262,7 @@ impl Plane {
 
     /// Ticks stepped so far.
     pub fn tick(&self) -> u64 {
-        self.tick
+        self.clock.tick
     }
 
     /// Every option and figure of the plane.
@@ -293,7 +271,7 @@ impl Plane {
             id: self.id,
             kind: PlaneKind::Rapier3d,
             settings: self.settings,
-            tick: self.tick,
+            tick: self.clock.tick,
             object_count: self.bodies.live(),
             effective_solver_iterations: self.solver_settings(self.nominal_dt()).iterations as u32,
             max_hit_box_quality: self.max_quality(),
@@ -303,34 +281,15 @@ impl Plane {
     /// Advances by `dt`. Returns false (and does nothing) when the plane is disabled.
     pub fn step(&mut self, dt: f32) -> Result<bool, CommandError> {
         // The last tick is kept before this one changes anything.
-        self.finish_keep()?;
-        let dt = validate::positive("dt", dt)?;
-        if dt > MAX_DT {
-            return Err(CommandError::invalid(format!(
-                "dt must be at most {MAX_DT} s, got {dt}"
-            )));
-        }
-        if !self.settings.enabled {
+        if !self.begin_step(dt)? {
             return Ok(false);
         }
         let started = Instant::now();
         // Whether this step can change any published state: bodies awake, or ops since the
         // last step. A settled plane keeps its hash without rehashing every slot.
-        let moving = self.tick == 0
+        let moving = self.clock.tick == 0
             || self.world.islands.num_active_bodies() > 0
-            || !self.dirty.since_step().is_empty();
-        #[cfg(feature = "gpu")]
-        if self.gpu.is_some() {
-            self.step_on_gpu(dt)?;
-            self.dirty.stepped(self.bodies.slot_count());
-            self.tick += 1;
-            self.sim_time += dt as f64;
-            self.last_dt = dt;
-            // Nothing sleeps on the GPU path: every step can move every body.
-            self.state_hash = self.state_hash();
-            self.last_step_us = started.elapsed().as_secs_f32() * 1e6;
-            return Ok(true);
-        }
+            || !self.bodies.since_step().is_empty();
         self.world.integration_parameters.dt = dt;
         self.tune_solver(dt);
         self.tick_controllers(dt);
@@ -355,21 +314,19 @@ impl Plane {
         self.held_after_step();
         self.query_stale.clear();
         self.limit_speeds_after_step();
-        self.dirty.stepped(self.bodies.slot_count());
-        self.tick += 1;
-        self.sim_time += dt as f64;
-        self.last_dt = dt;
+        self.bodies.stepped();
+        self.clock.advance(dt);
         self.collect_events();
         self.joints_after_step(dt);
         self.removed.clear();
         let rehash = moving || self.awake_count() > 0;
         let (figures, hash) = self.figures_and_hash(rehash);
-        (self.max_penetration, self.contact_pairs) = figures;
+        (self.clock.max_penetration, self.clock.contact_pairs) = figures;
         if let Some(hash) = hash {
             self.state_hash = hash;
         }
         self.adapt_solving();
-        self.last_step_us = started.elapsed().as_secs_f32() * 1e6;
+        self.clock.timed(started);
         // Kept for Rewind off the tick's path (see `rollback`).
         self.rollback.note_step();
         Ok(true)
@@ -382,22 +339,16 @@ impl Plane {
 
     /// The header of the newest tick.
     pub fn header(&self) -> TickHeader {
-        TickHeader {
-            layout_version: LAYOUT_VERSION,
-            plane_id: self.id,
-            tick: self.tick,
-            sim_time: self.sim_time,
-            tick_end_ns: 0,
-            step_time_us: self.last_step_us,
-            dt: self.last_dt,
-            slot_count: self.bodies.slot_count() as u32,
-            body_count: self.bodies.live(),
-            max_penetration: self.max_penetration,
-            max_joint_error: self.joints.max_error,
-            contact_pairs: self.contact_pairs,
-            event_count: self.event_seq as u32,
-            state_hash: self.state_hash,
-        }
+        self.clock.header(
+            self.id,
+            HeaderFigures {
+                slot_count: self.bodies.slot_count() as u32,
+                body_count: self.bodies.live(),
+                max_joint_error: self.joints.max_error,
+                event_count: self.event_seq,
+                state_hash: self.state_hash,
+            },
+        )
     }
 
     /// After a step: the contact figures of the tick header and, when `rehash`, the state
@@ -446,43 +397,11 @@ impl Plane {
 
     /// Number of bodies in [`Plane::awake_slots`].
     pub fn awake_count(&self) -> usize {
-        #[cfg(feature = "gpu")]
-        if self.gpu.is_some() {
-            return self.bodies.slot_count();
-        }
         self.world.islands.num_active_bodies()
     }
 
     /// The published state of slot `i` (dead slots carry only their generation).
     pub fn body_state(&self, i: usize) -> BodyState {
-        #[cfg(feature = "gpu")]
-        if let Some(gpu) = &self.gpu {
-            let generation = self.bodies.generation(i);
-            let Some((p, b)) = gpu.pose(i).zip(self.bodies.at(i)) else {
-                return BodyState {
-                    generation,
-                    ..BodyState::default()
-                };
-            };
-            let mut flags = FLAG_ALIVE | b.flags;
-            if self
-                .world
-                .bodies
-                .get(b.handle)
-                .is_some_and(|r| r.is_fixed())
-            {
-                flags |= FLAG_ANCHORED;
-            }
-            return BodyState {
-                position: p.position,
-                flags,
-                rotation: p.rotation,
-                linear_velocity: p.velocity,
-                generation,
-                angular_velocity: p.angular_velocity,
-                _reserved: 0,
-            };
-        }
         publish::body_state(&self.bodies, &self.world.bodies, i)
     }
 }

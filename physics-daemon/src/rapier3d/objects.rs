@@ -56,7 +56,6 @@ impl Plane {
             flags: 0,
         })?;
         debug_assert_eq!(handle.slot, slot);
-        self.dirty.mark(handle.slot);
         self.query_stale.push(h);
         for prop in props {
             self.set_object(handle, prop)?;
@@ -70,6 +69,16 @@ impl Plane {
             .get(handle)
             .map(|b| b.handle)
             .map_err(|e| self.in_plane(e))
+    }
+
+    /// The rapier body behind a handle the caller is about to change: the slot is marked
+    /// changed (the publisher rewrites it; the next force pass sees it even before rapier
+    /// lists it as awake). Errors as [`Plane::body_of`].
+    pub(super) fn changing(&mut self, handle: Handle) -> Result<RigidBodyHandle, CommandError> {
+        match self.bodies.get_mut(handle) {
+            Ok(b) => Ok(b.handle),
+            Err(e) => Err(self.in_plane(e)),
+        }
     }
 
     /// Adds "in plane N" to a slot-table error.
@@ -94,20 +103,18 @@ impl Plane {
     /// the linear velocity right after it.
     pub fn apply_impulse(&mut self, handle: Handle, impulse: Vec3) -> Result<Vec3, CommandError> {
         let impulse = shm_layout::validate::finite3("impulse", impulse)?;
-        let h = self.body_of(handle)?;
+        let h = self.changing(handle)?;
         // Rapier divides by the mass in effect and skips locked axes; fixed bodies absorb it.
         let body = &mut self.world.bodies[h];
         body.apply_impulse(Vector::from(impulse), true);
         let v = body.linvel();
-        self.dirty.mark(handle.slot);
         Ok([v.x, v.y, v.z])
     }
 
     /// Wakes the object up (rapier wakes what rests on it at the next step).
     pub fn wake(&mut self, handle: Handle) -> Result<(), CommandError> {
-        let h = self.body_of(handle)?;
+        let h = self.changing(handle)?;
         self.world.bodies[h].wake_up(true);
-        self.dirty.mark(handle.slot);
         Ok(())
     }
 
@@ -131,7 +138,6 @@ impl Plane {
         }
         self.remove_joints_of(h);
         self.world.remove_body(h);
-        self.dirty.mark(handle.slot);
         Ok(())
     }
 

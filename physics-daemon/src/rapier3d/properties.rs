@@ -14,7 +14,7 @@ impl Plane {
     pub fn set_object(&mut self, handle: Handle, prop: ObjectProp) -> Result<(), CommandError> {
         let prop = prop.checked()?;
         self.check_object_prop(handle, &prop)?;
-        let h = self.body_of(handle)?;
+        let h = self.changing(handle)?;
         let before = Counted::of(&self.bodies.get(handle)?.part);
         let touched = self.apply_to_body(handle, h, prop)?;
         if let ObjectProp::Held(on) = prop {
@@ -25,7 +25,6 @@ impl Plane {
         self.query_stale.push(h);
         // Any change may need the body awake and seen by the next force pass.
         self.world.bodies[h].wake_up(true);
-        self.dirty.mark(handle.slot);
         Ok(())
     }
 

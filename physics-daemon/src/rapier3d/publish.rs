@@ -65,16 +65,6 @@ fn write_run(
 impl Plane {
     /// [`crate::backend::Backend::write_states`] of this plane.
     pub(super) fn write_sample(&self, out: &mut [MaybeUninit<BodyState>], filter: SlotFilter<'_>) {
-        #[cfg(feature = "gpu")]
-        if self.gpu.is_some() {
-            // The GPU path's poses live in its read-back, not in rapier's bodies.
-            for (i, dst) in out.iter_mut().enumerate() {
-                if filter.wants(i) {
-                    dst.write(self.body_state(i));
-                }
-            }
-            return;
-        }
         let (slots, bodies) = (&self.bodies, &self.world.bodies);
         match self.world.physics_pipeline.thread_pool() {
             Some(pool) if out.len() >= PARALLEL_FROM => pool.install(|| {

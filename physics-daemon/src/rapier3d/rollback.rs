@@ -106,7 +106,9 @@ impl Plane {
             &self.state_bytes,
             BYTES_PER_SLOT * self.bodies.slot_count() as u64,
         );
-        self.rollback.kept.push_back((self.tick, copy, counted));
+        self.rollback
+            .kept
+            .push_back((self.clock.tick, copy, counted));
         while self.rollback.kept.len() > k + 1 {
             if let Some((_, state, _)) = self.rollback.kept.pop_front() {
                 dispose(state);
@@ -127,22 +129,28 @@ impl Plane {
             ));
         }
         if n == 0 {
-            return Ok(Reply::Applied { tick: self.tick });
+            return Ok(Reply::Applied {
+                tick: self.clock.tick,
+            });
         }
-        let at = self.tick.checked_sub(n as u64).and_then(|t| {
+        let at = self.clock.tick.checked_sub(n as u64).and_then(|t| {
             self.rollback
                 .kept
                 .iter()
                 .position(|(tick, _, _)| *tick == t)
         });
         let (Some(at), true) = (at, n <= k) else {
-            let oldest = self.rollback.kept.front().map_or(self.tick, |(t, _, _)| *t);
+            let oldest = self
+                .rollback
+                .kept
+                .front()
+                .map_or(self.clock.tick, |(t, _, _)| *t);
             return Err(CommandError::invalid_field(
                 "Rewind",
                 format!(
                     "Rewind({n}) goes further back than the plane keeps: RollbackTicks = {k}, \
                      ticks {oldest}..={} kept",
-                    self.tick
+                    self.clock.tick
                 ),
             ));
         };
@@ -152,7 +160,9 @@ impl Plane {
         // A copy: the kept state stays for another rewind to the same tick.
         let copy = self.rollback.kept[at].1.duplicate();
         self.adopt_copy(copy)?;
-        Ok(Reply::Applied { tick: self.tick })
+        Ok(Reply::Applied {
+            tick: self.clock.tick,
+        })
     }
 }
 

@@ -95,12 +95,7 @@ plane_state! {
     driven: u32,
     mesh_vertices: u64,
     held: Vec<held::HeldBody>,
-    tick: u64,
-    sim_time: f64,
-    last_step_us: f32,
-    last_dt: f32,
-    max_penetration: f32,
-    contact_pairs: u32,
+    clock: crate::backend::Clock,
     boosted: u32,
     stiffened: bool,
     reporting: u32,
@@ -115,14 +110,19 @@ plane_state! {
 
 /// A DeferGpu plane's GPU world as the snapshot holds it: each slot's state and parameters
 /// as the shaders hold them (64 bytes each), so a restore on the same adapter continues bit
-/// for bit.
+/// for bit. The GPU path (`crate::gpu::GpuPlane`) fills and reads it; this plane stores it.
 #[derive(Clone, serde::Serialize, serde::Deserialize)]
-struct GpuSaved {
-    states: Vec<u8>,
-    params: Vec<u8>,
-    brute_force: bool,
-    max_penetration: f32,
-    contact_pairs: u32,
+pub struct GpuSaved {
+    /// Each slot's state (64 bytes each).
+    pub states: Vec<u8>,
+    /// Each slot's parameters (64 bytes each).
+    pub params: Vec<u8>,
+    /// Whether pairs were found by testing every pair.
+    pub brute_force: bool,
+    /// The last tick's deepest contact.
+    pub max_penetration: f32,
+    /// The last tick's touching pairs.
+    pub contact_pairs: u32,
 }
 
 /// A snapshot body: the state, then the GPU world of a DeferGpu plane.
@@ -162,31 +162,32 @@ fn refused(what: String) -> CommandError {
     CommandError::new(ErrorKind::InvalidValue, format!("snapshot refused: {what}"))
 }
 
+/// A restore's GPU world where there is no GPU path: a DeferGpu snapshot is refused by name.
+fn no_gpu_world(saved: Option<GpuSaved>, defer_gpu: bool) -> Result<(), CommandError> {
+    match saved.is_some() || defer_gpu {
+        true => Err(CommandError::invalid_field(
+            "DeferGpu",
+            "the snapshot is of a DeferGpu plane and this daemon was built without the GPU \
+             path (feature \"gpu\")",
+        )),
+        false => Ok(()),
+    }
+}
+
 impl Plane {
     /// The plane's whole state as snapshot bytes (see `shm_layout::snapshot`).
     pub fn snapshot(&self) -> Result<Vec<u8>, CommandError> {
+        self.snapshot_with(None)
+    }
+
+    /// [`Plane::snapshot`] with the GPU world of a DeferGpu plane (`gpu`).
+    pub fn snapshot_with(&self, gpu: Option<GpuSaved>) -> Result<Vec<u8>, CommandError> {
         let body = postcard::to_allocvec(&Encoded {
             state: self.state_ref(),
-            gpu: self.gpu_saved(),
+            gpu,
         })
         .map_err(|e| CommandError::new(ErrorKind::Internal, format!("snapshot failed: {e}")))?;
         Ok(snapshot::encode(self.snapshot_header(), &body))
-    }
-
-    /// A DeferGpu plane's GPU bodies (`None` on the CPU path).
-    fn gpu_saved(&self) -> Option<GpuSaved> {
-        #[cfg(feature = "gpu")]
-        if let Some(gpu) = &self.gpu {
-            let (states, params, mode) = gpu.save();
-            return Some(GpuSaved {
-                states,
-                params,
-                brute_force: mode == crate::gpu::PairMode::BruteForce,
-                max_penetration: gpu.max_penetration,
-                contact_pairs: gpu.contact_pairs,
-            });
-        }
-        None
     }
 
     fn snapshot_header(&self) -> SnapshotHeader {
@@ -194,7 +195,7 @@ impl Plane {
         SnapshotHeader {
             engine: ENGINE.to_string(),
             kind: PlaneKind::Rapier3d,
-            tick: self.tick,
+            tick: self.clock.tick,
             state_hash: self.state_hash,
             objects: usage.objects,
             mesh_vertices: usage.mesh_vertices,
@@ -207,9 +208,16 @@ impl Plane {
     /// than the encode) and encoded by the returned job, on any thread, to the same bytes a
     /// snapshot of this tick gives.
     pub fn snapshot_later(&self) -> Result<crate::backend::SnapshotJob, CommandError> {
+        self.snapshot_later_with(None)
+    }
+
+    /// [`Plane::snapshot_later`] with the GPU world of a DeferGpu plane (`gpu`).
+    pub fn snapshot_later_with(
+        &self,
+        gpu: Option<GpuSaved>,
+    ) -> Result<crate::backend::SnapshotJob, CommandError> {
         let header = self.snapshot_header();
         let state = self.clone_state();
-        let gpu = self.gpu_saved();
         Ok(Box::new(move || {
             let encoded = Encoded {
                 state: state.as_ref(),
@@ -223,13 +231,26 @@ impl Plane {
     }
 
     /// Becomes exactly the state of `bytes` (same objects under the same handles). The
-    /// plane keeps its id. Nothing changes when the snapshot is refused.
+    /// plane keeps its id. Nothing changes when the snapshot is refused (a snapshot of a
+    /// DeferGpu plane is: see [`Plane::restore_with`]).
     pub fn restore(&mut self, bytes: &[u8], overrides: &[PlaneProp]) -> Result<(), CommandError> {
+        self.restore_with(bytes, overrides, no_gpu_world)
+    }
+
+    /// [`Plane::restore`] where `gpu_world` makes what the snapshot's GPU bodies (and its
+    /// DeferGpu setting) call for, before anything changes: its error refuses the restore;
+    /// what it made is returned once the plane is restored.
+    pub fn restore_with<T>(
+        &mut self,
+        bytes: &[u8],
+        overrides: &[PlaneProp],
+        gpu_world: impl FnOnce(Option<GpuSaved>, bool) -> Result<T, CommandError>,
+    ) -> Result<T, CommandError> {
         let (header, body) = snapshot::decode(bytes, PlaneKind::Rapier3d, ENGINE)?;
         let Decoded { mut state, gpu } =
             crate::backend::snapshot_decode::decode(body, refused, check_decoded)?;
         // A DeferGpu plane's GPU world, made before anything changes (no adapter: refused).
-        let gpu = self.gpu_from_saved(gpu, state.settings.defer_gpu)?;
+        let gpu = gpu_world(gpu, state.settings.defer_gpu)?;
         take_map_meshes(&mut state)?;
         // The overrides are checked on the decoded settings before anything changes.
         for prop in overrides {
@@ -276,69 +297,9 @@ impl Plane {
             )));
         }
         self.adopt(state, overrides)?;
-        #[cfg(feature = "gpu")]
-        {
-            self.gpu = gpu;
-        }
-        #[cfg(not(feature = "gpu"))]
-        let () = gpu;
         // Another timeline: the ticks kept for Rewind no longer lead here.
         self.rollback.clear();
-        Ok(())
-    }
-
-    /// The GPU world a snapshot's GPU bodies make (`None` for a CPU snapshot). A snapshot
-    /// of a DeferGpu plane restores only where a GPU adapter is (the same adapter for bit
-    /// for bit).
-    #[cfg(feature = "gpu")]
-    fn gpu_from_saved(
-        &self,
-        saved: Option<GpuSaved>,
-        defer_gpu: bool,
-    ) -> Result<Option<crate::gpu::GpuWorld>, CommandError> {
-        let Some(saved) = saved else {
-            return match defer_gpu {
-                true => Err(refused("its DeferGpu plane holds no GPU bodies".into())),
-                false => Ok(None),
-            };
-        };
-        if !defer_gpu {
-            return Err(refused(
-                "it holds GPU bodies for a plane not on the GPU".into(),
-            ));
-        }
-        let ctx = crate::gpu::context().map_err(|e| {
-            CommandError::invalid_field(
-                "DeferGpu",
-                format!("the snapshot is of a DeferGpu plane and this daemon cannot run it: {e}"),
-            )
-        })?;
-        let mode = match saved.brute_force {
-            true => crate::gpu::PairMode::BruteForce,
-            false => crate::gpu::PairMode::Hash,
-        };
-        crate::gpu::GpuWorld::load(
-            ctx,
-            &saved.states,
-            &saved.params,
-            mode,
-            (saved.max_penetration, saved.contact_pairs),
-        )
-        .map(Some)
-        .map_err(refused)
-    }
-
-    /// Without the GPU path, a DeferGpu snapshot is refused by name.
-    #[cfg(not(feature = "gpu"))]
-    fn gpu_from_saved(&self, saved: Option<GpuSaved>, defer_gpu: bool) -> Result<(), CommandError> {
-        match saved.is_some() || defer_gpu {
-            true => Err(CommandError::invalid_field(
-                "DeferGpu",
-                "the snapshot is of a DeferGpu plane and this daemon was built without the GPU \
-                 path (feature \"gpu\")",
-            )),
-            false => Ok(()),
-        }
+        Ok(gpu)
     }
 
     /// Becomes `state` (a copy this plane made with [`Plane::clone_state`]).
@@ -353,6 +314,7 @@ impl Plane {
     fn adopt(&mut self, mut state: State, overrides: &[PlaneProp]) -> Result<(), CommandError> {
         controllers::count_paths_in(&mut state.controllers, &self.state_bytes);
         let threads = state.settings.threads;
+        state.bodies.take_marks_of(&mut self.bodies);
         self.take_state(state);
         self.events.clear();
         self.pending_events.clear();
@@ -364,11 +326,12 @@ impl Plane {
             self.quality_counts[body.part.hit_box_quality as usize] += 1;
         }
         self.set_threads(threads)?;
-        // Their mapping onto the engine (Gravity, NeverSleep; Threads is set above).
+        // Their mapping onto the engine (Gravity, NeverSleep; Threads is set above; DeferGpu
+        // was refused as an override).
         for prop in overrides {
-            self.apply_prop(*prop, true)?;
+            self.apply_prop(*prop, true, &mut super::no_other_engine)?;
         }
-        self.dirty.mark_all();
+        self.bodies.mark_all();
         Ok(())
     }
 }

@@ -69,8 +69,8 @@ impl Plane {
     /// The step length the solver settings are computed for when no step gives one (plane
     /// info): the last step's, else the TickRate's, else 1/60 s.
     pub(super) fn nominal_dt(&self) -> f32 {
-        if self.last_dt > 0.0 {
-            self.last_dt
+        if self.clock.last_dt > 0.0 {
+            self.clock.last_dt
         } else if self.settings.tick_rate > 0.0 {
             1.0 / self.settings.tick_rate
         } else {

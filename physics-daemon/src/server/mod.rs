@@ -36,13 +36,14 @@ pub mod persist;
 pub mod quota;
 mod request_bytes;
 pub mod resources;
+mod serve;
 mod transfers;
 pub mod trim;
 mod worker;
 
 use std::collections::{BTreeMap, HashMap, VecDeque};
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::mpsc::{self, Receiver, Sender};
+use std::sync::atomic::AtomicBool;
+use std::sync::mpsc::{Receiver, Sender};
 use std::sync::Arc;
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
@@ -51,7 +52,6 @@ use iceoryx2::active_request::ActiveRequest;
 use iceoryx2::config::Config;
 use iceoryx2::port::server::Server;
 use iceoryx2::prelude::*;
-use iceoryx2_bb_posix::socket_pair::StreamingSocket;
 use shm_layout::{names, Command, CommandResult, PlaneId};
 
 use crate::publish::MAX_NODES;
@@ -218,7 +218,7 @@ pub fn run_with(domain: &str, shutdown: &AtomicBool, options: Options) -> Result
         s.spawn(|| heartbeat::run(&config, &beats, limits.max_clients));
         s.spawn(|| resources::run(&config, &limits, &watch));
         s.spawn(|| trim::run(&trims));
-        let served = serve(
+        let served = serve::serve(
             domain,
             &config,
             shutdown,
@@ -267,191 +267,6 @@ fn release_domain(config: &Config) {
         }
         std::thread::sleep(Duration::from_millis(5));
     }
-}
-
-fn serve(
-    domain: &str,
-    config: &Config,
-    shutdown: &AtomicBool,
-    options: Options,
-    beats: &heartbeat::Control,
-    watch: Arc<resources::Watch>,
-    trims: &trim::Trims,
-) -> Result<(), DaemonError> {
-    let node = NodeBuilder::new()
-        .name(&NodeName::new(names::DAEMON_NODE_NAME).expect("valid node name"))
-        .config(config)
-        .signal_handling_mode(SignalHandlingMode::Disabled)
-        .create::<ipc::Service>()
-        .map_err(|e| DaemonError::Ipc(format!("cannot create node: {e:?}")))?;
-    let listener = node
-        .service_builder(&names::control_wake())
-        .event()
-        .max_listeners(2)
-        .max_notifiers(options.limits.max_clients * 2)
-        .max_nodes(control_nodes(&options.limits))
-        .open_or_create()
-        .map_err(|e| DaemonError::Ipc(format!("cannot create the request event: {e:?}")))?
-        .listener_builder()
-        .create()
-        .map_err(|e| DaemonError::Ipc(format!("cannot create the request listener: {e:?}")))?;
-    let control = node
-        .service_builder(&names::control())
-        .request_response::<[u8], [u8]>()
-        .request_user_header::<u128>()
-        .max_servers(1)
-        // Room beyond --max-clients: ports that never say Hello (or a process at its
-        // per-process limit) leave ports for other processes.
-        .max_clients(options.limits.max_clients * 2)
-        .max_nodes(control_nodes(&options.limits))
-        .max_active_requests_per_client(4)
-        // One reply per request, copied out by the client at once: one place each. The
-        // server preallocates a reference count per possible reply for each of its 255
-        // growth segments (clients × 8 × these three), so the defaults (2 each) cost twice
-        // the memory for places no reply uses: 50 MB instead of 25 at 256 clients.
-        .max_response_buffer_size(1)
-        .max_borrowed_responses_per_pending_response(1)
-        .open_or_create()
-        .map_err(|e| DaemonError::Ipc(format!("cannot create the control service: {e:?}")))?;
-    let server = control
-        .server_builder()
-        .max_loaned_responses_per_request(1)
-        .initial_max_slice_len(4096)
-        .allocation_strategy(AllocationStrategy::PowerOfTwo)
-        .create()
-        .map_err(|_| DaemonError::AlreadyRunning {
-            domain: domain.to_string(),
-        })?;
-    let waitset = WaitSetBuilder::new()
-        .signal_handling_mode(SignalHandlingMode::Disabled)
-        .create::<ipc::Service>()
-        .map_err(|e| DaemonError::Ipc(format!("cannot create the waitset: {e:?}")))?;
-    let _request_guard = waitset
-        .attach_notification(&listener)
-        .map_err(|e| DaemonError::Ipc(format!("cannot attach the request listener: {e:?}")))?;
-    // Plane workers wake the loop through a socket pair the WaitSet watches.
-    let (worker_wake, wake_end) = StreamingSocket::create_pair()
-        .map_err(|e| DaemonError::Ipc(format!("cannot create the worker wake-up: {e:?}")))?;
-    let _worker_guard = waitset
-        .attach_notification(&worker_wake)
-        .map_err(|e| DaemonError::Ipc(format!("cannot attach the worker wake-up: {e:?}")))?;
-    let (events_tx, events) = mpsc::channel();
-
-    let memory_limit = options.limits.memory_bytes();
-    let writer = match &options.persistence {
-        Some(p) => Some(persist::Writer::start(p, domain).map_err(|e| {
-            DaemonError::Ipc(format!(
-                "cannot use the state directory {}: {e}",
-                persist::domain_dir(&p.dir, domain).display()
-            ))
-        })?),
-        None => None,
-    };
-    let mut daemon = Daemon {
-        domain: domain.to_string(),
-        config: config.clone(),
-        node,
-        server,
-        clients: Clients::new(options.limits.max_clients),
-        planes: BTreeMap::new(),
-        next_plane_id: 1,
-        options,
-        queues: HashMap::new(),
-        tickets: HashMap::new(),
-        next_ticket: 1,
-        events,
-        events_tx,
-        waker: Arc::new(Waker::new(wake_end)),
-        workers: Vec::new(),
-        owners: quota::Owners::new(memory_limit),
-        reply_left: 0,
-        control,
-        origins: origin::Origins::default(),
-        guest: None,
-        watch,
-        writer,
-        transfers: HashMap::new(),
-        stage_to: None,
-        liveness: liveness::Schedule::default(),
-        moved: moves::Tombstones::default(),
-    };
-    // Persistent planes of the last daemon come back before the first request.
-    daemon.restore_saved();
-    // iceoryx2 creates its node-counter segment world-writable: narrow it to this user.
-    files::restrict(domain);
-    tracing::info!(domain, pid = std::process::id(), "physics daemon ready");
-
-    let mut next_housekeeping = Instant::now() + HOUSEKEEPING;
-    let mut trim_schedule = trim::Schedule::default();
-    while !shutdown.load(Ordering::Relaxed) {
-        let housekeeping = !daemon.clients.is_empty() || daemon.options.starter_pid.is_some();
-        let waited = if housekeeping {
-            let timeout = next_housekeeping.saturating_duration_since(Instant::now());
-            waitset.wait_and_process_once_with_timeout(|_| CallbackProgression::Continue, timeout)
-        } else {
-            // Nothing to look after: sleep until a request, a worker or a shutdown wake-up.
-            waitset.wait_and_process_once(|_| CallbackProgression::Continue)
-        };
-        if let Err(e) = waited {
-            tracing::warn!("waitset: {e:?}");
-        }
-        // Consume the wake-ups, then serve everything that is queued.
-        if let Err(e) = listener.try_wait(|_| {}) {
-            tracing::warn!("request listener: {e:?}");
-        }
-        let mut buf = [0u8; 256];
-        while matches!(worker_wake.try_receive(&mut buf), Ok(n) if n > 0) {}
-        daemon.waker.disarm();
-        daemon.handle_events();
-        daemon.adopt_planes();
-        daemon.take_arrivals();
-        daemon.take_rebalance();
-        daemon.serve_requests();
-        if let Some(gauge) = &daemon.options.load {
-            gauge.track(daemon.planes.len(), daemon.next_plane_id, || {
-                daemon.planes.values().map(|p| p.usage.clone()).collect()
-            });
-        }
-        beats.beat(!daemon.clients.is_empty());
-        if daemon.clients.is_empty() {
-            if Instant::now() >= next_housekeeping {
-                daemon.update_watch();
-                // What the last clients' planes held goes back to the system too, once
-                // their workers have ended (an idle daemon asks for nothing else).
-                let workers = daemon.workers.len();
-                daemon.workers.retain(|w| !w.is_finished());
-                if daemon.workers.len() < workers {
-                    trims.request();
-                }
-                if daemon.starter_gone() {
-                    tracing::info!(
-                        starter = daemon.options.starter_pid,
-                        "the process that started this daemon is gone and no client is left"
-                    );
-                    break;
-                }
-                next_housekeeping = Instant::now() + HOUSEKEEPING;
-            }
-        } else if Instant::now() >= next_housekeeping {
-            daemon.release_gone_clients();
-            daemon.update_watch();
-            let workers = daemon.workers.len();
-            daemon.workers.retain(|w| !w.is_finished());
-            daemon.owners.prune();
-            // A plane gone (megabytes: its world and its ports' bookkeeping) is given back
-            // now, not up to a period later.
-            if trim_schedule.due(daemon.workers.len() < workers) {
-                trims.request();
-            }
-            next_housekeeping = Instant::now() + HOUSEKEEPING;
-        }
-    }
-    tracing::info!(domain = daemon.domain, "shutting down");
-    daemon.stop_workers();
-    if let Some(writer) = &mut daemon.writer {
-        writer.finish();
-    }
-    Ok(())
 }
 
 /// Nodes that may open the control services: every client's, one spare each for nodes

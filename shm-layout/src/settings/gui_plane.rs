@@ -1,10 +1,13 @@
 //! GUI plane options (`PhysicsService.NewGUI`): the wire variant, the defaults and the checks
 //! of each. They travel as [`PlaneProp::Gui`](crate::PlaneProp::Gui) next to the options every
 //! plane kind takes (`TickRate`, `Enabled`, `Shared`). Units are pixels and seconds, +Y down.
+//! One row each in the GUI plane settings table (`settings_table!`): wire variant, name,
+//! default, range, stored field, flags; the Lua rows of `GuiPhysicsPlane` come from it.
 
 use serde::{Deserialize, Serialize};
 
-use crate::validate::{non_negative, MAX_COORDINATE};
+use super::table::Range;
+use crate::validate::MAX_COORDINATE;
 use crate::CommandError;
 
 /// A 2D vector on the wire (pixels, pixels/s, ...).
@@ -13,86 +16,81 @@ pub type Vec2 = [f32; 2];
 /// Largest `SolverIterations` of a GUI plane (the reference clamps to 1..32).
 pub const MAX_GUI_SOLVER_ITERATIONS: u32 = 32;
 
-/// An option of a GUI plane.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub enum GuiPlaneProp {
-    /// Acceleration of every non-anchored body (px/s², +Y down). Default (0, 980).
-    Gravity(Vec2),
-    /// Per-second linear damping: each tick `v *= max(0, 1 - k·dt)`. Default 0.05.
-    LinearDamping(f32),
-    /// The same for angular velocity. Default 0.10.
-    AngularDamping(f32),
-    /// Quadratic drag coefficient: `F = -Drag·|v|·v`. Default 0.
-    Drag(f32),
-    /// Force on every non-anchored body (px·mass/s²). Default (0, 0).
-    ConstantForce(Vec2),
-    /// Speed (px/s) below which a body's sleep timer runs; after 0.5 s it sleeps. 0 disables
-    /// sleeping. Default 0.25.
-    RestThreshold(f32),
-    /// Solver iterations per tick, clamped to [1, 32]. Default 4.
-    SolverIterations(u32),
-    /// Keeps every body awake. Default false.
-    NeverSleep(bool),
-    /// Creation only: bodies are kept inside the rectangle `min`..`max` and bounce off its
-    /// sides with their own Bounciness.
-    Bounds {
-        /// Top-left corner.
-        min: Vec2,
-        /// Bottom-right corner.
-        max: Vec2,
-    },
+crate::settings_table! {
+    /// An option of a GUI plane.
+    #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+    pub enum GuiPlaneProp;
+    /// Every option of a GUI plane, as set. [`Default`] holds the documented defaults.
+    #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+    pub struct GuiPlaneSettings {
+        /// `TickRate` (the common plane option), default 60; 0 = manual.
+        tick_rate: f32 = 60.0,
+        /// `Enabled` (the common plane option), default true.
+        enabled: bool = true,
+        /// `Shared` (the common plane option), default false.
+        shared: bool = false,
+    };
+    rows {
+        /// Acceleration of every non-anchored body (px/s², +Y down). Default (0, 980).
+        Gravity(Vec2) "Gravity" = [0.0, 980.0], field: gravity, flags: [changes_forces, lua];
+        /// Per-second linear damping: each tick `v *= max(0, 1 - k·dt)`. Default 0.05.
+        LinearDamping(f32) "LinearDamping" = 0.05, range: Range::NonNegative,
+            field: linear_damping, flags: [lua];
+        /// The same for angular velocity. Default 0.10.
+        AngularDamping(f32) "AngularDamping" = 0.10, range: Range::NonNegative,
+            field: angular_damping, flags: [lua];
+        /// Quadratic drag coefficient: `F = -Drag·|v|·v`. Default 0.
+        Drag(f32) "Drag" = 0.0, range: Range::NonNegative, field: drag, flags: [lua];
+        /// Force on every non-anchored body (px·mass/s²). Default (0, 0).
+        ConstantForce(Vec2) "ConstantForce" = [0.0; 2], field: constant_force,
+            flags: [changes_forces, lua];
+        /// Speed (px/s) below which a body's sleep timer runs; after 0.5 s it sleeps. 0
+        /// disables sleeping. Default 0.25.
+        RestThreshold(f32) "RestThreshold" = 0.25, range: Range::NonNegative,
+            field: rest_threshold, flags: [lua];
+        /// Solver iterations per tick, clamped to [1, 32]. Default 4.
+        SolverIterations(u32) "SolverIterations" = 4,
+            range: Range::Clamped(1.0, MAX_GUI_SOLVER_ITERATIONS as f64),
+            field: solver_iterations, flags: [lua];
+        /// Keeps every body awake. Default false.
+        NeverSleep(bool) "NeverSleep" = false, field: never_sleep, flags: [lua];
+        /// Creation only: bodies are kept inside the rectangle `min`..`max` and bounce off
+        /// its sides with their own Bounciness. None by default (unbounded; the row's default
+        /// pair is no valid rectangle).
+        Bounds {
+            /// Top-left corner.
+            min: Vec2,
+            /// Bottom-right corner.
+            max: Vec2,
+        } "Bounds" = ([0.0; 2], [0.0; 2]), check: check_bounds,
+            field: bounds via store_bounds => Option<(Vec2, Vec2)> = None,
+            flags: [creation_only];
+    }
 }
 
-/// Every option of a GUI plane, as set. [`Default`] holds the documented defaults.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct GuiPlaneSettings {
-    /// `Gravity`, default (0, 980).
-    pub gravity: Vec2,
-    /// `LinearDamping`, default 0.05.
-    pub linear_damping: f32,
-    /// `AngularDamping`, default 0.10.
-    pub angular_damping: f32,
-    /// `Drag`, default 0.
-    pub drag: f32,
-    /// `ConstantForce`, default (0, 0).
-    pub constant_force: Vec2,
-    /// `RestThreshold`, default 0.25 px/s.
-    pub rest_threshold: f32,
-    /// `SolverIterations` (clamped to [1, 32]), default 4.
-    pub solver_iterations: u32,
-    /// `NeverSleep`, default false.
-    pub never_sleep: bool,
-    /// `BoundsMin` / `BoundsMax`, none by default (unbounded).
-    pub bounds: Option<(Vec2, Vec2)>,
-    /// `TickRate` (the common plane option), default 60; 0 = manual.
-    pub tick_rate: f32,
-    /// `Enabled` (the common plane option), default true.
-    pub enabled: bool,
-    /// `Shared` (the common plane option), default false.
-    pub shared: bool,
+/// `Bounds`: both corners finite, `max` at least 1 px right of and below `min`.
+fn check_bounds((min, max): (Vec2, Vec2)) -> Result<(Vec2, Vec2), CommandError> {
+    let min = finite2("BoundsMin", min)?;
+    let max = finite2("BoundsMax", max)?;
+    if max[0] - min[0] < 1.0 || max[1] - min[1] < 1.0 {
+        return Err(CommandError::invalid_field(
+            "BoundsMax",
+            format!(
+                "BoundsMax must be at least 1 px right of and below BoundsMin, got BoundsMin \
+                 {min:?}, BoundsMax {max:?}"
+            ),
+        ));
+    }
+    Ok((min, max))
+}
+
+/// Stores `Bounds` (the settings hold `None` while unbounded).
+fn store_bounds(field: &mut Option<(Vec2, Vec2)>, v: (Vec2, Vec2)) {
+    *field = Some(v);
 }
 
 /// Seconds a body must stay below `RestThreshold` before it sleeps.
 pub const GUI_TIME_UNTIL_SLEEP: f32 = 0.5;
-
-impl Default for GuiPlaneSettings {
-    fn default() -> Self {
-        GuiPlaneSettings {
-            gravity: [0.0, 980.0],
-            linear_damping: 0.05,
-            angular_damping: 0.10,
-            drag: 0.0,
-            constant_force: [0.0; 2],
-            rest_threshold: 0.25,
-            solver_iterations: 4,
-            never_sleep: false,
-            bounds: None,
-            tick_rate: 60.0,
-            enabled: true,
-            shared: false,
-        }
-    }
-}
 
 /// Checks a 2D value: both components finite (and within the coordinate range).
 pub fn finite2(field: &str, v: Vec2) -> Result<Vec2, CommandError> {
@@ -126,17 +124,7 @@ impl GuiPlaneSettings {
                 ));
             }
         }
-        match prop {
-            GuiPlaneProp::Gravity(g) => self.gravity = g,
-            GuiPlaneProp::LinearDamping(k) => self.linear_damping = k,
-            GuiPlaneProp::AngularDamping(k) => self.angular_damping = k,
-            GuiPlaneProp::Drag(k) => self.drag = k,
-            GuiPlaneProp::ConstantForce(f) => self.constant_force = f,
-            GuiPlaneProp::RestThreshold(v) => self.rest_threshold = v,
-            GuiPlaneProp::SolverIterations(n) => self.solver_iterations = n,
-            GuiPlaneProp::NeverSleep(on) => self.never_sleep = on,
-            GuiPlaneProp::Bounds { min, max } => self.bounds = Some((min, max)),
-        }
+        self.store(&prop);
         Ok(prop)
     }
 }
@@ -144,54 +132,12 @@ impl GuiPlaneSettings {
 impl GuiPlaneProp {
     /// The option's name in the API.
     pub fn name(&self) -> &'static str {
-        match self {
-            GuiPlaneProp::Gravity(_) => "Gravity",
-            GuiPlaneProp::LinearDamping(_) => "LinearDamping",
-            GuiPlaneProp::AngularDamping(_) => "AngularDamping",
-            GuiPlaneProp::Drag(_) => "Drag",
-            GuiPlaneProp::ConstantForce(_) => "ConstantForce",
-            GuiPlaneProp::RestThreshold(_) => "RestThreshold",
-            GuiPlaneProp::SolverIterations(_) => "SolverIterations",
-            GuiPlaneProp::NeverSleep(_) => "NeverSleep",
-            GuiPlaneProp::Bounds { .. } => "Bounds",
-        }
+        self.row().name
     }
 
     /// Options that change the forces on resting bodies (which must then wake up).
     pub fn changes_forces(&self) -> bool {
-        matches!(
-            self,
-            GuiPlaneProp::Gravity(_) | GuiPlaneProp::ConstantForce(_)
-        )
-    }
-
-    /// The option as the daemon applies it, or an error naming it and the value.
-    pub fn checked(self) -> Result<GuiPlaneProp, CommandError> {
-        use GuiPlaneProp::*;
-        Ok(match self {
-            Gravity(g) => Gravity(finite2("Gravity", g)?),
-            LinearDamping(k) => LinearDamping(non_negative("LinearDamping", k)?),
-            AngularDamping(k) => AngularDamping(non_negative("AngularDamping", k)?),
-            Drag(k) => Drag(non_negative("Drag", k)?),
-            ConstantForce(f) => ConstantForce(finite2("ConstantForce", f)?),
-            RestThreshold(v) => RestThreshold(non_negative("RestThreshold", v)?),
-            SolverIterations(n) => SolverIterations(n.clamp(1, MAX_GUI_SOLVER_ITERATIONS)),
-            NeverSleep(on) => NeverSleep(on),
-            Bounds { min, max } => {
-                let min = finite2("BoundsMin", min)?;
-                let max = finite2("BoundsMax", max)?;
-                if max[0] - min[0] < 1.0 || max[1] - min[1] < 1.0 {
-                    return Err(CommandError::invalid_field(
-                        "BoundsMax",
-                        format!(
-                            "BoundsMax must be at least 1 px right of and below BoundsMin, got \
-                             BoundsMin {min:?}, BoundsMax {max:?}"
-                        ),
-                    ));
-                }
-                Bounds { min, max }
-            }
-        })
+        self.row().changes_forces
     }
 }
 
@@ -224,5 +170,80 @@ mod tests {
         }
         .checked()
         .is_err());
+    }
+
+    /// The table keeps the wire: variant indices, the struct variant's fields, and the
+    /// settings' fields in the order (and with the defaults) they had before the table.
+    #[test]
+    fn the_table_keeps_the_wire_and_the_defaults() {
+        let names: Vec<&str> = GuiPlaneProp::ROWS.iter().map(|r| r.name).collect();
+        assert_eq!(
+            names,
+            [
+                "Gravity",
+                "LinearDamping",
+                "AngularDamping",
+                "Drag",
+                "ConstantForce",
+                "RestThreshold",
+                "SolverIterations",
+                "NeverSleep",
+                "Bounds"
+            ]
+        );
+        for (i, p) in GuiPlaneProp::DEFAULTS.iter().enumerate() {
+            assert_eq!(postcard::to_allocvec(p).unwrap()[0] as usize, i, "{p:?}");
+        }
+        let bounds = GuiPlaneProp::Bounds {
+            min: [1.0, 2.0],
+            max: [300.0, 400.0],
+        };
+        let pair = (8u8, [1.0f32, 2.0], [300.0f32, 400.0]);
+        assert_eq!(
+            postcard::to_allocvec(&bounds).unwrap(),
+            postcard::to_allocvec(&pair).unwrap()
+        );
+        let s = GuiPlaneSettings::default();
+        let fields = (
+            (
+                [0.0f32, 980.0],
+                0.05f32,
+                0.10f32,
+                0.0f32,
+                [0.0f32; 2],
+                0.25f32,
+                4u32,
+                false,
+            ),
+            (None::<(Vec2, Vec2)>, 60.0f32, true, false),
+        );
+        assert_eq!(
+            postcard::to_allocvec(&s).unwrap(),
+            postcard::to_allocvec(&fields).unwrap()
+        );
+        // Bounds is stored as a pair, and only at creation.
+        let mut s = GuiPlaneSettings::default();
+        assert_eq!(s.apply(bounds, true).unwrap(), bounds);
+        assert_eq!(s.bounds, Some(([1.0, 2.0], [300.0, 400.0])));
+        let e = s.apply(bounds, false).unwrap_err();
+        assert!(e.message.contains("construction-only"), "{e}");
+        assert!(GuiPlaneProp::row_named("Bounds").creation_only);
+        assert_eq!(
+            GuiPlaneProp::row_named("Bounds").kind,
+            super::super::table::PropKind::Other
+        );
+        assert!(GuiPlaneProp::Gravity([0.0; 2]).changes_forces());
+        assert_eq!(bounds.name(), "Bounds");
+        // Generic reads and writes of the plain rows.
+        let drag = GuiPlaneProp::Drag(0.0).index();
+        let p = GuiPlaneProp::from_any(drag, super::super::table::AnyValue::Float(0.5)).unwrap();
+        s.store(&p);
+        assert_eq!(s.get(drag), Some(super::super::table::AnyValue::Float(0.5)));
+        assert_eq!(s.get(bounds.index()), None, "a pair has no plain value");
+        let e = GuiPlaneProp::Drag(-1.0).checked().unwrap_err();
+        assert!(
+            e.message.contains("Drag") && e.message.contains("-1"),
+            "{e}"
+        );
     }
 }

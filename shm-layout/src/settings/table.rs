@@ -14,7 +14,9 @@
 //! ```
 //!
 //! - `Variant(Type) "Name" = default`: the wire variant, its payload, the API name and the
-//!   documented default (a const expression).
+//!   documented default (a const expression). A struct variant `Variant { a: A, b: B }`
+//!   (a pair such as a GUI plane's `Bounds { min, max }`) takes the tuple `(A, B)` as its
+//!   payload wherever a row's value is handled (range, check, store, default).
 //! - `range: Range::…` (default [`Range::Any`]): checked by the payload's [`PropValue::check`];
 //!   the same range gives the Lua row its accepted values.
 //! - `check: path`: a further check `fn(T) -> Result<T, CommandError>` after the range.
@@ -22,6 +24,9 @@
 //!   default` stores it through `f(&mut field, value)` into a field of another type. Rows
 //!   without a field live in the engine (poses, velocities, sizes).
 //! - `flags: [..]`: the [`PropRow`] booleans that are true for this row.
+//!
+//! The settings struct may list fields of its own after the rows' fields
+//! (`pub struct S { /// doc \n tick_rate: f32 = 60.0 };`), kept and defaulted with them.
 //!
 //! After the rows, `options: { struct }` also declares the options struct of a creation
 //! call: the fields given, then one `Option` per stored row, with `props()`, `set(prop)` and
@@ -349,12 +354,90 @@ macro_rules! structured_value {
 }
 
 structured_value!(
+    (super::gui_plane::Vec2, super::gui_plane::Vec2),
     super::object::Restraint,
     Option<super::object::RotateTo>,
     Option<super::object::Pin>,
     super::gui_plane::GuiPlaneProp,
     Option<f32>
 );
+
+/// The payload type of a row's variant: `(T)` gives `T`, `{ a: A, b: B }` gives `(A, B)`.
+#[doc(hidden)]
+#[macro_export]
+macro_rules! __table_ty {
+    (($t:ty)) => {
+        $t
+    };
+    ({ $($(#[$m:meta])* $f:ident : $ft:ty),+ $(,)? }) => {
+        ($($ft),+)
+    };
+}
+
+/// A pattern of a row's variant binding its payload: `$v` for a tuple variant, the
+/// fields by their names for a struct variant (see [`__table_payload`]).
+#[doc(hidden)]
+#[macro_export]
+macro_rules! __table_pat {
+    ($E:ident :: $V:ident ($t:ty); $v:ident) => {
+        $E::$V($v)
+    };
+    ($E:ident :: $V:ident { $($(#[$m:meta])* $f:ident : $ft:ty),+ $(,)? }; $v:ident) => {
+        $E::$V { $($f),+ }
+    };
+}
+
+/// A pattern of a row's variant that binds nothing.
+#[doc(hidden)]
+#[macro_export]
+macro_rules! __table_pat_any {
+    ($E:ident :: $V:ident ($t:ty)) => {
+        $E::$V(..)
+    };
+    ($E:ident :: $V:ident { $($body:tt)* }) => {
+        $E::$V { .. }
+    };
+}
+
+/// The payload bound by [`__table_pat`], as one value.
+#[doc(hidden)]
+#[macro_export]
+macro_rules! __table_payload {
+    (($t:ty); $v:ident) => {
+        $v
+    };
+    ({ $($(#[$m:meta])* $f:ident : $ft:ty),+ $(,)? }; $v:ident) => {
+        ($($f),+)
+    };
+}
+
+/// The row's variant holding the payload `$v`.
+#[doc(hidden)]
+#[macro_export]
+macro_rules! __table_build {
+    ($E:ident :: $V:ident ($t:ty); $v:expr) => {
+        $E::$V($v)
+    };
+    ($E:ident :: $V:ident { $($(#[$m:meta])* $f:ident : $ft:ty),+ $(,)? }; $v:expr) => {{
+        let ($($f),+) = $v;
+        $E::$V { $($f),+ }
+    }};
+}
+
+/// Declares the prop enum from its rows' variants (tuple or struct variants).
+#[doc(hidden)]
+#[macro_export]
+macro_rules! __table_enum {
+    ([$(#[$m:meta])*] $E:ident [$($done:tt)*]) => {
+        $(#[$m])*
+        pub enum $E {
+            $($done)*
+        }
+    };
+    ($meta:tt $E:ident [$($done:tt)*] [$(#[doc = $doc:literal])*] $V:ident $shape:tt $($rest:tt)*) => {
+        $crate::__table_enum! { $meta $E [$($done)* $(#[doc = $doc])* $V $shape,] $($rest)* }
+    };
+}
 
 /// `$a` when given, else `$b` (a type).
 #[doc(hidden)]
@@ -514,11 +597,12 @@ macro_rules! settings_table {
         $(#[$emeta:meta])*
         pub enum $Enum:ident;
         $(#[$smeta:meta])*
-        pub struct $Settings:ident;
+        pub struct $Settings:ident
+            $({ $($(#[doc = $xdoc:literal])* $xfield:ident : $xty:ty = $xdefault:expr),* $(,)? })?;
         rows {
             $(
                 $(#[doc = $doc:literal])*
-                $Variant:ident($ty:ty) $name:literal = $default:expr
+                $Variant:ident $shape:tt $name:literal = $default:expr
                     $(, range: $range:expr)?
                     $(, check: $check:path)?
                     $(, field: $field:ident $(via $via:path => $fty:ty = $fdefault:expr)?)?
@@ -530,15 +614,12 @@ macro_rules! settings_table {
     ) => {
         $crate::__table_options! {
             [$($options)?] $Enum;
-            $([$Variant($ty) $name $($field)?])*
+            $([$Variant($crate::__table_ty!($shape)) $name $($field)?])*
         }
 
-        $(#[$emeta])*
-        pub enum $Enum {
-            $(
-                $(#[doc = $doc])*
-                $Variant($ty),
-            )*
+        $crate::__table_enum! {
+            [$(#[$emeta])*] $Enum []
+            $([$(#[doc = $doc])*] $Variant $shape)*
         }
 
         $(#[$smeta])*
@@ -546,8 +627,12 @@ macro_rules! settings_table {
             $($(
                 #[doc = concat!("`", $name, "` (see [`", stringify!($Enum), "::",
                     stringify!($Variant), "`]).")]
-                pub $field: $crate::__table_pick_ty!([$($fty)?] $ty),
+                pub $field: $crate::__table_pick_ty!([$($fty)?] $crate::__table_ty!($shape)),
             )?)*
+            $($(
+                $(#[doc = $xdoc])*
+                pub $xfield: $xty,
+            )*)?
         }
 
         impl Default for $Settings {
@@ -556,6 +641,9 @@ macro_rules! settings_table {
                     $($(
                         $field: $crate::__table_pick!([$($fdefault)?] $default),
                     )?)*
+                    $($(
+                        $xfield: $xdefault,
+                    )*)?
                 }
             }
         }
@@ -566,7 +654,8 @@ macro_rules! settings_table {
             pub fn store(&mut self, prop: &$Enum) -> bool {
                 match *prop {
                     $(
-                        $Enum::$Variant(v) => {
+                        $crate::__table_pat!($Enum::$Variant $shape; v) => {
+                            let v = $crate::__table_payload!($shape; v);
                             $crate::__table_store!(self, v; $($field $(via $via)?)?)
                         }
                     )*
@@ -611,7 +700,7 @@ macro_rules! settings_table {
                     $crate::settings::table::PropRow {
                         name: $name,
                         doc: concat!($($doc, "\n"),*),
-                        kind: <$ty as $crate::settings::table::PropValue>::KIND,
+                        kind: <$crate::__table_ty!($shape) as $crate::settings::table::PropValue>::KIND,
                         range: $crate::__table_pick!([$($range)?]
                             $crate::settings::table::Range::Any),
                         stored: $crate::__table_has!([$($field)?]),
@@ -622,7 +711,8 @@ macro_rules! settings_table {
             ];
 
             /// Every variant at its documented default, in variant order.
-            pub const DEFAULTS: &'static [$Enum] = &[$($Enum::$Variant($default),)*];
+            pub const DEFAULTS: &'static [$Enum] =
+                &[$($crate::__table_build!($Enum::$Variant $shape; $default),)*];
 
             /// The variant's position in [`Self::ROWS`] (its wire index).
             pub const fn index(&self) -> usize {
@@ -631,7 +721,7 @@ macro_rules! settings_table {
                     $($Variant,)*
                 }
                 match self {
-                    $($Enum::$Variant(_) => Index::$Variant as usize,)*
+                    $($crate::__table_pat_any!($Enum::$Variant $shape) => Index::$Variant as usize,)*
                 }
             }
 
@@ -655,14 +745,20 @@ macro_rules! settings_table {
             /// Whether the value is the row's documented default.
             pub fn is_default(&self) -> bool {
                 match *self {
-                    $($Enum::$Variant(v) => v == $default,)*
+                    $($crate::__table_pat!($Enum::$Variant $shape; v) => {
+                        $crate::__table_payload!($shape; v) == $default
+                    })*
                 }
             }
 
             /// The value for messages.
             pub fn value_text(&self) -> String {
-                match self {
-                    $($Enum::$Variant(v) => $crate::settings::table::PropValue::text(v),)*
+                match *self {
+                    $($crate::__table_pat!($Enum::$Variant $shape; v) => {
+                        $crate::settings::table::PropValue::text(
+                            &$crate::__table_payload!($shape; v),
+                        )
+                    })*
                 }
             }
 
@@ -671,15 +767,15 @@ macro_rules! settings_table {
             pub fn checked(self) -> Result<$Enum, $crate::CommandError> {
                 Ok(match self {
                     $(
-                        $Enum::$Variant(v) => {
+                        $crate::__table_pat!($Enum::$Variant $shape; v) => {
                             let v = $crate::settings::table::PropValue::check(
-                                v,
+                                $crate::__table_payload!($shape; v),
                                 $name,
                                 &$crate::__table_pick!([$($range)?]
                                     $crate::settings::table::Range::Any),
                             )?;
                             $(let v = $check(v)?;)?
-                            $Enum::$Variant(v)
+                            $crate::__table_build!($Enum::$Variant $shape; v)
                         }
                     )*
                 })
@@ -692,8 +788,8 @@ macro_rules! settings_table {
                 let mut i = 0;
                 $(
                     if i == index {
-                        return <$ty as $crate::settings::table::PropValue>::from_any(v)
-                            .map($Enum::$Variant);
+                        return <$crate::__table_ty!($shape) as $crate::settings::table::PropValue>::from_any(v)
+                            .map(|v| $crate::__table_build!($Enum::$Variant $shape; v));
                     }
                     i += 1;
                 )*

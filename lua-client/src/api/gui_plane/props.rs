@@ -1,9 +1,12 @@
 //! GuiPhysicsPlane properties, which are also the options of `PhysicsService.NewGUI`: rows
-//! on the shared row system (`crate::props`), like `PhysicsPlane`'s. The settings read the
-//! daemon's info (one round trip); every write is one `PlaneProp` (`PlaneProp::Gui` for the
-//! 2D settings). `BoundsMin` / `BoundsMax` are options of `NewGUI` only (given as a pair).
+//! on the shared row system (`crate::props`), like `PhysicsPlane`'s. The 2D settings are not
+//! listed here: they are the GUI plane settings table's rows flagged `lua` ([`table_get`],
+//! [`table_prop`]), read from the daemon's info (one round trip) and written as one
+//! `PlaneProp::Gui`. `BoundsMin` / `BoundsMax` (the table's `Bounds` pair) are options of
+//! `NewGUI` only (given as a pair). What is left here are the rows that are not 2D settings.
 
 use client_sdk::settings::plane::MAX_ROLLBACK_TICKS;
+use client_sdk::settings::table::AnyValue;
 use client_sdk::validate::MAX_TICK_RATE;
 use client_sdk::{GuiPlaneInfo, GuiPlaneProp, PlaneProp};
 use mlua::{Error as LuaError, Lua, Value};
@@ -25,6 +28,35 @@ impl Target for GuiPlaneState {
         }
         .map_err(|e| sdk_error(&format!("GuiPhysicsPlane.{name}"), e))
     }
+
+    fn table_rows() -> &'static [Row<GuiPlaneState>] {
+        static ROWS: std::sync::OnceLock<Vec<Row<GuiPlaneState>>> = std::sync::OnceLock::new();
+        ROWS.get_or_init(|| crate::props::table_rows(GuiPlaneProp::ROWS))
+    }
+
+    fn table_get(&self, name: &str, index: usize) -> mlua::Result<AnyValue> {
+        table_get(self, name, index)
+    }
+
+    fn table_prop(name: &str, index: usize, v: AnyValue) -> mlua::Result<PlaneProp> {
+        table_prop(name, index, v)
+    }
+}
+
+/// The stored value of the GUI plane settings row at `index`, from the daemon's info.
+pub fn table_get(p: &GuiPlaneState, what: &str, index: usize) -> Result<AnyValue, LuaError> {
+    let name = what.trim_start_matches("GuiPhysicsPlane.");
+    info(p, name)?
+        .settings
+        .get(index)
+        .ok_or_else(|| LuaError::runtime(format!("{what} has no plain value")))
+}
+
+/// The option write of the GUI plane settings row at `index`.
+pub fn table_prop(what: &str, index: usize, v: AnyValue) -> Result<PlaneProp, LuaError> {
+    GuiPlaneProp::from_any(index, v)
+        .map(PlaneProp::Gui)
+        .ok_or_else(|| LuaError::runtime(format!("{what} cannot take {v:?}")))
 }
 
 /// The plane's settings as the daemon reports them (`what` names the property read).
@@ -46,80 +78,10 @@ fn bound(lua: &Lua, p: &GuiPlaneState, what: &str, max: bool) -> Result<Value, L
     }
 }
 
-/// One 2D setting: read from the info field, written as that `GuiPlaneProp`.
-macro_rules! setting {
-    ($name:literal, $kind:expr, $variant:ident, $field:ident, dim) => {
-        Row {
-            name: $name,
-            kind: $kind,
-            get: Get::Fn(|lua, p| dim_value(lua, info(p, $name)?.$field)),
-            set: Set::Prop(|a| Ok(PlaneProp::Gui(GuiPlaneProp::$variant(a.dim()?)))),
-        }
-    };
-    ($name:literal, $kind:expr, $variant:ident, $field:ident, number) => {
-        Row {
-            name: $name,
-            kind: $kind,
-            get: Get::Fn(|_, p| Ok(lua_number(info(p, $name)?.$field))),
-            set: Set::Prop(|a| Ok(PlaneProp::Gui(GuiPlaneProp::$variant(a.number()? as f32)))),
-        }
-    };
-}
-
-/// The rows of `GuiPhysicsPlane` (options of `NewGUI` as well).
+/// The rows of `GuiPhysicsPlane` beyond its 2D settings (options of `NewGUI` as well).
 pub static GUI_PLANE: Props<GuiPlaneState> = Props {
     owner: "GuiPhysicsPlane",
     rows: &[
-        setting!("Gravity", Kind::Dim, Gravity, gravity, dim),
-        setting!(
-            "LinearDamping",
-            Kind::NON_NEGATIVE,
-            LinearDamping,
-            linear_damping,
-            number
-        ),
-        setting!(
-            "AngularDamping",
-            Kind::NON_NEGATIVE,
-            AngularDamping,
-            angular_damping,
-            number
-        ),
-        setting!("Drag", Kind::NON_NEGATIVE, Drag, drag, number),
-        setting!(
-            "ConstantForce",
-            Kind::Dim,
-            ConstantForce,
-            constant_force,
-            dim
-        ),
-        setting!(
-            "RestThreshold",
-            Kind::NON_NEGATIVE,
-            RestThreshold,
-            rest_threshold,
-            number
-        ),
-        Row {
-            name: "SolverIterations",
-            kind: Kind::ANY_INTEGER,
-            get: Get::Fn(|_, p| {
-                Ok(Value::Integer(
-                    info(p, "SolverIterations")?.solver_iterations as i64,
-                ))
-            }),
-            // The daemon clamps the count to its range.
-            set: Set::Prop(|a| {
-                let n = a.number()?.clamp(0.0, u32::MAX as f64) as u32;
-                Ok(PlaneProp::Gui(GuiPlaneProp::SolverIterations(n)))
-            }),
-        },
-        Row {
-            name: "NeverSleep",
-            kind: Kind::Boolean,
-            get: Get::Fn(|_, p| Ok(Value::Boolean(info(p, "NeverSleep")?.never_sleep))),
-            set: Set::Prop(|a| Ok(PlaneProp::Gui(GuiPlaneProp::NeverSleep(a.bool()?)))),
-        },
         Row {
             name: "Enabled",
             kind: Kind::Boolean,

@@ -15,12 +15,14 @@ impl Plane {
                 let handle = self.create_controller(pose, size, controlled, &props)?;
                 Ok(Reply::Object {
                     handle,
-                    tick: self.tick,
+                    tick: self.clock.tick,
                 })
             }
             ControllerOp::Set { handle, prop } => {
                 self.set_controller(handle, prop)?;
-                Ok(Reply::Applied { tick: self.tick })
+                Ok(Reply::Applied {
+                    tick: self.clock.tick,
+                })
             }
             ControllerOp::Info { handle } => {
                 // The wall probe of the info reads the scene as ops left it.
@@ -32,7 +34,9 @@ impl Plane {
                 c.path
                     .replace(waypoints.into_iter().map(Vector::from).collect());
                 c.path_index = 0;
-                Ok(Reply::Applied { tick: self.tick })
+                Ok(Reply::Applied {
+                    tick: self.clock.tick,
+                })
             }
             ControllerOp::AppendWaypoint { handle, point } => {
                 let c = self.controller_mut(handle)?;
@@ -47,14 +51,18 @@ impl Plane {
                     c.path_index = 0;
                 }
                 c.path.push(Vector::from(point));
-                Ok(Reply::Applied { tick: self.tick })
+                Ok(Reply::Applied {
+                    tick: self.clock.tick,
+                })
             }
             ControllerOp::StopWalking { handle } => {
                 let c = self.controller_mut(handle)?;
                 c.path.clear();
                 c.path_index = 0;
                 c.move_vector = [0.0; 2];
-                Ok(Reply::Applied { tick: self.tick })
+                Ok(Reply::Applied {
+                    tick: self.clock.tick,
+                })
             }
             ControllerOp::Jump { handle } => {
                 let c = self.controller_mut(handle)?;
@@ -72,12 +80,16 @@ impl Plane {
                 c.intent_yaw = yaw;
                 c.ground = None;
                 self.place_controller(handle, Vector::from(pose.position), yaw)?;
-                Ok(Reply::Applied { tick: self.tick })
+                Ok(Reply::Applied {
+                    tick: self.clock.tick,
+                })
             }
             ControllerOp::Destroy { handle } => {
                 self.controller_mut(handle)?;
                 self.destroy_object(handle)?;
-                Ok(Reply::Applied { tick: self.tick })
+                Ok(Reply::Applied {
+                    tick: self.clock.tick,
+                })
             }
         }
     }
@@ -125,7 +137,6 @@ impl Plane {
             part: Box::new(part),
             flags: shm_layout::FLAG_CONTROLLER,
         })?;
-        self.dirty.mark(handle.slot);
         self.query_stale.push(h);
         self.controllers.insert(handle.slot, controller);
         for prop in state {
@@ -154,12 +165,11 @@ impl Plane {
         position: Vector,
         yaw: f32,
     ) -> Result<(), CommandError> {
-        let h = self.body_of(handle)?;
+        let h = self.changing(handle)?;
         let pose = rapier3d::math::Pose::from_parts(position, yaw_rotation(yaw));
         let body = &mut self.world.bodies[h];
         body.set_position(pose, true);
         body.set_next_kinematic_position(pose);
-        self.dirty.mark(handle.slot);
         self.query_stale.push(h);
         Ok(())
     }

@@ -230,7 +230,6 @@ impl Plane {
                 ..EventRecord::default()
             });
         }
-        self.dirty.mark(handle.slot);
         self.controllers.insert(slot, c);
     }
 }
