@@ -10,13 +10,16 @@
 //!
 //! - [`target`]: the trait and its implementations.
 //! - [`builders`]: the builders.
+//! - [`card_house`]: Box2D's card house.
 //!
 //! The fuzzer of the daemon's request decoder lives in its own crate, `physics-fuzz`.
 
 #![deny(missing_docs)]
 
 pub mod builders;
+pub mod card_house;
 pub mod target;
 
 pub use builders::*;
+pub use card_house::{card_house, Card, CARD_HOUSE_SETTLE};
 pub use target::{LocalPlane, SceneTarget, Spawn};

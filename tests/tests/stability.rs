@@ -3,11 +3,11 @@
 //! The full sweeps (tallest stack, largest mass ratio, highest speed) are in
 //! `physics-bench stability`.
 
-use client_sdk::{BodyState, Object, ObjectProp, Pin, PlaneOptions, PlaneProp, Pose};
+use client_sdk::{BodyState, Object, ObjectProp, Pin, PlaneOptions, PlaneProp, Pose, Shape};
 use integration_tests::Scene;
 use physics_scenes::{
-    ball, column, floor, launched_box, overlapping_pile, pair_gap, pyramid, stack_and_ball,
-    thin_wall,
+    ball, card_house, column, floor, launched_box, overlapping_pile, pair_gap, pyramid,
+    stack_and_ball, thin_wall, CARD_HOUSE_SETTLE,
 };
 use shm_layout::settings::plane::DEFAULT_MAX_LINEAR_SPEED;
 
@@ -394,4 +394,74 @@ fn an_extreme_pin_force_reaches_its_target_without_blowing_up() {
     run_finite(&scene, DT, 120);
     let d = dist(b.position().unwrap(), target);
     assert!(d <= 0.01, "{d} from the target");
+}
+
+#[test]
+fn a_card_house_stands_ten_seconds_at_the_defaults() {
+    // Box2D's card house (40 cards of 0.4 × 0.002, μ 0.7, ±25°, five levels) at HitBoxQuality
+    // 4 (cards free to rotate), g = 9.81. A leaning pair pinned at its tips presses them
+    // together horizontally, so where a tip meets the other card's face it needs
+    // μ ≥ tan 25° = 0.47 (its feet, under the load of the levels above, as much): μ 0.7
+    // stands. Criterion: after 0.5 s of settling from Box2D's start positions, no card moves
+    // more than 0.02 (5 % of a card) until t = 10 s. While thin cards' contacts were recycled
+    // (docs/api-3d.md, "Thin objects"), the top pair slid apart and fell (2.1) within 1.5 s.
+    let gravity = PlaneProp::Gravity([0.0, -9.81, 0.0]);
+    let scene = Scene::new("cards", PlaneOptions::default().with(gravity));
+    let props = [ObjectProp::Friction(0.7), ObjectProp::HitBoxQuality(4)];
+    let cards = card_house(&mut &scene.plane, 5, &props).unwrap();
+    assert_eq!(cards.len(), 40);
+    let settle = (CARD_HOUSE_SETTLE / DT).round() as u32;
+    run_finite(&scene, DT, settle);
+    let settled: Vec<_> = cards.iter().map(|c| c.handle.position().unwrap()).collect();
+    run_finite(&scene, DT, 600 - settle);
+    let (worst, card) = cards
+        .iter()
+        .zip(&settled)
+        .enumerate()
+        .map(|(i, (c, p))| (dist(c.handle.position().unwrap(), *p), i))
+        .fold((0.0, 0), |a, b| if b.0 > a.0 { b } else { a });
+    assert!(worst <= 0.02, "card {card} moved {worst} after settling");
+}
+
+/// How far either card of a pair leaning at ±25° with touching tips (0.4 × 0.002, 0.3 deep,
+/// HitBoxQuality 4, g = 9.81, on a floor) moves in 10 s at Friction `mu` (floor and cards).
+fn leaning_pair_moves(mu: f32) -> f32 {
+    let gravity = PlaneProp::Gravity([0.0, -9.81, 0.0]);
+    let scene = Scene::new("pair", PlaneOptions::default().with(gravity));
+    let props = [ObjectProp::HitBoxQuality(4), ObjectProp::Friction(mu)];
+    floor(&mut &scene.plane, 20.0, &props).unwrap();
+    let (lean, half, t) = (25f32.to_radians(), 0.2f32, 0.002f32);
+    let (s, c) = lean.sin_cos();
+    // Centres placed so that the feet stand on the floor and the tips meet above x = 0.
+    let (x, y) = (half * s + t / 2.0 * c, half * c + t / 2.0 * s);
+    let card = |x: f32, angle: f32| {
+        let (hs, hc) = (angle / 2.0).sin_cos();
+        let pose = Pose {
+            position: [x, y, 0.0],
+            rotation: [0.0, 0.0, hs, hc],
+        };
+        let size = [t, 2.0 * half, 0.3];
+        scene.plane.add(Shape::Cube { size }, pose, &props).unwrap()
+    };
+    let cards = [card(-x, -lean), card(x, lean)];
+    let start: Vec<_> = cards.iter().map(|c| c.position().unwrap()).collect();
+    run_finite(&scene, DT, 600);
+    cards
+        .iter()
+        .zip(&start)
+        .map(|(c, p)| dist(c.position().unwrap(), *p))
+        .fold(0.0, f32::max)
+}
+
+#[test]
+fn a_leaning_pair_of_cards_stands_from_friction_tan_25_degrees() {
+    // Two cards pinned at their tips press each other horizontally (their weights' torques
+    // about their feet balance), so where one tip meets the other card's face the contact
+    // needs μ ≥ tan 25° = 0.466 (the feet only tan 25° / 2). 10 % either side: the pair stands
+    // (moves < 0.01) at 1.1 · tan 25° and slides apart (moves > 0.1, a fall) at 0.9 · tan 25°.
+    let critical = 25f32.to_radians().tan();
+    let stands = leaning_pair_moves(1.1 * critical);
+    assert!(stands < 0.01, "μ = {}: moved {stands}", 1.1 * critical);
+    let falls = leaning_pair_moves(0.9 * critical);
+    assert!(falls > 0.1, "μ = {}: moved only {falls}", 0.9 * critical);
 }

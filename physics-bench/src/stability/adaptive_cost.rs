@@ -2,7 +2,8 @@
 //! once with it and once without, stepped in alternating blocks in one run, the median step
 //! of each compared. Scenes that do not need it (a settled and an awake 10,000-box pile) must
 //! cost the same within 3 %; scenes that need it show their price. Written as
-//! `adaptive.json` / `adaptive.md` beside the stability report.
+//! `adaptive.json` / `adaptive.md` beside the stability report, and as a section of the
+//! accuracy report (see [`section`]).
 
 use client_sdk::{ObjectProp, PlaneProp};
 use physics_scenes::{column, floor, pile, pyramid};
@@ -189,4 +190,11 @@ pub fn markdown(r: &CostReport) -> String {
         t.finish(),
         report::goals_table(&r.goals)
     )
+}
+
+/// The same page as a section of another report (the accuracy report): its headings one
+/// level down.
+pub fn section(r: &CostReport) -> String {
+    let page = markdown(r).replace("\n## ", "\n### ");
+    format!("#{page}")
 }

@@ -1,7 +1,7 @@
 //! `physics-bench stability`: stress scenes with automatic pass criteria, and sweeps for the
 //! critical values. In process, through the daemon's own plane code, like `accuracy`.
 
-mod adaptive_cost;
+pub(crate) mod adaptive_cost;
 mod before;
 mod markdown;
 pub mod scenes;

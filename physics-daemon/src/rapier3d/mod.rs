@@ -11,6 +11,7 @@
 //! - `controllers`: kinematic character controllers, ticked before each step.
 //! - `limits`: MaxLinearSpeed and MaxAngularSpeed.
 //! - `joints`: joints, their error figures and breaking; `maps`: triangle-mesh maps.
+//! - `thin`: thin colliders, whose contacts are recomputed every step.
 
 mod backend;
 mod body_pass;
@@ -43,6 +44,7 @@ mod queries;
 mod rollback;
 mod snapshot;
 mod solver;
+mod thin;
 #[cfg(test)]
 mod unstepped;
 

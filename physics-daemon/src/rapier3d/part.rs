@@ -308,11 +308,15 @@ impl Part {
         collider.set_collision_groups(self.interaction_groups(groups));
         // The rest-threshold hook only matters where something can bounce; a controller's
         // capsule needs it for its capped pushes.
-        collider.set_active_hooks(if self.bounciness > 0.0 || self.is_controller {
+        let hooks = if self.bounciness > 0.0 || self.is_controller {
             ActiveHooks::MODIFY_SOLVER_CONTACTS
         } else {
             ActiveHooks::empty()
-        });
+        };
+        // A body thinner than rapier's contact-recycling window: its contacts are recomputed
+        // every step (see `thin`).
+        let opt_out = super::thin::recycling_opt_out(collider.shape(), self.map.is_some());
+        collider.set_active_hooks(hooks | opt_out);
         collider.set_active_events(if self.report_contacts {
             ActiveEvents::COLLISION_EVENTS
         } else {
