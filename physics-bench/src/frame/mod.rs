@@ -76,6 +76,22 @@ impl Mode {
     }
 }
 
+/// The parts of a frame (medians, ms).
+#[derive(Debug, Clone, Copy, serde::Serialize)]
+pub struct Phases {
+    /// Stepping the physics (in process) or starting the frame (daemon).
+    pub step: f64,
+    /// The Luau game logic.
+    pub game_work: f64,
+    /// Reading every pose.
+    pub read_poses: f64,
+    /// Writing the velocities (the daemon: checked and queued).
+    pub write_velocities: f64,
+    /// Ending the frame (the daemon: the one request with the frame's writes, until its
+    /// reply).
+    pub end: f64,
+}
+
 /// One mode's frame times.
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct ModeRow {
@@ -83,6 +99,8 @@ pub struct ModeRow {
     pub frames: usize,
     /// Frame time, ms.
     pub frame_ms: Spread,
+    /// Medians of the frame's parts, ms.
+    pub phases_p50_ms: Phases,
     /// This mode's median frame over the no-physics one's.
     pub ratio_p50: f64,
     /// The same at p99.
@@ -274,17 +292,17 @@ fn load_average() -> f64 {
         .unwrap_or(f64::NAN)
 }
 
-/// Runs `frames` paced frames of `physics`; returns each frame's time (ms) and the game
-/// work's alone (ms).
+/// Runs `frames` paced frames of `physics`; returns each frame's time (ms) and its
+/// [`Phases`] (ms).
 fn block(
     physics: &mut dyn Physics,
     game: &mlua::Function,
     args: &FrameArgs,
     awake: usize,
     first_frame: usize,
-) -> BenchResult<(Vec<f64>, Vec<f64>)> {
+) -> BenchResult<(Vec<f64>, Vec<[f64; 5]>)> {
     let period = Duration::from_secs_f32(DT);
-    let (mut frames, mut work) = (Vec::with_capacity(args.frames), Vec::new());
+    let (mut frames, mut phases) = (Vec::with_capacity(args.frames), Vec::new());
     let mut next = Instant::now();
     for f in first_frame..first_frame + args.frames {
         next += period;
@@ -294,14 +312,24 @@ fn block(
         let _: f64 = game
             .call(DT as f64)
             .map_err(|e| BenchError::Failed(format!("game.luau: {e}")))?;
-        work.push(w.elapsed().as_secs_f64() * 1e3);
+        let r = Instant::now();
         black_box(physics.read()?);
+        let wr = Instant::now();
         for j in 0..args.writes.min(awake) {
             let k = (f * args.writes + j) % awake;
             physics.write(k, heading(k, f))?;
         }
+        let e = Instant::now();
         physics.end()?;
         frames.push(started.elapsed().as_secs_f64() * 1e3);
+        let ms = |a: Instant, b: Instant| (b - a).as_secs_f64() * 1e3;
+        phases.push([
+            ms(started, w),
+            ms(w, r),
+            ms(r, wr),
+            ms(wr, e),
+            e.elapsed().as_secs_f64() * 1e3,
+        ]);
         let now = Instant::now();
         if next > now {
             std::thread::sleep(next - now);
@@ -309,7 +337,7 @@ fn block(
             next = now;
         }
     }
-    Ok((frames, work))
+    Ok((frames, phases))
 }
 
 pub fn run(args: &FrameArgs) -> BenchResult<()> {
@@ -360,7 +388,7 @@ pub fn run(args: &FrameArgs) -> BenchResult<()> {
     };
     let (_lua, game) = game(args.bodies)?;
     let mut times: Vec<Vec<f64>> = vec![Vec::new(); 3];
-    let mut work_alone = Vec::new();
+    let mut phases: Vec<Vec<[f64; 5]>> = vec![Vec::new(); 3];
     let mut frame = 0;
     for _ in 0..args.blocks {
         let modes: [&mut dyn Physics; 3] = [&mut no_physics, &mut remote, &mut in_process];
@@ -372,9 +400,7 @@ pub fn run(args: &FrameArgs) -> BenchResult<()> {
             physics.active(false)?;
             frame += args.frames;
             times[m].extend(t);
-            if Mode::ALL[m] == Mode::NoPhysics {
-                work_alone.extend(w);
-            }
+            phases[m].extend(w);
         }
     }
     let asleep = asleep_fraction(plane.snapshot()?.bodies());
@@ -385,12 +411,24 @@ pub fn run(args: &FrameArgs) -> BenchResult<()> {
     let rows: Vec<ModeRow> = Mode::ALL
         .iter()
         .zip(&times)
-        .map(|(&mode, t)| {
+        .zip(&phases)
+        .map(|((&mode, t), p)| {
             let s = spread(t).unwrap_or(base);
+            let median = |k: usize| {
+                let v: Vec<f64> = p.iter().map(|x| x[k]).collect();
+                percentile(&v, 0.5).unwrap_or(f64::NAN)
+            };
             ModeRow {
                 mode,
                 frames: t.len(),
                 frame_ms: s,
+                phases_p50_ms: Phases {
+                    step: median(0),
+                    game_work: median(1),
+                    read_poses: median(2),
+                    write_velocities: median(3),
+                    end: median(4),
+                },
                 ratio_p50: s.p50 / base.p50,
                 ratio_p99: s.p99 / base.p99,
             }
@@ -422,7 +460,7 @@ pub fn run(args: &FrameArgs) -> BenchResult<()> {
         writes: args.writes,
         frames_per_block: args.frames,
         blocks: args.blocks,
-        game_work_ms: percentile(&work_alone, 0.5).unwrap_or(f64::NAN),
+        game_work_ms: rows[0].phases_p50_ms.game_work,
         daemon_step_ms: percentile(&step_us, 0.5).unwrap_or(f64::NAN) / 1e3,
         asleep_fraction: asleep,
         load_average: [load_start, load_average()],
@@ -445,6 +483,7 @@ fn markdown(r: &FrameReport) -> String {
         "max (ms)",
         "p50 / no physics",
         "p99 / no physics",
+        "step / work / read / write / end, p50 (ms)",
     ]);
     for m in &r.modes {
         t.row(&[
@@ -455,6 +494,13 @@ fn markdown(r: &FrameReport) -> String {
             num(Some(m.frame_ms.max)),
             format!("{:.3}", m.ratio_p50),
             format!("{:.3}", m.ratio_p99),
+            {
+                let p = &m.phases_p50_ms;
+                format!(
+                    "{:.3} / {:.3} / {:.3} / {:.3} / {:.3}",
+                    p.step, p.game_work, p.read_poses, p.write_velocities, p.end
+                )
+            },
         ]);
     }
     format!(
