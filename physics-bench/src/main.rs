@@ -30,6 +30,7 @@ mod cluster;
 mod controllers;
 mod daemon;
 mod error;
+mod frame;
 mod fuzz;
 mod gpu;
 mod hostile;
@@ -48,7 +49,6 @@ mod soak;
 mod stability;
 mod stats;
 mod validate;
-mod frame;
 
 use std::process::ExitCode;
 

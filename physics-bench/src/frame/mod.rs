@@ -155,7 +155,11 @@ pub fn world<T: SceneTarget>(
 fn heading(i: usize, frame: usize) -> [f32; 3] {
     let a = (i * 37 + frame) as f32 * 0.618;
     let b = (i * 11) as f32 * 0.377;
-    [2.0 * a.cos() * b.cos(), 2.0 * b.sin(), 2.0 * a.sin() * b.cos()]
+    [
+        2.0 * a.cos() * b.cos(),
+        2.0 * b.sin(),
+        2.0 * a.sin() * b.cos(),
+    ]
 }
 
 /// Plane settings of every mode: manual while building, no damping (the awake half keeps
@@ -279,7 +283,11 @@ impl Physics for InProcess {
 fn game(n: usize) -> BenchResult<(mlua::Lua, mlua::Function)> {
     let lua = mlua::Lua::new();
     let failed = |e: mlua::Error| BenchError::Failed(format!("game.luau: {e}"));
-    let new: mlua::Function = lua.load(GAME).set_name("=game.luau").eval().map_err(failed)?;
+    let new: mlua::Function = lua
+        .load(GAME)
+        .set_name("=game.luau")
+        .eval()
+        .map_err(failed)?;
     let frame: mlua::Function = new.call(n as f64).map_err(failed)?;
     lua.sandbox(true).map_err(failed)?;
     Ok((lua, frame))

@@ -3,12 +3,12 @@
 
 mod idle;
 mod lua;
+mod many_planes;
 mod markdown;
 mod planes;
 mod scene_run;
 mod socket;
 mod threads;
-mod many_planes;
 
 use std::collections::BTreeMap;
 use std::path::PathBuf;
@@ -22,10 +22,10 @@ use super::stats::Spread;
 
 pub use idle::IdleCpu;
 pub use lua::LuaReads;
+pub use many_planes::ManyPlanes;
 pub use planes::{HeadOfLine, MultiPlane};
 pub use scene_run::{Delivery, Memory, Overhead, Requests};
 pub use threads::{Threads, ThreadsScene};
-pub use many_planes::ManyPlanes;
 
 /// Options of the `ipc` subcommand.
 #[derive(Debug, Clone, clap::Args)]
