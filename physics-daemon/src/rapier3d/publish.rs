@@ -75,6 +75,19 @@ impl Plane {
             }
             return;
         }
+        if let Some(states) = self.mirror.current(&self.dirty, out.len()) {
+            // The last step's own copy, in slot order: a streaming copy.
+            return match self.world.physics_pipeline.thread_pool() {
+                Some(pool) if out.len() >= PARALLEL_FROM => pool.install(|| {
+                    out.par_chunks_mut(CHUNK)
+                        .enumerate()
+                        .for_each(|(c, chunk)| {
+                            super::pose_mirror::copy_run(states, c * CHUNK, chunk, filter)
+                        })
+                }),
+                _ => super::pose_mirror::copy_run(states, 0, out, filter),
+            };
+        }
         let (slots, bodies) = (&self.bodies, &self.world.bodies);
         match self.world.physics_pipeline.thread_pool() {
             Some(pool) if out.len() >= PARALLEL_FROM => pool.install(|| {
