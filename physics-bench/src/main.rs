@@ -10,6 +10,7 @@
 //! `physics-bench controllers [--quick] [--out DIR]` writes DIR/controllers.json and .md.
 //! `physics-bench gpu [--quick] [--out DIR]` writes DIR/gpu.json and DIR/gpu.md.
 //! `physics-bench hostile [--out DIR]` writes DIR/hostile.json and DIR/hostile.md.
+//! `physics-bench frame [--out DIR]` writes DIR/frame.json and DIR/frame.md.
 //!
 //! Its parts, shared by the subcommands:
 //!
@@ -29,6 +30,7 @@ mod cluster;
 mod controllers;
 mod daemon;
 mod error;
+mod frame;
 mod fuzz;
 mod gpu;
 mod hostile;
@@ -104,6 +106,9 @@ enum Bench {
     /// A cluster on loopback: a remote reader beside a local one (delivery latency p50/p99,
     /// bytes of a tick's frame, same StateHash), 1k and 10k bodies, settled and awake.
     Cluster(cluster::ClusterArgs),
+    /// Physics for free: a game loop's frame time with the daemon simulating 10,000 bodies
+    /// on the other core, against no physics and against physics stepped in the frame.
+    Frame(frame::FrameArgs),
 }
 
 fn main() -> ExitCode {
@@ -133,6 +138,7 @@ fn main() -> ExitCode {
         Bench::Snapshot(args) => snapshot::run(args),
         Bench::Persist(args) => persist::run(args),
         Bench::Cluster(args) => cluster::run(args),
+        Bench::Frame(args) => frame::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -92,7 +92,17 @@ pub fn config(domain: &str) -> Result<Config, DomainError> {
     config.global.prefix = FileName::new(prefix(domain).as_bytes()).map_err(|_| unusable())?;
     let root = iceoryx2::prelude::Path::new(root_path().as_bytes()).map_err(|_| unusable())?;
     config.global.set_root_path(&root);
+    // The domain's node records in a directory of their own: listing the domain's nodes
+    // (the daemon's resource guard and liveness checks do it every period) then reads only
+    // this domain's entries, not every node of every domain on the machine.
+    config.global.node.directory =
+        iceoryx2::prelude::Path::new(node_directory(domain).as_bytes()).map_err(|_| unusable())?;
     Ok(config)
+}
+
+/// The domain's node directory under the root path (iceoryx2's `global.node.directory`).
+pub fn node_directory(domain: &str) -> String {
+    format!("nodes/{}", prefix(domain))
 }
 
 fn service(name: String) -> ServiceName {
@@ -154,5 +164,15 @@ mod tests {
     fn config_carries_the_prefix() {
         let c = config("unit").unwrap();
         assert_eq!(c.global.prefix.to_string(), "phys_unit_");
+        // Each domain lists only its own nodes.
+        assert!(c
+            .global
+            .node_dir()
+            .to_string()
+            .ends_with("/nodes/phys_unit_"));
+        assert_ne!(
+            c.global.node_dir(),
+            config("other").unwrap().global.node_dir()
+        );
     }
 }

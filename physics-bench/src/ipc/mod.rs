@@ -3,6 +3,7 @@
 
 mod idle;
 mod lua;
+mod many_planes;
 mod markdown;
 mod planes;
 mod scene_run;
@@ -21,6 +22,7 @@ use super::stats::Spread;
 
 pub use idle::IdleCpu;
 pub use lua::LuaReads;
+pub use many_planes::ManyPlanes;
 pub use planes::{HeadOfLine, MultiPlane};
 pub use scene_run::{Delivery, Memory, Overhead, Requests};
 pub use threads::{Threads, ThreadsScene};
@@ -34,6 +36,9 @@ pub struct IpcArgs {
     /// Folder receiving ipc.json and ipc.md.
     #[arg(long, default_value = "bench-out")]
     pub out: PathBuf,
+    /// Only the many-planes row (writes ipc-many-planes.json and .md).
+    #[arg(long)]
+    pub many_planes_only: bool,
 }
 
 /// The size at which the goals are judged (and the only size of `--quick`).
@@ -56,6 +61,8 @@ pub struct Plan {
     pub head_of_line_round_trips: usize,
     /// Seconds per side of the multi-plane figure.
     pub multi_plane_s: f64,
+    /// Seconds of ticking per side of the many-planes figure.
+    pub many_planes_s: f64,
 }
 
 impl Plan {
@@ -72,6 +79,7 @@ impl Plan {
                 idle_window_s: 10,
                 head_of_line_round_trips: 1_000,
                 multi_plane_s: 3.0,
+                many_planes_s: 5.0,
             }
         } else {
             Plan {
@@ -85,6 +93,7 @@ impl Plan {
                 idle_window_s: 60,
                 head_of_line_round_trips: 3_000,
                 multi_plane_s: 6.0,
+                many_planes_s: 10.0,
             }
         }
     }
@@ -119,13 +128,18 @@ pub struct IpcReport {
     pub goals: Vec<Goal>,
     pub cpus: usize,
     pub seconds: f64,
+    /// 100 planes × 1,000 bodies at 60 Hz against one plane of 100,000 (see `many_planes`).
+    pub many_planes: ManyPlanes,
 }
 
 pub fn run(args: &IpcArgs) -> BenchResult<()> {
     let started = Instant::now();
     let plan = Plan::new(args.quick);
+    if args.many_planes_only {
+        return many_planes_only(args, &plan);
+    }
     let kinds = [Kind::Pile, Kind::Free];
-    let phases = 2 + 1 + 3 + (plan.sizes.len() * kinds.len() * 4) as u64 + 1;
+    let phases = 2 + 1 + 3 + (plan.sizes.len() * kinds.len() * 4) as u64 + 1 + 1;
     let progress = Progress::new(phases);
 
     let idle = idle::run(Duration::from_secs(plan.idle_window_s), &progress)?;
@@ -183,6 +197,13 @@ pub fn run(args: &IpcArgs) -> BenchResult<()> {
          plane.LinearDamping {:.3} µs",
         lua.cframe_x1000_us, lua.weight_read_us, lua.linear_damping_read_us
     ));
+
+    progress.phase(format!(
+        "many planes: {MANY_PLANES} planes × {MANY_PLANES_BODIES} bodies at 60 Hz vs one plane"
+    ));
+    let many_planes = many_planes::run(MANY_PLANES, MANY_PLANES_BODIES, plan.many_planes_s)?;
+    progress.done();
+    progress.note(many_planes_note(&many_planes));
 
     let mut scenes = Vec::new();
     let mut memory = Vec::new();
@@ -252,6 +273,7 @@ pub fn run(args: &IpcArgs) -> BenchResult<()> {
         plan,
         cpus: std::thread::available_parallelism().map_or(1, |n| n.get()),
         seconds: 0.0,
+        many_planes,
     };
     report.goals = goals(&report);
     report.seconds = started.elapsed().as_secs_f64();
@@ -264,6 +286,86 @@ pub fn run(args: &IpcArgs) -> BenchResult<()> {
         md_path.display(),
         report.seconds
     );
+    Ok(())
+}
+
+/// Planes of the many-planes figure.
+const MANY_PLANES: usize = 100;
+/// Bodies of each of them.
+const MANY_PLANES_BODIES: usize = 1_000;
+
+fn many_planes_note(m: &ManyPlanes) -> String {
+    format!(
+        "many planes: lateness p50/p99/max {:.2}/{:.2}/{:.2} ms, {:.1} ticks/s a plane, {:.1} ns \
+         CPU per body-tick ({} daemon threads); one plane: {:.2}/{:.2}/{:.2} ms, {:.1} ticks/s, \
+         {:.1} ns → {:.2}×",
+        m.many.lateness_ms.p50,
+        m.many.lateness_ms.p99,
+        m.many.lateness_ms.max,
+        m.many.ticks_per_s,
+        m.many.cpu_ns_per_body_tick,
+        m.many.daemon_threads,
+        m.one.lateness_ms.p50,
+        m.one.lateness_ms.p99,
+        m.one.lateness_ms.max,
+        m.one.ticks_per_s,
+        m.one.cpu_ns_per_body_tick,
+        m.cpu_ratio
+    )
+}
+
+/// The goal rows of the many-planes figure.
+fn many_planes_goals(m: &ManyPlanes) -> Vec<Goal> {
+    vec![
+        Goal {
+            goal: format!(
+                "many planes: {} planes × {} bodies at 60 Hz, every tick on time (p99 lateness ≤ 2 ms)",
+                m.many.planes, m.many.bodies_per_plane
+            ),
+            value: format!(
+                "p99 {:.2} ms (p50 {:.2}, max {:.2}; {:.1} ticks/s a plane)",
+                m.many.lateness_ms.p99,
+                m.many.lateness_ms.p50,
+                m.many.lateness_ms.max,
+                m.many.ticks_per_s
+            ),
+            met: Some(m.many.lateness_ms.p99 <= 2.0),
+        },
+        Goal {
+            goal: format!(
+                "many planes: CPU per body-tick ≤ 1.10 × one plane of {} bodies",
+                m.one.bodies_per_plane
+            ),
+            value: format!(
+                "{:.2}× ({:.1} against {:.1} ns)",
+                m.cpu_ratio, m.many.cpu_ns_per_body_tick, m.one.cpu_ns_per_body_tick
+            ),
+            met: Some(m.cpu_ratio <= 1.10),
+        },
+    ]
+}
+
+/// `ipc --many-planes-only`: the many-planes row alone.
+fn many_planes_only(args: &IpcArgs, plan: &Plan) -> BenchResult<()> {
+    let m = many_planes::run(MANY_PLANES, MANY_PLANES_BODIES, plan.many_planes_s)?;
+    eprintln!("{}", many_planes_note(&m));
+    #[derive(serde::Serialize)]
+    struct Only<'a> {
+        many_planes: &'a ManyPlanes,
+        goals: Vec<Goal>,
+    }
+    let goals = many_planes_goals(&m);
+    let md = format!(
+        "# physics-bench ipc --many-planes-only\n\n{}",
+        report::goals_table(&goals)
+    );
+    let only = Only {
+        many_planes: &m,
+        goals,
+    };
+    let (json, md_path) = report::write(&args.out, "ipc-many-planes", &only, &md)?;
+    println!("{md}");
+    eprintln!("wrote {} and {}", json.display(), md_path.display());
     Ok(())
 }
 
@@ -424,5 +526,6 @@ fn goals(r: &IpcReport) -> Vec<Goal> {
         ),
         met: Some(ratio <= 5.0),
     });
+    goals.extend(many_planes_goals(&r.many_planes));
     goals
 }

@@ -11,6 +11,9 @@ pub struct Dirty {
     stepped: usize,
     /// Unseen marks at which `mark` next folds repeats (at least `FOLD_MIN`).
     fold_at: usize,
+    /// Marks ever made (never reset): a copy of the plane's state taken when it read `n`
+    /// is current while it still reads `n`.
+    marks: u64,
 }
 
 impl Dirty {
@@ -19,6 +22,7 @@ impl Dirty {
     /// stepped nor published (manual, disabled) keeps at most twice its distinct marks
     /// plus [`super::marks::FOLD_MIN`], not one entry a write.
     pub fn mark(&mut self, slot: u32) {
+        self.marks += 1;
         self.slots.push(slot);
         let seen = self.stepped.min(self.slots.len());
         let unseen = self.slots.len() - seen;
@@ -33,7 +37,13 @@ impl Dirty {
 
     /// Marks every slot as changed (a plane-wide change).
     pub fn mark_all(&mut self) {
+        self.marks += 1;
         self.all = true;
+    }
+
+    /// Marks made so far, [`Dirty::mark`] and [`Dirty::mark_all`] alike.
+    pub fn marks(&self) -> u64 {
+        self.marks
     }
 
     /// Slots marked since the last step (possibly repeated).

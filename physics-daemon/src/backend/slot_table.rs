@@ -65,6 +65,12 @@ impl<T> SlotTable<T> {
         }
     }
 
+    /// Marks made so far in a tracked table ([`Dirty::marks`]; 0 in an untracked one): a
+    /// copy of the table's values taken when it read `n` is current while it reads `n`.
+    pub fn marks_made(&self) -> u64 {
+        self.marks.as_ref().map_or(0, Dirty::marks)
+    }
+
     /// Marks every slot as changed (a plane-wide change).
     pub fn mark_all(&mut self) {
         if let Some(marks) = &mut self.marks {

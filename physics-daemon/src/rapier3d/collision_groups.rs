@@ -27,6 +27,9 @@ impl Plane {
         }
         // Pairs that collide now must meet at the next step, including resting ones.
         self.world.wake_up_all(true);
+        // Every body's sleep flag may have changed: the last step's copy of the states is no
+        // longer theirs.
+        self.mirror.forget();
         Ok(())
     }
 

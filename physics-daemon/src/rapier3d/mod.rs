@@ -37,6 +37,7 @@ mod maps;
 mod objects;
 mod offload;
 mod part;
+mod pose_mirror;
 mod probes;
 mod properties;
 mod publish;
@@ -131,6 +132,8 @@ pub struct Plane {
     state_bytes: crate::backend::counted::Counter,
     /// States of the last ticks while RollbackTicks > 0 (see `rollback`).
     rollback: rollback::Ring,
+    /// Every slot's state as the last step left it, for the publisher (see `pose_mirror`).
+    mirror: pose_mirror::PoseMirror,
 }
 
 impl Plane {
@@ -178,6 +181,7 @@ impl Plane {
             state_hash: 0,
             state_bytes: Default::default(),
             rollback: Default::default(),
+            mirror: Default::default(),
         }
     }
 
@@ -322,7 +326,9 @@ impl Plane {
         self.joints_after_step(dt);
         self.removed.clear();
         let rehash = moving || self.awake_count() > 0;
-        let (figures, hash) = self.figures_and_hash(rehash);
+        let mut mirror = std::mem::take(&mut self.mirror);
+        let (figures, hash) = self.figures_and_hash(rehash, &mut mirror);
+        self.mirror = mirror;
         (self.clock.max_penetration, self.clock.contact_pairs) = figures;
         if let Some(hash) = hash {
             self.state_hash = hash;
@@ -356,10 +362,15 @@ impl Plane {
     /// After a step: the contact figures of the tick header and, when `rehash`, the state
     /// hash. The hash is one sequential chain over every slot; on the plane's pool it runs
     /// beside the contact figures (themselves split over the pool), not after them.
-    fn figures_and_hash(&self, rehash: bool) -> ((f32, u32), Option<u64>) {
+    fn figures_and_hash(
+        &self,
+        rehash: bool,
+        mirror: &mut pose_mirror::PoseMirror,
+    ) -> ((f32, u32), Option<u64>) {
         let (slots, bodies, narrow_phase) =
             (&self.bodies, &self.world.bodies, &self.world.narrow_phase);
-        let hash = || rehash.then(|| cpu_state_hash(slots, bodies));
+        let marks = slots.marks_made();
+        let hash = move || rehash.then(move || mirror.write_and_hash(slots, bodies, marks));
         let pairs = narrow_phase.contact_graph().raw_graph().raw_edges().len();
         let work = pairs + if rehash { slots.slot_count() } else { 0 };
         match self.pool_for(work) {
@@ -406,14 +417,4 @@ impl Plane {
     pub fn body_state(&self, i: usize) -> BodyState {
         publish::body_state(&self.bodies, &self.world.bodies, i)
     }
-}
-
-/// [`Plane::state_hash`] of a plane on the CPU, from the parts the hash reads (the plane
-/// itself is not `Sync`: its event channel).
-fn cpu_state_hash(slots: &SlotTable<Body>, bodies: &RigidBodySet) -> u64 {
-    let mut h = StateHasher::new();
-    for i in 0..slots.slot_count() {
-        h.add(&publish::body_state(slots, bodies, i));
-    }
-    h.finish()
 }

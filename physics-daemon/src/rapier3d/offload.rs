@@ -200,6 +200,7 @@ impl Plane {
             body.set_angvel(Vector::from(p.angular_velocity), false);
         }
         self.query_stale.push(h);
+        self.mirror.forget();
     }
 
     /// Whether `handle` names a live object.
@@ -210,6 +211,7 @@ impl Plane {
     /// Wakes every body (motion handed back to rapier).
     pub fn wake_all(&mut self) {
         self.world.wake_up_all(true);
+        self.mirror.forget();
     }
 
     /// What every step does first: the last tick kept for Rewind, `dt` checked. Returns

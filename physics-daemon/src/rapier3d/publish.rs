@@ -65,6 +65,19 @@ fn write_run(
 impl Plane {
     /// [`crate::backend::Backend::write_states`] of this plane.
     pub(super) fn write_sample(&self, out: &mut [MaybeUninit<BodyState>], filter: SlotFilter<'_>) {
+        if let Some(states) = self.mirror.current(self.bodies.marks_made(), out.len()) {
+            // The last step's own copy, in slot order: a streaming copy.
+            return match self.world.physics_pipeline.thread_pool() {
+                Some(pool) if out.len() >= PARALLEL_FROM => pool.install(|| {
+                    out.par_chunks_mut(CHUNK)
+                        .enumerate()
+                        .for_each(|(c, chunk)| {
+                            super::pose_mirror::copy_run(states, c * CHUNK, chunk, filter)
+                        })
+                }),
+                _ => super::pose_mirror::copy_run(states, 0, out, filter),
+            };
+        }
         let (slots, bodies) = (&self.bodies, &self.world.bodies);
         match self.world.physics_pipeline.thread_pool() {
             Some(pool) if out.len() >= PARALLEL_FROM => pool.install(|| {

@@ -260,6 +260,9 @@ fn release_domain(config: &Config) {
             // SAFETY: no node of this domain exists any more, so nobody uses the segment.
             let _ =
                 unsafe { iceoryx2::testing::remove_global_mgmt_segment::<ipc::Service>(config) };
+            // The domain's own node directory, once empty (another process of the domain
+            // starting now recreates it).
+            let _ = std::fs::remove_dir(config.global.node_dir().to_string());
             return;
         }
         if Instant::now() > deadline {
