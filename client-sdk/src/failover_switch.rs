@@ -35,6 +35,8 @@ impl Client {
         let Some(name) = shared.persistent_name.borrow().clone() else {
             return Ok(false);
         };
+        // The newest tick this client saw on the daemon that died.
+        let seen = shared.current_tick();
         let gone = transport.daemon().to_string();
         let cluster = transport.cluster().to_string();
         let deadline = Instant::now() + FAILOVER_WAIT;
@@ -63,16 +65,24 @@ impl Client {
                     peer: peer.downgrade(),
                     id: opened.id,
                 });
-                shared
-                    .recovered
-                    .set(Some(opened.recovered.unwrap_or_default()));
                 peer.remember_plane(opened.id, shared.clone());
                 self.requeue_to(id, &peer, opened.id);
                 if opened.owner {
                     peer.note_owned(opened.id);
                 }
                 // Asking after subscribing makes the daemon hand the newest tick at once.
-                peer.call(Command::plane(opened.id, PlaneOp::Info))?;
+                let resumed = match peer.call(Command::plane(opened.id, PlaneOp::Info))? {
+                    Reply::Plane(info) => Some(info.tick),
+                    _ => None,
+                };
+                // The daemon counts the lost ticks from the replicated tick record, which can
+                // lag the old daemon by a few hundred milliseconds (and tells only the first
+                // opener); the ticks this client saw past the tick the plane resumed at are
+                // lost too, so they are a floor.
+                let seen_lost = seen.zip(resumed).map_or(0, |(s, r)| s.saturating_sub(r));
+                shared
+                    .recovered
+                    .set(Some(opened.recovered.unwrap_or_default().max(seen_lost)));
                 tracing::warn!(
                     plane = id,
                     name,

@@ -158,6 +158,14 @@ impl RemoteTransport {
                 Ok(None) => check(self.alive.load(Ordering::SeqCst))?,
                 Err(_) => {
                     // The query ended without a reply: the daemon left, or never had a relay.
+                    // A daemon that died ends its queries at once, and the end of its
+                    // liveliness token can reach this session a little later: wait for that
+                    // verdict (bounded) so a death reads as `DaemonGone` (which the failover
+                    // switch-over acts on), not as a daemon that does not answer.
+                    let deadline = Instant::now() + ALIVE_WAIT;
+                    while self.alive.load(Ordering::SeqCst) && Instant::now() < deadline {
+                        std::thread::sleep(Duration::from_millis(5));
+                    }
                     check(false)?;
                     return Err(Error::Cluster(format!(
                         "daemon {:?} did not answer (is it a member of cluster {:?} with a \

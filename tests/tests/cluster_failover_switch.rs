@@ -201,6 +201,60 @@ fn a_remote_client_keeps_stepping_its_plane_on_the_member_that_took_it_over() {
     assert!(took < Duration::from_secs(10));
 }
 
+/// The daemon that takes a plane over counts the lost ticks from the replicated tick record,
+/// which follows the old daemon by up to a few hundred milliseconds. Ticks the client itself
+/// saw past the snapshot were lost all the same: `Recovered` never tells fewer.
+#[test]
+fn recovered_counts_every_tick_the_client_saw_past_the_snapshot() {
+    let mut pair = pair("fs-seen");
+    let remote = Client::connect_cluster(&RemoteOptions {
+        cluster: ClusterOptions {
+            cluster: pair.cluster.clone(),
+            endpoints: vec![endpoint(pair.east_port)],
+            ..Default::default()
+        },
+        daemon: Some("west".into()),
+    })
+    .unwrap();
+    let plane = remote
+        .create_plane(
+            &PlaneOptions {
+                tick_rate: Some(0.0),
+                gravity: Some([0.0, -G, 0.0]),
+                ..integration_tests::no_damping()
+            }
+            .with(PlaneProp::Name(PlaneName::new("arena").unwrap()))
+            .with(PlaneProp::Persistent(true)),
+        )
+        .unwrap();
+    plane
+        .add(Shape::Sphere { radius: 0.5 }, Pose::at([0.0, Y0, 0.0]), &[])
+        .unwrap();
+    for _ in 0..30 {
+        plane.step(DT).unwrap();
+    }
+    assert_eq!(plane.save().unwrap(), 30);
+    for _ in 0..5 {
+        plane.step(DT).unwrap();
+    }
+    pair.replicated_up_to(35);
+    // Ten more ticks, read by this client, then west dies before its next tick record
+    // (written every 100 ms) can reach the cluster.
+    for _ in 0..10 {
+        plane.step(DT).unwrap();
+    }
+    pair.west.kill9();
+    let tick = plane
+        .step(DT)
+        .expect("the step goes on on the member that took over");
+    assert_eq!(tick, 31, "resumed at the snapshot's tick 30, then stepped");
+    assert_eq!(
+        plane.take_recovered(),
+        Some(15),
+        "ticks 31 to 45 were seen by this client and are gone"
+    );
+}
+
 #[test]
 fn a_cluster_luau_script_hears_recovered_and_goes_on() {
     let mut pair = pair("fs-lua");
