@@ -161,3 +161,92 @@ fn a_persistent_plane_of_a_killed_member_comes_back_on_another() {
     drop((opened, local, east, west));
     let _ = std::fs::remove_dir_all(state);
 }
+
+/// `--replicate-every N` (no `--state-dir`): a persistent plane is written, and so
+/// replicated, every N of its ticks; the member that takes it over resumes at the last
+/// multiple of N, not at a `Save`.
+#[test]
+fn a_plane_replicated_every_ten_ticks_resumes_at_the_last_tenth() {
+    let cluster = unique_cluster("fo-ticks");
+    let (pe, pw) = (free_port(), free_port());
+    // Time-based writes out of the way: only the tick count writes.
+    let flags = ["--replicate-every", "10", "--snapshot-every", "86400"];
+    let east = member(&cluster, "east", pe, &[], &flags);
+    let mut west = member(&cluster, "west", pw, &[pe], &flags);
+    let view = client_sdk::cluster::Cluster::connect(&cluster, &[&endpoint(pe)]).unwrap();
+    eventually(Duration::from_secs(10), || {
+        (view.daemons().ok()?.len() == 2).then_some(())
+    })
+    .expect("both members joined");
+    use zenoh::Wait;
+    let recorded = std::sync::Arc::new(std::sync::atomic::AtomicU64::new(0));
+    let r = recorded.clone();
+    let _ticks = view
+        .session()
+        .declare_subscriber(format!("physics/{cluster}/replica-tick/west/arena"))
+        .callback(move |s| {
+            let b = s.payload().to_bytes();
+            let tick = u64::from_le_bytes(b[..8].try_into().unwrap());
+            r.store(tick, std::sync::atomic::Ordering::SeqCst)
+        })
+        .wait()
+        .unwrap();
+
+    let client = west.client();
+    let plane = client
+        .create_plane(
+            &PlaneOptions {
+                tick_rate: Some(0.0),
+                gravity: Some([0.0, -G, 0.0]),
+                ..integration_tests::no_damping()
+            }
+            .with(PlaneProp::Name(PlaneName::new("arena").unwrap()))
+            .with(PlaneProp::Persistent(true)),
+        )
+        .unwrap();
+    let y0 = 1000.0;
+    plane
+        .add(Shape::Sphere { radius: 0.5 }, Pose::at([0.0, y0, 0.0]), &[])
+        .unwrap();
+    for _ in 0..25 {
+        plane.step(DT).unwrap();
+    }
+    eventually(Duration::from_secs(10), || {
+        (recorded.load(std::sync::atomic::Ordering::SeqCst) == 25).then_some(())
+    })
+    .expect("west's tick record of tick 25 was replicated");
+    // The file of tick 20 went out with or before that record; a scan period of margin.
+    std::thread::sleep(Duration::from_millis(300));
+    drop((plane, client));
+
+    west.kill9();
+    let local = east.client();
+    let opened = eventually(Duration::from_secs(10), || local.open_named("arena").ok())
+        .expect("east serves the plane west held");
+    let tick = opened.plane.snapshot().unwrap().tick();
+    assert_eq!(
+        (tick, opened.recovered),
+        (20, Some(5)),
+        "resumed at the last write (every 10 ticks), 5 ticks lost"
+    );
+    let ball = opened
+        .plane
+        .snapshot()
+        .unwrap()
+        .bodies()
+        .iter()
+        .find(|b| b.is_alive())
+        .copied()
+        .expect("the ball came back");
+    assert!((ball.position[1] - fallen(y0, 20)).abs() < 1e-2);
+    assert_eq!(opened.plane.step(DT).unwrap(), 21);
+    let dirs = [east.domain.clone(), west.domain.clone()];
+    drop((opened, local, east, west));
+    for d in dirs {
+        let _ = std::fs::remove_dir_all(
+            std::env::temp_dir()
+                .join(physics_daemon::server::persist::REPLICA_DIR)
+                .join(d),
+        );
+    }
+}

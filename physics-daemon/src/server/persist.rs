@@ -39,6 +39,9 @@ use crate::backend::Backend;
 pub const EXTENSION: &str = "physnap";
 /// How often the writer records the ticks of persistent planes that moved.
 pub const TICK_RECORD_PERIOD: Duration = Duration::from_millis(100);
+/// The state folder of a daemon given `--replicate-every` without `--state-dir`, under the
+/// system's temporary directory (each domain has its own folder in it, mode 0700).
+pub const REPLICA_DIR: &str = "physics-replicated-planes";
 /// Default `--snapshot-every`, in seconds.
 pub const DEFAULT_EVERY: f64 = 5.0;
 
@@ -54,6 +57,24 @@ pub struct PersistArgs {
     /// `Save` and at a clean shutdown). Within [0.05, 86400].
     #[arg(long = "snapshot-every", default_value_t = DEFAULT_EVERY, value_parser = parse_every)]
     pub snapshot_every: f64,
+    /// In a cluster: a persistent plane that changed is also written (and so replicated to
+    /// the other members, docs/cluster.md "Failover") every TICKS of its own ticks. Without
+    /// `--state-dir` the daemon keeps its planes' files in a folder of its own under the
+    /// system's temporary directory. Within [1, 1000000].
+    #[arg(long = "replicate-every", value_name = "TICKS", value_parser = parse_ticks)]
+    pub replicate_every: Option<u64>,
+}
+
+fn parse_ticks(s: &str) -> Result<u64, String> {
+    let v: u64 = s
+        .parse()
+        .map_err(|_| format!("--replicate-every takes a number of ticks, got {s:?}"))?;
+    if !(1..=1_000_000).contains(&v) {
+        return Err(format!(
+            "--replicate-every must be within [1, 1000000] ticks, got {v}"
+        ));
+    }
+    Ok(v)
 }
 
 fn parse_every(s: &str) -> Result<f64, String> {
@@ -75,14 +96,23 @@ pub struct Persistence {
     pub dir: PathBuf,
     /// Time between two writes of a plane that changed.
     pub every: Duration,
+    /// Ticks of a plane between two writes when it changed (`--replicate-every`), besides
+    /// `every`.
+    pub every_ticks: Option<u64>,
 }
 
 impl PersistArgs {
-    /// The daemon's persistence, when `--state-dir` is given.
+    /// The daemon's persistence, when `--state-dir` (or `--replicate-every`) is given.
     pub fn persistence(&self) -> Option<Persistence> {
+        let dir = match (&self.state_dir, self.replicate_every) {
+            (Some(dir), _) => dir.clone(),
+            (None, Some(_)) => std::env::temp_dir().join(REPLICA_DIR),
+            (None, None) => return None,
+        };
         Some(Persistence {
-            dir: self.state_dir.clone()?,
+            dir,
             every: Duration::from_secs_f64(self.snapshot_every),
+            every_ticks: self.replicate_every,
         })
     }
 }
@@ -144,6 +174,7 @@ enum Write {
 pub struct Writer {
     dir: PathBuf,
     every: Duration,
+    every_ticks: Option<u64>,
     jobs: Option<Sender<Write>>,
     thread: Option<JoinHandle<()>>,
 }
@@ -166,6 +197,7 @@ impl Writer {
         Ok(Writer {
             dir,
             every: persistence.every,
+            every_ticks: persistence.every_ticks,
             jobs: Some(jobs),
             thread: Some(thread),
         })
@@ -198,8 +230,10 @@ impl Writer {
             name: name.to_string(),
             jobs,
             every: self.every,
+            every_ticks: self.every_ticks,
             // The first write comes at once: a plane is on disk from its creation on.
             next_save: Instant::now(),
+            saved_tick: 0,
         })
     }
 
@@ -236,22 +270,36 @@ pub(super) struct PlaneFile {
     name: String,
     jobs: Sender<Write>,
     every: Duration,
+    every_ticks: Option<u64>,
     next_save: Instant,
+    /// The plane's tick at the last periodic write.
+    saved_tick: u64,
 }
 
 impl PlaneFile {
-    /// When the next periodic write is due.
+    /// When the next periodic write is due (by time; see [`PlaneFile::is_due`]).
     pub fn due(&self) -> Instant {
         self.next_save
+    }
+
+    /// Whether the periodic write is due at `now` with the plane at `tick`: its period has
+    /// passed, or it ran `--replicate-every` ticks since the last one.
+    pub fn is_due(&self, now: Instant, tick: u64) -> bool {
+        now >= self.next_save
+            || self
+                .every_ticks
+                .is_some_and(|n| tick >= self.saved_tick.saturating_add(n))
     }
 
     /// The periodic write: when due and the plane changed, snapshot it and hand the bytes
     /// to the writer (the worker does not wait for the disk).
     pub fn save_if_due(&mut self, plane: &mut dyn Backend, marks: &Marks, now: Instant) {
-        if now < self.next_save || marks.destroyed.load(Ordering::SeqCst) {
+        let tick = marks.tick.load(Ordering::SeqCst);
+        if !self.is_due(now, tick) || marks.destroyed.load(Ordering::SeqCst) {
             return;
         }
         self.next_save = now + self.every;
+        self.saved_tick = tick;
         if marks.changed.swap(false, Ordering::SeqCst) {
             if let Err(e) = self.send(plane, None) {
                 // Next period tries again.
@@ -618,6 +666,15 @@ fn load_one(dir: &Path, path: &Path, stem: &str) -> Result<Loaded, String> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn replicate_every_is_bounded() {
+        assert_eq!(parse_ticks("10"), Ok(10));
+        for bad in ["0", "1000001", "-3", "1.5", "x"] {
+            let e = parse_ticks(bad).unwrap_err();
+            assert!(e.contains("--replicate-every"), "{e}");
+        }
+    }
 
     #[test]
     fn snapshot_every_is_bounded() {

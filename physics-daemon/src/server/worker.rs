@@ -646,7 +646,7 @@ impl Worker {
         let Some(file) = self.file.as_mut() else {
             return;
         };
-        if now < file.due() {
+        if !file.is_due(now, self.cell.marks.tick.load(Ordering::SeqCst)) {
             return;
         }
         let mut guard = self.cell.lock();
