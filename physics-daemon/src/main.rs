@@ -85,6 +85,13 @@ fn main() -> ExitCode {
         }
     };
     let mut cluster = cluster;
+    if let (Some(n), None) = (args.persist.replicate_every, cluster.as_ref()) {
+        tracing::error!(
+            "--replicate-every {n} replicates persistent planes to the other members of a \
+             cluster: it needs --cluster NAME --name DAEMON"
+        );
+        return ExitCode::FAILURE;
+    }
     let persistence = args.persist.persistence();
     let mut adopt = None;
     let mut migrate = None;

@@ -195,6 +195,14 @@ fn unsafe_or_malformed_cluster_flags_are_refused_by_name() {
         "udp/127.0.0.1:1",
     ]);
     assert!(!ok && err.contains("udp/127.0.0.1:1"), "{err}");
+    // Replication needs a cluster, and a count of ticks.
+    let (ok, err) = refused(&["--replicate-every", "10"]);
+    assert!(
+        !ok && err.contains("--replicate-every") && err.contains("--cluster"),
+        "{err}"
+    );
+    let (ok, err) = refused(&["--cluster", "x", "--name", "a", "--replicate-every", "0"]);
+    assert!(!ok && err.contains("--replicate-every"), "{err}");
 }
 
 /// Certificates for a TLS cluster on loopback, made with the `openssl` tool: one authority
