@@ -432,6 +432,41 @@ pub mod cluster {
         super::unique_domain(tag).replace('.', "-")
     }
 
+    /// A remote client of daemon `daemon` of `cluster`, through the member listening on
+    /// `port`.
+    pub fn remote_client(cluster: &str, port: u16, daemon: &str) -> client_sdk::Client {
+        client_sdk::Client::connect_cluster(&client_sdk::remote::RemoteOptions {
+            cluster: client_sdk::cluster::ClusterOptions {
+                cluster: cluster.to_string(),
+                endpoints: vec![endpoint(port)],
+                ..Default::default()
+            },
+            daemon: Some(daemon.to_string()),
+        })
+        .expect("remote client")
+    }
+
+    /// `physics-lua SCRIPT --cluster CLUSTER --connect tcp/127.0.0.1:PORT --daemon DAEMON`.
+    pub fn cluster_lua(
+        cluster: &str,
+        port: u16,
+        daemon: &str,
+        script: &std::path::Path,
+    ) -> std::process::Command {
+        super::physics_lua(
+            "unused-domain",
+            script.to_str().expect("a UTF-8 script path"),
+            &[
+                "--cluster",
+                cluster,
+                "--connect",
+                &endpoint(port),
+                "--daemon",
+                daemon,
+            ],
+        )
+    }
+
     /// Daemon `name` of `cluster`, listening on `listen`, connecting to `connect`, with
     /// `extra` flags.
     pub fn member(

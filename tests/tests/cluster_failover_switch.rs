@@ -9,9 +9,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-use client_sdk::cluster::ClusterOptions;
-use client_sdk::remote::RemoteOptions;
-use client_sdk::{Client, PlaneName, PlaneOptions, PlaneProp, Pose, Shape};
+use client_sdk::{PlaneName, PlaneOptions, PlaneProp, Pose, Shape};
 use integration_tests::cluster::{endpoint, free_port, member, unique_cluster};
 use integration_tests::{eventually, unique_domain, TestDaemon};
 use zenoh::Wait;
@@ -135,15 +133,7 @@ impl Pair {
 #[test]
 fn a_remote_client_keeps_stepping_its_plane_on_the_member_that_took_it_over() {
     let mut pair = pair("fs-rust");
-    let remote = Client::connect_cluster(&RemoteOptions {
-        cluster: ClusterOptions {
-            cluster: pair.cluster.clone(),
-            endpoints: vec![endpoint(pair.east_port)],
-            ..Default::default()
-        },
-        daemon: Some("west".into()),
-    })
-    .unwrap();
+    let remote = integration_tests::cluster::remote_client(&pair.cluster, pair.east_port, "west");
     let plane = remote
         .create_plane(
             &PlaneOptions {
@@ -207,15 +197,7 @@ fn a_remote_client_keeps_stepping_its_plane_on_the_member_that_took_it_over() {
 #[test]
 fn recovered_counts_every_tick_the_client_saw_past_the_snapshot() {
     let mut pair = pair("fs-seen");
-    let remote = Client::connect_cluster(&RemoteOptions {
-        cluster: ClusterOptions {
-            cluster: pair.cluster.clone(),
-            endpoints: vec![endpoint(pair.east_port)],
-            ..Default::default()
-        },
-        daemon: Some("west".into()),
-    })
-    .unwrap();
+    let remote = integration_tests::cluster::remote_client(&pair.cluster, pair.east_port, "west");
     let plane = remote
         .create_plane(
             &PlaneOptions {
@@ -298,20 +280,10 @@ print("SWITCHED OK")
 "#,
     )
     .unwrap();
-    let mut child = integration_tests::physics_lua(
-        "unused-domain",
-        script.to_str().unwrap(),
-        &[
-            "--cluster",
-            &pair.cluster,
-            "--connect",
-            &endpoint(pair.east_port),
-            "--daemon",
-            "west",
-        ],
-    )
-    .spawn()
-    .unwrap();
+    let mut child =
+        integration_tests::cluster::cluster_lua(&pair.cluster, pair.east_port, "west", &script)
+            .spawn()
+            .unwrap();
     let mut lines = BufReader::new(child.stdout.take().unwrap()).lines();
     let ready = lines.by_ref().map_while(Result::ok).any(|l| l == "READY");
     assert!(ready, "the script got ready");

@@ -8,8 +8,6 @@
 
 use std::time::{Duration, Instant};
 
-use client_sdk::cluster::ClusterOptions;
-use client_sdk::remote::RemoteOptions;
 use client_sdk::{Client, ErrorKind, Object, Plane, PlaneKind, PlaneOptions, Pose, Shape};
 use integration_tests::cluster::{endpoint, free_port, member, unique_cluster};
 use integration_tests::{eventually, TestDaemon};
@@ -48,15 +46,7 @@ fn pair(tag: &str) -> Pair {
 impl Pair {
     /// A remote client of daemon `daemon` through a's endpoint.
     fn remote(&self, daemon: &str) -> Client {
-        Client::connect_cluster(&RemoteOptions {
-            cluster: ClusterOptions {
-                cluster: self.cluster.clone(),
-                endpoints: vec![endpoint(self.a_port)],
-                ..Default::default()
-            },
-            daemon: Some(daemon.to_string()),
-        })
-        .expect("remote client")
+        integration_tests::cluster::remote_client(&self.cluster, self.a_port, daemon)
     }
 }
 
@@ -310,20 +300,9 @@ print("MOVED OK")
 "#,
     )
     .unwrap();
-    let out = integration_tests::physics_lua(
-        "unused-domain",
-        script.to_str().unwrap(),
-        &[
-            "--cluster",
-            &pair.cluster,
-            "--connect",
-            &endpoint(pair.a_port),
-            "--daemon",
-            "a",
-        ],
-    )
-    .output()
-    .unwrap();
+    let out = integration_tests::cluster::cluster_lua(&pair.cluster, pair.a_port, "a", &script)
+        .output()
+        .unwrap();
     let text =
         String::from_utf8_lossy(&out.stdout).to_string() + &String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success() && text.contains("MOVED OK"), "{text}");

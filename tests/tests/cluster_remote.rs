@@ -270,20 +270,10 @@ fn a_remote_clients_planes_are_released_when_it_leaves_or_dies() {
         "local plane = import(\"PhysicsService\").New({})\nHeart:Connect(function() local _ = plane end)\n",
     )
     .unwrap();
-    let mut child = integration_tests::physics_lua(
-        "unused-domain",
-        script.to_str().unwrap(),
-        &[
-            "--cluster",
-            &two.cluster,
-            "--connect",
-            &endpoint(two.east_port),
-            "--daemon",
-            "west",
-        ],
-    )
-    .spawn()
-    .unwrap();
+    let mut child =
+        integration_tests::cluster::cluster_lua(&two.cluster, two.east_port, "west", &script)
+            .spawn()
+            .unwrap();
     eventually(Duration::from_secs(20), || {
         (west_planes(&two) == before + 1).then_some(())
     })
@@ -558,20 +548,9 @@ print("PLACED OK")
 "#,
     )
     .unwrap();
-    let out = integration_tests::physics_lua(
-        "unused-domain",
-        script.to_str().unwrap(),
-        &[
-            "--cluster",
-            &two.cluster,
-            "--connect",
-            &endpoint(two.east_port),
-            "--daemon",
-            "east",
-        ],
-    )
-    .output()
-    .unwrap();
+    let out = integration_tests::cluster::cluster_lua(&two.cluster, two.east_port, "east", &script)
+        .output()
+        .unwrap();
     let text =
         String::from_utf8_lossy(&out.stdout).to_string() + &String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success() && text.contains("PLACED OK"), "{text}");
