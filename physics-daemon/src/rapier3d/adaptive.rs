@@ -61,6 +61,12 @@ impl Plane {
             }
             return;
         }
+        // Nothing awake, nothing to decide: a sleeping pair keeps what it had (it costs
+        // nothing asleep) and is looked at again once something wakes. A settled pile pays
+        // no pass at all (the periodic pass over every pair cost it 12 % of its step).
+        if self.awake_count() == 0 {
+            return;
+        }
         let scale = self
             .world
             .integration_parameters
