@@ -10,7 +10,7 @@
 //!
 //! - [`target`]: the trait and its implementations.
 //! - [`builders`]: the builders.
-//! - [`card_house`]: Box2D's card house.
+//! - [`card_house`](mod@card_house): Box2D's card house.
 //!
 //! The fuzzer of the daemon's request decoder lives in its own crate, `physics-fuzz`.
 

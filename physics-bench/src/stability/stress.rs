@@ -289,7 +289,7 @@ pub fn pyramid_drift(
     Ok(Check::at_most(&sim, worst, 0.1))
 }
 
-/// Box2D v3's card house (see [`physics_scenes::card_house`]): 40 cards of 0.4 × 0.002
+/// Box2D v3's card house (see [`physics_scenes::card_house()`]): 40 cards of 0.4 × 0.002
 /// (0.3 deep), friction 0.7, leaning in pairs at ±25° with a flat card across each two
 /// pairs, 5 levels, g = 9.81. The cards start as Box2D places them, with gaps that close as
 /// the house settles (the top pair lands ~2 cm lower, a rigid solution included), so the
