@@ -326,31 +326,12 @@ impl Daemon {
             _ => None,
         };
         let setup = worker::Setup {
-            id,
-            kind,
-            props,
-            ticket,
-            config: self.config.clone(),
-            cell: cell.clone(),
-            usage: usage.clone(),
-            events: self.events_tx.clone(),
-            waker: self.waker.clone(),
-            panic_on_step_dt: self.options.panic_on_step_dt,
             file,
-            restore: None,
+            ..self.worker_setup(id, kind, props, &cell, &usage)
         };
-        let spawned = worker::spawn(setup, receiver);
-        match spawned {
-            Ok(handle) => self.workers.push(handle),
-            Err(e) => {
-                return refuse(CommandError::new(
-                    ErrorKind::Internal,
-                    format!("cannot start the thread of plane {id}: {e}"),
-                ))
-            }
+        if let Err(e) = self.start_worker(setup, receiver) {
+            return refuse(CommandError::new(ErrorKind::Internal, e));
         }
-        self.next_ticket += 1;
-        self.next_plane_id += 1;
         self.planes.insert(
             id,
             PlaneEntry {
@@ -392,4 +373,48 @@ pub(super) fn panic_message(panic: &(dyn std::any::Any + Send)) -> String {
         .map(|s| s.to_string())
         .or_else(|| panic.downcast_ref::<String>().cloned())
         .unwrap_or_else(|| "a panic without a message".to_string())
+}
+
+impl Daemon {
+    /// The start of plane `id`'s worker with what every worker gets from the daemon, under
+    /// the next ticket (no file, no snapshot to restore: set those on the result).
+    pub(super) fn worker_setup(
+        &self,
+        id: PlaneId,
+        kind: PlaneKind,
+        props: Vec<PlaneProp>,
+        cell: &Arc<PlaneCell>,
+        usage: &Arc<SharedUsage>,
+    ) -> worker::Setup {
+        worker::Setup {
+            id,
+            kind,
+            props,
+            ticket: self.next_ticket,
+            config: self.config.clone(),
+            cell: cell.clone(),
+            usage: usage.clone(),
+            events: self.events_tx.clone(),
+            waker: self.waker.clone(),
+            panic_on_step_dt: self.options.panic_on_step_dt,
+            file: None,
+            restore: None,
+        }
+    }
+
+    /// Starts the worker of `setup` (made by [`Daemon::worker_setup`]) on `jobs`; the plane
+    /// id and the ticket it used are taken.
+    pub(super) fn start_worker(
+        &mut self,
+        setup: worker::Setup,
+        jobs: mpsc::Receiver<worker::Job>,
+    ) -> Result<(), String> {
+        let id = setup.id;
+        let handle = worker::spawn(setup, jobs)
+            .map_err(|e| format!("cannot start the thread of plane {id}: {e}"))?;
+        self.workers.push(handle);
+        self.next_ticket += 1;
+        self.next_plane_id += 1;
+        Ok(())
+    }
 }

@@ -421,24 +421,11 @@ impl Daemon {
             _ => None,
         };
         let setup = worker::Setup {
-            id,
-            kind: moving.kind,
-            props,
-            ticket,
-            config: self.config.clone(),
-            cell: cell.clone(),
-            usage: usage.clone(),
-            events: self.events_tx.clone(),
-            waker: self.waker.clone(),
-            panic_on_step_dt: self.options.panic_on_step_dt,
             file,
             restore: Some(moving.bytes),
+            ..self.worker_setup(id, moving.kind, props, &cell, &usage)
         };
-        let handle = worker::spawn(setup, receiver)
-            .map_err(|e| format!("cannot start the thread of plane {id}: {e}"))?;
-        self.workers.push(handle);
-        self.next_ticket += 1;
-        self.next_plane_id += 1;
+        self.start_worker(setup, receiver)?;
         self.planes.insert(
             id,
             PlaneEntry {

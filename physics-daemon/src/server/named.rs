@@ -304,29 +304,14 @@ impl Daemon {
         cell.marks.held.store(true, Ordering::SeqCst);
         let writer = self.writer.as_ref().expect("restore_saved checked it");
         let (jobs, receiver) = mpsc::channel();
+        let props = vec![PlaneProp::Name(loaded.name), PlaneProp::Persistent(true)];
         let setup = worker::Setup {
-            id,
-            kind: loaded.kind,
-            props: vec![PlaneProp::Name(loaded.name), PlaneProp::Persistent(true)],
-            ticket,
-            config: self.config.clone(),
-            cell: cell.clone(),
-            usage: usage.clone(),
-            events: self.events_tx.clone(),
-            waker: self.waker.clone(),
-            panic_on_step_dt: self.options.panic_on_step_dt,
             file: writer.plane_file(id, loaded.name.as_str(), &cell.marks, Some(loaded.tick)),
             restore: Some(loaded.bytes),
+            ..self.worker_setup(id, loaded.kind, props, &cell, &usage)
         };
-        let handle = worker::spawn(setup, receiver).map_err(|e| {
-            CommandError::new(
-                ErrorKind::Internal,
-                format!("cannot start the thread of plane {id}: {e}"),
-            )
-        })?;
-        self.workers.push(handle);
-        self.next_ticket += 1;
-        self.next_plane_id += 1;
+        self.start_worker(setup, receiver)
+            .map_err(|e| CommandError::new(ErrorKind::Internal, e))?;
         self.planes.insert(
             id,
             PlaneEntry {
