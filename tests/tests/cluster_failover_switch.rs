@@ -9,7 +9,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-use client_sdk::{PlaneName, PlaneOptions, PlaneProp, Pose, Shape};
+use client_sdk::{Client, Object, Plane, PlaneName, PlaneOptions, PlaneProp, Pose, Shape};
 use integration_tests::cluster::{endpoint, free_port, member, unique_cluster};
 use integration_tests::{eventually, unique_domain, TestDaemon};
 use zenoh::Wait;
@@ -130,11 +130,10 @@ impl Pair {
     }
 }
 
-#[test]
-fn a_remote_client_keeps_stepping_its_plane_on_the_member_that_took_it_over() {
-    let mut pair = pair("fs-rust");
-    let remote = integration_tests::cluster::remote_client(&pair.cluster, pair.east_port, "west");
-    let plane = remote
+/// The persistent plane "arena" on `client`'s daemon with a ball falling from `Y0`, stepped
+/// to tick 30 and saved there.
+fn saved_arena(client: &Client) -> (Plane, Object) {
+    let plane = client
         .create_plane(
             &PlaneOptions {
                 tick_rate: Some(0.0),
@@ -152,6 +151,14 @@ fn a_remote_client_keeps_stepping_its_plane_on_the_member_that_took_it_over() {
         plane.step(DT).unwrap();
     }
     assert_eq!(plane.save().unwrap(), 30);
+    (plane, ball)
+}
+
+#[test]
+fn a_remote_client_keeps_stepping_its_plane_on_the_member_that_took_it_over() {
+    let mut pair = pair("fs-rust");
+    let remote = integration_tests::cluster::remote_client(&pair.cluster, pair.east_port, "west");
+    let (plane, ball) = saved_arena(&remote);
     for _ in 0..10 {
         plane.step(DT).unwrap();
     }
@@ -198,24 +205,7 @@ fn a_remote_client_keeps_stepping_its_plane_on_the_member_that_took_it_over() {
 fn recovered_counts_every_tick_the_client_saw_past_the_snapshot() {
     let mut pair = pair("fs-seen");
     let remote = integration_tests::cluster::remote_client(&pair.cluster, pair.east_port, "west");
-    let plane = remote
-        .create_plane(
-            &PlaneOptions {
-                tick_rate: Some(0.0),
-                gravity: Some([0.0, -G, 0.0]),
-                ..integration_tests::no_damping()
-            }
-            .with(PlaneProp::Name(PlaneName::new("arena").unwrap()))
-            .with(PlaneProp::Persistent(true)),
-        )
-        .unwrap();
-    plane
-        .add(Shape::Sphere { radius: 0.5 }, Pose::at([0.0, Y0, 0.0]), &[])
-        .unwrap();
-    for _ in 0..30 {
-        plane.step(DT).unwrap();
-    }
-    assert_eq!(plane.save().unwrap(), 30);
+    let (plane, _ball) = saved_arena(&remote);
     for _ in 0..5 {
         plane.step(DT).unwrap();
     }
