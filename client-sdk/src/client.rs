@@ -98,6 +98,24 @@ struct Queued {
     impulse: Option<u32>,
 }
 
+/// What applying the results of a request's queued writes needs, in queue order.
+struct Sent {
+    n_queued: usize,
+    confirms: Vec<Option<(PlaneId, Handle)>>,
+    /// The plane, object and whether it is a removal, of each queued command.
+    targets: Vec<Option<(PlaneId, Option<Handle>, bool)>>,
+    releases: Vec<bool>,
+    origins: Vec<(u32, Option<u32>)>,
+}
+
+/// A pipelined flush's request whose reply is not applied yet.
+struct InFlight {
+    pending: crate::transport::PendingReply,
+    sent: Sent,
+    commands: Vec<Command>,
+    since: Instant,
+}
+
 /// The host's answer to "which line of the script is running?" (0: none).
 type Origin = Box<dyn Fn() -> u32>;
 
@@ -142,6 +160,10 @@ struct Inner {
     peers: RefCell<HashMap<String, Client>>,
     /// How this client reached its cluster, when it did ([`Client::connect_cluster`]).
     remote: Option<RemoteOptions>,
+    /// Pipelined flushes' requests, oldest first ([`Client::flush`]).
+    in_flight: RefCell<std::collections::VecDeque<InFlight>>,
+    /// What applying that request's reply failed with, for the next call.
+    in_flight_error: RefCell<Option<Error>>,
 }
 
 /// A connection to the physics daemon of one domain. Cheap to clone; not `Send` (shared
@@ -150,6 +172,10 @@ struct Inner {
 pub struct Client {
     inner: Rc<Inner>,
 }
+
+/// Pipelined flushes whose replies may be outstanding at once ([`Client::flush`]; the
+/// daemon takes four requests of a client at a time).
+pub const MAX_IN_FLIGHT: usize = 2;
 
 /// How long the handshake waits for an answer before it asks again.
 const HELLO_RETRY: Duration = Duration::from_secs(1);
@@ -208,6 +234,8 @@ impl Client {
             last_node_check: std::cell::Cell::new(Instant::now()),
             peers: RefCell::default(),
             remote: None,
+            in_flight: RefCell::default(),
+            in_flight_error: RefCell::default(),
         };
         let hello = Command::Hello {
             crate_version: inner.options.crate_version.clone(),
@@ -293,13 +321,19 @@ impl Client {
     /// ones sent along with earlier calls) come back together; the others were applied.
     ///
     /// With [`ConnectOptions::refusals_at_next_call`] the refusals stay with their planes
-    /// for the next call into each (or [`Client::take_refused`]) and `flush` reports only
-    /// a failure to send.
+    /// for the next call into each (or [`Client::take_refused`]), and `flush` does not wait
+    /// for the daemon: it sends the writes and returns (pipelined; on this host's
+    /// transport). The daemon applies them in order before any later request of this
+    /// client; their reply is collected by the next request, the next
+    /// [`Client::begin_frame`] or the next read that takes a new sample, and until then
+    /// reads show the writes (read-your-writes). A frame that ends with a flush therefore
+    /// never waits for a step the daemon is in the middle of. `flush` then reports a
+    /// failure to send, or a failure of the previous flush's request (the daemon gone).
     pub fn flush(&self) -> Result<(), Error> {
-        self.send_queue()?;
         if self.inner.options.refusals_at_next_call {
-            return Ok(());
+            return self.flush_pipelined();
         }
+        self.send_queue()?;
         let mut deferred = self.take_refused(None);
         // Refusals of writes to planes that moved to other daemons.
         for peer in self.inner.peers.borrow().values() {
@@ -315,6 +349,11 @@ impl Client {
     /// Takes the refused writes not reported yet: of plane `plane`, or of every plane
     /// (`None`, which also takes refusals of commands that name no plane).
     pub fn take_refused(&self, plane: Option<PlaneId>) -> Vec<CommandError> {
+        // A pipelined flush's refusals count too. A failure to collect them stays for the
+        // next call to report.
+        if let Err(e) = self.collect_in_flight(true) {
+            *self.inner.in_flight_error.borrow_mut() = Some(e);
+        }
         let mut state = self.inner.state.borrow_mut();
         if state.deferred.is_empty() {
             return Vec::new();
@@ -340,6 +379,8 @@ impl Client {
     /// looks.
     pub fn begin_frame(&self) {
         self.inner.frame.set(self.inner.frame.get() + 1);
+        // The last frame's pipelined flush, if its reply is here (usually: a frame later).
+        let _ = self.collect_in_flight(false);
     }
 
     /// The frame of [`Client::begin_frame`] (0 before the first).
@@ -366,6 +407,9 @@ impl Client {
     /// back, after it ran; a creating call keeps them for the next call, so its handle is
     /// never lost.
     pub(crate) fn call(&self, command: Command) -> Result<Reply, Error> {
+        // The refusals of a pipelined flush are reported before the next call into their
+        // plane, as those of any earlier request.
+        self.collect_in_flight(true)?;
         // A plane that moved: its commands go to its new daemon, under its id there.
         let command = match self.reroute(command) {
             Rerouted::Here(command) => command,
@@ -448,6 +492,20 @@ impl Client {
             origin: self.inner.origin.borrow().as_ref().map_or(0, |f| f()),
             impulse,
         });
+    }
+
+    /// [`Client::flush`] with [`ConnectOptions::refusals_at_next_call`]: this connection's
+    /// writes and those of the planes that moved to other daemons, each sent without
+    /// waiting.
+    fn flush_pipelined(&self) -> Result<(), Error> {
+        if !self.inner.state.borrow().queue.is_empty() {
+            self.send_pipelined()?;
+        }
+        let peers: Vec<Client> = self.inner.peers.borrow().values().cloned().collect();
+        for peer in peers {
+            peer.flush_pipelined()?;
+        }
+        Ok(())
     }
 
     /// Sends the queued writes now, if any (their refusals are kept as for any send).
@@ -546,18 +604,117 @@ impl Client {
 
     /// One request: the queued commands first, then `extra`. Returns the results of `extra`.
     pub(crate) fn send(&self, extra: Vec<Command>) -> Result<Vec<CommandResult>, Error> {
+        // A pipelined flush's reply comes first: replies are applied in request order.
+        self.collect_in_flight(true)?;
+        let (sent, commands) = self.take_queue(extra);
+        let (results, commands) = self.inner.round_trip_keeping(commands)?;
+        self.apply_results(sent, commands, results)
+    }
+
+    /// Sends the queued writes without waiting for the reply, which the next request, the
+    /// next frame ([`Client::begin_frame`]) or the next read of a new sample collects
+    /// (`collect_in_flight`). At most [`MAX_IN_FLIGHT`] such requests wait for their
+    /// replies: a flush past that waits for the oldest (a daemon more than a frame behind
+    /// slows its client's frames rather than gathering requests). Only on this host's
+    /// transport; elsewhere a plain send.
+    fn send_pipelined(&self) -> Result<(), Error> {
+        let Some(local) = self.inner.transport.local() else {
+            return self.send(Vec::new()).map(|_| ());
+        };
+        self.collect_in_flight(false)?;
+        while self.inner.in_flight.borrow().len() >= MAX_IN_FLIGHT {
+            self.collect_oldest(true)?;
+        }
+        if self.inner.state.borrow().gone {
+            return Err(self.inner.gone());
+        }
+        let (sent, commands) = self.take_queue(Vec::new());
+        let request = Request { commands };
+        let bytes = self.inner.encode(&request);
+        let pending = local.send(&bytes, self.inner.transport.id())?;
+        self.inner.in_flight.borrow_mut().push_back(InFlight {
+            pending,
+            sent,
+            commands: request.commands,
+            since: Instant::now(),
+        });
+        Ok(())
+    }
+
+    /// Applies the replies of pipelined flushes, in order: every one (`wait`), or those
+    /// that have arrived. An error met while applying them without a caller to tell (a
+    /// frame's start) is kept for the next call that waits.
+    pub(crate) fn collect_in_flight(&self, wait: bool) -> Result<(), Error> {
+        if let Some(e) = self.inner.in_flight_error.borrow_mut().take() {
+            return Err(e);
+        }
+        loop {
+            match self.collect_oldest(wait) {
+                Ok(true) => {}
+                Ok(false) => return Ok(()),
+                Err(e) if wait => return Err(e),
+                Err(e) => {
+                    *self.inner.in_flight_error.borrow_mut() = Some(e);
+                    return Ok(());
+                }
+            }
+        }
+    }
+
+    /// Applies the oldest pipelined flush's reply: waiting for it (`wait`), or only when it
+    /// has arrived. False when there was none to apply.
+    fn collect_oldest(&self, wait: bool) -> Result<bool, Error> {
+        let Some(local) = self.inner.transport.local() else {
+            return Ok(false);
+        };
+        let reply = {
+            let in_flight = self.inner.in_flight.borrow();
+            let Some(f) = in_flight.front() else {
+                return Ok(false);
+            };
+            match wait {
+                true => Some(self.inner.await_reply(local, &f.pending, f.since)),
+                false => local.try_reply(&f.pending).transpose(),
+            }
+        };
+        let Some(reply) = reply else {
+            return Ok(false);
+        };
+        let f = self
+            .inner
+            .in_flight
+            .borrow_mut()
+            .pop_front()
+            .expect("checked above");
+        let results = self.inner.results_of(&reply?, f.commands.len())?;
+        let results = self.inner.rejoin_if_forgotten(&f.commands, results)?;
+        self.apply_results(f.sent, f.commands, results)?;
+        Ok(true)
+    }
+
+    /// Whether a pipelined flush's reply has not been applied yet.
+    pub(crate) fn has_in_flight(&self) -> bool {
+        !self.inner.in_flight.borrow().is_empty()
+    }
+
+    /// Takes the queue (plus `extra`) as one request's commands and what applying their
+    /// results needs.
+    fn take_queue(&self, extra: Vec<Command>) -> (Sent, Vec<Command>) {
         let queued = std::mem::take(&mut self.inner.state.borrow_mut().queue);
         let n_queued = queued.len();
-        let mut confirms = Vec::with_capacity(n_queued);
-        let mut targets = Vec::with_capacity(n_queued);
+        let mut sent = Sent {
+            n_queued,
+            confirms: Vec::with_capacity(n_queued),
+            targets: Vec::with_capacity(n_queued),
+            releases: Vec::with_capacity(n_queued),
+            origins: Vec::with_capacity(n_queued),
+        };
         let mut commands = Vec::with_capacity(n_queued + extra.len());
-        let mut releases = Vec::with_capacity(n_queued);
-        let mut origins = Vec::with_capacity(n_queued);
         for q in queued {
-            origins.push((q.origin, q.impulse));
-            confirms.push(q.confirms);
-            releases.push(is_release(&q.command));
-            targets.push(match &q.command {
+            sent.origins.push((q.origin, q.impulse));
+            sent.confirms.push(q.confirms);
+            sent.releases.push(is_release(&q.command));
+            sent.targets.push(match &q.command {
                 Command::Plane {
                     plane,
                     op: PlaneOp::Object { handle, op },
@@ -582,7 +739,24 @@ impl Client {
             commands.push(q.command);
         }
         commands.extend(extra);
-        let (mut results, commands) = self.inner.round_trip_keeping(commands)?;
+        (sent, commands)
+    }
+
+    /// Applies a request's results: the queued writes' confirmations and refusals (kept
+    /// for later: `deferred`); returns the results of the commands after them.
+    fn apply_results(
+        &self,
+        sent: Sent,
+        commands: Vec<Command>,
+        mut results: Vec<CommandResult>,
+    ) -> Result<Vec<CommandResult>, Error> {
+        let Sent {
+            n_queued,
+            confirms,
+            targets,
+            releases,
+            origins,
+        } = sent;
         // A reply is a sign of life as good as a beat.
         self.inner.last_beat.set(Instant::now());
         // Refused because their plane moved (not applied): switch over, send them again.
@@ -649,6 +823,7 @@ impl Client {
     /// Test support: sends raw request bytes and returns the raw reply.
     #[doc(hidden)]
     pub fn raw_request(&self, bytes: &[u8]) -> Result<Vec<u8>, Error> {
+        self.collect_in_flight(true)?;
         self.inner.exchange(bytes, self.inner.transport.id())
     }
 
@@ -656,6 +831,7 @@ impl Client {
     /// their id (the request's user header), as a forging client would.
     #[doc(hidden)]
     pub fn raw_request_claiming(&self, bytes: &[u8], claimed: u128) -> Result<Vec<u8>, Error> {
+        self.collect_in_flight(true)?;
         self.inner.exchange(bytes, claimed)
     }
 
@@ -856,39 +1032,64 @@ impl Inner {
     /// A beat buffered from before the request can delay a stall verdict by one check
     /// (100 ms) at most, so the request's hot path does not drain the heartbeat first.
     fn exchange(&self, bytes: &[u8], header: u128) -> Result<Vec<u8>, Error> {
-        let started = Instant::now();
+        let spin = self.reply_spin.take();
+        self.transport.exchange(
+            bytes,
+            header,
+            LIVENESS_PERIOD,
+            spin,
+            self.waiting(Instant::now()),
+        )
+    }
+
+    /// Waits for a pipelined flush's reply as [`Inner::exchange`] waits for its own.
+    fn await_reply(
+        &self,
+        local: &crate::transport::LocalTransport,
+        pending: &crate::transport::PendingReply,
+        since: Instant,
+    ) -> Result<Vec<u8>, Error> {
+        local.await_reply(
+            pending,
+            LIVENESS_PERIOD,
+            Duration::ZERO,
+            self.waiting(since),
+        )
+    }
+
+    /// What a request waiting for its reply since `started` checks between sleeps: the
+    /// daemon's liveness, a stall, the request timeout.
+    fn waiting(&self, started: Instant) -> impl FnMut(bool) -> Result<(), Error> + '_ {
         let mut last_check = started;
         let mut last_beat = started;
-        let spin = self.reply_spin.take();
-        self.transport
-            .exchange(bytes, header, LIVENESS_PERIOD, spin, |connected| {
-                if !connected {
-                    self.check_daemon()?;
+        move |connected| {
+            if !connected {
+                self.check_daemon()?;
+            }
+            let now = Instant::now();
+            if now.duration_since(last_check) >= LIVENESS_PERIOD {
+                self.check_daemon()?;
+                last_check = now;
+                if self.transport.heartbeat_arrived() != Some(false) {
+                    last_beat = now;
+                    self.last_beat.set(now);
                 }
-                let now = Instant::now();
-                if now.duration_since(last_check) >= LIVENESS_PERIOD {
-                    self.check_daemon()?;
-                    last_check = now;
-                    if self.transport.heartbeat_arrived() != Some(false) {
-                        last_beat = now;
-                        self.last_beat.set(now);
-                    }
-                }
-                let silent = now.duration_since(last_beat);
-                let stalled = silent > HUNG_AFTER
-                    || (silent > STALL_AFTER && process_stopped(self.daemon_pid));
-                if stalled && self.daemon_node != 0 {
-                    return Err(Error::Stalled {
-                        domain: self.options.domain.clone(),
-                        pid: self.daemon_pid,
-                        silent,
-                    });
-                }
-                if now.duration_since(started) > self.options.request_timeout {
-                    return Err(Error::Timeout(self.options.request_timeout));
-                }
-                Ok(())
-            })
+            }
+            let silent = now.duration_since(last_beat);
+            let stalled =
+                silent > HUNG_AFTER || (silent > STALL_AFTER && process_stopped(self.daemon_pid));
+            if stalled && self.daemon_node != 0 {
+                return Err(Error::Stalled {
+                    domain: self.options.domain.clone(),
+                    pid: self.daemon_pid,
+                    silent,
+                });
+            }
+            if now.duration_since(started) > self.options.request_timeout {
+                return Err(Error::Timeout(self.options.request_timeout));
+            }
+            Ok(())
+        }
     }
 
     pub(crate) fn check_daemon(&self) -> Result<(), Error> {

@@ -47,7 +47,7 @@ pub mod spin;
 mod transport;
 
 pub use client::{
-    Client, ConnectOptions, DaemonHealth, HUNG_AFTER, STALL_AFTER, WATCH_STALL_AFTER,
+    Client, ConnectOptions, DaemonHealth, HUNG_AFTER, MAX_IN_FLIGHT, STALL_AFTER, WATCH_STALL_AFTER,
 };
 pub use collision_groups::CollisionGroup;
 pub use controller::Controller;

@@ -85,7 +85,13 @@ impl Plane {
     /// process's unconfirmed writes on top. `None` when the object does not exist.
     pub(crate) fn body(&self, handle: Handle) -> Result<Option<BodyState>, Error> {
         let (tick, base) = {
-            self.shared.refresh_in_frame(self.client.frame())?;
+            let frame = self.client.frame();
+            if self.shared.looks_in(frame) && self.client.has_in_flight() {
+                // A pipelined flush's reply says which tick applied its writes: with it, a
+                // newer sample replaces them (`Client::flush`).
+                self.client.collect_in_flight(false)?;
+            }
+            self.shared.refresh_in_frame(frame)?;
             let latest = self.shared.latest.borrow();
             let sample = latest.as_ref();
             (
@@ -125,6 +131,8 @@ impl Plane {
         if !self.shared.alive.get() {
             return Ok(None);
         }
+        // A removal in a pipelined flush counts until its reply says which tick applied it.
+        self.client.collect_in_flight(true)?;
         self.shared.refresh_in_frame(self.client.frame())?;
         let header = self
             .shared

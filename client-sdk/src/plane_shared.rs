@@ -88,9 +88,14 @@ impl PlaneShared {
         Ok(self.latest.borrow().clone())
     }
 
+    /// Whether [`PlaneShared::refresh_in_frame`] looks for a newer sample in `frame`.
+    pub(crate) fn looks_in(&self, frame: u64) -> bool {
+        frame == 0 || self.refreshed_in.get() != frame
+    }
+
     /// Looks for a newer sample once per client frame (`frame` 0: every time).
     pub(crate) fn refresh_in_frame(&self, frame: u64) -> Result<(), Error> {
-        if frame == 0 || self.refreshed_in.get() != frame {
+        if self.looks_in(frame) {
             self.refresh()?;
             self.refreshed_in.set(frame);
         }

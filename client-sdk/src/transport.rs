@@ -181,6 +181,15 @@ impl Transport {
         }
     }
 
+    /// This host's transport, when it is one (only its requests can be pipelined: see
+    /// `Client::flush`).
+    pub(crate) fn local(&self) -> Option<&LocalTransport> {
+        match self {
+            Transport::Local(t) => Some(t),
+            Transport::Remote(_) => None,
+        }
+    }
+
     /// What the daemon knows this client by.
     pub(crate) fn id(&self) -> u128 {
         match self {
@@ -339,8 +348,15 @@ impl LocalTransport {
         header: u128,
         period: Duration,
         spin: Duration,
-        mut check: impl FnMut(bool) -> Result<(), Error>,
+        check: impl FnMut(bool) -> Result<(), Error>,
     ) -> Result<Vec<u8>, Error> {
+        let pending = self.send(bytes, header)?;
+        self.await_reply(&pending, period, spin, check)
+    }
+
+    /// Sends request bytes and wakes the daemon, without waiting: the reply is collected
+    /// later ([`LocalTransport::await_reply`], [`LocalTransport::try_reply`]).
+    pub(crate) fn send(&self, bytes: &[u8], header: u128) -> Result<PendingReply, Error> {
         let loaned = self.port.borrow().loan_slice_uninit(bytes.len());
         let mut request = match loaned {
             Ok(r) => r,
@@ -369,15 +385,32 @@ impl LocalTransport {
         self.daemon_wake
             .notify()
             .map_err(|e| Error::ipc("wake daemon", e))?;
+        Ok(PendingReply(pending))
+    }
+
+    /// The reply of `pending` if it has arrived (never waits).
+    pub(crate) fn try_reply(&self, pending: &PendingReply) -> Result<Option<Vec<u8>>, Error> {
+        Ok(pending
+            .0
+            .receive()
+            .map_err(|e| Error::ipc("receive reply", e))?
+            .map(|response| response.payload().to_vec()))
+    }
+
+    /// Waits for the reply of `pending` ([`LocalTransport::exchange`]'s wait).
+    pub(crate) fn await_reply(
+        &self,
+        pending: &PendingReply,
+        period: Duration,
+        spin: Duration,
+        mut check: impl FnMut(bool) -> Result<(), Error>,
+    ) -> Result<Vec<u8>, Error> {
         if !spin.is_zero() {
             let until = std::time::Instant::now() + spin;
             while std::time::Instant::now() < until {
-                if let Some(response) = pending
-                    .receive()
-                    .map_err(|e| Error::ipc("receive reply", e))?
-                {
+                if let Some(reply) = self.try_reply(pending)? {
                     // The reply event stays set: the next wait consumes it and looks again.
-                    return Ok(response.payload().to_vec());
+                    return Ok(reply);
                 }
                 // Yield rather than spin: on a machine with few cores the daemon's threads
                 // that produce the reply may need this one.
@@ -385,13 +418,10 @@ impl LocalTransport {
             }
         }
         loop {
-            if let Some(response) = pending
-                .receive()
-                .map_err(|e| Error::ipc("receive reply", e))?
-            {
-                return Ok(response.payload().to_vec());
+            if let Some(reply) = self.try_reply(pending)? {
+                return Ok(reply);
             }
-            check(pending.is_connected())?;
+            check(pending.0.is_connected())?;
             let _ = self.replies.timed_wait(|_| {}, period);
         }
     }
@@ -481,6 +511,11 @@ type ControlFactory = iceoryx2::service::port_factory::request_response::PortFac
     [u8],
     (),
 >;
+
+/// A request sent whose reply has not been read yet (a pipelined flush keeps one).
+pub(crate) struct PendingReply(
+    iceoryx2::pending_response::PendingResponse<ipc::Service, [u8], u128, [u8], ()>,
+);
 
 /// A request port on the control service, growing its memory by powers of two.
 fn request_port(control: &ControlFactory) -> Result<ControlPort, Error> {

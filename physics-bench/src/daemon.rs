@@ -65,6 +65,14 @@ impl DaemonProcess {
     pub fn connect(&self) -> BenchResult<Client> {
         Ok(Client::connect(&self.domain)?)
     }
+
+    /// Connects as the Luau host does: refusals reported by the next call into their
+    /// plane, so a frame's flush sends its writes without waiting for the daemon.
+    pub fn connect_as_game(&self) -> BenchResult<Client> {
+        let mut options = client_sdk::ConnectOptions::new(&self.domain);
+        options.refusals_at_next_call = true;
+        Ok(Client::connect_with(options)?)
+    }
 }
 
 impl Drop for DaemonProcess {

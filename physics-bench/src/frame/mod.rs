@@ -8,7 +8,8 @@
 //! - **daemon**: a 60 Hz daemon plane of `--bodies` bodies (half a settled pile, half awake
 //!   cubes flying without gravity) steps on the other core; the frame takes the newest
 //!   sample (zero-copy), reads every pose from it, queues the writes and flushes them as one
-//!   request;
+//!   request, connected as the Luau host is (`refusals_at_next_call`: the flush sends the
+//!   writes without waiting for the reply, which the next frame collects);
 //! - **in process**: the same world stepped by the daemon's own plane code inside the frame,
 //!   poses read from it, writes applied to it.
 //!
@@ -369,7 +370,7 @@ pub fn run(args: &FrameArgs) -> BenchResult<()> {
     let awake = local_awake.len();
     // The same world in the daemon.
     let daemon = DaemonProcess::start("frame")?;
-    let client = daemon.connect()?;
+    let client = daemon.connect_as_game()?;
     let mut options = client_sdk::PlaneOptions::manual();
     for p in plane_props() {
         options = options.with(p);
@@ -410,6 +411,15 @@ pub fn run(args: &FrameArgs) -> BenchResult<()> {
             times[m].extend(t);
             phases[m].extend(w);
         }
+    }
+    // Connected as the Luau host is, refusals wait for a later call: none may be left.
+    let refused = client.take_refused(None);
+    if let Some(first) = refused.first() {
+        return Err(BenchError::Failed(format!(
+            "the daemon refused {} of the frames' writes, first: {}",
+            refused.len(),
+            first.message
+        )));
     }
     let asleep = asleep_fraction(plane.snapshot()?.bodies());
     let step_us = std::mem::take(&mut remote.step_us);
