@@ -282,31 +282,38 @@ impl Plane {
     /// Waits until a tick newer than the one visible now is published. Returns its number.
     ///
     /// On a timer-driven plane the next tick is due a period after the last one ended: the
-    /// wait sleeps until [`crate::spin::LEAD`] before that, polls shared memory until
-    /// [`crate::spin::TAIL`] after it, and only then sleeps on the tick event, so a tick on
-    /// time reaches the reader without the scheduler's wake-up (about 1 ms of one core per
-    /// tick at most). [`Plane::wait_tick_spin`] with no spin only ever sleeps on the event.
+    /// wait sleeps until shortly before that, polls shared memory until shortly after it,
+    /// and only then sleeps on the tick event, so a tick on time reaches the reader without
+    /// the scheduler's wake-up. The polling window starts as [`crate::spin::LEAD`] before
+    /// to [`crate::spin::TAIL`] after the predicted moment and then follows where this
+    /// plane's ticks actually land ([`crate::spin::Landing`]), polling at most
+    /// [`crate::spin::MAX_SPIN`] of one core per tick. [`Plane::wait_tick_spin`] with no
+    /// spin only ever sleeps on the event.
     pub fn wait_tick(&self, timeout: Duration) -> Result<u64, Error> {
         self.shared.refresh()?;
         let seen = self.shared.current_tick();
-        let due = self
+        let last = self
             .shared
             .latest
             .borrow()
             .as_ref()
-            .and_then(|s| crate::spin::next_tick_ns(s.user_header()));
-        let Some(due) = due else {
+            .map(|s| *s.user_header());
+        let Some((due, period)) = last.and_then(|h| {
+            let due = crate::spin::next_tick_ns(&h)?;
+            Some((due, due - h.tick_end_ns))
+        }) else {
             return self.wait_tick_after(seen, timeout, Duration::ZERO);
         };
+        let window = self.shared.landing.borrow().window();
         let deadline = Instant::now() + timeout;
-        loop {
+        let tick = loop {
             self.shared.refresh()?;
             match self.shared.current_tick() {
-                Some(t) if Some(t) != seen => return Ok(t),
+                Some(t) if Some(t) != seen => break t,
                 _ => {}
             }
             let left = deadline.saturating_duration_since(Instant::now());
-            match crate::spin::phase(shm_layout::monotonic_ns(), due) {
+            match crate::spin::phase_in(shm_layout::monotonic_ns(), due, window) {
                 // Yield rather than spin: the daemon may need this core to publish.
                 crate::spin::Phase::Poll if !left.is_zero() => std::thread::yield_now(),
                 crate::spin::Phase::Doze(d) if !left.is_zero() => {
@@ -318,9 +325,22 @@ impl Plane {
                 }
                 // Past the window (or the time is up): the plain wait, which also watches
                 // the daemon's liveness and reports the timeout.
-                _ => return self.wait_tick_after(seen, left, Duration::ZERO),
+                _ => break self.wait_tick_after(seen, left, Duration::ZERO)?,
             }
+        };
+        // The tick right after the one the prediction came from teaches the window.
+        let end = self
+            .shared
+            .latest
+            .borrow()
+            .as_ref()
+            .map(|s| *s.user_header())
+            .filter(|h| seen.is_some_and(|s| h.tick == s + 1))
+            .map(|h| h.tick_end_ns);
+        if let Some(end) = end {
+            self.shared.landing.borrow_mut().observe(due, end, period);
         }
+        Ok(tick)
     }
 
     /// Like [`Plane::wait_tick`], but first polls the shared-memory queue for up to `spin`

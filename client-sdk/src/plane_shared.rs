@@ -36,6 +36,8 @@ pub(crate) struct PlaneShared {
     pub(crate) persistent_name: RefCell<Option<String>>,
     /// Ticks lost when the plane came back on another member (`Plane::take_recovered`).
     pub(crate) recovered: Cell<Option<u64>>,
+    /// Where the plane's ticks land against their prediction (`Plane::wait_tick`).
+    pub(crate) landing: RefCell<crate::spin::Landing>,
 }
 
 impl PlaneShared {
@@ -55,6 +57,7 @@ impl PlaneShared {
             route: RefCell::new(None),
             persistent_name: RefCell::new(None),
             recovered: Cell::new(None),
+            landing: RefCell::default(),
         })
     }
 

@@ -52,16 +52,108 @@ pub enum Phase {
     Sleep,
 }
 
-/// The phase of a wait at `now_ns` for a tick due at `due_ns`.
+/// The phase of a wait at `now_ns` for a tick due at `due_ns`, with the fixed window
+/// ([`LEAD`] before, [`TAIL`] after).
 pub fn phase(now_ns: u64, due_ns: u64) -> Phase {
-    let lead = LEAD.as_nanos() as u64;
-    let tail = TAIL.as_nanos() as u64;
-    if now_ns + lead < due_ns {
-        Phase::Doze(Duration::from_nanos(due_ns - lead - now_ns))
-    } else if now_ns <= due_ns + tail {
+    phase_in(now_ns, due_ns, Window::default())
+}
+
+/// The phase of a wait at `now_ns` for a tick due at `due_ns`, polling in `window`.
+pub fn phase_in(now_ns: u64, due_ns: u64, window: Window) -> Phase {
+    let start = due_ns as i64 - window.lead_ns;
+    let end = due_ns as i64 + window.tail_ns;
+    let now = now_ns as i64;
+    if now < start {
+        Phase::Doze(Duration::from_nanos((start - now) as u64))
+    } else if now <= end {
         Phase::Poll
     } else {
         Phase::Sleep
+    }
+}
+
+/// When a wait polls, relative to the predicted moment: from `lead_ns` before it to
+/// `tail_ns` after it (either may be negative: a window that lies wholly after or before
+/// the prediction).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Window {
+    /// Nanoseconds before the predicted moment that the polling starts.
+    pub lead_ns: i64,
+    /// Nanoseconds after the predicted moment that the polling ends.
+    pub tail_ns: i64,
+}
+
+impl Default for Window {
+    fn default() -> Self {
+        Window {
+            lead_ns: LEAD.as_nanos() as i64,
+            tail_ns: TAIL.as_nanos() as i64,
+        }
+    }
+}
+
+/// What a reader learned of where its plane's ticks land against [`next_tick_ns`]'s
+/// prediction: the mean and the mean absolute deviation of the error, as running averages.
+/// The daemon's timer wakes a little late or early, and steps vary; on a loaded machine by
+/// milliseconds. The window then follows the ticks: centred on the mean error, wide enough
+/// for [`SPREADS`] deviations either side (never narrower than the fixed window), and never
+/// longer than [`MAX_SPIN`] — a reader still polls at most that much of a core per tick.
+#[derive(Debug, Default, Clone)]
+pub struct Landing {
+    mean_ns: f64,
+    deviation_ns: f64,
+    seen: u32,
+}
+
+/// How many mean absolute deviations of the error either side of its mean the window covers
+/// (2.5 of them are about two standard deviations of a normal error: ~95 % of the ticks).
+pub const SPREADS: f64 = 2.5;
+
+/// Weight of a new error in the running averages (about the last 16 ticks count).
+const WEIGHT: f64 = 1.0 / 16.0;
+
+impl Landing {
+    /// Notes that a tick predicted for `due_ns` ended at `end_ns`. An error of more than
+    /// half of `period_ns` (a tick skipped, a paused daemon) says nothing of the timer's
+    /// jitter and is ignored.
+    pub fn observe(&mut self, due_ns: u64, end_ns: u64, period_ns: u64) {
+        let err = end_ns as f64 - due_ns as f64;
+        if !err.is_finite() || err.abs() > period_ns as f64 / 2.0 {
+            return;
+        }
+        if self.seen == 0 {
+            self.mean_ns = err;
+            self.deviation_ns = 0.0;
+        } else {
+            let w = WEIGHT.max(1.0 / f64::from(self.seen + 1));
+            self.deviation_ns += w * ((err - self.mean_ns).abs() - self.deviation_ns);
+            self.mean_ns += w * (err - self.mean_ns);
+        }
+        self.seen = self.seen.saturating_add(1);
+    }
+
+    /// Where to poll for the next tick, relative to its prediction.
+    pub fn window(&self) -> Window {
+        let fixed = Window::default();
+        if self.seen < 4 {
+            return fixed;
+        }
+        let spread = SPREADS * self.deviation_ns;
+        let lead = (spread - self.mean_ns).max(fixed.lead_ns as f64);
+        let tail = (self.mean_ns + spread).max(fixed.tail_ns as f64);
+        let max = MAX_SPIN.as_nanos() as f64;
+        if lead + tail <= max {
+            return Window {
+                lead_ns: lead as i64,
+                tail_ns: tail as i64,
+            };
+        }
+        // Too wide to poll through: the part around the mean error.
+        let lead = (max / 2.0 - self.mean_ns) as i64;
+        Window {
+            lead_ns: lead,
+            tail_ns: max as i64 - lead,
+        }
     }
 }
 
@@ -93,6 +185,48 @@ mod tests {
         assert!((due as i64 - 1_016_666_666).abs() <= 1, "{due}");
         assert_eq!(next_tick_ns(&header(5, 0.0, 1.0)), None);
         assert_eq!(next_tick_ns(&header(5, f32::NAN, 1.0)), None);
+    }
+
+    #[test]
+    fn the_window_follows_where_ticks_land_and_never_polls_past_the_cap() {
+        let period = 16_666_667;
+        let due = 1_000_000_000u64;
+        // Too few ticks seen: the fixed window.
+        let mut landing = Landing::default();
+        landing.observe(due, due + 1_000_000, period);
+        assert_eq!(landing.window(), Window::default());
+        // Ticks that land 1.2 ms late, ±0.1 ms: the window moves after the prediction and
+        // covers them; polling starts no later than 0.3 ms before the earliest of them.
+        let mut landing = Landing::default();
+        for k in 0..64u64 {
+            let jitter: i64 = if k % 2 == 0 { 100_000 } else { -100_000 };
+            landing.observe(due, (due as i64 + 1_200_000 + jitter) as u64, period);
+        }
+        let w = landing.window();
+        let end = due as i64 + w.tail_ns;
+        assert!(end >= due as i64 + 1_300_000, "{w:?}");
+        assert!(w.lead_ns + w.tail_ns <= MAX_SPIN.as_nanos() as i64, "{w:?}");
+        assert_eq!(
+            phase_in(due + 1_250_000, due, w),
+            Phase::Poll,
+            "a tick 1.25 ms late is polled for: {w:?}"
+        );
+        // Widely scattered ticks (±5 ms): the window is capped at MAX_SPIN.
+        let mut landing = Landing::default();
+        for k in 0..64u64 {
+            let end = if k % 2 == 0 {
+                due + 5_000_000
+            } else {
+                due - 5_000_000
+            };
+            landing.observe(due, end, period);
+        }
+        let w = landing.window();
+        assert_eq!(w.lead_ns + w.tail_ns, MAX_SPIN.as_nanos() as i64, "{w:?}");
+        // A skipped tick (an error past half a period) teaches nothing.
+        let before = landing.clone();
+        landing.observe(due, due + 10_000_000, period);
+        assert_eq!(landing.window(), before.window());
     }
 
     #[test]
