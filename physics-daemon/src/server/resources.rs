@@ -196,6 +196,12 @@ struct Guard {
     /// Nodes evicted, and when.
     evicted: HashMap<u128, Instant>,
     planes: HashMap<PlaneId, PlaneServices>,
+    /// When the nodes were last listed, and the domain's node folder's modification time
+    /// then (`list_nodes_now`).
+    listed: Option<(Instant, Option<std::time::SystemTime>)>,
+    /// Nodes of other processes that have not said Hello yet and are not evicted: their
+    /// verdict is due at a later look.
+    pending_hello: usize,
 }
 
 /// A node as the node list shows it.
@@ -221,6 +227,50 @@ impl Guard {
     ) -> Vec<Eviction> {
         let now = Instant::now();
         let own = std::process::id();
+        let mut done = Vec::new();
+        if self.list_nodes_now(config, now) {
+            self.enforce_nodes(config, connected, limits, now, own, &mut done);
+        }
+        self.enforce_ports(node, control, planes, limits, config, own, &mut done);
+        done
+    }
+
+    /// Whether the nodes must be listed this period. Listing reads every node's files (the
+    /// most of an idle daemon's CPU when done every period), and what it finds changes only
+    /// when a node comes or goes, which changes the domain's node folder. So the nodes are
+    /// listed when that folder changed, while a node's Hello verdict is pending, and at least
+    /// every [`super::liveness::FULL_CHECK`] (a killed process leaves its node behind without
+    /// touching the folder: its resources are removed then).
+    fn list_nodes_now(&mut self, config: &Config, now: Instant) -> bool {
+        let folder = config.global.node_dir().to_string();
+        let stamp = std::fs::metadata(&folder)
+            .and_then(|m| m.modified())
+            .ok();
+        let due = match self.listed {
+            None => true,
+            Some((at, seen)) => {
+                self.pending_hello > 0
+                    || stamp.is_none()
+                    || seen != stamp
+                    || now.duration_since(at) >= super::liveness::FULL_CHECK
+            }
+        };
+        if due {
+            self.listed = Some((now, stamp));
+        }
+        due
+    }
+
+    /// The node caps: Hello within the timeout, nodes per process; and dead nodes' cleanup.
+    fn enforce_nodes(
+        &mut self,
+        config: &Config,
+        connected: &dyn Fn(u128) -> bool,
+        limits: &Limits,
+        now: Instant,
+        own: u32,
+        done: &mut Vec<Eviction>,
+    ) {
         let mut alive = Vec::new();
         let mut dead = Vec::new();
         let _ = Node::<ipc::Service>::list(config, |state| {
@@ -294,7 +344,6 @@ impl Guard {
             }
         }
 
-        let mut done = Vec::new();
         if !everywhere.is_empty() {
             let targets: BTreeSet<u128> = everywhere.iter().map(|(n, _)| n.id.value()).collect();
             let mut joined: Vec<(UniqueNodeId, ServiceHash, String)> = Vec::new();
@@ -330,7 +379,25 @@ impl Guard {
                 self.evicted.insert(n.id.value(), now);
             }
         }
+        self.pending_hello = nodes
+            .iter()
+            .filter(|n| !n.connected && !self.evicted.contains_key(&n.id.value()))
+            .count();
+    }
 
+    /// Ports per process in each service: read from the services' port lists in shared
+    /// memory every period (cheap; a process can open ports without a new node).
+    #[allow(clippy::too_many_arguments)]
+    fn enforce_ports(
+        &mut self,
+        node: &Node<ipc::Service>,
+        control: &ControlService,
+        planes: impl Iterator<Item = PlaneId>,
+        limits: &Limits,
+        config: &Config,
+        own: u32,
+        done: &mut Vec<Eviction>,
+    ) {
         // Ports per process in each service.
         // Each client of a process has one port per service.
         let cap = limits.ports_per_process.max(limits.clients_per_process);
@@ -392,7 +459,6 @@ impl Guard {
                 }
             }
         }
-        done
     }
 
     fn plane_services(&mut self, node: &Node<ipc::Service>, id: PlaneId) -> Option<&PlaneServices> {
