@@ -279,6 +279,26 @@ impl Plane {
         }
     }
 
+    /// Queues a step of `dt` seconds after the writes queued so far: it runs when the queue
+    /// is sent (the next [`Client::flush`] or call), and its tick is published as a
+    /// [`Plane::step`]'s is. On a client connected with
+    /// [`crate::ConnectOptions::refusals_at_next_call`] the flush does not wait for it, so a
+    /// game loop that ends each frame with `queue_step` and `flush` has the daemon step
+    /// while the game sleeps or renders, and reads the new tick in its next frame; a
+    /// refused step (a bad `dt`, a daemon-side limit) is reported by the next call into the
+    /// plane, as a refused write is.
+    pub fn queue_step(&self, dt: f32) -> Result<(), Error> {
+        if !(dt.is_finite() && dt > 0.0) {
+            return Err(Error::Invalid {
+                field: "dt".into(),
+                message: format!("a step needs a finite dt > 0 s, got {dt}"),
+            });
+        }
+        self.client
+            .queue(Command::plane(self.id(), PlaneOp::Step { dt }), None);
+        Ok(())
+    }
+
     /// Waits until a tick newer than the one visible now is published. Returns its number.
     ///
     /// On a timer-driven plane the next tick is due a period after the last one ended: the

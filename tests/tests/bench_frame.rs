@@ -1,12 +1,13 @@
 //! `physics-bench frame` as a user runs it (the built binary, its own daemon), in a tiny
-//! configuration: the report's JSON has the three modes with their frame times, the world
-//! the bench promises (half the bodies settled and asleep, half flying and awake), and the
-//! goals list with the daemon / no-physics verdict.
+//! configuration: the report's JSON has the four modes with their frame times, the world
+//! the bench promises (half the bodies settled and asleep, half flying and awake), the goals
+//! list with the daemon / no-physics verdicts, and no write refused (a frame-stepped plane
+//! advanced one tick a frame).
 
 use std::process::Command;
 
 #[test]
-fn frame_reports_three_modes_and_the_goal() {
+fn frame_reports_four_modes_and_the_goals() {
     let bench = client_sdk::daemon_executable().with_file_name("physics-bench");
     assert!(bench.is_file(), "build the workspace's binaries first");
     let out = std::env::temp_dir().join(integration_tests::unique_domain("frame"));
@@ -26,7 +27,10 @@ fn frame_reports_three_modes_and_the_goal() {
     assert_eq!(report["bodies"], 200);
     let modes = report["modes"].as_array().expect("modes");
     let names: Vec<&str> = modes.iter().filter_map(|m| m["mode"].as_str()).collect();
-    assert_eq!(names, ["no_physics", "daemon", "in_process"]);
+    assert_eq!(
+        names,
+        ["no_physics", "daemon", "in_process", "daemon_frame_stepped"]
+    );
     for m in modes {
         // Two blocks of 20 frames per mode.
         assert_eq!(m["frames"], 40, "{m}");
@@ -46,17 +50,24 @@ fn frame_reports_three_modes_and_the_goal() {
     assert!(report["game_work_ms"].as_f64().unwrap() > 0.0);
 
     let goals = report["goals"].as_array().expect("goals");
-    let main = goals
-        .iter()
-        .find(|g| {
-            g["goal"]
-                .as_str()
-                .is_some_and(|s| s.contains("without physics") && s.contains("≤ 1.05"))
-        })
-        .unwrap_or_else(|| panic!("no daemon / no-physics goal in {goals:?}"));
-    assert!(main["met"].is_boolean(), "{main}");
-    let value: f64 = main["value"].as_str().unwrap().parse().unwrap();
-    let ratio = modes[1]["ratio_p50"].as_f64().unwrap();
-    assert!((value - ratio).abs() < 1e-3, "{value} against {ratio}");
-    assert_eq!(main["met"].as_bool(), Some(ratio <= 1.05));
+    for (mode, words) in [(1, "60 Hz timer"), (3, "stepped after each frame")] {
+        let main = goals
+            .iter()
+            .find(|g| {
+                g["goal"].as_str().is_some_and(|s| {
+                    s.contains("without physics") && s.contains("≤ 1.05") && s.contains(words)
+                })
+            })
+            .unwrap_or_else(|| panic!("no daemon / no-physics goal ({words}) in {goals:?}"));
+        assert!(main["met"].is_boolean(), "{main}");
+        let value: f64 = main["value"].as_str().unwrap().parse().unwrap();
+        let ratio = modes[mode]["ratio_p50"].as_f64().unwrap();
+        assert!((value - ratio).abs() < 1e-3, "{value} against {ratio}");
+        assert_eq!(main["met"].as_bool(), Some(ratio <= 1.05));
+    }
+    // The frame-stepped plane stepped: its step time was read off its own ticks.
+    assert!(
+        report["frame_stepped_step_ms"].as_f64().unwrap() >= 0.0,
+        "{report}"
+    );
 }

@@ -187,3 +187,43 @@ fn a_daemon_gone_with_a_flush_in_flight_fails_the_next_call_in_bounded_time() {
         started.elapsed()
     );
 }
+
+#[test]
+fn a_queued_step_runs_behind_the_frames_writes_and_the_frame_does_not_wait_for_it() {
+    let daemon = TestDaemon::start("pipelined-step");
+    let client = game_client(&daemon);
+    let plane = client
+        .create_plane(&PlaneOptions {
+            tick_rate: Some(0.0),
+            ..integration_tests::zero_gravity()
+        })
+        .unwrap();
+    let ball = plane
+        .add(Shape::Sphere { radius: 0.5 }, Pose::at([0.0; 3]), &[])
+        .unwrap();
+    let start = plane.info().unwrap().tick;
+    // Ten frames, each writing a velocity and stepping 0.1 s behind it: with neither gravity
+    // nor damping the ball moves v·dt a frame, each step seeing its own frame's write.
+    for k in 1..=10 {
+        client.begin_frame();
+        ball.set_velocity([k as f32, 0.0, 0.0]).unwrap();
+        plane.queue_step(0.1).unwrap();
+        client.flush().unwrap();
+    }
+    let info = plane.info().unwrap();
+    assert_eq!(info.tick, start + 10, "one tick per frame");
+    let x = plane.snapshot().unwrap().bodies()[ball.handle().slot as usize].position[0];
+    assert!((x - 5.5).abs() < 1e-4, "x = Σ k·0.1 = 5.5, got {x}");
+    // A bad dt is refused where it is queued, naming the field.
+    for dt in [0.0, -1.0, f32::NAN, f32::INFINITY] {
+        match plane.queue_step(dt) {
+            Err(Error::Invalid { field, .. }) => assert_eq!(field, "dt"),
+            other => panic!("dt {dt} must be refused, got {other:?}"),
+        }
+    }
+    assert_eq!(
+        client.queued(),
+        0,
+        "nothing was queued by the refused steps"
+    );
+}

@@ -243,9 +243,7 @@ impl Guard {
     /// touching the folder: its resources are removed then).
     fn list_nodes_now(&mut self, config: &Config, now: Instant) -> bool {
         let folder = config.global.node_dir().to_string();
-        let stamp = std::fs::metadata(&folder)
-            .and_then(|m| m.modified())
-            .ok();
+        let stamp = std::fs::metadata(&folder).and_then(|m| m.modified()).ok();
         let due = match self.listed {
             None => true,
             Some((at, seen)) => {
