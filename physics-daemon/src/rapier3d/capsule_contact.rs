@@ -156,6 +156,42 @@ pub(super) fn capsule_box(
     )))
 }
 
+/// [`capsule_box`] asked from the box's side, the box first (as [`contact`] answers a box
+/// and a capsule): the capsule (segment `a`–`b`, `radius`, in its own frame) placed at
+/// `pose21` in the frame of the box of half extents `he`. A cast moves the capsule in the
+/// box's frame, so this saves inverting its pose twice per step; the pose back to the
+/// capsule's frame is worked out only for a contact within `prediction`.
+pub(super) fn box_capsule(
+    pose21: &Pose,
+    a: Vector,
+    b: Vector,
+    radius: f32,
+    he: Vector,
+    prediction: f32,
+) -> Option<Option<Contact>> {
+    let (on_segment, on_box, d2) = segment_box(*pose21 * a, *pose21 * b, he);
+    if !d2.is_finite() || !on_segment.is_finite() {
+        return None;
+    }
+    let d = d2.sqrt();
+    if d <= 1.0e-5 * (1.0 + he.max_element()) {
+        return None;
+    }
+    let dist = d - radius;
+    if dist > prediction {
+        return Some(None);
+    }
+    let n = (on_segment - on_box) / d;
+    let to_capsule = pose21.inverse();
+    Some(Some(Contact::new(
+        on_box,
+        to_capsule * (on_segment - n * radius),
+        n,
+        to_capsule.rotation * -n,
+        dist,
+    )))
+}
+
 /// The closest points of the segment `a`–`b` and the solid box `[-he, he]` and their
 /// squared distance: (point of the segment, point of the box, squared distance).
 fn segment_box(a: Vector, b: Vector, he: Vector) -> (Vector, Vector, f32) {
@@ -246,6 +282,49 @@ mod tests {
     use super::*;
     use rapier3d::parry::query::{DefaultQueryDispatcher, QueryDispatcher};
     use rapier3d::parry::shape::{Capsule, Cuboid};
+
+    /// From the box's side: the capsule's contact flipped, for capsules beside, over and
+    /// into boxes, upright and tilted, near and beyond the prediction.
+    #[test]
+    fn box_first_is_the_flipped_capsule_contact() {
+        let capsule = Capsule::new_y(1.5, 1.0);
+        let he = Vector::new(1.5, 0.5, 4.0);
+        let mut checked = 0;
+        for at in [
+            [3.0f32, 0.2, 0.5],
+            [0.3, 3.05, -1.0],
+            [-2.4, -3.2, 3.9],
+            [0.0, 2.2, 0.0],
+            [9.0, 0.0, 0.0],
+        ] {
+            for angle in [0.0f32, 0.7] {
+                for axis in [Vector::Y, Vector::new(0.3, 0.5, 0.8).normalize()] {
+                    let pose21 = Pose::from_parts(
+                        Vector::from(at),
+                        rapier3d::math::Rotation::from_axis_angle(axis, angle),
+                    );
+                    let (a, b) = (capsule.segment.a, capsule.segment.b);
+                    let ours = box_capsule(&pose21, a, b, capsule.radius, he, 2.0);
+                    let theirs = capsule_box(&pose21.inverse(), a, b, capsule.radius, he, 2.0)
+                        .map(|found| found.map(Contact::flipped));
+                    let what = format!("at {at:?} angle {angle}: {ours:?} against {theirs:?}");
+                    match (ours, theirs) {
+                        (Some(Some(o)), Some(Some(t))) => {
+                            assert!((o.dist - t.dist).abs() < 1e-5, "{what}");
+                            assert!((o.point1 - t.point1).length() < 1e-4, "{what}");
+                            assert!((o.point2 - t.point2).length() < 1e-4, "{what}");
+                            assert!((o.normal1 - t.normal1).length() < 1e-5, "{what}");
+                            assert!((o.normal2 - t.normal2).length() < 1e-5, "{what}");
+                            checked += 1;
+                        }
+                        (Some(None), Some(None)) | (None, None) => {}
+                        _ => panic!("{what}"),
+                    }
+                }
+            }
+        }
+        assert!(checked >= 8, "only {checked} contacts compared");
+    }
 
     /// The axis-parallel closed form gives the general path's closest points: beside,
     /// above, below, crossing and inside the box, along each axis and both ways.

@@ -204,8 +204,8 @@ impl<'a> Nearby<'a> {
             let pos12 = co_pose.inv_mul(pose);
             let vel12 = co_pose.rotation.inverse() * dir;
             let found = match c.cuboid {
-                // The plane's dispatcher on a box and a capsule, the same contacts in the
-                // same order, without asking the shapes what they are.
+                // The plane's dispatcher on a box and a capsule (the same contacts, to f32
+                // rounding, in the same order) without asking the shapes what they are.
                 Some(he) => crate::rapier3d::clipped::cast_convex_with(
                     &pos12,
                     vel12,
@@ -214,15 +214,10 @@ impl<'a> Nearby<'a> {
                     options,
                     |at, reach| {
                         let (a, b, radius) = (capsule.segment.a, capsule.segment.b, capsule.radius);
-                        match crate::rapier3d::capsule_contact::capsule_box(
-                            &at.inverse(),
-                            a,
-                            b,
-                            radius,
-                            he,
-                            reach,
+                        match crate::rapier3d::capsule_contact::box_capsule(
+                            at, a, b, radius, he, reach,
                         ) {
-                            Some(found) => Ok(found.map(Contact::flipped)),
+                            Some(found) => Ok(found),
                             None => {
                                 crate::rapier3d::clipped::contact(at, self.shape(c), capsule, reach)
                             }
