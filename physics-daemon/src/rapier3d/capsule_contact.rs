@@ -120,8 +120,9 @@ fn segment_segment(p1: Vector, q1: Vector, p2: Vector, q2: Vector) -> (Vector, V
 }
 
 /// The contact of the capsule (segment `a`–`b`, `radius`, in its own frame) with the box of
-/// half extents `he` placed at `pos12` in the capsule's frame.
-fn capsule_box(
+/// half extents `he` placed at `pos12` in the capsule's frame; `None` where the closed
+/// form does not apply (see [`contact`]).
+pub(super) fn capsule_box(
     pos12: &Pose,
     a: Vector,
     b: Vector,
@@ -155,10 +156,52 @@ fn capsule_box(
     )))
 }
 
+/// [`capsule_box`] asked from the box's side, the box first (as [`contact`] answers a box
+/// and a capsule): the capsule (segment `a`–`b`, `radius`, in its own frame) placed at
+/// `pose21` in the frame of the box of half extents `he`. A cast moves the capsule in the
+/// box's frame, so this saves inverting its pose twice per step; the pose back to the
+/// capsule's frame is worked out only for a contact within `prediction`.
+pub(super) fn box_capsule(
+    pose21: &Pose,
+    a: Vector,
+    b: Vector,
+    radius: f32,
+    he: Vector,
+    prediction: f32,
+) -> Option<Option<Contact>> {
+    let (on_segment, on_box, d2) = segment_box(*pose21 * a, *pose21 * b, he);
+    if !d2.is_finite() || !on_segment.is_finite() {
+        return None;
+    }
+    let d = d2.sqrt();
+    if d <= 1.0e-5 * (1.0 + he.max_element()) {
+        return None;
+    }
+    let dist = d - radius;
+    if dist > prediction {
+        return Some(None);
+    }
+    let n = (on_segment - on_box) / d;
+    let to_capsule = pose21.inverse();
+    Some(Some(Contact::new(
+        on_box,
+        to_capsule * (on_segment - n * radius),
+        n,
+        to_capsule.rotation * -n,
+        dist,
+    )))
+}
+
 /// The closest points of the segment `a`–`b` and the solid box `[-he, he]` and their
 /// squared distance: (point of the segment, point of the box, squared distance).
 fn segment_box(a: Vector, b: Vector, he: Vector) -> (Vector, Vector, f32) {
     let d = b - a;
+    parallel_segment_box(a, d, he).unwrap_or_else(|| segment_box_pieces(a, d, he))
+}
+
+/// [`segment_box`] for any segment `a` + `d` t, t in [0, 1]: the least of the pieces'
+/// minima.
+fn segment_box_pieces(a: Vector, d: Vector, he: Vector) -> (Vector, Vector, f32) {
     // Where a coordinate crosses a face: the pieces' ends.
     let mut cuts = [0.0f32; 8];
     let mut n = 0;
@@ -214,11 +257,105 @@ fn segment_box(a: Vector, b: Vector, he: Vector) -> (Vector, Vector, f32) {
     best
 }
 
+/// [`segment_box`] for a segment parallel to one of the box's axes (an upright capsule
+/// beside an upright box, the controllers' usual case): the two other coordinates stay
+/// put, so the closest point of the segment is where it enters the box's slab along that
+/// axis (its start when it starts inside, else the end nearer the slab), the point the
+/// general path picks too (the first of equally close points). `None` when `d` is not
+/// along one axis.
+fn parallel_segment_box(a: Vector, d: Vector, he: Vector) -> Option<(Vector, Vector, f32)> {
+    let axis = match (d.x != 0.0, d.y != 0.0, d.z != 0.0) {
+        (false, true, false) => 1,
+        (true, false, false) => 0,
+        (false, false, true) => 2,
+        _ => return None,
+    };
+    let entry = a[axis].max(-he[axis]).min(he[axis]);
+    let t = ((entry - a[axis]) / d[axis]).clamp(0.0, 1.0);
+    let p = a + d * t;
+    let q = p.clamp(-he, he);
+    Some((p, q, (p - q).length_squared()))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use rapier3d::parry::query::{DefaultQueryDispatcher, QueryDispatcher};
     use rapier3d::parry::shape::{Capsule, Cuboid};
+
+    /// From the box's side: the capsule's contact flipped, for capsules beside, over and
+    /// into boxes, upright and tilted, near and beyond the prediction.
+    #[test]
+    fn box_first_is_the_flipped_capsule_contact() {
+        let capsule = Capsule::new_y(1.5, 1.0);
+        let he = Vector::new(1.5, 0.5, 4.0);
+        let mut checked = 0;
+        for at in [
+            [3.0f32, 0.2, 0.5],
+            [0.3, 3.05, -1.0],
+            [-2.4, -3.2, 3.9],
+            [0.0, 2.2, 0.0],
+            [9.0, 0.0, 0.0],
+        ] {
+            for angle in [0.0f32, 0.7] {
+                for axis in [Vector::Y, Vector::new(0.3, 0.5, 0.8).normalize()] {
+                    let pose21 = Pose::from_parts(
+                        Vector::from(at),
+                        rapier3d::math::Rotation::from_axis_angle(axis, angle),
+                    );
+                    let (a, b) = (capsule.segment.a, capsule.segment.b);
+                    let ours = box_capsule(&pose21, a, b, capsule.radius, he, 2.0);
+                    let theirs = capsule_box(&pose21.inverse(), a, b, capsule.radius, he, 2.0)
+                        .map(|found| found.map(Contact::flipped));
+                    let what = format!("at {at:?} angle {angle}: {ours:?} against {theirs:?}");
+                    match (ours, theirs) {
+                        (Some(Some(o)), Some(Some(t))) => {
+                            assert!((o.dist - t.dist).abs() < 1e-5, "{what}");
+                            assert!((o.point1 - t.point1).length() < 1e-4, "{what}");
+                            assert!((o.point2 - t.point2).length() < 1e-4, "{what}");
+                            assert!((o.normal1 - t.normal1).length() < 1e-5, "{what}");
+                            assert!((o.normal2 - t.normal2).length() < 1e-5, "{what}");
+                            checked += 1;
+                        }
+                        (Some(None), Some(None)) | (None, None) => {}
+                        _ => panic!("{what}"),
+                    }
+                }
+            }
+        }
+        assert!(checked >= 8, "only {checked} contacts compared");
+    }
+
+    /// The axis-parallel closed form gives the general path's closest points: beside,
+    /// above, below, crossing and inside the box, along each axis and both ways.
+    #[test]
+    fn parallel_segments_match_the_pieces() {
+        let he = Vector::new(1.5, 0.5, 2.0);
+        let mut checked = 0;
+        for axis in 0..3 {
+            for len in [-5.0f32, -0.3, 0.3, 5.0] {
+                for start in [-7.0f32, -2.1, -0.2, 0.4, 1.7, 6.0] {
+                    for side in [[0.0f32, 0.0], [0.7, -0.3], [2.5, 0.1], [-3.0, 4.0]] {
+                        let mut a = Vector::new(side[0], side[1], 0.0);
+                        a = Vector::new(a[(3 - axis) % 3], a[(4 - axis) % 3], a[(5 - axis) % 3]);
+                        a[axis] = start;
+                        let mut d = Vector::ZERO;
+                        d[axis] = len;
+                        let fast = parallel_segment_box(a, d, he).expect("axis-parallel");
+                        let general = segment_box_pieces(a, d, he);
+                        let what = format!("a {a:?} d {d:?}: {fast:?} against {general:?}");
+                        assert!((fast.2 - general.2).abs() < 1e-5, "{what}");
+                        assert!((fast.0 - general.0).length() < 1e-5, "{what}");
+                        assert!((fast.1 - general.1).length() < 1e-5, "{what}");
+                        checked += 1;
+                    }
+                }
+            }
+        }
+        assert_eq!(checked, 3 * 4 * 6 * 4);
+        // Not along one axis: left to the pieces.
+        assert!(parallel_segment_box(Vector::ZERO, Vector::new(1.0, 1.0, 0.0), he).is_none());
+    }
 
     /// Against parry's GJK on small boxes (where it is exact): capsules beside faces, over
     /// edges and corners, tilted, separated and sunk less than their radius.

@@ -269,6 +269,22 @@ fn cast_convex(
     g2: &dyn Shape,
     options: ShapeCastOptions,
 ) -> Result<Option<ShapeCastHit>, Unsupported> {
+    cast_convex_with(pos12, vel12, g1, g2, options, |at, reach| {
+        contact(at, g1, g2, reach)
+    })
+}
+
+/// [`cast_convex`] with `contact(pos12, prediction)` answering the contact query of `g1`
+/// and `g2` (a caller that knows the pair's shapes skips the dispatch; it must answer as
+/// [`contact`] does).
+pub(super) fn cast_convex_with(
+    pos12: &Pose,
+    vel12: Vector,
+    g1: &dyn Shape,
+    g2: &dyn Shape,
+    options: ShapeCastOptions,
+    contact: impl Fn(&Pose, f32) -> Result<Option<Contact>, Unsupported>,
+) -> Result<Option<ShapeCastHit>, Unsupported> {
     let speed = vel12.length();
     if !speed.is_finite() || speed == 0.0 {
         return DefaultQueryDispatcher.cast_shapes(pos12, vel12, g1, g2, options);
@@ -284,17 +300,17 @@ fn cast_convex(
         let at = Pose::from_translation(vel12 * t) * *pos12;
         // Nothing within the rest of the travel: no hit.
         let reach = target + speed * (max_toi - t) + ADVANCE_TOLERANCE;
-        let Some(contact) = contact(&at, g1, g2, reach)? else {
+        let Some(found) = contact(&at, reach)? else {
             return Ok(None);
         };
-        if contact.dist > reach {
+        if found.dist > reach {
             return Ok(None);
         }
-        let gap = contact.dist - target;
+        let gap = found.dist - target;
         // Closing speed along the normal; motion along a surface (a controller walking on a
         // floor it is within the target distance of) neither approaches nor leaves it, whatever
         // the rounding of a rotated normal says.
-        let closing = -contact.normal1.dot(vel12);
+        let closing = -found.normal1.dot(vel12);
         let closing = if closing.abs() <= speed * 1.0e-5 {
             0.0
         } else {
@@ -307,23 +323,21 @@ fn cast_convex(
             // The geometry just before the touch: a step back of [`WITNESS_BACKOFF`] from
             // it, not the previous iterate (Newton's first step from far away lands on a
             // plane at once, and the contact seen from the start lies elsewhere on a slope).
-            let contact = match before {
+            let touch = match before {
                 Some(_) => {
                     let back = (t - WITNESS_BACKOFF / speed).max(0.0);
                     let near = Pose::from_translation(vel12 * back) * *pos12;
-                    self::contact(&near, g1, g2, reach)?
-                        .or(before)
-                        .unwrap_or(contact)
+                    contact(&near, reach)?.or(before).unwrap_or(found)
                 }
-                None => contact,
+                None => found,
             };
             return Ok(Some(ShapeCastHit {
                 time_of_impact: t,
-                witness1: contact.point1,
-                witness2: contact.point2,
-                normal1: contact.normal1,
-                normal2: contact.normal2,
-                status: if step == 0 && contact.dist < target {
+                witness1: touch.point1,
+                witness2: touch.point2,
+                normal1: touch.normal1,
+                normal2: touch.normal2,
+                status: if step == 0 && touch.dist < target {
                     ShapeCastStatus::PenetratingOrWithinTargetDist
                 } else {
                     ShapeCastStatus::Converged
@@ -336,7 +350,7 @@ fn cast_convex(
             return Ok(None); // moving apart: a convex pair never meets again
         }
         t += gap / closing;
-        before = Some(contact);
+        before = Some(found);
         if t > max_toi {
             return Ok(None);
         }

@@ -2,8 +2,9 @@
 //! depenetration. Each reads the tick's [`Nearby`] colliders.
 
 use rapier3d::parry::bounding_volume::BoundingVolume;
+use rapier3d::parry::shape::Capsule;
 
-use super::nearby::Nearby;
+use super::nearby::{capsule_aabb, Nearby};
 use super::tick::Scene;
 use super::*;
 
@@ -44,7 +45,7 @@ impl Scene<'_> {
     /// no higher than StepHeight.
     pub(super) fn step_up(
         &self,
-        shape: &SharedShape,
+        shape: &Capsule,
         position: Vector,
         yaw: f32,
         remaining: Vector,
@@ -58,7 +59,7 @@ impl Scene<'_> {
         let rotation = yaw_rotation(yaw);
         let reach = remaining.length().max(s.capsule_radius);
         // Everything the lift, the move and the drop can touch.
-        let here = shape.compute_aabb(&rapier3d::math::Pose::from_parts(position, rotation));
+        let here = capsule_aabb(shape, &rapier3d::math::Pose::from_parts(position, rotation));
         let need = here
             .merged(&here.translated(Vector::Y * s.step_height + dir * reach))
             .loosened(SKIN * 4.0);
@@ -74,7 +75,7 @@ impl Scene<'_> {
                 .cast_shape(
                     &rapier3d::math::Pose::from_parts(from, rotation),
                     along,
-                    &**shape,
+                    shape,
                     options,
                 )
                 .map(|(_, hit)| hit)
@@ -110,7 +111,7 @@ impl Scene<'_> {
         }
         // Nothing may overlap the capsule where it lands.
         let pose = rapier3d::math::Pose::from_parts(landed, rotation);
-        if nearby.intersects_any(&pose, &**shape) {
+        if nearby.intersects_any(&pose, shape) {
             return None;
         }
         Some(landed)
@@ -119,22 +120,20 @@ impl Scene<'_> {
     /// Pushes the capsule at `position` out of everything it overlaps, deepest first.
     pub(super) fn depenetrate(
         &self,
-        shape: &SharedShape,
+        shape: &Capsule,
         position: Vector,
         nearby: &mut Nearby<'_>,
     ) -> Vector {
         let mut offset = Vector::ZERO;
         for _ in 0..DEPENETRATION_PASSES {
             let pose = rapier3d::math::Pose::from_translation(position + offset);
-            let aabb = shape.compute_aabb(&pose);
+            let aabb = capsule_aabb(shape, &pose);
             nearby.ensure(aabb, 1.0);
             let mut deepest: Option<(f32, Vector)> = None;
             for c in nearby.within(aabb) {
                 // The pose has no rotation: the contact's capsule-local normal is the world's.
-                let pos12 = pose.inv_mul(c.collider.position());
-                if let Ok(Some(contact)) =
-                    crate::rapier3d::clipped::contact(&pos12, &**shape, c.collider.shape(), 0.0)
-                {
+                let pos12 = pose.inv_mul(&c.pose);
+                if let Ok(Some(contact)) = nearby.contact(c, &pos12, shape, 0.0) {
                     if contact.dist < 0.0 && deepest.is_none_or(|(d, _)| contact.dist < d) {
                         deepest = Some((contact.dist, contact.normal1));
                     }
@@ -154,7 +153,7 @@ impl Scene<'_> {
     /// whether the surface's own normal is).
     pub(super) fn probe_ground(
         &self,
-        shape: &SharedShape,
+        shape: &Capsule,
         position: Vector,
         yaw: f32,
         reach: f32,
@@ -162,7 +161,7 @@ impl Scene<'_> {
         nearby: &mut Nearby<'_>,
     ) -> Option<(RigidBodyHandle, f32, bool, bool)> {
         let pose = rapier3d::math::Pose::from_parts(position, yaw_rotation(yaw));
-        let here = shape.compute_aabb(&pose);
+        let here = capsule_aabb(shape, &pose);
         nearby.ensure(here.merged(&here.translated(-Vector::Y * reach)), 1.0);
         let options = ShapeCastOptions {
             max_time_of_impact: reach,
@@ -170,7 +169,7 @@ impl Scene<'_> {
             stop_at_penetration: false,
             compute_impact_geometry_on_penetration: true,
         };
-        let (col, hit) = nearby.cast_shape(&pose, -Vector::Y, &**shape, options)?;
+        let (col, hit) = nearby.cast_shape(&pose, -Vector::Y, shape, options)?;
         // The normal as the capsule feels it: on a box's edge it leans (a box reports its
         // face normal there).
         let felt = -(pose.rotation * hit.normal2);

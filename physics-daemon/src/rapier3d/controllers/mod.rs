@@ -131,6 +131,14 @@ impl Controller {
         )
     }
 
+    /// The capsule as a plain shape (no allocation, for a tick's queries).
+    fn capsule(&self) -> rapier3d::parry::shape::Capsule {
+        rapier3d::parry::shape::Capsule::new_y(
+            self.settings.capsule_half_height,
+            self.settings.capsule_radius,
+        )
+    }
+
     /// Full size of the capsule's box, for the object's Size.
     fn size(&self) -> Vec3 {
         let r = self.settings.capsule_radius;

@@ -3,11 +3,14 @@
 //! (rapier 0.36, Apache-2.0; without autostep, which the controllers replace with their own
 //! step), run over the tick's [`Nearby`] colliders with the plane's exact dispatcher.
 //!
-//! Two things differ from rapier's, both for speed: every query reads the short candidate
-//! list instead of the plane's tree, and whether the capsule is grounded (checked after
-//! every slide iteration) comes from one contact per nearby collider through the plane's
+//! Three things differ from rapier's, all for speed: every query reads the short candidate
+//! list instead of the plane's tree; whether the capsule is grounded at the start (which
+//! decides the snap) comes from one contact per nearby collider through the plane's
 //! dispatcher (a box's face answers it in closed form) instead of full contact manifolds
-//! from parry's GJK-based default dispatcher, which rapier's version hard-wires. A manifold's
+//! from parry's GJK-based default dispatcher, which rapier's version hard-wires; and the
+//! pass after every slide iteration asks only kinematic bodies for a contact (it carries
+//! the capsule along them; whether the capsule ended grounded, rapier's other use of it,
+//! is read by nobody here: the tick's own ground probe decides OnGround). A manifold's
 //! test — its normal leans less than 89.94° from up and one of its points lies within the
 //! prediction — holds exactly when the deepest point's does, since all of a convex pair's
 //! manifold points share its normal. The push of a kinematic body the capsule touches (rapier's
@@ -16,9 +19,10 @@
 use rapier3d::control::CharacterCollision;
 use rapier3d::parry::bounding_volume::BoundingVolume;
 use rapier3d::parry::query::{ShapeCastHit, ShapeCastOptions};
+use rapier3d::parry::shape::Capsule;
 use rapier3d::prelude::*;
 
-use super::nearby::Nearby;
+use super::nearby::{capsule_aabb, Nearby};
 
 /// Rapier's default nudge along a hit's normal after sliding (units).
 const NORMAL_NUDGE: f32 = 1.0e-4;
@@ -45,8 +49,6 @@ pub(super) struct Mover {
 pub(super) struct Moved {
     /// The translation it made.
     pub translation: Vector,
-    /// Whether it ended on ground (rapier's notion: a contact leaning less than 89.94°).
-    pub grounded: bool,
 }
 
 /// A hit and how the slope rules read it.
@@ -75,14 +77,13 @@ impl Mover {
         &self,
         dt: f32,
         nearby: &Nearby<'_>,
-        shape: &dyn Shape,
+        shape: &Capsule,
         pose: &Pose,
         desired: Vector,
         mut events: impl FnMut(CharacterCollision),
     ) -> Moved {
         let mut result = Moved {
             translation: Vector::ZERO,
-            grounded: false,
         };
         // Nothing near: the whole motion, nothing to stand on.
         if nearby.is_empty() {
@@ -95,16 +96,14 @@ impl Mover {
         }
         let at = |t: Vector| Pose::from_translation(t) * *pose;
         let mut remaining = desired;
-        let grounded_at_start = self.grounded(dt, nearby, shape, &at(result.translation), None);
+        let grounded_at_start = self.grounded(nearby, shape, &at(result.translation));
         let mut friction = Vector::ZERO;
-        let mut moving = false;
         let mut iterations = MAX_ITERATIONS;
         while let Some((dir, dist)) = normalize_and_length(remaining, MIN_MOTION) {
             if iterations == 0 {
                 break;
             }
             iterations -= 1;
-            moving = true;
             let options = ShapeCastOptions {
                 target_distance: self.offset,
                 stop_at_penetration: false,
@@ -128,19 +127,16 @@ impl Mover {
                 remaining = self.handle_slopes(&info, desired, remaining);
             } else {
                 result.translation += remaining;
-                result.grounded = self.grounded(dt, nearby, shape, &at(result.translation), None);
                 break;
             }
-            result.grounded = self.grounded(
+            self.kinematic_friction(
                 dt,
                 nearby,
                 shape,
                 &at(result.translation),
-                Some((&mut friction, &mut remaining)),
+                &mut friction,
+                &mut remaining,
             );
-        }
-        if !moving {
-            result.grounded = self.grounded(dt, nearby, shape, &at(result.translation), None);
         }
         if grounded_at_start {
             self.snap(nearby, shape, &at(result.translation), &mut result);
@@ -149,7 +145,7 @@ impl Mover {
     }
 
     /// Rapier's snap to the ground: down by at most the snap distance unless the move rose.
-    fn snap(&self, nearby: &Nearby<'_>, shape: &dyn Shape, pose: &Pose, result: &mut Moved) {
+    fn snap(&self, nearby: &Nearby<'_>, shape: &Capsule, pose: &Pose, result: &mut Moved) {
         let Some(distance) = self.snap_to_ground else {
             return;
         };
@@ -164,7 +160,6 @@ impl Mover {
         };
         if let Some((_, hit)) = nearby.cast_shape(pose, -Vector::Y, shape, options) {
             result.translation -= Vector::Y * hit.time_of_impact;
-            result.grounded = true;
         }
     }
 
@@ -173,7 +168,7 @@ impl Mover {
     fn fix_penetrations(
         &self,
         nearby: &Nearby<'_>,
-        shape: &dyn Shape,
+        shape: &Capsule,
         pose: &Pose,
         height: f32,
         result: &mut Moved,
@@ -182,14 +177,12 @@ impl Mover {
         let mut applied = 0.0;
         for _ in 0..4 {
             let here = Pose::from_translation(result.translation) * *pose;
-            let aabb = shape.compute_aabb(&here).loosened(self.offset);
+            let aabb = capsule_aabb(shape, &here).loosened(self.offset);
             let mut corrected = false;
             for c in nearby.within(aabb) {
                 let here = Pose::from_translation(result.translation) * *pose;
-                let pos12 = here.inv_mul(c.collider.position());
-                if let Ok(Some(contact)) =
-                    crate::rapier3d::clipped::contact(&pos12, shape, c.collider.shape(), 0.0)
-                {
+                let pos12 = here.inv_mul(&c.pose);
+                if let Ok(Some(contact)) = nearby.contact(c, &pos12, shape, 0.0) {
                     if contact.dist < -1.0e-5 {
                         let push = (self.offset - contact.dist).min(max_correction - applied);
                         if push <= 0.0 {
@@ -207,58 +200,64 @@ impl Mover {
         }
     }
 
-    /// Whether the shape at `pose` is grounded; while sliding (`friction` given) also
-    /// carries it along kinematic bodies it touches (rapier's kinematic friction).
-    fn grounded(
+    /// Whether the shape at `pose` is grounded (rapier's notion: a contact within the
+    /// prediction leaning less than 89.94° from up).
+    fn grounded(&self, nearby: &Nearby<'_>, shape: &Capsule, pose: &Pose) -> bool {
+        let prediction = self.offset + 0.05;
+        let aabb = capsule_aabb(shape, pose).loosened(prediction);
+        nearby.within(aabb).any(|c| {
+            let pos12 = pose.inv_mul(&c.pose);
+            let Ok(Some(contact)) = nearby.contact(c, &pos12, shape, prediction) else {
+                return false;
+            };
+            let normal = -(pose.rotation * contact.normal1);
+            contact.dist <= prediction && normal.y >= 1.0e-3
+        })
+    }
+
+    /// While sliding, carries the shape at `pose` along the kinematic bodies it touches
+    /// (rapier's kinematic friction, applied after every slide iteration): only kinematic
+    /// candidates are asked for a contact (rapier's pass also decides whether the shape is
+    /// grounded there, which nothing reads).
+    fn kinematic_friction(
         &self,
         dt: f32,
         nearby: &Nearby<'_>,
-        shape: &dyn Shape,
+        shape: &Capsule,
         pose: &Pose,
-        mut friction: Option<(&mut Vector, &mut Vector)>,
-    ) -> bool {
+        friction: &mut Vector,
+        remaining: &mut Vector,
+    ) {
         let prediction = self.offset + 0.05;
-        let aabb = shape.compute_aabb(pose).loosened(prediction);
-        let mut grounded = false;
+        let aabb = capsule_aabb(shape, pose).loosened(prediction);
         for c in nearby.within(aabb) {
-            let pos12 = pose.inv_mul(c.collider.position());
-            let Ok(Some(contact)) =
-                crate::rapier3d::clipped::contact(&pos12, shape, c.collider.shape(), prediction)
+            let Some(body) = c
+                .parent
+                .and_then(|p| nearby.bodies().get(p))
+                .filter(|rb| rb.is_kinematic())
             else {
                 continue;
             };
-            let normal = -(pose.rotation * contact.normal1);
-            let touching = contact.dist <= prediction;
-            if touching && normal.y >= 1.0e-3 {
-                grounded = true;
+            let pos12 = pose.inv_mul(&c.pose);
+            let Ok(Some(contact)) = nearby.contact(c, &pos12, shape, prediction) else {
+                continue;
+            };
+            if contact.dist > prediction {
+                continue;
             }
-            let Some((friction, remaining)) = friction.as_mut() else {
-                if grounded {
-                    return true;
-                }
-                continue;
-            };
-            let kinematic = c
-                .collider
-                .parent()
-                .and_then(|p| nearby.bodies().get(p))
-                .filter(|rb| rb.is_kinematic());
-            let (Some(body), true) = (kinematic, touching) else {
-                continue;
-            };
-            let before = **friction;
-            let point = c.collider.position() * contact.point2;
+            let normal = -(pose.rotation * contact.normal1);
+            let before = *friction;
+            let point = c.pose * contact.point2;
             let target = body.velocity_at_point(point);
-            **remaining += normal * (target.dot(normal) * dt - remaining.dot(normal));
+            *remaining += normal * (target.dot(normal) * dt - remaining.dot(normal));
             let tangent = (target - normal * target.dot(normal)) * dt;
             for k in 0..3 {
                 if tangent[k].abs() > friction[k].abs() {
                     friction[k] = tangent[k];
                 }
             }
-            **remaining += **friction - before;
+            *remaining += *friction - before;
         }
-        grounded
     }
 
     fn hit_info(&self, toi: ShapeCastHit) -> HitInfo {

@@ -9,19 +9,32 @@
 //! mover behaves as it did on the whole scene, as long as the region holds everything the
 //! tick reaches (each stage asks [`Nearby::ensure`] for the region it reads, which gathers
 //! again when it sticks out).
+//!
+//! A tick allocates nothing here: the candidate list is a buffer of the thread it runs on,
+//! handed back when the tick ends. A box candidate keeps its half extents, so the
+//! capsule's contacts with it (most of a tick's work) go straight to the closed form of
+//! `capsule_contact` without asking the shapes what they are.
+
+use std::cell::RefCell;
 
 use rapier3d::parry::bounding_volume::{Aabb, BoundingVolume};
-use rapier3d::parry::query::{QueryDispatcher, Ray, RayCast, ShapeCastHit, ShapeCastOptions};
+use rapier3d::parry::query::{
+    Contact, QueryDispatcher, Ray, RayCast, ShapeCastHit, ShapeCastOptions, Unsupported,
+};
+use rapier3d::parry::shape::Capsule;
 use rapier3d::prelude::*;
 
 use crate::rapier3d::clipped::ClippedQueries;
 
-/// A collider near the controller: its handle, the collider, and its AABB now.
+/// A collider near the controller: its handle, pose, body and AABB now, and its half
+/// extents when it is a box.
 #[derive(Clone, Copy)]
-pub(super) struct Candidate<'a> {
+pub(super) struct Candidate {
     pub handle: ColliderHandle,
-    pub collider: &'a Collider,
+    pub pose: Pose,
+    pub parent: Option<RigidBodyHandle>,
     pub aabb: Aabb,
+    cuboid: Option<Vector>,
 }
 
 /// What a controller's queries read: the plane's broad phase, bodies and colliders
@@ -37,7 +50,7 @@ pub(super) struct SceneRefs<'a> {
 /// its collision group does not collide with left out).
 pub(super) struct Nearby<'a> {
     /// Every candidate, in the broad phase's order.
-    pub items: Vec<Candidate<'a>>,
+    pub items: Vec<Candidate>,
     /// The region they were gathered from.
     region: Aabb,
     scene: SceneRefs<'a>,
@@ -48,6 +61,26 @@ pub(super) struct Nearby<'a> {
 /// The dispatcher of every controller query (see the module docs).
 static DISPATCHER: ClippedQueries = ClippedQueries;
 
+thread_local! {
+    /// The candidate buffer of this thread's ticks (see the module docs).
+    static BUFFER: RefCell<Vec<Candidate>> = const { RefCell::new(Vec::new()) };
+}
+
+/// The AABB of the controller's `capsule` at `pose`: for an upright pose (turned about Y
+/// only, as a controller always is) its segment's ends less and plus the radius, as
+/// parry's own AABB has them, without rotating the ends; parry's otherwise.
+pub(super) fn capsule_aabb(capsule: &Capsule, pose: &Pose) -> Aabb {
+    if pose.rotation.x != 0.0 || pose.rotation.z != 0.0 {
+        return capsule.compute_aabb(pose);
+    }
+    let (a, b) = (
+        pose.translation + capsule.segment.a,
+        pose.translation + capsule.segment.b,
+    );
+    let r = Vector::splat(capsule.radius);
+    Aabb::new(a.min(b) - r, a.max(b) + r)
+}
+
 impl<'a> Nearby<'a> {
     /// The colliders whose broad-phase AABB meets `region` and that `own` (a controller's
     /// body, of collision groups `groups`) can touch.
@@ -57,8 +90,9 @@ impl<'a> Nearby<'a> {
         groups: InteractionGroups,
         region: Aabb,
     ) -> Nearby<'a> {
+        let items = BUFFER.with(|b| std::mem::take(&mut *b.borrow_mut()));
         let mut nearby = Nearby {
-            items: Vec::new(),
+            items,
             region,
             scene,
             own,
@@ -81,19 +115,19 @@ impl<'a> Nearby<'a> {
             colliders,
         } = self.scene;
         let pipeline = broad_phase.as_query_pipeline(&DISPATCHER, bodies, colliders, filter);
-        let handles: Vec<ColliderHandle> = pipeline
-            .intersect_aabb_conservative(self.region)
-            .map(|(handle, _)| handle)
-            .collect();
         self.items.clear();
-        self.items.extend(handles.into_iter().filter_map(|handle| {
-            let collider = colliders.get(handle)?;
-            Some(Candidate {
-                handle,
-                collider,
-                aabb: collider.compute_aabb(),
-            })
-        }));
+        self.items
+            .extend(
+                pipeline
+                    .intersect_aabb_conservative(self.region)
+                    .map(|(handle, collider)| Candidate {
+                        handle,
+                        pose: *collider.position(),
+                        parent: collider.parent(),
+                        aabb: collider.compute_aabb(),
+                        cuboid: collider.shape().as_cuboid().map(|c| c.half_extents),
+                    }),
+            );
     }
 
     /// Makes sure every query within `need` is answered: gathers again (over both regions,
@@ -111,24 +145,50 @@ impl<'a> Nearby<'a> {
         self.scene.bodies
     }
 
+    /// The shape of candidate `c`.
+    pub fn shape(&self, c: &Candidate) -> &'a dyn Shape {
+        self.scene.colliders[c.handle].shape()
+    }
+
     /// Whether nothing at all is near.
     pub fn is_empty(&self) -> bool {
         self.items.is_empty()
     }
 
-    /// The first collider `shape` at `pose` hits moving along the unit `dir` (or any
+    /// The contact of `capsule` with candidate `c` placed at `pos12` in the capsule's
+    /// frame, as [`crate::rapier3d::clipped::contact`] answers it.
+    pub fn contact(
+        &self,
+        c: &Candidate,
+        pos12: &Pose,
+        capsule: &Capsule,
+        prediction: f32,
+    ) -> Result<Option<Contact>, Unsupported> {
+        if let Some(he) = c.cuboid {
+            let (a, b) = (capsule.segment.a, capsule.segment.b);
+            let radius = capsule.radius;
+            if let Some(found) =
+                crate::rapier3d::capsule_contact::capsule_box(pos12, a, b, radius, he, prediction)
+            {
+                return Ok(found);
+            }
+        }
+        crate::rapier3d::clipped::contact(pos12, capsule, self.shape(c), prediction)
+    }
+
+    /// The first collider `capsule` at `pose` hits moving along the unit `dir` (or any
     /// direction of length = speed) within `options.max_time_of_impact`, as
     /// `QueryPipeline::cast_shape` answers it.
     pub fn cast_shape(
         &self,
         pose: &Pose,
         dir: Vector,
-        shape: &dyn Shape,
+        capsule: &Capsule,
         options: ShapeCastOptions,
     ) -> Option<(ColliderHandle, ShapeCastHit)> {
         // The swept shape's AABB against each candidate's, as a ray against their
         // Minkowski sum (parry's own pruning of a composite cast).
-        let own = shape.compute_aabb(pose);
+        let own = capsule_aabb(capsule, pose);
         let margin = own.half_extents() + Vector::splat(options.target_distance);
         let ray = Ray::new(own.center(), dir);
         let mut best: Option<(ColliderHandle, ShapeCastHit)> = None;
@@ -140,14 +200,33 @@ impl<'a> Nearby<'a> {
             if msum.cast_local_ray(&ray, reach, true).is_none() {
                 continue;
             }
-            let co_pose = c.collider.position();
-            let Ok(Some(hit)) = DISPATCHER.cast_shapes(
-                &co_pose.inv_mul(pose),
-                co_pose.rotation.inverse() * dir,
-                c.collider.shape(),
-                shape,
-                options,
-            ) else {
+            let co_pose = &c.pose;
+            let pos12 = co_pose.inv_mul(pose);
+            let vel12 = co_pose.rotation.inverse() * dir;
+            let found = match c.cuboid {
+                // The plane's dispatcher on a box and a capsule (the same contacts, to f32
+                // rounding, in the same order) without asking the shapes what they are.
+                Some(he) => crate::rapier3d::clipped::cast_convex_with(
+                    &pos12,
+                    vel12,
+                    self.shape(c),
+                    capsule,
+                    options,
+                    |at, reach| {
+                        let (a, b, radius) = (capsule.segment.a, capsule.segment.b, capsule.radius);
+                        match crate::rapier3d::capsule_contact::box_capsule(
+                            at, a, b, radius, he, reach,
+                        ) {
+                            Some(found) => Ok(found),
+                            None => {
+                                crate::rapier3d::clipped::contact(at, self.shape(c), capsule, reach)
+                            }
+                        }
+                    },
+                ),
+                None => DISPATCHER.cast_shapes(&pos12, vel12, self.shape(c), capsule, options),
+            };
+            let Ok(Some(hit)) = found else {
                 continue;
             };
             if best
@@ -161,17 +240,26 @@ impl<'a> Nearby<'a> {
     }
 
     /// The candidates whose AABB meets `aabb`.
-    pub fn within(&self, aabb: Aabb) -> impl Iterator<Item = &Candidate<'a>> + '_ {
+    pub fn within(&self, aabb: Aabb) -> impl Iterator<Item = &Candidate> + '_ {
         self.items.iter().filter(move |c| c.aabb.intersects(&aabb))
     }
 
-    /// Whether `shape` at `pose` overlaps any candidate.
-    pub fn intersects_any(&self, pose: &Pose, shape: &dyn Shape) -> bool {
-        self.within(shape.compute_aabb(pose)).any(|c| {
-            let pos12 = pose.inv_mul(c.collider.position());
+    /// Whether `capsule` at `pose` overlaps any candidate.
+    pub fn intersects_any(&self, pose: &Pose, capsule: &Capsule) -> bool {
+        self.within(capsule_aabb(capsule, pose)).any(|c| {
+            let pos12 = pose.inv_mul(&c.pose);
             DISPATCHER
-                .intersection_test(&pos12, shape, c.collider.shape())
+                .intersection_test(&pos12, capsule, self.shape(c))
                 .is_ok_and(|hit| hit.intersecting)
         })
+    }
+}
+
+impl Drop for Nearby<'_> {
+    /// Hands the candidate buffer back to the thread for its next tick.
+    fn drop(&mut self) {
+        let mut items = std::mem::take(&mut self.items);
+        items.clear();
+        BUFFER.with(|b| *b.borrow_mut() = items);
     }
 }

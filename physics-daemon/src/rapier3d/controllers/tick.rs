@@ -6,22 +6,28 @@
 //!
 //! On a plane with a pool (Threads > 1) and enough controllers to share, every controller
 //! first works out its move on the pool from the scene as the last tick left it, reading
-//! the plane only. A controller whose tick read nothing another controller changes (no
-//! other controller among the colliders near it, none near it, no dynamic body that
-//! another one also reads) got the same move it would get in slot order, and commits it;
-//! the others are ticked again in slot order as above. Either way the result is the same.
+//! the plane only, in tasks of [`PARALLEL_CHUNK`] controllers. A controller whose tick read
+//! nothing a controller before it in slot order changes (no such controller among the
+//! colliders near it, none near it, no dynamic body that one of them also reads) got the
+//! same move it would get in slot order, and commits it; the others are ticked again in
+//! slot order as above. Either way the result is the same.
 
-use std::collections::{HashMap, HashSet};
+use std::collections::HashSet;
 
 use rapier3d::parry::bounding_volume::{Aabb, BoundingVolume};
 use rayon::prelude::*;
 
 use super::mover::Mover;
-use super::nearby::{Nearby, SceneRefs};
+use rapier3d::parry::shape::Capsule;
+
+use super::nearby::{capsule_aabb, Nearby, SceneRefs};
 use super::*;
 
 /// Fewest controllers handed to the plane's pool (fewer are ticked on the plane's thread).
 const PARALLEL_FROM: usize = 8;
+/// Fewest controllers ticked as one task of the pool: a task costs a few microseconds to
+/// hand over, a controller's tick one or two.
+const PARALLEL_CHUNK: usize = 64;
 
 /// The read-only view of a plane a controller's tick works from.
 #[derive(Clone, Copy)]
@@ -96,15 +102,16 @@ impl Plane {
         }
         self.refresh_scene();
         let mut work = Vec::with_capacity(self.controllers.len());
+        // The controllers as they commit, in slot order: the map is built again in one
+        // pass at the end (inserting them one by one cost more than some of their ticks).
+        let mut done = Vec::with_capacity(self.controllers.len());
         for (slot, c) in std::mem::take(&mut self.controllers) {
             let Some(handle) = self.bodies.handle_at(slot as usize) else {
                 continue; // its object is gone
             };
             match self.body_of(handle) {
                 Ok(h) => work.push((slot, handle, h, c)),
-                Err(_) => {
-                    self.controllers.insert(slot, c);
-                }
+                Err(_) => done.push((slot, c)),
             }
         }
         let pool = (work.len() >= PARALLEL_FROM)
@@ -113,8 +120,9 @@ impl Plane {
         let Some(pool) = pool else {
             for (slot, handle, h, c) in work {
                 let o = self.scene(None).tick(slot, handle, h, c, dt);
-                self.commit_tick(o, dt);
+                done.push(self.commit_tick(o, dt));
             }
+            self.controllers = done.into_iter().collect();
             return;
         };
         let controller_bodies: HashSet<RigidBodyHandle> =
@@ -123,24 +131,24 @@ impl Plane {
             let scene = self.scene(Some(&controller_bodies));
             pool.install(|| {
                 work.into_par_iter()
+                    .with_min_len(PARALLEL_CHUNK)
                     .map(|(slot, handle, h, c)| scene.tick(slot, handle, h, c, dt))
                     .collect()
             })
         };
-        // Who read what another controller may change: other controllers, controllers
-        // read by others, dynamic bodies read by two or more.
-        let mut readers: HashMap<RigidBodyHandle, u32> = HashMap::new();
-        for o in &outcomes {
-            for b in &o.shared {
-                *readers.entry(*b).or_default() += 1;
-            }
-        }
+        // What the controllers before each one in slot order change or read: their own
+        // bodies (their commits move them) and what they read (the controllers near them,
+        // which a commit of theirs may come near; the dynamic bodies they push).
+        let mut touched: HashSet<RigidBodyHandle> = HashSet::new();
         for o in outcomes {
-            let again =
-                o.shared.iter().any(|b| {
-                    controller_bodies.contains(b) || readers.get(b).is_some_and(|n| *n > 1)
-                }) || readers.contains_key(&o.t.h);
-            if again {
+            // Only those before it commit before it in slot order: it read the scene they
+            // leave if none of them moved something it read, came near it (then it is among
+            // what they read: the region each tick reads reaches as far beyond its move as
+            // beyond its start) or pushed a body it reads.
+            let again = touched.contains(&o.t.h) || o.shared.iter().any(|b| touched.contains(b));
+            touched.insert(o.t.h);
+            touched.extend(o.shared.iter().copied());
+            let o = if again {
                 let Outcome {
                     slot,
                     mut controller,
@@ -149,12 +157,17 @@ impl Plane {
                     ..
                 } = o;
                 saved.restore(&mut controller);
-                let o = self.scene(None).tick(slot, t.handle, t.h, controller, dt);
-                self.commit_tick(o, dt);
+                let scene = self.scene(Some(&controller_bodies));
+                let o = scene.tick(slot, t.handle, t.h, controller, dt);
+                // What it read ticked again counts for those after it too.
+                touched.extend(o.shared.iter().copied());
+                o
             } else {
-                self.commit_tick(o, dt);
-            }
+                o
+            };
+            done.push(self.commit_tick(o, dt));
         }
+        self.controllers = done.into_iter().collect();
     }
 
     /// The read-only view a controller's tick works from; `controllers` (the bodies of the
@@ -173,8 +186,8 @@ impl Plane {
 
     /// The end of a controller's tick: its pushes, the next kinematic pose (and the
     /// colliders and broad phase, so queries before the step see it where it is going), the
-    /// published flags and the tick's events.
-    fn commit_tick(&mut self, o: Outcome, dt: f32) {
+    /// published flags and the tick's events. Returns the controller, for the plane's map.
+    fn commit_tick(&mut self, o: Outcome, dt: f32) -> (u32, Controller) {
         let Outcome {
             slot,
             controller: mut c,
@@ -230,7 +243,7 @@ impl Plane {
                 ..EventRecord::default()
             });
         }
-        self.controllers.insert(slot, c);
+        (slot, c)
     }
 }
 
@@ -259,7 +272,7 @@ impl<'a> Scene<'a> {
             Some(controllers) => nearby
                 .items
                 .iter()
-                .filter_map(|n| n.collider.parent())
+                .filter_map(|n| n.parent)
                 .filter(|b| {
                     controllers.contains(b)
                         || self.refs.bodies.get(*b).is_some_and(|rb| rb.is_dynamic())
@@ -296,7 +309,7 @@ impl<'a> Scene<'a> {
         TickState {
             handle,
             h,
-            shape: c.shape(),
+            shape: c.capsule(),
             half_height: s.capsule_half_height + s.capsule_radius,
             start: bodies[h].translation(),
             groups,
@@ -387,7 +400,7 @@ impl<'a> Scene<'a> {
         };
         let pose = rapier3d::math::Pose::from_parts(position, yaw_rotation(c.yaw));
         let mut collisions: Vec<CharacterCollision> = Vec::new();
-        let moved = mover.move_shape(dt, nearby, &*t.shape, &pose, m.desired, |col| {
+        let moved = mover.move_shape(dt, nearby, &t.shape, &pose, m.desired, |col| {
             collisions.push(col)
         });
         let mut next = position + moved.translation;
@@ -500,7 +513,7 @@ impl<'a> Scene<'a> {
 struct TickState {
     handle: Handle,
     h: RigidBodyHandle,
-    shape: SharedShape,
+    shape: Capsule,
     half_height: f32,
     start: Vector,
     groups: InteractionGroups,
@@ -520,10 +533,11 @@ impl TickState {
     /// The capsule from `from` to `from + desired`, widened as in [`TickState::reach`].
     fn swept(&self, s: &ControllerSettings, from: Vector, desired: Vector) -> Aabb {
         let pose = rapier3d::math::Pose::from_translation(from);
-        let a = self.shape.compute_aabb(&pose);
-        let b = self
-            .shape
-            .compute_aabb(&(rapier3d::math::Pose::from_translation(desired) * pose));
+        let a = capsule_aabb(&self.shape, &pose);
+        let b = capsule_aabb(
+            &self.shape,
+            &(rapier3d::math::Pose::from_translation(desired) * pose),
+        );
         let margin = s.step_height.max(SKIN * 4.0) + s.capsule_radius + 0.25;
         a.merged(&b).loosened(margin)
     }
