@@ -265,7 +265,9 @@ fn stages() -> BenchResult<Vec<Stage>> {
             let t = Instant::now();
             plane.step(DT)?;
             let total = t.elapsed().as_secs_f64();
-            let times = plane.gpu_stage_times().ok_or_else(|| err("not on the GPU"))?;
+            let times = plane
+                .gpu_stage_times()
+                .ok_or_else(|| err("not on the GPU"))?;
             let gpu: f64 = times.iter().map(|t| t.1).sum();
             for (stage, secs) in times.into_iter().chain([("plane (CPU)", total - gpu)]) {
                 add(samples, stage, secs);

@@ -460,7 +460,7 @@ impl GpuWorld {
         let atoms = buffer("atoms", (2 * table as u64 + 4) * 4, usage_storage());
         let index = buffer(
             "index",
-            (table as u64 + capacity as u64) * 4,
+            (table as u64 + 4 * capacity as u64) * 4,
             usage_storage(),
         );
         let lists = buffer("lists", lists_bytes, usage_storage());
