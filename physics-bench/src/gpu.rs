@@ -31,6 +31,12 @@ pub struct GpuArgs {
     /// path is skipped there.
     #[arg(long, default_value_t = 2.0)]
     pub max_tick_s: f64,
+    /// Diagnosis only: time each stage of a GPU hash tick (upload, forces, count, scan,
+    /// scatter, solve, readback, the CPU pass after it) at 10k and 40k bodies (every stage
+    /// submitted and waited for on its own), then the hash path's interleaved 10k → 40k
+    /// ratio, and stop (no other paths, sizes, containment or accuracy).
+    #[arg(long)]
+    pub stages: bool,
     /// Folder receiving gpu.json and gpu.md.
     #[arg(long, default_value = "bench-out")]
     pub out: PathBuf,
@@ -108,6 +114,15 @@ pub struct Accuracy {
     pub gpu_refused: Option<String>,
 }
 
+/// One stage of a GPU tick at one size (`physics-bench gpu --stages`).
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct Stage {
+    pub bodies: usize,
+    pub stage: String,
+    /// Median wall time per tick (ms), summed over the substeps.
+    pub ms: f64,
+}
+
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct GpuReport {
     pub adapter: String,
@@ -115,6 +130,8 @@ pub struct GpuReport {
     pub ratios: Vec<Ratio>,
     pub containment: Option<Containment>,
     pub accuracy: Vec<Accuracy>,
+    /// Per-stage times (`--stages`), empty otherwise.
+    pub stages: Vec<Stage>,
 }
 
 /// The accuracy report's scenes at the plane defaults (60 Hz, 4 iterations), on the CPU and
@@ -213,6 +230,63 @@ fn interleaved_ratio(path: Path, n: usize) -> BenchResult<f64> {
     Ok(median(&b)? / median(&a)?)
 }
 
+/// Median wall time of each stage of a GPU hash tick at 10k and 40k bodies, the two
+/// planes' ticks interleaved after the usual 30 warm-up ticks (20 rounds, each a normal
+/// tick and a staged tick of both planes), with `plane (CPU)`: the rest of the plane's step
+/// (the state hash and the tick's bookkeeping after the read-back), and `tick, one
+/// submission`: the normal tick for comparison with the stages' sum.
+fn stages() -> BenchResult<Vec<Stage>> {
+    const SIZES: [usize; 2] = [10_000, 40_000];
+    let mut planes = Vec::new();
+    for n in SIZES {
+        planes.push(scene(n, Path::GpuHash)?);
+    }
+    for _ in 0..30 {
+        for plane in &mut planes {
+            plane.step(DT)?;
+        }
+    }
+    type Samples = Vec<(&'static str, Vec<f64>)>;
+    let mut samples: Vec<Samples> = vec![Vec::new(); SIZES.len()];
+    let add = |samples: &mut Samples, stage: &'static str, secs: f64| match samples
+        .iter_mut()
+        .find(|s| s.0 == stage)
+    {
+        Some(s) => s.1.push(secs * 1e3),
+        None => samples.push((stage, vec![secs * 1e3])),
+    };
+    for _ in 0..20 {
+        for (plane, samples) in planes.iter_mut().zip(&mut samples) {
+            plane.set_gpu_stage_timing(false);
+            let t = Instant::now();
+            plane.step(DT)?;
+            add(samples, "tick, one submission", t.elapsed().as_secs_f64());
+            plane.set_gpu_stage_timing(true);
+            let t = Instant::now();
+            plane.step(DT)?;
+            let total = t.elapsed().as_secs_f64();
+            let times = plane
+                .gpu_stage_times()
+                .ok_or_else(|| err("not on the GPU"))?;
+            let gpu: f64 = times.iter().map(|t| t.1).sum();
+            for (stage, secs) in times.into_iter().chain([("plane (CPU)", total - gpu)]) {
+                add(samples, stage, secs);
+            }
+        }
+    }
+    let mut rows = Vec::new();
+    for (n, samples) in SIZES.into_iter().zip(samples) {
+        for (stage, v) in samples {
+            rows.push(Stage {
+                bodies: n,
+                stage: stage.into(),
+                ms: super::stats::median(&v).ok_or_else(|| err("no samples"))?,
+            });
+        }
+    }
+    Ok(rows)
+}
+
 /// 100,000 (10,000 quick) bodies in the container for 10 s: finite, inside, penetration.
 fn containment(n: usize) -> BenchResult<Containment> {
     let mut plane = scene(n, Path::GpuHash)?;
@@ -248,6 +322,9 @@ fn containment(n: usize) -> BenchResult<Containment> {
 pub fn run(args: &GpuArgs) -> BenchResult<()> {
     let adapter = physics_daemon::gpu::adapter_name().map_err(err)?;
     println!("GPU adapter: {adapter}");
+    if args.stages {
+        return run_stages(&adapter, &args.out);
+    }
     let sizes: &[usize] = if args.quick { &QUICK_SIZES } else { &SIZES };
     let mut cells = Vec::new();
     for path in [Path::GpuHash, Path::GpuBruteForce, Path::CpuRapier] {
@@ -319,9 +396,35 @@ pub fn run(args: &GpuArgs) -> BenchResult<()> {
         ratios,
         containment: Some(containment),
         accuracy: accuracy(),
+        stages: Vec::new(),
     };
     let md = markdown(&report);
     let (json, md_path) = report::write(&args.out, "gpu", &report, &md)?;
+    println!("{md}");
+    println!("wrote {} and {}", json.display(), md_path.display());
+    Ok(())
+}
+
+/// `--stages`: per-stage times at 10k and 40k and the hash path's 10k → 40k ratio.
+fn run_stages(adapter: &str, out: &std::path::Path) -> BenchResult<()> {
+    let rows = stages()?;
+    let ratio = interleaved_ratio(Path::GpuHash, 10_000)?;
+    println!("GPU, spatial hash 10000 → 40000: ×{}", num(Some(ratio)));
+    let report = GpuReport {
+        adapter: adapter.into(),
+        cells: Vec::new(),
+        ratios: vec![Ratio {
+            path: Path::GpuHash,
+            from: 10_000,
+            to: 40_000,
+            ratio,
+        }],
+        containment: None,
+        accuracy: Vec::new(),
+        stages: rows,
+    };
+    let md = markdown(&report);
+    let (json, md_path) = report::write(out, "gpu-stages", &report, &md)?;
     println!("{md}");
     println!("wrote {} and {}", json.display(), md_path.display());
     Ok(())
@@ -415,6 +518,39 @@ fn markdown(r: &GpuReport) -> String {
             format!("finite: {}, outside: {}", c.finite, c.escaped),
             Some(c.finite && c.escaped == 0),
         ));
+    }
+    if !r.stages.is_empty() {
+        let _ = writeln!(
+            md,
+            "\nStages of a GPU hash tick (median ms per tick, each stage submitted and waited \
+             for on its own, summed over the substeps; per body in µs):\n"
+        );
+        let mut t = report::Table::new(&[
+            "stage",
+            "10k (ms)",
+            "40k (ms)",
+            "ratio",
+            "10k µs/body",
+            "40k µs/body",
+        ]);
+        for s in r.stages.iter().filter(|s| s.bodies == 10_000) {
+            let Some(big) = r
+                .stages
+                .iter()
+                .find(|b| b.bodies == 40_000 && b.stage == s.stage)
+            else {
+                continue;
+            };
+            t.row(&[
+                s.stage.clone(),
+                num(Some(s.ms)),
+                num(Some(big.ms)),
+                format!("{:.2}", big.ms / s.ms),
+                format!("{:.3}", s.ms * 1e3 / 10_000.0),
+                format!("{:.3}", big.ms * 1e3 / 40_000.0),
+            ]);
+        }
+        md.push_str(&t.finish());
     }
     let _ = writeln!(md, "\n{}", goals_table(&goals));
     let _ = writeln!(

@@ -6,9 +6,14 @@
 //!    over the block totals: three levels cover 2^27 buckets) gives each bucket its first
 //!    index;
 //! 3. `scatter`: each body takes the next index of its bucket (atomics on a copy of the
-//!    starts) and writes its id there, so the ids are sorted by bucket;
-//! 4. `solve` / `pairs`: each body visits the buckets of its 27 neighbour cells (each bucket
-//!    once: two cells may hash to one) and tests the bodies listed there.
+//!    starts) and writes an entry there, its id and its cell, so the entries are sorted by
+//!    bucket;
+//! 4. `solve` / `pairs`: each body visits its 27 neighbour cells and tests the bodies whose
+//!    entries name one of those cells. A cell's bucket is its x plus a hash of its row
+//!    (y, z), so the three cells of a row are consecutive buckets and one run of entries:
+//!    9 runs per body, and a body that only shares a bucket is skipped by its entry, without
+//!    reading its state (on lavapipe those scattered reads fell out of L2 at 40k bodies:
+//!    docs/gpu.md, "Scaling").
 //!
 //! The cell size is the largest full extent of any dynamic collidable body, so two touching
 //! bodies are never more than one cell apart. Anchored bodies larger than a cell (floors,

@@ -177,6 +177,20 @@ impl GpuPlane {
         self.gpu.as_mut().map(|g| g.pairs(mode))
     }
 
+    /// Turns per-stage timing of GPU ticks on or off (for the benchmark; each stage is then
+    /// submitted and waited for on its own). No effect off the GPU.
+    pub fn set_gpu_stage_timing(&mut self, on: bool) {
+        if let Some(g) = &mut self.gpu {
+            g.set_stage_timing(on);
+        }
+    }
+
+    /// With stage timing on, the wall time (s) of each stage of the last GPU tick
+    /// ([`GpuWorld::stage_times`]); `None` off the GPU.
+    pub fn gpu_stage_times(&self) -> Option<Vec<(&'static str, f64)>> {
+        self.gpu.as_ref().map(|g| g.stage_times().to_vec())
+    }
+
     /// Chooses how the GPU solver finds pairs (for the benchmark's brute-force runs).
     pub fn set_gpu_pair_mode(&mut self, mode: PairMode) {
         if let Some(g) = &mut self.gpu {

@@ -5,6 +5,7 @@
 
 use std::num::NonZeroU64;
 use std::sync::Arc;
+use std::time::Instant;
 
 use bytemuck::{Pod, Zeroable};
 
@@ -123,6 +124,62 @@ pub struct GpuWorld {
     pub max_penetration: f32,
     /// Touching pairs in the last substep of the last tick.
     pub contact_pairs: u32,
+    clock: StageClock,
+}
+
+/// Wall time of each stage of a tick, when on: the step then submits and waits after every
+/// stage (slower than one submission, but each stage's share shows; CPU wall time works on
+/// adapters without timestamp queries, such as lavapipe).
+#[derive(Default)]
+struct StageClock {
+    on: bool,
+    last: Option<Instant>,
+    /// Seconds per stage, summed over the substeps of the last tick, in first-seen order.
+    times: Vec<(&'static str, f64)>,
+}
+
+impl StageClock {
+    fn start(&mut self) {
+        self.times.clear();
+        self.last = self.on.then(Instant::now);
+    }
+
+    /// Charges the time since the last mark to `stage`.
+    fn mark(&mut self, stage: &'static str) {
+        let Some(last) = self.last else {
+            return;
+        };
+        let now = Instant::now();
+        let secs = (now - last).as_secs_f64();
+        match self.times.iter_mut().find(|t| t.0 == stage) {
+            Some(t) => t.1 += secs,
+            None => self.times.push((stage, secs)),
+        }
+        self.last = Some(now);
+    }
+
+    /// When on: submits what `encoder` holds, waits for it, charges the time to `stage`
+    /// and leaves a fresh encoder.
+    fn cut(
+        &mut self,
+        ctx: &Context,
+        encoder: &mut wgpu::CommandEncoder,
+        stage: &'static str,
+    ) -> Result<(), String> {
+        if !self.on {
+            return Ok(());
+        }
+        let done = std::mem::replace(
+            encoder,
+            ctx.device.create_command_encoder(&Default::default()),
+        );
+        ctx.queue.submit([done.finish()]);
+        ctx.device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map_err(|e| format!("the GPU ({}) failed: {e}", ctx.adapter))?;
+        self.mark(stage);
+        Ok(())
+    }
 }
 
 fn usage_storage() -> wgpu::BufferUsages {
@@ -145,7 +202,21 @@ impl GpuWorld {
             mode: PairMode::Hash,
             max_penetration: 0.0,
             contact_pairs: 0,
+            clock: StageClock::default(),
         }
+    }
+
+    /// Turns per-stage timing of the step on or off (see [`GpuWorld::stage_times`]).
+    pub fn set_stage_timing(&mut self, on: bool) {
+        self.clock.on = on;
+    }
+
+    /// With stage timing on, the wall time (s) of each stage of the last step, summed over
+    /// its substeps: `upload`, `forces`, `count` (clearing the buckets and counting),
+    /// `scan`, `scatter`, `solve`, `readback` (copy, map and copy out) and `figures` (the
+    /// CPU pass over the read-back states). Empty when off.
+    pub fn stage_times(&self) -> &[(&'static str, f64)] {
+        &self.clock.times
     }
 
     /// The adapter this world runs on.
@@ -389,7 +460,7 @@ impl GpuWorld {
         let atoms = buffer("atoms", (2 * table as u64 + 4) * 4, usage_storage());
         let index = buffer(
             "index",
-            (table as u64 + capacity as u64) * 4,
+            (table as u64 + 4 * capacity as u64) * 4,
             usage_storage(),
         );
         let lists = buffer("lists", lists_bytes, usage_storage());
@@ -520,7 +591,11 @@ impl GpuWorld {
     }
 
     /// Encodes the hash grid build over the current states.
-    fn encode_grid(&self, encoder: &mut wgpu::CommandEncoder) {
+    fn encode_grid(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        clock: &mut StageClock,
+    ) -> Result<(), String> {
         let b = self.buffers.as_ref().expect("allocated");
         let ctx = &self.ctx;
         let groups = (self.states.len() as u32).div_ceil(WG);
@@ -532,6 +607,7 @@ impl GpuWorld {
             pass.set_pipeline(&ctx.count);
             pass.dispatch_workgroups(groups, 1, 1);
         }
+        clock.cut(ctx, encoder, "count")?;
         encoder.copy_buffer_to_buffer(&b.atoms, 0, &b.index, 0, Some(t));
         {
             let mut pass = encoder.begin_compute_pass(&Default::default());
@@ -547,15 +623,27 @@ impl GpuWorld {
             }
         }
         encoder.copy_buffer_to_buffer(&b.index, 0, &b.atoms, t, Some(t));
-        let mut pass = encoder.begin_compute_pass(&Default::default());
-        pass.set_bind_group(0, &b.bind[self.current], &[]);
-        pass.set_pipeline(&ctx.scatter);
-        pass.dispatch_workgroups(groups, 1, 1);
+        clock.cut(ctx, encoder, "scan")?;
+        {
+            let mut pass = encoder.begin_compute_pass(&Default::default());
+            pass.set_bind_group(0, &b.bind[self.current], &[]);
+            pass.set_pipeline(&ctx.scatter);
+            pass.dispatch_workgroups(groups, 1, 1);
+        }
+        clock.cut(ctx, encoder, "scatter")
     }
 
     /// Advances every body by `step.dt` in `step.substeps` substeps, then reads the states
     /// back.
     pub fn step(&mut self, step: &StepEnv) -> Result<(), String> {
+        let mut clock = std::mem::take(&mut self.clock);
+        clock.start();
+        let stepped = self.step_with(step, &mut clock);
+        self.clock = clock;
+        stepped
+    }
+
+    fn step_with(&mut self, step: &StepEnv, clock: &mut StageClock) -> Result<(), String> {
         self.flush(0)?;
         let n = self.states.len();
         if n == 0 {
@@ -571,15 +659,18 @@ impl GpuWorld {
             .create_command_encoder(&wgpu::CommandEncoderDescriptor {
                 label: Some("gpu-step"),
             });
+        // An empty submission runs the writes flush and the env queued.
+        clock.cut(&ctx, &mut encoder, "upload")?;
         {
             let mut pass = encoder.begin_compute_pass(&Default::default());
             pass.set_bind_group(0, &b.bind[self.current], &[]);
             pass.set_pipeline(&ctx.forces);
             pass.dispatch_workgroups(groups, 1, 1);
         }
+        clock.cut(&ctx, &mut encoder, "forces")?;
         for _ in 0..env.counts[3] {
             if self.mode == PairMode::Hash {
-                self.encode_grid(&mut encoder);
+                self.encode_grid(&mut encoder, clock)?;
             }
             let b = self.buffers.as_ref().expect("allocated");
             {
@@ -588,6 +679,7 @@ impl GpuWorld {
                 pass.set_pipeline(&ctx.solve);
                 pass.dispatch_workgroups(groups, 1, 1);
             }
+            clock.cut(&ctx, &mut encoder, "solve")?;
             self.current = 1 - self.current;
         }
         let b = self.buffers.as_ref().expect("allocated");
@@ -600,6 +692,7 @@ impl GpuWorld {
             bytes,
             bytemuck::cast_slice_mut(&mut self.states),
         )?;
+        clock.mark("readback");
         let (mut deepest, mut touching) = (0.0f32, 0.0f32);
         for s in &self.states {
             deepest = deepest.max(s.pos[3]);
@@ -607,6 +700,7 @@ impl GpuWorld {
         }
         self.max_penetration = deepest;
         self.contact_pairs = (touching / 2.0).round() as u32;
+        clock.mark("figures");
         Ok(())
     }
 
@@ -643,7 +737,7 @@ impl GpuWorld {
         let mut encoder = ctx.device.create_command_encoder(&Default::default());
         encoder.clear_buffer(&b.atoms, 0, None);
         if mode == PairMode::Hash {
-            self.encode_grid(&mut encoder);
+            self.encode_grid(&mut encoder, &mut StageClock::default())?;
         }
         {
             let mut pass = encoder.begin_compute_pass(&Default::default());

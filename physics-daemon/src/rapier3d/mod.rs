@@ -327,6 +327,9 @@ impl Plane {
         self.removed.clear();
         let rehash = moving || self.awake_count() > 0;
         let mut mirror = std::mem::take(&mut self.mirror);
+        if rehash {
+            self.list_moved(&mut mirror.moved);
+        }
         let (figures, hash) = self.figures_and_hash(rehash, &mut mirror);
         self.mirror = mirror;
         (self.clock.max_penetration, self.clock.contact_pairs) = figures;
@@ -370,7 +373,7 @@ impl Plane {
         let (slots, bodies, narrow_phase) =
             (&self.bodies, &self.world.bodies, &self.world.narrow_phase);
         let marks = slots.marks_made();
-        let hash = move || rehash.then(move || mirror.write_and_hash(slots, bodies, marks));
+        let hash = move || rehash.then(move || mirror.rehash(slots, bodies, marks));
         let pairs = narrow_phase.contact_graph().raw_graph().raw_edges().len();
         let work = pairs + if rehash { slots.slot_count() } else { 0 };
         match self.pool_for(work) {
@@ -380,6 +383,24 @@ impl Plane {
             }),
             None => (contacts::contact_figures(narrow_phase, false), hash()),
         }
+    }
+
+    /// The slots this step can have changed without an op marking them, for the pose
+    /// mirror's rehash: the bodies awake before the step (the body pass's list) and after
+    /// it (a body outside both has not moved), and the controllers (their published flags
+    /// change in the controllers' tick).
+    fn list_moved(&self, moved: &mut Vec<u32>) {
+        moved.clear();
+        let bodies = &self.world.bodies;
+        moved.extend(
+            self.pass
+                .handles
+                .iter()
+                .filter_map(|h| bodies.get(*h))
+                .map(|b| b.user_data as u32),
+        );
+        moved.extend(self.awake_slots().map(|s| s as u32));
+        moved.extend(self.controllers.keys().copied());
     }
 
     /// [`StateHasher`] over every slot's state now, in slot order. The tick header carries
