@@ -319,8 +319,11 @@ impl Plane {
             .as_ref()
             .map(|s| *s.user_header());
         let Some((due, period)) = last.and_then(|h| {
-            let due = crate::spin::next_tick_ns(&h)?;
-            Some((due, due - h.tick_end_ns))
+            let mut landing = self.shared.landing.borrow_mut();
+            landing.follow(&h);
+            let due = landing.next_end_ns(&h)?;
+            let period = crate::spin::next_tick_ns(&h)? - h.tick_end_ns;
+            Some((due, period))
         }) else {
             return self.wait_tick_after(seen, timeout, Duration::ZERO);
         };
@@ -337,10 +340,21 @@ impl Plane {
                 // Yield rather than spin: the daemon may need this core to publish.
                 crate::spin::Phase::Poll if !left.is_zero() => std::thread::yield_now(),
                 crate::spin::Phase::Doze(d) if !left.is_zero() => {
-                    self.tick_listener()
-                        .map_err(|e| self.via().0.check_daemon().err().unwrap_or(e))?;
-                    if let Some(l) = self.shared.ticks.borrow().as_ref() {
-                        l.timed_wait(d.min(left).min(LIVENESS_PERIOD));
+                    let d = d.min(left).min(LIVENESS_PERIOD);
+                    if d > crate::spin::COARSE {
+                        // Far from the moment: sleep on the tick event (an early tick wakes
+                        // us), stopping COARSE short of the window.
+                        self.tick_listener()
+                            .map_err(|e| self.via().0.check_daemon().err().unwrap_or(e))?;
+                        if let Some(l) = self.shared.ticks.borrow().as_ref() {
+                            l.timed_wait(d - crate::spin::COARSE);
+                        }
+                    } else {
+                        // The event's timed wait ends on the kernel's coarse socket timer
+                        // (rounded up by milliseconds: past the window, and the tick then
+                        // wakes the reader through the scheduler). A plain sleep ends on
+                        // time.
+                        std::thread::sleep(d);
                     }
                 }
                 // Past the window (or the time is up): the plain wait, which also watches
