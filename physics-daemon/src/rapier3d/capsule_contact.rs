@@ -131,22 +131,11 @@ pub(super) fn capsule_box(
     prediction: f32,
 ) -> Option<Option<Contact>> {
     let to_box = pos12.inverse();
-    let (a_box, b_box) = (to_box * a, to_box * b);
-    let (on_segment, on_box, d2) = segment_box(a_box, b_box, he);
-    if !d2.is_finite() || !on_segment.is_finite() {
-        return None;
-    }
-    let d = d2.sqrt();
-    // Touching or inside: no direction to read from the closest points.
-    if d <= 1.0e-5 * (1.0 + he.max_element()) {
-        return None;
-    }
-    let dist = d - radius;
-    if dist > prediction {
+    let Some((on_segment, on_box, n, dist)) =
+        closest_in_box_frame(to_box * a, to_box * b, radius, he, prediction)?
+    else {
         return Some(None);
-    }
-    // The box's outward normal at its closest point, toward the segment.
-    let n = (on_segment - on_box) / d;
+    };
     Some(Some(Contact::new(
         *pos12 * (on_segment - n * radius),
         on_box,
@@ -169,7 +158,34 @@ pub(super) fn box_capsule(
     he: Vector,
     prediction: f32,
 ) -> Option<Option<Contact>> {
-    let (on_segment, on_box, d2) = segment_box(*pose21 * a, *pose21 * b, he);
+    let Some((on_segment, on_box, n, dist)) =
+        closest_in_box_frame(*pose21 * a, *pose21 * b, radius, he, prediction)?
+    else {
+        return Some(None);
+    };
+    let to_capsule = pose21.inverse();
+    Some(Some(Contact::new(
+        on_box,
+        to_capsule * (on_segment - n * radius),
+        n,
+        to_capsule.rotation * -n,
+        dist,
+    )))
+}
+
+/// The closest points of the capsule (segment `a`–`b` in the box's frame, `radius`) and the
+/// box of half extents `he`, the box's outward normal there (toward the segment) and the
+/// distance: `Some(None)` beyond `prediction`, `None` where the closed form does not apply
+/// (touching or inside: no direction to read from the closest points; non-finite input).
+#[allow(clippy::type_complexity)]
+fn closest_in_box_frame(
+    a: Vector,
+    b: Vector,
+    radius: f32,
+    he: Vector,
+    prediction: f32,
+) -> Option<Option<(Vector, Vector, Vector, f32)>> {
+    let (on_segment, on_box, d2) = segment_box(a, b, he);
     if !d2.is_finite() || !on_segment.is_finite() {
         return None;
     }
@@ -181,15 +197,7 @@ pub(super) fn box_capsule(
     if dist > prediction {
         return Some(None);
     }
-    let n = (on_segment - on_box) / d;
-    let to_capsule = pose21.inverse();
-    Some(Some(Contact::new(
-        on_box,
-        to_capsule * (on_segment - n * radius),
-        n,
-        to_capsule.rotation * -n,
-        dist,
-    )))
+    Some(Some((on_segment, on_box, (on_segment - on_box) / d, dist)))
 }
 
 /// The closest points of the segment `a`–`b` and the solid box `[-he, he]` and their
