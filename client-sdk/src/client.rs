@@ -331,7 +331,7 @@ impl Client {
     /// failure to send, or a failure of the previous flush's request (the daemon gone).
     pub fn flush(&self) -> Result<(), Error> {
         if self.inner.options.refusals_at_next_call {
-            return self.flush_pipelined();
+            return self.send_queues(true);
         }
         self.send_queue()?;
         let mut deferred = self.take_refused(None);
@@ -494,28 +494,24 @@ impl Client {
         });
     }
 
-    /// [`Client::flush`] with [`ConnectOptions::refusals_at_next_call`]: this connection's
-    /// writes and those of the planes that moved to other daemons, each sent without
-    /// waiting.
-    fn flush_pipelined(&self) -> Result<(), Error> {
-        if !self.inner.state.borrow().queue.is_empty() {
-            self.send_pipelined()?;
-        }
-        let peers: Vec<Client> = self.inner.peers.borrow().values().cloned().collect();
-        for peer in peers {
-            peer.flush_pipelined()?;
-        }
-        Ok(())
-    }
-
     /// Sends the queued writes now, if any (their refusals are kept as for any send).
     pub(crate) fn send_queue(&self) -> Result<(), Error> {
+        self.send_queues(false)
+    }
+
+    /// This connection's queued writes and those of the planes that moved to other
+    /// daemons, each as one request: `pipelined`, without waiting for the answers
+    /// ([`Client::flush`] with [`ConnectOptions::refusals_at_next_call`]).
+    fn send_queues(&self, pipelined: bool) -> Result<(), Error> {
         if !self.inner.state.borrow().queue.is_empty() {
-            self.send(Vec::new())?;
+            match pipelined {
+                true => self.send_pipelined()?,
+                false => self.send(Vec::new()).map(|_| ())?,
+            }
         }
         let peers: Vec<Client> = self.inner.peers.borrow().values().cloned().collect();
         for peer in peers {
-            peer.send_queue()?;
+            peer.send_queues(pipelined)?;
         }
         Ok(())
     }

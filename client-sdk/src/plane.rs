@@ -321,9 +321,7 @@ impl Plane {
         let Some((due, period)) = last.and_then(|h| {
             let mut landing = self.shared.landing.borrow_mut();
             landing.follow(&h);
-            let due = landing.next_end_ns(&h)?;
-            let period = crate::spin::next_tick_ns(&h)? - h.tick_end_ns;
-            Some((due, period))
+            Some((landing.next_end_ns(&h)?, crate::spin::period_ns(&h)? as u64))
         }) else {
             return self.wait_tick_after(seen, timeout, Duration::ZERO);
         };

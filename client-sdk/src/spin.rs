@@ -60,12 +60,6 @@ pub enum Phase {
     Sleep,
 }
 
-/// The phase of a wait at `now_ns` for a tick due at `due_ns`, with the fixed window
-/// ([`LEAD`] before, [`TAIL`] after).
-pub fn phase(now_ns: u64, due_ns: u64) -> Phase {
-    phase_in(now_ns, due_ns, Window::default())
-}
-
 /// The phase of a wait at `now_ns` for a tick due at `due_ns`, polling in `window`.
 pub fn phase_in(now_ns: u64, due_ns: u64, window: Window) -> Phase {
     let start = due_ns as i64 - window.lead_ns;
@@ -127,7 +121,7 @@ pub struct Landing {
 }
 
 /// A timer-driven plane's period as its header tells it (its dt), ns.
-fn period_ns(header: &TickHeader) -> Option<f64> {
+pub fn period_ns(header: &TickHeader) -> Option<f64> {
     let dt = header.dt;
     (dt.is_finite() && dt > 0.0).then(|| f64::from(dt) * 1e9)
 }
@@ -351,11 +345,12 @@ mod tests {
         let lead = LEAD.as_nanos() as u64;
         let tail = TAIL.as_nanos() as u64;
         assert_eq!(
-            phase(due - lead - 5_000, due),
+            phase_in(due - lead - 5_000, due, Window::default()),
             Phase::Doze(Duration::from_nanos(5_000))
         );
-        assert_eq!(phase(due - lead, due), Phase::Poll);
-        assert_eq!(phase(due + tail, due), Phase::Poll);
-        assert_eq!(phase(due + tail + 1, due), Phase::Sleep);
+        let fixed = Window::default();
+        assert_eq!(phase_in(due - lead, due, fixed), Phase::Poll);
+        assert_eq!(phase_in(due + tail, due, fixed), Phase::Poll);
+        assert_eq!(phase_in(due + tail + 1, due, fixed), Phase::Sleep);
     }
 }
