@@ -4,7 +4,7 @@
 use std::collections::HashMap;
 
 use iceoryx2::config::Config;
-use iceoryx2::node::NodeView;
+use iceoryx2::node::{NodeCleanupFailure, NodeView};
 use iceoryx2::port::notifier::Notifier;
 use iceoryx2::prelude::*;
 use shm_layout::names;
@@ -178,8 +178,15 @@ impl Clients {
                 node = format!("{id:032x}"),
                 "removing resources of a dead process"
             );
-            if let Err(e) = view.try_remove_stale_resources() {
-                tracing::warn!("cleanup of dead node failed: {e:?}");
+            match view.try_remove_stale_resources() {
+                // The resource guard looks at the same exits: whoever comes second finds the
+                // work done.
+                Ok(_)
+                | Err(
+                    NodeCleanupFailure::ResourcesAlreadyCleanedUp
+                    | NodeCleanupFailure::AnotherInstanceIsCleaningUpTheNode,
+                ) => {}
+                Err(e) => tracing::warn!("cleanup of dead node failed: {e:?}"),
             }
         }
         let gone: Vec<u128> = self

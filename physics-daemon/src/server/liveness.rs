@@ -8,10 +8,15 @@
 //! a client's process looks dead, and otherwise once every [`FULL_CHECK`] (a client that
 //! closed its node but kept its process running, or a reused pid, is found then).
 
-use std::time::{Duration, Instant};
+use std::time::{Duration, Instant, SystemTime};
+
+use super::pidwatch::{folder_stamp, PidWatch};
 
 /// The longest the loop goes without listing nodes while clients are connected.
 pub const FULL_CHECK: Duration = Duration::from_secs(5);
+/// The longest the loop goes without listing nodes when pidfds watch every client and the
+/// node folder did not change.
+pub const SAFETY_NET: Duration = Duration::from_secs(30);
 
 /// Whether process `pid` runs: its `/proc` entry exists and it is not a zombie (a client
 /// killed by its parent shows as one until the parent waits for it). Without `/proc`
@@ -31,25 +36,54 @@ pub fn process_alive(pid: u32) -> bool {
 #[derive(Debug)]
 pub struct Schedule {
     last_full: Instant,
+    /// The clients' processes, watched through pidfds (`pidwatch`).
+    pids: PidWatch,
+    /// The node folder's modification time at the last listing.
+    stamp: Option<SystemTime>,
 }
 
 impl Default for Schedule {
     fn default() -> Self {
         Schedule {
             last_full: Instant::now(),
+            pids: PidWatch::default(),
+            stamp: None,
         }
     }
 }
 
 impl Schedule {
-    /// Whether to list nodes now: some client's process looks dead (`all_alive` false), or
-    /// [`FULL_CHECK`] has passed since the last listing. Records the listing when it says yes.
-    pub fn list_now(&mut self, all_alive: impl FnOnce() -> bool) -> bool {
+    /// Whether to list nodes now; records the listing when it says yes. Yes when a client's
+    /// process exited (its pidfd, or `all_alive` false where pidfds cannot tell), when the
+    /// domain's node folder at `folder` changed (a node came or went: a client that closed
+    /// its node but kept running), or when [`FULL_CHECK`] passed (only [`SAFETY_NET`] where
+    /// pidfds watch every client: a pid cannot be reused under a pidfd).
+    pub fn list_now(
+        &mut self,
+        pids: impl IntoIterator<Item = u32>,
+        folder: &str,
+        all_alive: impl FnOnce() -> bool,
+    ) -> bool {
         let now = Instant::now();
-        if now.duration_since(self.last_full) < FULL_CHECK && all_alive() {
+        self.pids.watch(pids);
+        let stamp = folder_stamp(folder);
+        let exited = self.pids.any_exited();
+        let period = match exited {
+            Some(_) => SAFETY_NET,
+            None => FULL_CHECK,
+        };
+        let quiet = now.duration_since(self.last_full) < period
+            && stamp.is_some()
+            && stamp == self.stamp
+            && match exited {
+                Some(exited) => !exited,
+                None => all_alive(),
+            };
+        if quiet {
             return false;
         }
         self.last_full = now;
+        self.stamp = stamp;
         true
     }
 }
@@ -74,12 +108,45 @@ mod tests {
     }
 
     #[test]
-    fn nodes_are_listed_when_a_process_looks_dead_or_a_period_passed() {
+    fn nodes_are_listed_when_a_process_exits_the_folder_changes_or_a_period_passed() {
+        let dir = std::env::temp_dir().join(format!("liveness-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let folder = dir.to_str().unwrap().to_string();
+        let own = std::process::id();
         let mut s = Schedule::default();
-        assert!(!s.list_now(|| true), "all alive, within the period");
-        assert!(s.list_now(|| false), "a dead-looking process");
+        assert!(
+            s.list_now([own], &folder, || true),
+            "first look: no stamp yet"
+        );
+        assert!(
+            !s.list_now([own], &folder, || true),
+            "all alive, nothing changed"
+        );
+        // A node came: the folder changed (sleep past the file system's time granularity).
+        std::thread::sleep(Duration::from_millis(20));
+        std::fs::write(dir.join("node"), b"").unwrap();
+        assert!(s.list_now([own], &folder, || true), "the folder changed");
+        assert!(!s.list_now([own], &folder, || true), "and is recorded");
+        // A client process exits.
+        let mut child = std::process::Command::new("sleep")
+            .arg("30")
+            .spawn()
+            .unwrap();
+        assert!(!s.list_now([own, child.id()], &folder, || true));
+        child.kill().unwrap();
+        child.wait().unwrap();
+        assert!(
+            s.list_now([own, child.id()], &folder, || true),
+            "a client exited"
+        );
+        // The safety net with pidfds, the short period without.
+        s.last_full = Instant::now() - SAFETY_NET;
+        assert!(s.list_now([own], &folder, || true), "the safety net passed");
         s.last_full = Instant::now() - FULL_CHECK;
-        assert!(s.list_now(|| true), "the period passed");
-        assert!(!s.list_now(|| true), "and a new one started");
+        assert!(
+            !s.list_now([own], &folder, || true),
+            "pidfds watch: no short period"
+        );
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 }

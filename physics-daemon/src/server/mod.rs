@@ -33,6 +33,7 @@ pub mod moves;
 mod named;
 mod origin;
 pub mod persist;
+pub mod pidwatch;
 pub mod quota;
 mod request_bytes;
 pub mod resources;
@@ -546,8 +547,8 @@ impl Daemon {
     }
 
     fn release_gone_clients(&mut self) {
-        // Listing nodes reads every node on the machine: only when a client's process looks
-        // dead, or once a `liveness::FULL_CHECK`.
+        // Listing nodes reads every node of the domain: only when a client's process exited,
+        // a node came or went, or rarely (`liveness::Schedule`).
         let clients = &self.clients;
         let all_alive = || {
             clients.ids().all(|id| {
@@ -556,7 +557,11 @@ impl Daemon {
                     .is_some_and(|c| liveness::process_alive(c.pid))
             })
         };
-        if !self.liveness.list_now(all_alive) {
+        let pids = clients
+            .ids()
+            .filter_map(|id| clients.get(id).map(|c| c.pid));
+        let folder = self.config.global.node_dir().to_string();
+        if !self.liveness.list_now(pids, &folder, all_alive) {
             return;
         }
         for client in self.clients.reap(&self.config) {

@@ -202,6 +202,8 @@ struct Guard {
     /// Nodes of other processes that have not said Hello yet and are not evicted: their
     /// verdict is due at a later look.
     pending_hello: usize,
+    /// The processes of the live nodes last listed (a killed one leaves its node behind).
+    pids: super::pidwatch::PidWatch,
 }
 
 /// A node as the node list shows it.
@@ -238,19 +240,27 @@ impl Guard {
     /// Whether the nodes must be listed this period. Listing reads every node's files (the
     /// most of an idle daemon's CPU when done every period), and what it finds changes only
     /// when a node comes or goes, which changes the domain's node folder. So the nodes are
-    /// listed when that folder changed, while a node's Hello verdict is pending, and at least
-    /// every [`super::liveness::FULL_CHECK`] (a killed process leaves its node behind without
-    /// touching the folder: its resources are removed then).
+    /// listed when that folder changed, while a node's Hello verdict is pending, when the
+    /// process of a listed node exited (a killed process leaves its node behind without
+    /// touching the folder: its resources are removed then; seen through pidfds,
+    /// `super::pidwatch`), and at least every [`super::liveness::SAFETY_NET`]
+    /// ([`super::liveness::FULL_CHECK`] where pidfds cannot watch every such process).
     fn list_nodes_now(&mut self, config: &Config, now: Instant) -> bool {
         let folder = config.global.node_dir().to_string();
-        let stamp = std::fs::metadata(&folder).and_then(|m| m.modified()).ok();
+        let stamp = super::pidwatch::folder_stamp(&folder);
+        let exited = self.pids.any_exited();
+        let period = match exited {
+            Some(_) => super::liveness::SAFETY_NET,
+            None => super::liveness::FULL_CHECK,
+        };
         let due = match self.listed {
             None => true,
             Some((at, seen)) => {
                 self.pending_hello > 0
                     || stamp.is_none()
                     || seen != stamp
-                    || now.duration_since(at) >= super::liveness::FULL_CHECK
+                    || exited == Some(true)
+                    || now.duration_since(at) >= period
             }
         };
         if due {
@@ -293,6 +303,7 @@ impl Guard {
                 tracing::debug!(node = format!("{id:032x}"), "cleanup of a dead node: {e:?}");
             }
         }
+        self.pids.watch(alive.iter().map(|&(_, pid)| pid));
         self.seen
             .retain(|id, _| alive.iter().any(|(n, _)| n.value() == *id));
         self.evicted.retain(|id, at| {

@@ -596,6 +596,8 @@ impl<
             // one channel suffices
             number_of_channels: 1,
             initial_channel_state: CHANNEL_STATE_OPEN,
+            // PATCH(physics-service): see `Sender::slots_in_use`.
+            slots_in_use: AtomicUsize::new(0),
         };
 
         let number_of_to_be_removed_connections = service

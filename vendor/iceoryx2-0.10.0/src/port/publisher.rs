@@ -582,6 +582,8 @@ impl<
                     message_type_details: static_config.message_type_details,
                     number_of_channels: 1,
                     initial_channel_state: CHANNEL_STATE_OPEN,
+                    // PATCH(physics-service): see `Sender::slots_in_use`.
+                    slots_in_use: AtomicUsize::new(0),
                 },
                 config: *config,
                 subscriber_list_state: UnsafeCell::new(unsafe { subscriber_list.get_state() }),

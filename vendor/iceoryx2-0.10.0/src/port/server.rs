@@ -509,6 +509,8 @@ impl<
             message_type_details: static_config.response_message_type_details,
             number_of_channels: number_of_requests_per_client,
             initial_channel_state: CHANNEL_STATE_CLOSED,
+            // PATCH(physics-service): see `Sender::slots_in_use`.
+            slots_in_use: AtomicUsize::new(0),
         };
 
         let shared_state = Service::ArcThreadSafetyPolicy::new(SharedServerState {

@@ -150,6 +150,10 @@ pub(crate) struct Sender<Service: service::Service, Resource: ServiceResource> {
     pub(crate) message_type_details: MessageTypeDetails,
     pub(crate) number_of_channels: usize,
     pub(crate) initial_channel_state: ChannelState,
+    // PATCH(physics-service): one past the highest connection slot ever created; the loops of
+    // every send walk only these slots instead of all `connections` (sized for the service's
+    // maximum receivers, hundreds of mostly empty, cold slots).
+    pub(crate) slots_in_use: AtomicUsize,
 }
 
 impl<Service: service::Service, Resource: ServiceResource> Grow<ShmPointer>
@@ -212,7 +216,7 @@ impl<Service: service::Service, Resource: ServiceResource> Sender<Service, Resou
     }
 
     pub(crate) fn get_connection_id_of(&self, receiver_port_id: u128) -> Option<usize> {
-        for i in 0..self.len() {
+        for i in 0..self.len_in_use() {
             if let Some(connection) = self.get(i)
                 && connection.receiver_port_id == receiver_port_id
             {
@@ -408,7 +412,7 @@ impl<Service: service::Service, Resource: ServiceResource> Sender<Service, Resou
 
         let mut number_of_recipients = 0;
         let mut delivery_error = None;
-        for i in 0..self.len() {
+        for i in 0..self.len_in_use() {
             match self.deliver_offset_to_connection_impl(chunk, channel_id, i) {
                 Ok(n) => number_of_recipients += n,
                 Err(error) => match error {
@@ -462,11 +466,19 @@ impl<Service: service::Service, Resource: ServiceResource> Sender<Service, Resou
             self.initial_channel_state,
         )?);
 
+        // PATCH(physics-service): see `slots_in_use`.
+        self.slots_in_use.fetch_max(index + 1, Ordering::Relaxed);
+
         Ok(())
     }
 
     fn len(&self) -> usize {
         self.connections.len()
+    }
+
+    // PATCH(physics-service): see `slots_in_use`.
+    fn len_in_use(&self) -> usize {
+        self.slots_in_use.load(Ordering::Relaxed).min(self.len())
     }
 
     pub(crate) fn allocate(&self, layout: Layout) -> Result<ChunkMut, LoanError> {
@@ -520,7 +532,7 @@ impl<Service: service::Service, Resource: ServiceResource> Sender<Service, Resou
     }
 
     pub(crate) fn retrieve_returned_chunks(&self) {
-        for i in 0..self.len() {
+        for i in 0..self.len_in_use() {
             if let Some(connection) = self.get(i) {
                 for channel_id in 0..self.number_of_channels {
                     let id = ChannelId::new(channel_id);
@@ -628,7 +640,7 @@ impl<Service: service::Service, Resource: ServiceResource> Sender<Service, Resou
     }
 
     pub(crate) fn finish_update_connection_cycle(&self) {
-        for n in 0..self.len() {
+        for n in 0..self.len_in_use() {
             if let Some(connection) = self.get(n)
                 && !connection.was_tagged_by(&self.tagger)
             {
