@@ -379,6 +379,9 @@ fn run(setup: Setup, file: Option<super::persist::PlaneFile>, jobs: Receiver<Job
                 ops,
                 budget,
             }) => {
+                if let Some(frames) = worker.frames.as_mut() {
+                    frames.request(Instant::now());
+                }
                 let (results, failed) = worker.run_job(ops, budget);
                 report(Event::Done {
                     ticket,
@@ -433,6 +436,8 @@ struct Worker {
     period: Option<Duration>,
     /// When the next automatic tick is due; `None` for manual or disabled planes.
     next_tick: Option<Instant>,
+    /// The phase of the clients' frame ends the schedule moves toward (`frame_phase`).
+    frames: Option<super::frame_phase::FramePhase>,
     /// The plane's file, when it is persistent.
     file: Option<super::persist::PlaneFile>,
     // The node goes last: the ports above are dropped before it.
@@ -495,6 +500,7 @@ fn create(setup: &Setup) -> Result<(Worker, Reply), CommandError> {
             panic_on_step_dt: setup.panic_on_step_dt,
             period: None,
             next_tick: None,
+            frames: None,
             file: None,
             _node: node,
         },
@@ -513,6 +519,7 @@ impl Worker {
         if period != self.period {
             self.period = period;
             self.next_tick = period.and_then(|p| now.checked_add(p));
+            self.frames = period.map(|p| super::frame_phase::FramePhase::new(now, p));
         }
     }
 
@@ -568,6 +575,11 @@ impl Worker {
             now + period
         } else {
             next
+        };
+        // After the clients' frames, when they end at a steady phase.
+        let next = match self.frames.as_mut() {
+            Some(frames) => frames.next_tick(next, now),
+            None => next,
         };
         // A process past its CPU share slows its own planes.
         let ready = self.usage.owner().cpu.charge(now - started, now);
