@@ -15,6 +15,7 @@
 //!
 //! The worker has an iceoryx2 node of its own (ports stay on the thread that made them).
 
+use super::frame_phase::FramePhase;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::mpsc::{Receiver, RecvTimeoutError, Sender};
@@ -93,6 +94,9 @@ pub(super) struct PlaneCell {
     queued: AtomicUsize,
     /// Its tick, whether it changed since its last write, held or destroyed (`persist`).
     pub marks: super::persist::Marks,
+    /// When a timer-driven plane's clients end their frames (`frame_phase`): every run the
+    /// loop gets for the plane is noted here, the worker moves its ticks after them.
+    frames: Mutex<Option<FramePhase>>,
 }
 
 /// What [`PlaneCell::try_apply`] did.
@@ -143,6 +147,9 @@ impl PlaneCell {
         budget: &Budget,
         usage: &SharedUsage,
     ) -> Inline {
+        if let Some(frames) = self.frames().as_mut() {
+            frames.request(Instant::now());
+        }
         if !ops.iter().all(PlaneCell::inline_op) || self.queued.load(Ordering::SeqCst) != 0 {
             return Inline::HandOver(ops);
         }
@@ -193,6 +200,11 @@ impl PlaneCell {
 
     fn lock(&self) -> MutexGuard<'_, Option<Box<dyn Backend>>> {
         self.plane.lock().unwrap_or_else(|p| p.into_inner())
+    }
+
+    /// The phase of the clients' frame ends (`None` while the plane has no timer).
+    fn frames(&self) -> MutexGuard<'_, Option<FramePhase>> {
+        self.frames.lock().unwrap_or_else(|p| p.into_inner())
     }
 
     /// Locks the plane between two ticks once every run handed to its worker is applied
@@ -379,9 +391,6 @@ fn run(setup: Setup, file: Option<super::persist::PlaneFile>, jobs: Receiver<Job
                 ops,
                 budget,
             }) => {
-                if let Some(frames) = worker.frames.as_mut() {
-                    frames.request(Instant::now());
-                }
                 let (results, failed) = worker.run_job(ops, budget);
                 report(Event::Done {
                     ticket,
@@ -436,8 +445,6 @@ struct Worker {
     period: Option<Duration>,
     /// When the next automatic tick is due; `None` for manual or disabled planes.
     next_tick: Option<Instant>,
-    /// The phase of the clients' frame ends the schedule moves toward (`frame_phase`).
-    frames: Option<super::frame_phase::FramePhase>,
     /// The plane's file, when it is persistent.
     file: Option<super::persist::PlaneFile>,
     // The node goes last: the ports above are dropped before it.
@@ -500,7 +507,6 @@ fn create(setup: &Setup) -> Result<(Worker, Reply), CommandError> {
             panic_on_step_dt: setup.panic_on_step_dt,
             period: None,
             next_tick: None,
-            frames: None,
             file: None,
             _node: node,
         },
@@ -519,7 +525,7 @@ impl Worker {
         if period != self.period {
             self.period = period;
             self.next_tick = period.and_then(|p| now.checked_add(p));
-            self.frames = period.map(|p| super::frame_phase::FramePhase::new(now, p));
+            *self.cell.frames() = period.map(|p| FramePhase::new(now, p));
         }
     }
 
@@ -577,7 +583,7 @@ impl Worker {
             next
         };
         // After the clients' frames, when they end at a steady phase.
-        let next = match self.frames.as_mut() {
+        let next = match self.cell.frames().as_mut() {
             Some(frames) => frames.next_tick(next, now),
             None => next,
         };

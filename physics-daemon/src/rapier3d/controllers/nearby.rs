@@ -15,7 +15,7 @@
 //! capsule's contacts with it (most of a tick's work) go straight to the closed form of
 //! `capsule_contact` without asking the shapes what they are.
 
-use std::cell::RefCell;
+use std::cell::{Cell, RefCell};
 
 use rapier3d::parry::bounding_volume::{Aabb, BoundingVolume};
 use rapier3d::parry::query::{
@@ -56,6 +56,9 @@ pub(super) struct Nearby<'a> {
     scene: SceneRefs<'a>,
     own: RigidBodyHandle,
     groups: InteractionGroups,
+    /// What the tick's queries covered so far: every query's volume merged (a candidate
+    /// whose AABB stays outside it cannot change any answer).
+    covered: Cell<Aabb>,
 }
 
 /// The dispatcher of every controller query (see the module docs).
@@ -97,6 +100,7 @@ impl<'a> Nearby<'a> {
             scene,
             own,
             groups,
+            covered: Cell::new(Aabb::new_invalid()),
         };
         nearby.fill();
         nearby
@@ -150,7 +154,21 @@ impl<'a> Nearby<'a> {
         self.scene.colliders[c.handle].shape()
     }
 
-    /// Whether nothing at all is near.
+    /// Merges `aabb` into what the tick's queries covered.
+    pub fn cover(&self, aabb: Aabb) {
+        self.covered.set(self.covered.get().merged(&aabb));
+    }
+
+    /// What the tick's queries covered: the volume of every query asked so far (and what
+    /// [`Nearby::cover`] added). A candidate whose AABB stays outside it, before and after
+    /// a change, answers no query differently (each query prunes by AABB first).
+    pub fn covered(&self) -> Aabb {
+        self.covered.get()
+    }
+
+    /// Whether nothing at all is near. (With nothing near a tick moves by its whole motion;
+    /// with candidates that no query reaches it moves exactly as far, so this answer reads
+    /// nothing that [`Nearby::covered`] must hold.)
     pub fn is_empty(&self) -> bool {
         self.items.is_empty()
     }
@@ -190,6 +208,12 @@ impl<'a> Nearby<'a> {
         // Minkowski sum (parry's own pruning of a composite cast).
         let own = capsule_aabb(capsule, pose);
         let margin = own.half_extents() + Vector::splat(options.target_distance);
+        // The cast's volume: the shape's AABB swept the whole way (a candidate outside it
+        // fails the pruning below).
+        self.cover(
+            own.merged(&own.translated(dir * options.max_time_of_impact))
+                .loosened(options.target_distance),
+        );
         let ray = Ray::new(own.center(), dir);
         let mut best: Option<(ColliderHandle, ShapeCastHit)> = None;
         for c in &self.items {
@@ -241,6 +265,7 @@ impl<'a> Nearby<'a> {
 
     /// The candidates whose AABB meets `aabb`.
     pub fn within(&self, aabb: Aabb) -> impl Iterator<Item = &Candidate> + '_ {
+        self.cover(aabb);
         self.items.iter().filter(move |c| c.aabb.intersects(&aabb))
     }
 

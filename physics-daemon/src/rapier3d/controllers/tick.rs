@@ -6,11 +6,15 @@
 //!
 //! On a plane with a pool (Threads > 1) and enough controllers to share, every controller
 //! first works out its move on the pool from the scene as the last tick left it, reading
-//! the plane only, in tasks of [`PARALLEL_CHUNK`] controllers. A controller whose tick read
-//! nothing a controller before it in slot order changes (no such controller among the
-//! colliders near it, none near it, no dynamic body that one of them also reads) got the
-//! same move it would get in slot order, and commits it; the others are ticked again in
-//! slot order as above. Either way the result is the same.
+//! the plane only, in tasks of [`PARALLEL_CHUNK`] controllers. Each tick records what its
+//! queries covered (the volume of every cast and contact query, its capsule where it starts
+//! and ends: [`Nearby::covered`]) and the dynamic bodies in it. A controller got the same
+//! move it would get in slot order, and commits it, unless a controller before it in slot
+//! order moved with its capsule, where it was or where it went, inside that volume, or
+//! pushed a dynamic body it read; those are ticked again in slot order as above. Either
+//! way the result is the same, bit for bit. The pairs to compare are the controllers whose
+//! covered volumes overlap (a sweep over the volumes sorted along X), and the controllers
+//! ticked again (whose moves changed) are compared with every later one.
 
 use std::collections::HashSet;
 
@@ -35,10 +39,14 @@ pub(super) struct Scene<'a> {
     pub refs: SceneRefs<'a>,
     /// The plane's gravity (Y), for UsePlaneGravity.
     pub gravity_y: f32,
-    /// The bodies of the plane's controllers, when ticks run side by side and must say
-    /// what they read that another controller's commit changes.
-    pub controllers: Option<&'a HashSet<RigidBodyHandle>>,
+    /// Whether ticks run side by side and must say what they read that another
+    /// controller's commit changes (`Outcome::covered`, `Outcome::dynamic`).
+    pub side_by_side: bool,
 }
+
+/// Slack added to every covered volume: the colliders' own AABBs (what a commit changes)
+/// and the queries' volumes are computed apart and may differ by rounding.
+const COVER_SLACK: f32 = 1.0e-3;
 
 /// A controller's tick ready to commit.
 struct Outcome {
@@ -49,10 +57,17 @@ struct Outcome {
     pushes: Vec<Push>,
     /// The controller's state before the tick (to tick it again).
     saved: Saved,
-    /// The other controllers' and the dynamic bodies among the colliders near it (what
-    /// another controller's commit could change under it).
-    shared: Vec<RigidBodyHandle>,
+    /// What the tick's queries covered, its capsule at the start and the end included
+    /// (side by side only; empty otherwise).
+    covered: Aabb,
+    /// The dynamic bodies the tick read (their velocities: pushes, the platform it rides),
+    /// which another controller's push changes (side by side only).
+    dynamic: Vec<RigidBodyHandle>,
 }
+
+/// Where a committed controller's capsule was and went (its colliders' AABBs), when its
+/// pose changed.
+type Moved = Option<(Aabb, Aabb)>;
 
 /// What a controller's tick changes in it, kept to tick it again from the start.
 #[derive(Clone, Copy)]
@@ -119,16 +134,14 @@ impl Plane {
             .flatten();
         let Some(pool) = pool else {
             for (slot, handle, h, c) in work {
-                let o = self.scene(None).tick(slot, handle, h, c, dt);
-                done.push(self.commit_tick(o, dt));
+                let o = self.scene(false).tick(slot, handle, h, c, dt);
+                done.push(self.commit_tick(o, dt).0);
             }
             self.controllers = done.into_iter().collect();
             return;
         };
-        let controller_bodies: HashSet<RigidBodyHandle> =
-            work.iter().map(|(_, _, h, _)| *h).collect();
         let outcomes: Vec<Outcome> = {
-            let scene = self.scene(Some(&controller_bodies));
+            let scene = self.scene(true);
             pool.install(|| {
                 work.into_par_iter()
                     .with_min_len(PARALLEL_CHUNK)
@@ -136,18 +149,23 @@ impl Plane {
                     .collect()
             })
         };
-        // What the controllers before each one in slot order change or read: their own
-        // bodies (their commits move them) and what they read (the controllers near them,
-        // which a commit of theirs may come near; the dynamic bodies they push).
-        let mut touched: HashSet<RigidBodyHandle> = HashSet::new();
-        for o in outcomes {
-            // Only those before it commit before it in slot order: it read the scene they
-            // leave if none of them moved something it read, came near it (then it is among
-            // what they read: the region each tick reads reaches as far beyond its move as
-            // beyond its start) or pushed a body it reads.
-            let again = touched.contains(&o.t.h) || o.shared.iter().any(|b| touched.contains(b));
-            touched.insert(o.t.h);
-            touched.extend(o.shared.iter().copied());
+        let pairs = overlapping_pairs(&outcomes);
+        let mut next_pair = 0;
+        // Where the committed controllers went (by position in slot order), those ticked
+        // again apart (their moves are not the ones the pairs were found from).
+        let mut moved: Vec<Moved> = vec![None; outcomes.len()];
+        let mut moved_again: Vec<(Aabb, Aabb)> = Vec::new();
+        let mut pushed: HashSet<RigidBodyHandle> = HashSet::new();
+        for (j, o) in outcomes.into_iter().enumerate() {
+            let cov = o.covered;
+            let inside = |(was, went): &(Aabb, Aabb)| was.intersects(&cov) || went.intersects(&cov);
+            let mut again =
+                o.dynamic.iter().any(|b| pushed.contains(b)) || moved_again.iter().any(inside);
+            while let Some(&(later, earlier)) = pairs.get(next_pair).filter(|p| p.0 as usize == j) {
+                debug_assert!(later as usize == j);
+                again = again || moved[earlier as usize].as_ref().is_some_and(inside);
+                next_pair += 1;
+            }
             let o = if again {
                 let Outcome {
                     slot,
@@ -157,22 +175,25 @@ impl Plane {
                     ..
                 } = o;
                 saved.restore(&mut controller);
-                let scene = self.scene(Some(&controller_bodies));
-                let o = scene.tick(slot, t.handle, t.h, controller, dt);
-                // What it read ticked again counts for those after it too.
-                touched.extend(o.shared.iter().copied());
-                o
+                self.scene(false).tick(slot, t.handle, t.h, controller, dt)
             } else {
                 o
             };
-            done.push(self.commit_tick(o, dt));
+            pushed.extend(o.pushes.iter().map(|p| p.body));
+            let (entry, m) = self.commit_tick(o, dt);
+            match (again, m) {
+                (true, Some(m)) => moved_again.push(m),
+                (false, m) => moved[j] = m,
+                (true, None) => {}
+            }
+            done.push(entry);
         }
         self.controllers = done.into_iter().collect();
     }
 
-    /// The read-only view a controller's tick works from; `controllers` (the bodies of the
-    /// plane's controllers) when the tick must report what it read that others change.
-    fn scene<'a>(&'a self, controllers: Option<&'a HashSet<RigidBodyHandle>>) -> Scene<'a> {
+    /// The read-only view a controller's tick works from; `side_by_side` when the tick must
+    /// report what it read that others change.
+    fn scene(&self, side_by_side: bool) -> Scene<'_> {
         Scene {
             refs: SceneRefs {
                 broad_phase: &self.world.broad_phase,
@@ -180,14 +201,15 @@ impl Plane {
                 colliders: &self.world.colliders,
             },
             gravity_y: self.settings.gravity[1],
-            controllers,
+            side_by_side,
         }
     }
 
     /// The end of a controller's tick: its pushes, the next kinematic pose (and the
     /// colliders and broad phase, so queries before the step see it where it is going), the
-    /// published flags and the tick's events. Returns the controller, for the plane's map.
-    fn commit_tick(&mut self, o: Outcome, dt: f32) -> (u32, Controller) {
+    /// published flags and the tick's events. Returns the controller, for the plane's map,
+    /// and where its capsule was and went when its pose changed.
+    fn commit_tick(&mut self, o: Outcome, dt: f32) -> ((u32, Controller), Moved) {
         let Outcome {
             slot,
             controller: mut c,
@@ -215,10 +237,14 @@ impl Plane {
         let next_pose = rapier3d::math::Pose::from_parts(next, yaw_rotation(c.yaw));
         self.world.bodies[h].set_next_kinematic_position(next_pose);
         let world = &mut self.world;
+        let (mut was, mut went, mut changed) = (Aabb::new_invalid(), Aabb::new_invalid(), false);
         for col in world.bodies[h].colliders() {
             if let Some(co) = world.colliders.get_mut(*col) {
+                changed |= !same_pose(co.position(), &next_pose);
+                was.merge(&co.compute_aabb());
                 co.set_position(next_pose);
                 let aabb = co.compute_aabb();
+                went.merge(&aabb);
                 world
                     .broad_phase
                     .set_aabb(&world.integration_parameters, *col, aabb);
@@ -243,8 +269,42 @@ impl Plane {
                 ..EventRecord::default()
             });
         }
-        (slot, c)
+        ((slot, c), changed.then_some((was, went)))
     }
+}
+
+/// Whether `a` and `b` are the same pose bit for bit (a query's answer can change with the
+/// last bit of either).
+fn same_pose(a: &rapier3d::math::Pose, b: &rapier3d::math::Pose) -> bool {
+    let bits = |p: &rapier3d::math::Pose| {
+        let (t, r) = (p.translation, p.rotation);
+        [t.x, t.y, t.z, r.x, r.y, r.z, r.w].map(f32::to_bits)
+    };
+    bits(a) == bits(b)
+}
+
+/// The pairs (later, earlier), as positions in slot order, of outcomes whose covered volumes
+/// overlap, sorted by the later one: a sweep along X over the volumes sorted by their start.
+fn overlapping_pairs(outcomes: &[Outcome]) -> Vec<(u32, u32)> {
+    let mut order: Vec<u32> = (0..outcomes.len() as u32).collect();
+    let min_x = |i: u32| outcomes[i as usize].covered.mins.x;
+    order.sort_unstable_by(|a, b| min_x(*a).total_cmp(&min_x(*b)));
+    let mut pairs = Vec::new();
+    for (k, &a) in order.iter().enumerate() {
+        let box_a = &outcomes[a as usize].covered;
+        for &b in &order[k + 1..] {
+            let box_b = &outcomes[b as usize].covered;
+            // NaN or beyond: nothing later in X order starts inside this one.
+            if !(box_b.mins.x <= box_a.maxs.x) {
+                break;
+            }
+            if box_a.intersects(box_b) {
+                pairs.push((a.max(b), a.min(b)));
+            }
+        }
+    }
+    pairs.sort_unstable();
+    pairs
 }
 
 impl<'a> Scene<'a> {
@@ -268,17 +328,10 @@ impl<'a> Scene<'a> {
         c.turn_toward(motion.v, dt);
         c.follow_path(next, &mut t.events);
         c.velocity = motion.v;
-        let shared = match self.controllers {
-            Some(controllers) => nearby
-                .items
-                .iter()
-                .filter_map(|n| n.parent)
-                .filter(|b| {
-                    controllers.contains(b)
-                        || self.refs.bodies.get(*b).is_some_and(|rb| rb.is_dynamic())
-                })
-                .collect(),
-            None => Vec::new(),
+        let (covered, dynamic) = if self.side_by_side {
+            self.what_it_read(&c, &saved, &t, next, &nearby)
+        } else {
+            (Aabb::new_invalid(), Vec::new())
         };
         Outcome {
             slot,
@@ -287,8 +340,41 @@ impl<'a> Scene<'a> {
             next,
             pushes,
             saved,
-            shared,
+            covered,
+            dynamic,
         }
+    }
+
+    /// What a tick that ends at `next` read that another controller's commit can change:
+    /// the volume its queries covered (with its capsule where it started and ends, and some
+    /// slack) and the dynamic bodies within it or under it at the start.
+    fn what_it_read(
+        &self,
+        c: &Controller,
+        saved: &Saved,
+        t: &TickState,
+        next: Vector,
+        nearby: &Nearby<'_>,
+    ) -> (Aabb, Vec<RigidBodyHandle>) {
+        let at = |p: Vector| rapier3d::math::Pose::from_parts(p, yaw_rotation(c.yaw));
+        let start = capsule_aabb(&t.shape, &at(t.start));
+        let end = capsule_aabb(&t.shape, &at(next));
+        let covered = nearby
+            .covered()
+            .merged(&start)
+            .merged(&end)
+            .loosened(COVER_SLACK);
+        let bodies = self.refs.bodies;
+        let is_dynamic = |b: &RigidBodyHandle| bodies.get(*b).is_some_and(|rb| rb.is_dynamic());
+        let mut dynamic: Vec<RigidBodyHandle> = nearby
+            .items
+            .iter()
+            .filter(|n| n.aabb.intersects(&covered))
+            .filter_map(|n| n.parent)
+            .filter(is_dynamic)
+            .collect();
+        dynamic.extend(saved.ground.map(|g| g.body).filter(is_dynamic));
+        (covered, dynamic)
     }
 
     /// What the stages share: the controller's body, its capsule, its collision groups, its
