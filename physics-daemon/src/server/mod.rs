@@ -25,7 +25,6 @@ pub mod clients;
 mod dispatch;
 pub mod fair;
 pub mod files;
-pub mod frame_phase;
 pub mod gauge;
 pub mod heartbeat;
 pub mod limits;

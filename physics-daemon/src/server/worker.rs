@@ -15,7 +15,6 @@
 //!
 //! The worker has an iceoryx2 node of its own (ports stay on the thread that made them).
 
-use super::frame_phase::FramePhase;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::mpsc::{Receiver, RecvTimeoutError, Sender};
@@ -94,9 +93,6 @@ pub(super) struct PlaneCell {
     queued: AtomicUsize,
     /// Its tick, whether it changed since its last write, held or destroyed (`persist`).
     pub marks: super::persist::Marks,
-    /// When a timer-driven plane's clients end their frames (`frame_phase`): every run the
-    /// loop gets for the plane is noted here, the worker moves its ticks after them.
-    frames: Mutex<Option<FramePhase>>,
 }
 
 /// What [`PlaneCell::try_apply`] did.
@@ -147,9 +143,6 @@ impl PlaneCell {
         budget: &Budget,
         usage: &SharedUsage,
     ) -> Inline {
-        if let Some(frames) = self.frames().as_mut() {
-            frames.request(Instant::now());
-        }
         if !ops.iter().all(PlaneCell::inline_op) || self.queued.load(Ordering::SeqCst) != 0 {
             return Inline::HandOver(ops);
         }
@@ -200,11 +193,6 @@ impl PlaneCell {
 
     fn lock(&self) -> MutexGuard<'_, Option<Box<dyn Backend>>> {
         self.plane.lock().unwrap_or_else(|p| p.into_inner())
-    }
-
-    /// The phase of the clients' frame ends (`None` while the plane has no timer).
-    fn frames(&self) -> MutexGuard<'_, Option<FramePhase>> {
-        self.frames.lock().unwrap_or_else(|p| p.into_inner())
     }
 
     /// Locks the plane between two ticks once every run handed to its worker is applied
@@ -525,7 +513,6 @@ impl Worker {
         if period != self.period {
             self.period = period;
             self.next_tick = period.and_then(|p| now.checked_add(p));
-            *self.cell.frames() = period.map(|p| FramePhase::new(now, p));
         }
     }
 
@@ -581,11 +568,6 @@ impl Worker {
             now + period
         } else {
             next
-        };
-        // After the clients' frames, when they end at a steady phase.
-        let next = match self.cell.frames().as_mut() {
-            Some(frames) => frames.next_tick(next, now),
-            None => next,
         };
         // A process past its CPU share slows its own planes.
         let ready = self.usage.owner().cpu.charge(now - started, now);
