@@ -6,7 +6,8 @@
 //! the `Threads` it uses.
 //!
 //! Each worker of a pool is pinned to a core of its own (among the cores the daemon may run
-//! on, pools taking turns), as game engines pin their job threads. Unpinned, a worker woken
+//! on, pools taking turns, each daemon process starting at a core of its own), as game
+//! engines pin their job threads. Unpinned, a worker woken
 //! for a parallel phase is placed by Linux on the core of the thread that woke it (which
 //! then goes on working), and waits there for a millisecond or more until the scheduler
 //! moves it: measured with 1,000 controllers on a 2-core machine, the second worker of a
@@ -43,9 +44,10 @@ pub fn shared(n: u32) -> Result<Arc<rayon::ThreadPool>, rayon::ThreadPoolBuildEr
     }
     let allowed = allowed_cores();
     // Pools take turns over the cores: the next pool's first worker goes where this one's
-    // last did not.
+    // last did not. Daemons of other domains on the machine start elsewhere (by process id),
+    // so their pools do not all crowd the first cores.
     static NEXT: AtomicUsize = AtomicUsize::new(0);
-    let first = NEXT.fetch_add(n as usize, Ordering::Relaxed);
+    let first = NEXT.fetch_add(n as usize, Ordering::Relaxed) + std::process::id() as usize;
     let pin = (n > 1 && n as usize <= allowed.len()).then_some((allowed, first));
     let pool = Arc::new(
         rayon::ThreadPoolBuilder::new()
