@@ -7,12 +7,12 @@
 //!
 //! Each worker of a pool is pinned to a core of its own (among the cores the daemon may run
 //! on, pools taking turns, each daemon process starting at a core of its own), as game
-//! engines pin their job threads. Unpinned, a worker woken
-//! for a parallel phase is placed by Linux on the core of the thread that woke it (which
-//! then goes on working), and waits there for a millisecond or more until the scheduler
-//! moves it: measured with 1,000 controllers on a 2-core machine, the second worker of a
-//! Threads = 2 plane started its first task 0.85–1.2 ms into a 1.5 ms phase or not at all,
-//! against 45–80 µs pinned. A pool with more threads than those cores is not pinned.
+//! engines pin their job threads. Unpinned, a worker woken for a parallel phase is placed
+//! by Linux on the core of the thread that woke it (which then goes on working), and waits
+//! there for a millisecond or more until the scheduler moves it: measured with 1,000
+//! controllers on a 2-core machine, the second worker of a Threads = 2 plane started its
+//! first task 0.85–1.2 ms into a 1.5 ms phase or not at all, against 15–80 µs pinned. A pool
+//! with more threads than those cores is not pinned.
 
 use std::collections::HashMap;
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -66,7 +66,7 @@ pub fn shared(n: u32) -> Result<Arc<rayon::ThreadPool>, rayon::ThreadPoolBuildEr
 }
 
 /// The cores this thread may run on (its affinity mask), in order; empty when unknown.
-pub fn allowed_cores() -> Vec<usize> {
+fn allowed_cores() -> Vec<usize> {
     // SAFETY: a zeroed cpu_set_t is a valid empty set, and sched_getaffinity writes at most
     // the size it is given.
     unsafe {

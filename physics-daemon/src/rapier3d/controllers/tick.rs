@@ -135,7 +135,7 @@ impl Plane {
         let Some(pool) = pool else {
             for (slot, handle, h, c) in work {
                 let o = self.scene(false).tick(slot, handle, h, c, dt);
-                done.push(self.commit_tick(o, dt).0);
+                done.push(self.commit_tick(o, dt, false).0);
             }
             self.controllers = done.into_iter().collect();
             return;
@@ -161,8 +161,7 @@ impl Plane {
             let inside = |(was, went): &(Aabb, Aabb)| was.intersects(&cov) || went.intersects(&cov);
             let mut again =
                 o.dynamic.iter().any(|b| pushed.contains(b)) || moved_again.iter().any(inside);
-            while let Some(&(later, earlier)) = pairs.get(next_pair).filter(|p| p.0 as usize == j) {
-                debug_assert!(later as usize == j);
+            while let Some(&(_, earlier)) = pairs.get(next_pair).filter(|p| p.0 as usize == j) {
                 again = again || moved[earlier as usize].as_ref().is_some_and(inside);
                 next_pair += 1;
             }
@@ -180,7 +179,7 @@ impl Plane {
                 o
             };
             pushed.extend(o.pushes.iter().map(|p| p.body));
-            let (entry, m) = self.commit_tick(o, dt);
+            let (entry, m) = self.commit_tick(o, dt, true);
             match (again, m) {
                 (true, Some(m)) => moved_again.push(m),
                 (false, m) => moved[j] = m,
@@ -208,8 +207,9 @@ impl Plane {
     /// The end of a controller's tick: its pushes, the next kinematic pose (and the
     /// colliders and broad phase, so queries before the step see it where it is going), the
     /// published flags and the tick's events. Returns the controller, for the plane's map,
-    /// and where its capsule was and went when its pose changed.
-    fn commit_tick(&mut self, o: Outcome, dt: f32) -> ((u32, Controller), Moved) {
+    /// and, when `track` (ticks side by side), where its capsule was and went if its pose
+    /// changed.
+    fn commit_tick(&mut self, o: Outcome, dt: f32, track: bool) -> ((u32, Controller), Moved) {
         let Outcome {
             slot,
             controller: mut c,
@@ -240,8 +240,10 @@ impl Plane {
         let (mut was, mut went, mut changed) = (Aabb::new_invalid(), Aabb::new_invalid(), false);
         for col in world.bodies[h].colliders() {
             if let Some(co) = world.colliders.get_mut(*col) {
-                changed |= !same_pose(co.position(), &next_pose);
-                was.merge(&co.compute_aabb());
+                if track && !same_pose(co.position(), &next_pose) {
+                    changed = true;
+                    was.merge(&co.compute_aabb());
+                }
                 co.set_position(next_pose);
                 let aabb = co.compute_aabb();
                 went.merge(&aabb);
@@ -695,39 +697,31 @@ mod tests {
     fn crowd(threads: u32, seed: u64, n: usize, ticks: usize) -> (Vec<u64>, Vec<[u32; 3]>) {
         let mut plane =
             Plane::new(1, &[PlaneProp::TickRate(0.0), PlaneProp::Threads(threads)]).unwrap();
-        plane
-            .add_object(
-                &Shape::Cube {
-                    size: [200.0, 1.0, 200.0],
-                },
-                Pose::at([0.0, -0.5, 0.0]),
-                &[ObjectProp::Anchored(true)],
-            )
-            .unwrap();
+        let mut cube = |size: [f32; 3], at: [f32; 3], anchored: bool| {
+            plane
+                .add_object(
+                    &Shape::Cube { size },
+                    Pose::at(at),
+                    &[ObjectProp::Anchored(anchored)],
+                )
+                .unwrap();
+        };
+        cube([200.0, 1.0, 200.0], [0.0, -0.5, 0.0], true);
         let mut rng = Rng(seed);
         for _ in 0..6 {
-            let at = [rng.next() * 30.0 - 15.0, 1.0, rng.next() * 30.0 - 15.0];
-            plane
-                .add_object(
-                    &Shape::Cube {
-                        size: [2.0, 2.0, 2.0],
-                    },
-                    Pose::at(at),
-                    &[ObjectProp::Anchored(true)],
-                )
-                .unwrap();
+            cube(
+                [2.0; 3],
+                [rng.next() * 30.0 - 15.0, 1.0, rng.next() * 30.0 - 15.0],
+                true,
+            );
         }
+        // Light crates the controllers push.
         for _ in 0..8 {
-            let at = [rng.next() * 24.0 - 12.0, 0.5, rng.next() * 24.0 - 12.0];
-            plane
-                .add_object(
-                    &Shape::Cube {
-                        size: [1.0, 1.0, 1.0],
-                    },
-                    Pose::at(at),
-                    &[],
-                )
-                .unwrap();
+            cube(
+                [1.0; 3],
+                [rng.next() * 24.0 - 12.0, 0.5, rng.next() * 24.0 - 12.0],
+                false,
+            );
         }
         let side = (n as f32).sqrt().ceil() as usize;
         let mut handles = Vec::new();
@@ -778,6 +772,11 @@ mod tests {
 
     #[test]
     fn a_crowd_ticked_side_by_side_matches_slot_order_bit_for_bit() {
+        // One core: Threads = 2 is capped to 1 and nothing runs side by side to compare.
+        if crate::backend::pools::cores() < 2 {
+            eprintln!("one core: no pool, nothing to compare");
+            return;
+        }
         for seed in [1, 42] {
             let (one, one_poses) = crowd(1, seed, 144, 60);
             let (two, two_poses) = crowd(2, seed, 144, 60);
