@@ -55,11 +55,14 @@ impl Object {
 
     /// The current position and rotation.
     pub fn pose(&self) -> Result<Pose, Error> {
-        let s = self.state()?;
-        Ok(Pose {
-            position: s.position,
-            rotation: s.rotation,
-        })
+        match self.plane.pose(self.handle)? {
+            Some(pose) => Ok(pose),
+            // The same error `state` gives.
+            None => self.state().map(|s| Pose {
+                position: s.position,
+                rotation: s.rotation,
+            }),
+        }
     }
 
     /// The current position.

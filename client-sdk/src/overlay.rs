@@ -143,6 +143,12 @@ impl Overlay {
         self.entries.get(&handle)
     }
 
+    /// Whether a write on `handle` may still wait for its tick (its reads then need
+    /// [`Overlay::get`]).
+    pub fn has(&self, handle: Handle) -> bool {
+        !self.entries.is_empty() && self.entries.contains_key(&handle)
+    }
+
     #[cfg(test)]
     pub fn is_empty(&self) -> bool {
         self.entries.is_empty()

@@ -28,10 +28,25 @@ type TouchContact<'a> = (
     bool,
 );
 
+thread_local! {
+    /// Counts every change that can change whether a plane's parts have touch handlers (a
+    /// part's Touched / TouchEnded handlers connected or gone, a part added to or removed
+    /// from a plane): a plane asks its parts again only after one.
+    static TOUCH_EPOCH: Cell<u64> = const { Cell::new(0) };
+}
+
+/// A part's touch handlers, or a plane's parts, changed (see `TOUCH_EPOCH`).
+pub(crate) fn touch_handlers_changed() {
+    TOUCH_EPOCH.with(|e| e.set(e.get().wrapping_add(1)));
+}
+
 /// Per plane: whether events are being read, and the `EventsLost` signal.
 pub struct ContactPump {
     /// True while some part of the plane has touch handlers (events are drained each frame).
     reading: Cell<bool>,
+    /// Whether a part had touch handlers, as of a `TOUCH_EPOCH` (so a frame with nothing
+    /// changed does not ask every part again).
+    parts_listen: Cell<Option<(u64, bool)>>,
     /// `plane.EventsLost`, created on first access.
     lost: RefCell<Option<Signal>>,
     /// `joint.Broke` of the joints whose signal was read, by joint handle.
@@ -42,6 +57,7 @@ impl Default for ContactPump {
     fn default() -> Self {
         ContactPump {
             reading: Cell::new(false),
+            parts_listen: Cell::new(None),
             lost: RefCell::new(None),
             broke: RefCell::default(),
         }
@@ -112,7 +128,16 @@ impl PlaneState {
     /// Whether anyone listens to the plane's events: a part's touch handlers, a
     /// controller's signals or a joint's Broke.
     fn touch_handlers(&self) -> bool {
-        self.any_part(|p| p.touch_listeners() > 0)
+        let epoch = TOUCH_EPOCH.with(Cell::get);
+        let parts = match self.contacts.parts_listen.get() {
+            Some((seen, listen)) if seen == epoch => listen,
+            _ => {
+                let listen = self.any_part(|p| p.touch_listeners() > 0);
+                self.contacts.parts_listen.set(Some((epoch, listen)));
+                listen
+            }
+        };
+        parts
             || self.controller_listeners()
             || self
                 .contacts

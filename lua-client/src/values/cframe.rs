@@ -111,14 +111,8 @@ impl CFrameCache {
 impl CFrame {
     /// Whether both hold the same bits (unlike `==`, tells -0 from 0, as `tostring` does).
     pub fn same_bits(&self, other: &CFrame) -> bool {
-        let bits = |cf: &CFrame| {
-            let mut b = [0u32; 7];
-            for (i, c) in cf.position.iter().chain(&cf.rotation).enumerate() {
-                b[i] = c.to_bits();
-            }
-            b
-        };
-        bits(self) == bits(other)
+        let same = |a: &[f32], b: &[f32]| a.iter().zip(b).all(|(a, b)| a.to_bits() == b.to_bits());
+        same(&self.position, &other.position) && same(&self.rotation, &other.rotation)
     }
 
     /// The CFrame `value` holds, if it is one.

@@ -246,6 +246,8 @@ pub struct PartState {
     cframe_value: CFrameCache,
     /// The pose of the value `part.CFrame` last handed out (see `pose_index`).
     handed_out: Cell<Option<CFrame>>,
+    /// The address of the BasePart value the pose index knows it by (0: none yet).
+    pub(crate) pose_key: Cell<usize>,
     /// Added anchored (`Renderable.Plane`, `Renderable.Brush`: static shapes).
     anchor_on_add: Cell<bool>,
     /// The ragdoll bone the part is (hits on it name the bone).
@@ -270,6 +272,7 @@ impl PartState {
             mesh: RefCell::new(None),
             cframe_value: CFrameCache::default(),
             handed_out: Cell::new(None),
+            pose_key: Cell::new(0),
             anchor_on_add: Cell::new(false),
             bone: RefCell::new(None),
         }
@@ -449,6 +452,7 @@ impl PartState {
         if created {
             let part = Rc::downgrade(self);
             signal.on_listeners(move |_| {
+                crate::api::contacts::touch_handlers_changed();
                 if let Some(part) = part.upgrade() {
                     part.sync_contact_reports();
                 }
