@@ -428,6 +428,71 @@ fn nodes_that_never_say_hello_are_evicted() {
     serves_on(&mut daemon, &survivor);
 }
 
+/// How often the threads of process `pid` have gone to sleep and woken (the sum of their
+/// voluntary context switches).
+fn wake_ups(pid: u32) -> u64 {
+    let tasks = std::fs::read_dir(format!("/proc/{pid}/task")).expect("the daemon's threads");
+    tasks
+        .filter_map(|t| std::fs::read_to_string(t.ok()?.path().join("status")).ok())
+        .filter_map(|status| {
+            status
+                .lines()
+                .find_map(|l| l.strip_prefix("voluntary_ctxt_switches:"))
+                .and_then(|v| v.trim().parse::<u64>().ok())
+        })
+        .sum()
+}
+
+/// The clients (ports) of the control service of `domain`, as the daemon's guard sees them.
+fn control_ports(domain: &str) -> usize {
+    let config = names::config(domain).unwrap();
+    let node = NodeBuilder::new()
+        .config(&config)
+        .signal_handling_mode(SignalHandlingMode::Disabled)
+        .create::<ipc::Service>()
+        .unwrap();
+    let control = node
+        .service_builder(&names::control())
+        .request_response::<[u8], [u8]>()
+        .request_user_header::<u128>()
+        .open()
+        .unwrap();
+    control.dynamic_config().number_of_clients()
+}
+
+#[test]
+fn an_idle_daemon_sleeps_until_a_process_joins_its_domain() {
+    let daemon = TestDaemon::start_with("idle-guard", &["--hello-timeout-ms", "1000"], &[]);
+    // The readiness check's client goes; the guard looks once more, then has nothing to cap.
+    std::thread::sleep(Duration::from_secs(2));
+    let before = wake_ups(daemon.pid());
+    std::thread::sleep(Duration::from_secs(4));
+    let woke = wake_ups(daemon.pid()) - before;
+    // A resource guard looking every 500 ms wakes 8 times in 4 s; with no other process in
+    // the domain there is nothing to look at (the loop and the heartbeat sleep too).
+    assert!(
+        woke <= 2,
+        "a daemon without clients woke {woke} times in 4 s"
+    );
+
+    // Sleeping, it still sees a process that joins: nodes that never say Hello are evicted
+    // after --hello-timeout-ms (1 s) and a guard period, as when it was awake.
+    let _few = Hoarder::start(&["nodes", &daemon.domain, "4"]);
+    let started = Instant::now();
+    let mut last = control_ports(&daemon.domain);
+    assert!(last >= 4, "the hoarder's 4 ports are listed: {last}");
+    time_until(Duration::from_secs(20), || {
+        last = control_ports(&daemon.domain);
+        (last == 0).then_some(())
+    })
+    .unwrap_or_else(|| panic!("the nodes without Hello were not evicted: {last} ports held"));
+    assert!(
+        started.elapsed() >= Duration::from_millis(900),
+        "evicted before the Hello timeout: {:?}",
+        started.elapsed()
+    );
+}
+
 #[test]
 fn one_process_cannot_hold_a_planes_reader_slots() {
     let mut daemon = TestDaemon::start("hostile-readers");

@@ -25,6 +25,7 @@ pub mod clients;
 mod dispatch;
 pub mod fair;
 pub mod files;
+pub mod folder_watch;
 pub mod gauge;
 pub mod heartbeat;
 pub mod limits;

@@ -5,7 +5,9 @@
 //! could fill the control service (`ExceedsMaxNumberOfNodes` for everyone after).
 //!
 //! A thread of its own (with its own node, so the request loop never waits for it) looks at
-//! who holds what every [`PERIOD`] and evicts the excess: it removes
+//! who holds what every [`PERIOD`] while any other process has a node in the domain (with
+//! none there is nothing to cap, and it sleeps until the domain's node folder changes:
+//! [`super::folder_watch`]) and evicts the excess: it removes
 //! the offending node from the service, exactly as it removes a dead process's node (its
 //! ports there, their connections and data segments; iceoryx2's slots are owner-tagged, so
 //! the evicted process cannot later release a slot someone else got). The evicted process
@@ -33,6 +35,7 @@ use iceoryx2::service::internal::ServiceInternal;
 use iceoryx2::service::service_hash::ServiceHash;
 use shm_layout::{names, BodyState, EventRecord, PlaneId, TickHeader};
 
+use super::folder_watch::{FolderWatch, Wake};
 use super::origin::ControlService;
 use super::Limits;
 use crate::DaemonError;
@@ -78,10 +81,23 @@ pub struct Eviction {
 
 /// What the request loop tells the guard thread: who said Hello, which planes exist, and
 /// when to stop.
-#[derive(Debug, Default)]
+#[derive(Debug)]
 pub struct Watch {
     state: Mutex<WatchState>,
     changed: Condvar,
+    /// Ends the guard's wait at once on stop (`None`: the system gave no eventfd; the guard
+    /// then waits on `changed` a period at a time).
+    wake: Option<Wake>,
+}
+
+impl Default for Watch {
+    fn default() -> Self {
+        Watch {
+            state: Mutex::default(),
+            changed: Condvar::new(),
+            wake: Wake::new(),
+        }
+    }
 }
 
 #[derive(Debug, Default)]
@@ -110,19 +126,49 @@ impl Watch {
             state.stop = true;
             self.changed.notify_all();
         }
-    }
-
-    /// Waits one period; false once stopped.
-    fn wait(&self) -> bool {
-        let Ok(state) = self.state.lock() else {
-            return false;
-        };
-        match self.changed.wait_timeout_while(state, PERIOD, |s| !s.stop) {
-            Ok((state, _)) => !state.stop,
-            Err(_) => false,
+        if let Some(wake) = &self.wake {
+            wake.wake();
         }
     }
+
+    fn stopped(&self) -> bool {
+        self.state.lock().map_or(true, |s| s.stop)
+    }
+
+    /// Waits one period, or while `quiet` until `folder` changes (at most [`QUIET_LOOK`]).
+    /// Returns `None` once stopped, else whether the folder changed.
+    fn wait(&self, quiet: bool, folder: Option<&FolderWatch>) -> Option<bool> {
+        if self.stopped() {
+            return None;
+        }
+        let changed = match (&self.wake, folder) {
+            (Some(wake), Some(folder)) if quiet => {
+                super::folder_watch::wait(wake, Some(folder), QUIET_LOOK)
+            }
+            (Some(wake), folder) => {
+                super::folder_watch::wait(wake, None, PERIOD);
+                folder.is_some_and(FolderWatch::drain)
+            }
+            (None, folder) => {
+                let state = self.state.lock().ok()?;
+                let (state, _) = self
+                    .changed
+                    .wait_timeout_while(state, PERIOD, |s| !s.stop)
+                    .ok()?;
+                if state.stop {
+                    return None;
+                }
+                drop(state);
+                folder.is_some_and(FolderWatch::drain)
+            }
+        };
+        (!self.stopped()).then_some(changed)
+    }
 }
+
+/// The longest a quiet guard sleeps without a change in the node folder: a safety net, as
+/// the loop's own listing ([`super::liveness::SAFETY_NET`]).
+const QUIET_LOOK: Duration = super::liveness::SAFETY_NET;
 
 /// Runs the guard until `watch` says stop. Errors are logged: without the guard the daemon
 /// still serves (only without the caps).
@@ -143,7 +189,17 @@ fn guard(config: &Config, limits: &Limits, watch: &Watch) -> Result<(), DaemonEr
         .map_err(|e| ipc("node", &e))?;
     let mut control: Option<ControlService> = None;
     let mut guard = Guard::default();
-    while watch.wait() {
+    // Watched from before the first listing, so no node created after it goes unnoticed.
+    let folder_path = config.global.node_dir().to_string();
+    let mut folder = FolderWatch::new(&folder_path);
+    let mut quiet = false;
+    while let Some(changed) = watch.wait(quiet, folder.as_ref()) {
+        guard.folder_changed |= changed;
+        if !folder.as_ref().is_some_and(FolderWatch::is_live) {
+            // Removed and made again (or never watched): watch it anew, and look.
+            folder = FolderWatch::new(&folder_path);
+            guard.folder_changed = true;
+        }
         // The loop creates the control service after this thread starts.
         if control.is_none() {
             control = node
@@ -184,6 +240,13 @@ fn guard(config: &Config, limits: &Limits, watch: &Watch) -> Result<(), DaemonEr
                 "resource caps enforced"
             );
         }
+        // Nothing to cap while no other process has a node in the domain (every port
+        // belongs to a node; a client gone since the loop last said who is connected has
+        // no node either): sleep until the node folder changes.
+        quiet = folder.as_ref().is_some_and(FolderWatch::is_live)
+            && guard.seen.is_empty()
+            && guard.pending_hello == 0
+            && guard.listed.is_some();
     }
     Ok(())
 }
@@ -204,6 +267,8 @@ struct Guard {
     pending_hello: usize,
     /// The processes of the live nodes last listed (a killed one leaves its node behind).
     pids: super::pidwatch::PidWatch,
+    /// The node folder changed since the last listing (its watch woke the guard).
+    folder_changed: bool,
 }
 
 /// A node as the node list shows it.
@@ -256,7 +321,8 @@ impl Guard {
         let due = match self.listed {
             None => true,
             Some((at, seen)) => {
-                self.pending_hello > 0
+                std::mem::take(&mut self.folder_changed)
+                    || self.pending_hello > 0
                     || stamp.is_none()
                     || seen != stamp
                     || exited == Some(true)
