@@ -375,6 +375,54 @@ fn a_daemon_started_on_demand_exits_once_its_starter_is_gone() {
 }
 
 #[test]
+fn a_daemon_started_on_demand_sleeps_without_clients_until_its_starter_exits() {
+    let domain = integration_tests::unique_domain("starter-idle");
+    // A process that starts a daemon on demand, says goodbye and lives on unconnected.
+    let mut starter = Command::new(env!("CARGO_BIN_EXE_test-client"))
+        .args(["start-and-leave", &domain])
+        .stdout(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut line = String::new();
+    {
+        use std::io::BufRead;
+        let stdout = starter.stdout.as_mut().unwrap();
+        std::io::BufReader::new(stdout)
+            .read_line(&mut line)
+            .unwrap();
+    }
+    let pid: u32 = line
+        .trim()
+        .strip_prefix("daemon=")
+        .and_then(|p| p.parse().ok())
+        .unwrap_or_else(|| panic!("unexpected output {line:?}"));
+    // The goodbye is handled and the resource guard has looked once more.
+    std::thread::sleep(Duration::from_secs(2));
+    let before = integration_tests::wake_ups(pid);
+    std::thread::sleep(Duration::from_secs(4));
+    let woke = integration_tests::wake_ups(pid) - before;
+    // Looking for the starter at the housekeeping period (500 ms) wakes 8 times in 4 s; its
+    // pidfd in the loop's WaitSet wakes it only when the starter exits.
+    assert!(
+        woke <= 2,
+        "an on-demand daemon without clients woke {woke} times in 4 s"
+    );
+    starter.kill().unwrap();
+    starter.wait().unwrap();
+    let started = Instant::now();
+    // SAFETY: kill(pid, 0) only probes whether the process exists.
+    let gone = eventually(Duration::from_secs(5), || {
+        (unsafe { libc::kill(pid as i32, 0) } != 0).then_some(())
+    });
+    assert!(
+        gone.is_some(),
+        "the on-demand daemon {pid} outlived its starter"
+    );
+    eprintln!("the daemon ended {:?} after its starter", started.elapsed());
+    let _ = physics_daemon::cleanup_domain(&domain);
+}
+
+#[test]
 fn stale_handles_name_the_object() {
     let daemon = TestDaemon::start("stale2");
     let client = daemon.client();

@@ -428,21 +428,6 @@ fn nodes_that_never_say_hello_are_evicted() {
     serves_on(&mut daemon, &survivor);
 }
 
-/// How often the threads of process `pid` have gone to sleep and woken (the sum of their
-/// voluntary context switches).
-fn wake_ups(pid: u32) -> u64 {
-    let tasks = std::fs::read_dir(format!("/proc/{pid}/task")).expect("the daemon's threads");
-    tasks
-        .filter_map(|t| std::fs::read_to_string(t.ok()?.path().join("status")).ok())
-        .filter_map(|status| {
-            status
-                .lines()
-                .find_map(|l| l.strip_prefix("voluntary_ctxt_switches:"))
-                .and_then(|v| v.trim().parse::<u64>().ok())
-        })
-        .sum()
-}
-
 /// The clients (ports) of the control service of `domain`, as the daemon's guard sees them.
 fn control_ports(domain: &str) -> usize {
     let config = names::config(domain).unwrap();
@@ -465,9 +450,9 @@ fn an_idle_daemon_sleeps_until_a_process_joins_its_domain() {
     let daemon = TestDaemon::start_with("idle-guard", &["--hello-timeout-ms", "1000"], &[]);
     // The readiness check's client goes; the guard looks once more, then has nothing to cap.
     std::thread::sleep(Duration::from_secs(2));
-    let before = wake_ups(daemon.pid());
+    let before = integration_tests::wake_ups(daemon.pid());
     std::thread::sleep(Duration::from_secs(4));
-    let woke = wake_ups(daemon.pid()) - before;
+    let woke = integration_tests::wake_ups(daemon.pid()) - before;
     // A resource guard looking every 500 ms wakes 8 times in 4 s; with no other process in
     // the domain there is nothing to look at (the loop and the heartbeat sleep too).
     assert!(

@@ -114,6 +114,45 @@ fn pidfd_open(pid: u32) -> std::io::Result<OwnedFd> {
     Ok(unsafe { OwnedFd::from_raw_fd(fd as i32) })
 }
 
+/// A process's exit as something a WaitSet can wait on: its pidfd, which becomes readable
+/// once the process exits (zombies included).
+#[derive(Debug)]
+pub struct ProcessExit {
+    pidfd: OwnedFd,
+    /// The same descriptor as iceoryx2 sees it (not owned: `pidfd` closes it).
+    view: iceoryx2_bb_posix::file_descriptor::FileDescriptor,
+}
+
+impl ProcessExit {
+    /// Watches `pid`; `None` when it is gone already or pidfds cannot be had.
+    pub fn watch(pid: u32) -> Option<ProcessExit> {
+        let pidfd = pidfd_open(pid).ok()?;
+        let view =
+            iceoryx2_bb_posix::file_descriptor::FileDescriptor::non_owning_new(pidfd.as_raw_fd())?;
+        Some(ProcessExit { pidfd, view })
+    }
+
+    /// Whether the process has exited.
+    pub fn exited(&self) -> bool {
+        let mut fd = libc::pollfd {
+            fd: self.pidfd.as_raw_fd(),
+            events: libc::POLLIN,
+            revents: 0,
+        };
+        // SAFETY: one valid pollfd record whose descriptor we own, for the call.
+        let ready = unsafe { libc::poll(&mut fd, 1, 0) };
+        ready > 0
+    }
+}
+
+impl iceoryx2_bb_posix::file_descriptor::FileDescriptorBased for ProcessExit {
+    fn file_descriptor(&self) -> &iceoryx2_bb_posix::file_descriptor::FileDescriptor {
+        &self.view
+    }
+}
+
+impl iceoryx2_bb_posix::file_descriptor_set::SynchronousMultiplexing for ProcessExit {}
+
 /// Modification time of the folder at `path` (a folder's time changes when an entry is
 /// added or removed), or `None` when it cannot be read.
 pub fn folder_stamp(path: &str) -> Option<std::time::SystemTime> {

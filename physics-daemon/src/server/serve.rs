@@ -17,8 +17,8 @@ use shm_layout::names;
 
 use super::worker::Waker;
 use super::{
-    control_nodes, heartbeat, liveness, moves, origin, persist, quota, resources, trim, Clients,
-    ControlServer, Daemon, Options, HOUSEKEEPING,
+    control_nodes, heartbeat, liveness, moves, origin, persist, pidwatch, quota, resources, trim,
+    Clients, ControlServer, Daemon, Options, HOUSEKEEPING,
 };
 use crate::DaemonError;
 
@@ -56,12 +56,28 @@ pub(super) fn serve(
         .attach_notification(&worker_wake)
         .map_err(|e| DaemonError::Ipc(format!("cannot attach the worker wake-up: {e:?}")))?;
     let mut daemon = start(domain, config, ports, options, watch, wake_end)?;
+    // A daemon started on demand hears of its starter's exit through a pidfd the WaitSet
+    // watches, so without clients it sleeps until a request or that exit instead of
+    // looking twice a second.
+    let starter = daemon
+        .options
+        .starter_pid
+        .and_then(pidwatch::ProcessExit::watch);
+    let mut starter_guard = starter
+        .as_ref()
+        .and_then(|s| waitset.attach_notification(s).ok());
     let mut house = House {
         next: Instant::now() + HOUSEKEEPING,
         trims: trim::Schedule::default(),
     };
     while !shutdown.load(Ordering::Relaxed) {
-        daemon.wait(&waitset, house.next);
+        daemon.wait(&waitset, house.next, starter_guard.is_some());
+        if starter_guard.is_some() && starter.as_ref().is_some_and(|s| s.exited()) {
+            // Its pidfd stays readable: stop watching it, and look after now (the daemon
+            // ends here without clients, else at a later look once the last one is gone).
+            starter_guard = None;
+            house.next = Instant::now();
+        }
         consume_wake_ups(&listener, &worker_wake, &daemon.waker);
         daemon.serve_round(beats);
         if Instant::now() >= house.next && !daemon.look_after(&mut house, trims) {
@@ -220,10 +236,12 @@ fn consume_wake_ups(
 }
 
 impl Daemon {
-    /// Sleeps in `waitset` until a request, a worker or a shutdown wake-up arrives, and while
-    /// clients are connected (or a starter is watched) no later than `housekeeping`.
-    fn wait(&self, waitset: &WaitSet<ipc::Service>, housekeeping: Instant) {
-        let watching = !self.clients.is_empty() || self.options.starter_pid.is_some();
+    /// Sleeps in `waitset` until a request, a worker, a shutdown wake-up or (when
+    /// `starter_watched`) the starter's exit arrives, and while clients are connected (or a
+    /// starter is looked for at the period) no later than `housekeeping`.
+    fn wait(&self, waitset: &WaitSet<ipc::Service>, housekeeping: Instant, starter_watched: bool) {
+        let watching =
+            !self.clients.is_empty() || (self.options.starter_pid.is_some() && !starter_watched);
         let waited = if watching {
             let timeout = housekeeping.saturating_duration_since(Instant::now());
             waitset.wait_and_process_once_with_timeout(|_| CallbackProgression::Continue, timeout)

@@ -27,6 +27,18 @@ fn main() {
         std::thread::sleep(std::time::Duration::from_secs(3600));
         return;
     }
+    if args[1] == "start-and-leave" {
+        // Starts a daemon on demand, says goodbye, and lives on without a connection.
+        let client_sdk::Session { client, daemon } =
+            client_sdk::connect_or_start(&args[2]).expect("connect or start");
+        drop(client);
+        let daemon = daemon.expect("a daemon was started");
+        println!("daemon={}", daemon.pid());
+        std::io::stdout().flush().unwrap();
+        std::thread::sleep(std::time::Duration::from_secs(3600));
+        drop(daemon);
+        return;
+    }
     let client = Client::connect(&args[2]).expect("connect");
     match args[1].as_str() {
         "hold" => {
