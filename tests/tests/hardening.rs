@@ -339,12 +339,11 @@ fn a_stopped_daemon_is_reported_stalled_within_about_a_second() {
     assert!(eventually(Duration::from_secs(5), || plane.info().ok()).is_some());
 }
 
-#[test]
-fn a_daemon_started_on_demand_exits_once_its_starter_is_gone() {
-    let domain = integration_tests::unique_domain("starter");
-    // A process that starts a daemon on demand, then is killed without any cleanup.
+/// Runs `test-client MODE DOMAIN`, which starts a daemon on demand: the starter, and the
+/// daemon's pid it prints.
+fn start_on_demand(mode: &str, domain: &str) -> (std::process::Child, i32) {
     let mut starter = Command::new(env!("CARGO_BIN_EXE_test-client"))
-        .args(["start-and-hold", &domain])
+        .args([mode, domain])
         .stdout(Stdio::piped())
         .spawn()
         .unwrap();
@@ -361,6 +360,14 @@ fn a_daemon_started_on_demand_exits_once_its_starter_is_gone() {
         .strip_prefix("daemon=")
         .and_then(|p| p.parse().ok())
         .unwrap_or_else(|| panic!("unexpected output {line:?}"));
+    (starter, pid)
+}
+
+#[test]
+fn a_daemon_started_on_demand_exits_once_its_starter_is_gone() {
+    let domain = integration_tests::unique_domain("starter");
+    // A process that starts a daemon on demand, then is killed without any cleanup.
+    let (mut starter, pid) = start_on_demand("start-and-hold", &domain);
     starter.kill().unwrap();
     starter.wait().unwrap();
     // SAFETY: kill(pid, 0) only probes whether the process exists.
@@ -378,29 +385,12 @@ fn a_daemon_started_on_demand_exits_once_its_starter_is_gone() {
 fn a_daemon_started_on_demand_sleeps_without_clients_until_its_starter_exits() {
     let domain = integration_tests::unique_domain("starter-idle");
     // A process that starts a daemon on demand, says goodbye and lives on unconnected.
-    let mut starter = Command::new(env!("CARGO_BIN_EXE_test-client"))
-        .args(["start-and-leave", &domain])
-        .stdout(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let mut line = String::new();
-    {
-        use std::io::BufRead;
-        let stdout = starter.stdout.as_mut().unwrap();
-        std::io::BufReader::new(stdout)
-            .read_line(&mut line)
-            .unwrap();
-    }
-    let pid: u32 = line
-        .trim()
-        .strip_prefix("daemon=")
-        .and_then(|p| p.parse().ok())
-        .unwrap_or_else(|| panic!("unexpected output {line:?}"));
+    let (mut starter, pid) = start_on_demand("start-and-leave", &domain);
     // The goodbye is handled and the resource guard has looked once more.
     std::thread::sleep(Duration::from_secs(2));
-    let before = integration_tests::wake_ups(pid);
+    let before = integration_tests::wake_ups(pid as u32);
     std::thread::sleep(Duration::from_secs(4));
-    let woke = integration_tests::wake_ups(pid) - before;
+    let woke = integration_tests::wake_ups(pid as u32) - before;
     // Looking for the starter at the housekeeping period (500 ms) wakes 8 times in 4 s; its
     // pidfd in the loop's WaitSet wakes it only when the starter exits.
     assert!(

@@ -385,21 +385,7 @@ fn nodes_that_never_say_hello_are_evicted() {
     // Few nodes (under the per-process cap) without Hello go after --hello-timeout-ms.
     let _few = Hoarder::start(&["nodes", &daemon.domain, "8"]);
     let started = Instant::now();
-    let held = || {
-        let config = names::config(&daemon.domain).unwrap();
-        let node = NodeBuilder::new()
-            .config(&config)
-            .signal_handling_mode(SignalHandlingMode::Disabled)
-            .create::<ipc::Service>()
-            .unwrap();
-        let control = node
-            .service_builder(&names::control())
-            .request_response::<[u8], [u8]>()
-            .request_user_header::<u128>()
-            .open()
-            .unwrap();
-        control.dynamic_config().number_of_clients()
-    };
+    let held = || control_ports(&daemon.domain);
     // The victim's port and the hoarder's 8: not evicted at once. A port of the client that
     // got in above, or of the big hoarder's last nodes, can still be listed while iceoryx2
     // removes it (seen once as 10), so at least 9.
