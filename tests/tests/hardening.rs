@@ -402,7 +402,7 @@ fn a_daemon_started_on_demand_sleeps_without_clients_until_its_starter_exits() {
     let started = Instant::now();
     // SAFETY: kill(pid, 0) only probes whether the process exists.
     let gone = eventually(Duration::from_secs(5), || {
-        (unsafe { libc::kill(pid as i32, 0) } != 0).then_some(())
+        (unsafe { libc::kill(pid, 0) } != 0).then_some(())
     });
     assert!(
         gone.is_some(),
