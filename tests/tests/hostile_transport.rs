@@ -36,18 +36,8 @@ struct Hostile {
 
 impl Hostile {
     fn open(domain: &str) -> Hostile {
-        let config = names::config(domain).unwrap();
-        let node = NodeBuilder::new()
-            .config(&config)
-            .signal_handling_mode(SignalHandlingMode::Disabled)
-            .create::<ipc::Service>()
-            .unwrap();
-        let port = node
-            .service_builder(&names::control())
-            .request_response::<[u8], [u8]>()
-            .request_user_header::<u128>()
-            .open()
-            .unwrap()
+        let (node, control) = open_control(domain);
+        let port = control
             .client_builder()
             .initial_max_slice_len(4096)
             .allocation_strategy(AllocationStrategy::PowerOfTwo)
@@ -414,8 +404,17 @@ fn nodes_that_never_say_hello_are_evicted() {
     serves_on(&mut daemon, &survivor);
 }
 
-/// The clients (ports) of the control service of `domain`, as the daemon's guard sees them.
-fn control_ports(domain: &str) -> usize {
+/// The daemon's control service, as a process of the domain opens it.
+type ControlService = iceoryx2::service::port_factory::request_response::PortFactory<
+    ipc::Service,
+    [u8],
+    u128,
+    [u8],
+    (),
+>;
+
+/// A node of this process in `domain`, and the daemon's control service opened from it.
+fn open_control(domain: &str) -> (Node<ipc::Service>, ControlService) {
     let config = names::config(domain).unwrap();
     let node = NodeBuilder::new()
         .config(&config)
@@ -428,6 +427,12 @@ fn control_ports(domain: &str) -> usize {
         .request_user_header::<u128>()
         .open()
         .unwrap();
+    (node, control)
+}
+
+/// The clients (ports) of the control service of `domain`, as the daemon's guard sees them.
+fn control_ports(domain: &str) -> usize {
+    let (_node, control) = open_control(domain);
     control.dynamic_config().number_of_clients()
 }
 
