@@ -196,9 +196,10 @@ fn guard(config: &Config, limits: &Limits, watch: &Watch) -> Result<(), DaemonEr
     while let Some(changed) = watch.wait(quiet, folder.as_ref()) {
         guard.folder_changed |= changed;
         if !folder.as_ref().is_some_and(FolderWatch::is_live) {
-            // Removed and made again (or never watched): watch it anew, and look.
+            // Removed and made again (or never watched): watch it anew, and look once. Where
+            // inotify cannot watch it, the guard looks every period as before.
             folder = FolderWatch::new(&folder_path);
-            guard.folder_changed = true;
+            guard.folder_changed |= folder.is_some();
         }
         // The loop creates the control service after this thread starts.
         if control.is_none() {
