@@ -392,9 +392,10 @@ fn a_daemon_started_on_demand_sleeps_without_clients_until_its_starter_exits() {
     std::thread::sleep(Duration::from_secs(4));
     let woke = integration_tests::wake_ups(pid as u32) - before;
     // Looking for the starter at the housekeeping period (500 ms) wakes 8 times in 4 s; its
-    // pidfd in the loop's WaitSet wakes it only when the starter exits.
+    // pidfd in the loop's WaitSet wakes it only when the starter exits. Up to 3 allows a
+    // last look delayed by a loaded machine.
     assert!(
-        woke <= 2,
+        woke <= 3,
         "an on-demand daemon without clients woke {woke} times in 4 s"
     );
     starter.kill().unwrap();

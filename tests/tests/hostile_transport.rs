@@ -445,9 +445,10 @@ fn an_idle_daemon_sleeps_until_a_process_joins_its_domain() {
     std::thread::sleep(Duration::from_secs(4));
     let woke = integration_tests::wake_ups(daemon.pid()) - before;
     // A resource guard looking every 500 ms wakes 8 times in 4 s; with no other process in
-    // the domain there is nothing to look at (the loop and the heartbeat sleep too).
+    // the domain there is nothing to look at (the loop and the heartbeat sleep too). Up to
+    // 3 allows a last look delayed by a loaded machine.
     assert!(
-        woke <= 2,
+        woke <= 3,
         "a daemon without clients woke {woke} times in 4 s"
     );
 
