@@ -339,9 +339,27 @@ fn a_stopped_daemon_is_reported_stalled_within_about_a_second() {
     assert!(eventually(Duration::from_secs(5), || plane.info().ok()).is_some());
 }
 
+/// A process that started a daemon on demand, killed when dropped (a failing test must not
+/// leave it, and the daemon it watches, running for an hour).
+struct Starter(std::process::Child);
+
+impl Starter {
+    /// Kills the starter and reaps it.
+    fn kill(&mut self) {
+        let _ = self.0.kill();
+        let _ = self.0.wait();
+    }
+}
+
+impl Drop for Starter {
+    fn drop(&mut self) {
+        self.kill();
+    }
+}
+
 /// Runs `test-client MODE DOMAIN`, which starts a daemon on demand: the starter, and the
 /// daemon's pid it prints.
-fn start_on_demand(mode: &str, domain: &str) -> (std::process::Child, i32) {
+fn start_on_demand(mode: &str, domain: &str) -> (Starter, i32) {
     let mut starter = Command::new(env!("CARGO_BIN_EXE_test-client"))
         .args([mode, domain])
         .stdout(Stdio::piped())
@@ -360,7 +378,7 @@ fn start_on_demand(mode: &str, domain: &str) -> (std::process::Child, i32) {
         .strip_prefix("daemon=")
         .and_then(|p| p.parse().ok())
         .unwrap_or_else(|| panic!("unexpected output {line:?}"));
-    (starter, pid)
+    (Starter(starter), pid)
 }
 
 #[test]
@@ -368,8 +386,7 @@ fn a_daemon_started_on_demand_exits_once_its_starter_is_gone() {
     let domain = integration_tests::unique_domain("starter");
     // A process that starts a daemon on demand, then is killed without any cleanup.
     let (mut starter, pid) = start_on_demand("start-and-hold", &domain);
-    starter.kill().unwrap();
-    starter.wait().unwrap();
+    starter.kill();
     // SAFETY: kill(pid, 0) only probes whether the process exists.
     let gone = eventually(Duration::from_secs(5), || {
         (unsafe { libc::kill(pid, 0) } != 0).then_some(())
@@ -398,8 +415,7 @@ fn a_daemon_started_on_demand_sleeps_without_clients_until_its_starter_exits() {
         woke <= 3,
         "an on-demand daemon without clients woke {woke} times in 4 s"
     );
-    starter.kill().unwrap();
-    starter.wait().unwrap();
+    starter.kill();
     let started = Instant::now();
     // SAFETY: kill(pid, 0) only probes whether the process exists.
     let gone = eventually(Duration::from_secs(5), || {
