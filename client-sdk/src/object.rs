@@ -58,10 +58,7 @@ impl Object {
         match self.plane.pose(self.handle)? {
             Some(pose) => Ok(pose),
             // The same error `state` gives.
-            None => self.state().map(|s| Pose {
-                position: s.position,
-                rotation: s.rotation,
-            }),
+            None => self.state().map(|s| s.pose()),
         }
     }
 

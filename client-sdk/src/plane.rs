@@ -96,15 +96,9 @@ impl Plane {
                 .as_ref()
                 .and_then(|s| s.payload().get(handle.slot as usize))
                 .filter(|s| s.matches(handle))
-                .map(|s| Pose {
-                    position: s.position,
-                    rotation: s.rotation,
-                }));
+                .map(|s| s.pose()));
         }
-        Ok(self.body(handle)?.map(|s| Pose {
-            position: s.position,
-            rotation: s.rotation,
-        }))
+        Ok(self.body(handle)?.map(|s| s.pose()))
     }
 
     /// The state of `handle` as this process should see it: the newest sample with this

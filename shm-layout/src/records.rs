@@ -58,6 +58,14 @@ pub struct BodyState {
 }
 
 impl BodyState {
+    /// Its position and rotation.
+    pub fn pose(&self) -> crate::Pose {
+        crate::Pose {
+            position: self.position,
+            rotation: self.rotation,
+        }
+    }
+
     /// Whether the slot holds a live body ([`FLAG_ALIVE`]).
     pub fn is_alive(&self) -> bool {
         self.flags & FLAG_ALIVE != 0

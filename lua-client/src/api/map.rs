@@ -11,7 +11,7 @@
 use std::cell::Cell;
 use std::rc::{Rc, Weak};
 
-use client_sdk::{Handle, Object, ObjectProp, Pose};
+use client_sdk::{Handle, Object, ObjectProp};
 use mlua::{AnyUserData, Lua, MetaMethod, Table, UserData, UserDataMethods, Value};
 
 use super::plane::{PhysicsPlane, PlaneState};
@@ -194,10 +194,7 @@ pub static MAP: Props<MapState> = Props {
                     .live("Map.CFrame")?
                     .state()
                     .map_err(|e| sdk_error("Map.CFrame", e))?;
-                let cf = CFrame::from_pose(Pose {
-                    position: s.position,
-                    rotation: s.rotation,
-                });
+                let cf = CFrame::from_pose(s.pose());
                 cf.into_value(lua)
             }),
             set: Set::Prop(|a| Ok(ObjectProp::Pose(a.cframe()?.pose()))),

@@ -119,22 +119,19 @@ impl Wake {
 /// Waits up to `timeout` for `wake`, or for a change in `folder`. Returns whether the folder
 /// changed (its queued changes are read).
 pub fn wait(wake: &Wake, folder: Option<&FolderWatch>, timeout: Duration) -> bool {
-    let mut fds = vec![libc::pollfd {
-        fd: wake.fd.as_raw_fd(),
+    let polled = |fd| libc::pollfd {
+        fd,
         events: libc::POLLIN,
         revents: 0,
-    }];
-    if let Some(f) = folder {
-        fds.push(libc::pollfd {
-            fd: f.raw_fd(),
-            events: libc::POLLIN,
-            revents: 0,
-        });
-    }
+    };
+    let mut fds = [
+        polled(wake.fd.as_raw_fd()),
+        polled(folder.map_or(-1, FolderWatch::raw_fd)),
+    ];
+    let n = if folder.is_some() { 2 } else { 1 };
     let ms = timeout.as_millis().min(i32::MAX as u128) as i32;
-    // SAFETY: `fds` is a valid array of `fds.len()` pollfd records whose descriptors live
-    // for the call.
-    unsafe { libc::poll(fds.as_mut_ptr(), fds.len() as libc::nfds_t, ms) };
+    // SAFETY: `fds` holds `n` valid pollfd records whose descriptors live for the call.
+    unsafe { libc::poll(fds.as_mut_ptr(), n, ms) };
     let mut count = [0u8; 8];
     // SAFETY: reads the eventfd's 8-byte counter into `count` (resetting it; nothing when it
     // was not written).

@@ -7,7 +7,7 @@
 //! `lua` ([`table_get`], [`table_prop`]).
 
 use client_sdk::settings::table::AnyValue;
-use client_sdk::{BodyState, ObjectInfo, ObjectProp, Pose};
+use client_sdk::{BodyState, ObjectInfo, ObjectProp};
 use mlua::{Error as LuaError, Value};
 
 use super::PhysicsObject;
@@ -56,10 +56,7 @@ pub static OBJECT: Props<PhysicsObject> = Props {
             kind: Kind::named(ObjectProp::ROWS, "CFrame"),
             get: Get::Fn(|lua, o| {
                 let s = state(o, "CFrame")?;
-                let cf = CFrame::from_pose(Pose {
-                    position: s.position,
-                    rotation: s.rotation,
-                });
+                let cf = CFrame::from_pose(s.pose());
                 o.part.cframe_value(lua, cf)
             }),
             set: Set::Prop(|a| Ok(ObjectProp::Pose(a.cframe()?.pose()))),
