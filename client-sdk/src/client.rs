@@ -17,7 +17,8 @@ use crate::remote::{RemoteOptions, RemoteTransport};
 use crate::transport::{Transport, LIVENESS_PERIOD};
 use crate::Error;
 
-/// A daemon whose heartbeat (a few beats a second, from a thread of its own) has been
+/// A daemon whose heartbeat (two beats a second, from a thread that never waits for its
+/// request loop) has been
 /// silent this long while a request waits, and whose process is stopped (SIGSTOP), is
 /// stalled, not slow.
 pub const STALL_AFTER: Duration = Duration::from_secs(1);
@@ -27,8 +28,8 @@ pub const STALL_AFTER: Duration = Duration::from_secs(1);
 pub const HUNG_AFTER: Duration = Duration::from_secs(3);
 
 /// A silent heartbeat this long, with the daemon's process stopped, is a stall for
-/// [`Client::watch_daemon`] (three missed beats: a reader learns of a SIGSTOP within a
-/// second).
+/// [`Client::watch_daemon`] (a beat missed: a reader learns of a SIGSTOP within a second;
+/// a silence this long with the process running only costs a look at `/proc`).
 pub const WATCH_STALL_AFTER: Duration = Duration::from_millis(600);
 
 /// What [`Client::watch_daemon`] finds.

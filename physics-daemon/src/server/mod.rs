@@ -212,24 +212,13 @@ pub fn run_with(domain: &str, shutdown: &AtomicBool, options: Options) -> Result
     let config = names::config(domain)?;
     files::check_ownership(domain)?;
     remove_dead_nodes(&config);
-    let beats = heartbeat::Control::default();
     let watch = Arc::new(resources::Watch::default());
     let trims = trim::Trims::default();
     let limits = options.limits;
     std::thread::scope(|s| {
-        s.spawn(|| heartbeat::run(&config, &beats, limits.max_clients));
         s.spawn(|| resources::run(&config, &limits, &watch));
         s.spawn(|| trim::run(&trims));
-        let served = serve::serve(
-            domain,
-            &config,
-            shutdown,
-            options,
-            &beats,
-            watch.clone(),
-            &trims,
-        );
-        beats.stop();
+        let served = serve::serve(domain, &config, shutdown, options, watch.clone(), &trims);
         watch.stop();
         trims.stop();
         served

@@ -20,10 +20,14 @@
 //! - in each service, the nodes of a process holding more than `--max-ports-per-process`
 //!   ports there (the node with the most ports first).
 //!
+//! The same thread beats the daemon's heartbeat at each look while clients are connected
+//! ([`super::heartbeat`]).
+//!
 //! Identities here come from iceoryx2's node and port lists (see `docs/security.md` for
 //! what a process of the same user can still forge).
 
 use std::collections::{BTreeSet, HashMap, HashSet};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Condvar, Mutex};
 use std::time::{Duration, Instant};
 
@@ -85,9 +89,11 @@ pub struct Eviction {
 pub struct Watch {
     state: Mutex<WatchState>,
     changed: Condvar,
-    /// Ends the guard's wait at once on stop (`None`: the system gave no eventfd; the guard
-    /// then waits on `changed` a period at a time).
+    /// Ends the guard's wait at once on stop or when beats start (`None`: the system gave no
+    /// eventfd; the guard then waits on `changed` a period at a time).
     wake: Option<Wake>,
+    /// Whether clients are connected: the guard then beats the heartbeat every look.
+    beating: AtomicBool,
 }
 
 impl Default for Watch {
@@ -96,6 +102,7 @@ impl Default for Watch {
             state: Mutex::default(),
             changed: Condvar::new(),
             wake: Wake::new(),
+            beating: AtomicBool::new(false),
         }
     }
 }
@@ -118,6 +125,20 @@ impl Watch {
             state.connected = connected.collect();
             state.planes = planes.collect();
         }
+    }
+
+    /// Beats the heartbeat at every look while `on` (clients are connected); a quiet guard
+    /// is woken to start at once.
+    pub fn beat(&self, on: bool) {
+        if self.beating.swap(on, Ordering::Relaxed) != on && on {
+            if let Some(wake) = &self.wake {
+                wake.wake();
+            }
+        }
+    }
+
+    fn beating(&self) -> bool {
+        self.beating.load(Ordering::Relaxed)
     }
 
     /// Ends the guard thread.
@@ -189,11 +210,22 @@ fn guard(config: &Config, limits: &Limits, watch: &Watch) -> Result<(), DaemonEr
         .map_err(|e| ipc("node", &e))?;
     let mut control: Option<ControlService> = None;
     let mut guard = Guard::default();
+    let mut heart = match super::heartbeat::Heart::open(&node, limits.max_clients) {
+        Ok(heart) => Some(heart),
+        Err(e) => {
+            tracing::warn!("no heartbeat: {e}");
+            None
+        }
+    };
     // Watched from before the first listing, so no node created after it goes unnoticed.
     let folder_path = config.global.node_dir().to_string();
     let mut folder = FolderWatch::new(&folder_path);
     let mut quiet = false;
     while let Some(changed) = watch.wait(quiet, folder.as_ref()) {
+        // The beat first: a long look must not delay it.
+        if let Some(heart) = heart.as_mut().filter(|_| watch.beating()) {
+            heart.beat();
+        }
         guard.folder_changed |= changed;
         if !folder.as_ref().is_some_and(FolderWatch::is_live) {
             // Removed and made again (or never watched): watch it anew, and look once. Where
@@ -245,6 +277,7 @@ fn guard(config: &Config, limits: &Limits, watch: &Watch) -> Result<(), DaemonEr
         // belongs to a node; a client gone since the loop last said who is connected has
         // no node either): sleep until the node folder changes.
         quiet = folder.as_ref().is_some_and(FolderWatch::is_live)
+            && !watch.beating()
             && guard.seen.is_empty()
             && guard.pending_hello == 0
             && guard.listed.is_some();

@@ -17,8 +17,8 @@ use shm_layout::names;
 
 use super::worker::Waker;
 use super::{
-    control_nodes, heartbeat, liveness, moves, origin, persist, pidwatch, quota, resources, trim,
-    Clients, ControlServer, Daemon, Options, HOUSEKEEPING,
+    control_nodes, liveness, moves, origin, persist, pidwatch, quota, resources, trim, Clients,
+    ControlServer, Daemon, Options, HOUSEKEEPING,
 };
 use crate::DaemonError;
 
@@ -37,7 +37,6 @@ pub(super) fn serve(
     config: &Config,
     shutdown: &AtomicBool,
     options: Options,
-    beats: &heartbeat::Control,
     watch: Arc<resources::Watch>,
     trims: &trim::Trims,
 ) -> Result<(), DaemonError> {
@@ -79,7 +78,7 @@ pub(super) fn serve(
             house.next = Instant::now();
         }
         consume_wake_ups(&listener, &worker_wake, &daemon.waker);
-        daemon.serve_round(beats);
+        daemon.serve_round();
         if Instant::now() >= house.next && !daemon.look_after(&mut house, trims) {
             break;
         }
@@ -256,7 +255,7 @@ impl Daemon {
 
     /// One round of work after a wake-up: what workers reported, planes handed over,
     /// every queued request, the load report and the heartbeat.
-    fn serve_round(&mut self, beats: &heartbeat::Control) {
+    fn serve_round(&mut self) {
         self.handle_events();
         self.adopt_planes();
         self.take_arrivals();
@@ -267,7 +266,7 @@ impl Daemon {
                 self.planes.values().map(|p| p.usage.clone()).collect()
             });
         }
-        beats.beat(!self.clients.is_empty());
+        self.watch.beat(!self.clients.is_empty());
     }
 
     /// Housekeeping, once `house.next` has come: with clients, gone clients released, ended
