@@ -471,6 +471,59 @@ fn an_idle_daemon_sleeps_until_a_process_joins_its_domain() {
 }
 
 #[test]
+fn a_daemon_whose_clients_sit_idle_sleeps_and_still_releases_a_killed_one_at_once() {
+    use std::io::BufRead;
+    let daemon = TestDaemon::start("idle-clients");
+    // Killed when the test ends, passing or not (a holder left running keeps the test's
+    // output open).
+    let mut holder = Hoarder(
+        std::process::Command::new(env!("CARGO_BIN_EXE_test-client"))
+            .args(["hold", &daemon.domain])
+            .stdout(std::process::Stdio::piped())
+            .spawn()
+            .unwrap(),
+    );
+    let mut line = String::new();
+    std::io::BufReader::new(holder.0.stdout.take().unwrap())
+        .read_line(&mut line)
+        .unwrap();
+    let plane_id: u32 = line.trim().strip_prefix("plane=").unwrap().parse().unwrap();
+    // The connection's requests done, the loop looks once more and then has nothing to do.
+    std::thread::sleep(Duration::from_secs(2));
+    let before = integration_tests::wake_ups(daemon.pid());
+    std::thread::sleep(Duration::from_secs(4));
+    let woke = integration_tests::wake_ups(daemon.pid()) - before;
+    // With a client holding an idle manual plane, a loop looking every 500 ms, a guard
+    // looking every 500 ms and a heartbeat of its own every 200 ms woke 36 times in 4 s, and
+    // 15-16 with the heartbeat on the guard's looks. Now the guard's 8 looks (which beat) and
+    // at most a quiet look of the loop; up to 12 allows a loaded machine's delays.
+    assert!(
+        woke <= 12,
+        "a daemon with one idle client woke {woke} times in 4 s"
+    );
+
+    // Asleep, it still hears at once of a client that dies (its process's pidfd rings the
+    // loop's alarm): the plane is released well before the loop's next quiet look (5 s).
+    let client = Client::connect(&daemon.domain).unwrap();
+    let theirs = client.attach_plane(plane_id).unwrap();
+    assert_eq!(theirs.info().unwrap().object_count, 1);
+    std::thread::sleep(Duration::from_millis(1500));
+    holder.0.kill().unwrap();
+    holder.0.wait().unwrap();
+    let killed = Instant::now();
+    time_until(Duration::from_secs(10), || match theirs.info() {
+        Err(client_sdk::Error::Command(e)) if e.kind == ErrorKind::UnknownPlane => Some(()),
+        _ => None,
+    })
+    .unwrap_or_else(|| panic!("plane {plane_id} of the killed client was not released"));
+    let took = killed.elapsed();
+    assert!(
+        took < Duration::from_secs(2),
+        "the killed client's plane was released after {took:?}"
+    );
+}
+
+#[test]
 fn one_process_cannot_hold_a_planes_reader_slots() {
     let mut daemon = TestDaemon::start("hostile-readers");
     let victim = daemon.client();

@@ -10,6 +10,8 @@
 
 use std::time::{Duration, Instant, SystemTime};
 
+use super::alarm::Registry;
+use super::folder_watch::FolderWatch;
 use super::pidwatch::{folder_stamp, PidWatch};
 
 /// The longest the loop goes without listing nodes while clients are connected.
@@ -40,6 +42,10 @@ pub struct Schedule {
     pids: PidWatch,
     /// The node folder's modification time at the last listing.
     stamp: Option<SystemTime>,
+    /// The loop's alarm and the node folder it watches, once [`Schedule::ring`] set them.
+    alarm: Option<(Registry, FolderWatch)>,
+    /// A watched process had exited at the last look (its client may not be released yet).
+    exited: bool,
 }
 
 impl Default for Schedule {
@@ -48,11 +54,34 @@ impl Default for Schedule {
             last_full: Instant::now(),
             pids: PidWatch::default(),
             stamp: None,
+            alarm: None,
+            exited: false,
         }
     }
 }
 
 impl Schedule {
+    /// From now on rings `alarm` when a client's process exits or an entry of the node
+    /// folder at `folder` comes or goes (nothing when the folder cannot be watched).
+    pub fn ring(&mut self, alarm: Registry, folder: &str) {
+        if let Some(watch) = FolderWatch::new(folder) {
+            if alarm.add(watch.raw_fd()) {
+                self.alarm = Some((alarm, watch));
+            }
+        }
+    }
+
+    /// Whether the alarm rings for everything [`Schedule::list_now`] would find: every
+    /// client's exit and every change of the node folder. Only then may the loop look less
+    /// often than its period.
+    pub fn alarmed(&self) -> bool {
+        self.alarm
+            .as_ref()
+            .is_some_and(|(_, folder)| folder.is_live())
+            && self.pids.all_alarmed()
+            && !self.exited
+    }
+
     /// Whether to list nodes now; records the listing when it says yes. Yes when a client's
     /// process exited (its pidfd, or `all_alive` false where pidfds cannot tell), when the
     /// domain's node folder at `folder` changed (a node came or went: a client that closed
@@ -65,9 +94,15 @@ impl Schedule {
         all_alive: impl FnOnce() -> bool,
     ) -> bool {
         let now = Instant::now();
-        self.pids.watch(pids);
+        let alarm = self.alarm.as_ref().map(|(registry, folder)| {
+            // Its queued changes are read here; the folder's time says what changed.
+            folder.drain();
+            registry
+        });
+        self.pids.watch_with(pids, alarm);
         let stamp = folder_stamp(folder);
         let exited = self.pids.any_exited();
+        self.exited = exited == Some(true);
         let period = match exited {
             Some(_) => SAFETY_NET,
             None => FULL_CHECK,

@@ -21,6 +21,7 @@
 //! The server knows planes only through [`crate::backend::Backend`]: it never names an
 //! engine type, an object property or a per-feature op.
 
+pub mod alarm;
 pub mod clients;
 mod dispatch;
 pub mod fair;

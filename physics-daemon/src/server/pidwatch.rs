@@ -27,6 +27,8 @@ pub struct PidWatch {
     gone_at_watch: bool,
     /// More pids were asked for than [`MAX_WATCHED`].
     overflow: bool,
+    /// A descriptor the alarm refused to watch (sticky: the alarm cannot be trusted after).
+    unalarmed: bool,
 }
 
 impl PidWatch {
@@ -34,6 +36,16 @@ impl PidWatch {
     /// new ones opened (a pid that no longer runs counts as exited at the next
     /// [`PidWatch::any_exited`]).
     pub fn watch(&mut self, pids: impl IntoIterator<Item = u32>) {
+        self.watch_with(pids, None);
+    }
+
+    /// [`PidWatch::watch`], registering each new descriptor with `alarm` too (the loop's
+    /// [`super::alarm`], which then rings when that process exits).
+    pub fn watch_with(
+        &mut self,
+        pids: impl IntoIterator<Item = u32>,
+        alarm: Option<&super::alarm::Registry>,
+    ) {
         let mut wanted: Vec<u32> = pids.into_iter().filter(|&p| p != 0).collect();
         wanted.sort_unstable();
         wanted.dedup();
@@ -46,6 +58,9 @@ impl PidWatch {
             }
             match pidfd_open(pid) {
                 Ok(fd) => {
+                    if let Some(alarm) = alarm {
+                        self.unalarmed |= !alarm.add(fd.as_raw_fd());
+                    }
                     self.fds.insert(pid, Some(fd));
                 }
                 Err(e) if e.raw_os_error() == Some(libc::ESRCH) => self.gone_at_watch = true,
@@ -92,6 +107,11 @@ impl PidWatch {
         } else {
             Some(false)
         }
+    }
+
+    /// Whether every watched pid has a descriptor the alarm watches (so an exit rings it).
+    pub fn all_alarmed(&self) -> bool {
+        !self.overflow && !self.unalarmed && self.fds.values().all(Option::is_some)
     }
 
     /// Pids being watched with a descriptor.

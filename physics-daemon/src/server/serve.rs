@@ -17,8 +17,8 @@ use shm_layout::names;
 
 use super::worker::Waker;
 use super::{
-    control_nodes, liveness, moves, origin, persist, pidwatch, quota, resources, trim, Clients,
-    ControlServer, Daemon, Options, HOUSEKEEPING,
+    alarm, control_nodes, liveness, moves, origin, persist, pidwatch, quota, resources, trim,
+    Clients, ControlServer, Daemon, Options, HOUSEKEEPING,
 };
 use crate::DaemonError;
 
@@ -65,21 +65,51 @@ pub(super) fn serve(
     let mut starter_guard = starter
         .as_ref()
         .and_then(|s| waitset.attach_notification(s).ok());
+    // Clients' exits and the node folder's changes ring an alarm the WaitSet watches, so
+    // with idle clients the loop sleeps instead of looking at its period.
+    let alarm = alarm::Alarm::new().map(|(alarm, registry)| {
+        let folder = daemon.config.global.node_dir().to_string();
+        daemon.liveness.ring(registry, &folder);
+        alarm
+    });
+    // Watched only while clients are connected: without, nothing is looked for, and a loop
+    // woken by other processes' nodes would serve them (connecting to their ports) for
+    // nothing.
+    let mut alarm_guard = None;
+    let mut alarmed = false;
     let mut house = House {
         next: Instant::now() + HOUSEKEEPING,
         trims: trim::Schedule::default(),
+        busy: true,
     };
     while !shutdown.load(Ordering::Relaxed) {
         daemon.wait(&waitset, house.next, starter_guard.is_some());
+        let now = Instant::now();
+        if now < house.next {
+            // Something woke the loop: look after the house within the period again.
+            house.busy = true;
+            house.next = house.next.min(now + HOUSEKEEPING);
+        }
         if starter_guard.is_some() && starter.as_ref().is_some_and(|s| s.exited()) {
             // Its pidfd stays readable: stop watching it, and look after now (the daemon
             // ends here without clients, else at a later look once the last one is gone).
             starter_guard = None;
-            house.next = Instant::now();
+            house.next = now;
+        }
+        if alarm.as_ref().is_some_and(alarm::Alarm::drain) {
+            // A client's process exited or a node came or went: look now.
+            house.next = now;
         }
         consume_wake_ups(&listener, &worker_wake, &daemon.waker);
         daemon.serve_round();
-        if Instant::now() >= house.next && !daemon.look_after(&mut house, trims) {
+        if daemon.clients.is_empty() == alarm_guard.is_some() {
+            alarm_guard = match (&alarm, daemon.clients.is_empty()) {
+                (Some(alarm), false) => waitset.attach_notification(alarm).ok(),
+                _ => None,
+            };
+            alarmed = alarm_guard.is_some();
+        }
+        if Instant::now() >= house.next && !daemon.look_after(&mut house, trims, alarmed) {
             break;
         }
     }
@@ -213,10 +243,17 @@ fn start(
     Ok(daemon)
 }
 
+/// The longest the loop goes without a look while its clients sit idle and the alarm
+/// watches every one of them (what it then looks for is rare: ended workers, pruned quota
+/// counters, memory given back).
+const QUIET_LOOK: std::time::Duration = std::time::Duration::from_secs(5);
+
 /// When the house is next looked after, and when freed memory is next given back.
 struct House {
     next: Instant,
     trims: trim::Schedule,
+    /// Something woke the loop since the last look (a request, a worker, an alarm).
+    busy: bool,
 }
 
 /// Consumes the wake-ups that ended the wait (requests announced, workers reporting), so
@@ -273,7 +310,7 @@ impl Daemon {
     /// workers reaped, quotas pruned and memory given back; without, the watch updated and
     /// ended workers' memory given back. Returns false when the daemon should stop (an
     /// on-demand daemon whose starter is gone and no client is left).
-    fn look_after(&mut self, house: &mut House, trims: &trim::Trims) -> bool {
+    fn look_after(&mut self, house: &mut House, trims: &trim::Trims, alarmed: bool) -> bool {
         let idle = self.clients.is_empty();
         if !idle {
             self.release_gone_clients();
@@ -302,7 +339,10 @@ impl Daemon {
                 trims.request();
             }
         }
-        house.next = Instant::now() + HOUSEKEEPING;
+        // Nothing happened since the last look and the alarm rings for every exit and node
+        // change: the next look can wait (it is a safety net then); else the period.
+        let quiet = !std::mem::take(&mut house.busy) && alarmed && self.liveness.alarmed();
+        house.next = Instant::now() + if quiet { QUIET_LOOK } else { HOUSEKEEPING };
         true
     }
 
