@@ -75,8 +75,9 @@ pub(super) fn serve(
     // Watched only while clients are connected: without, nothing is looked for, and a loop
     // woken by other processes' nodes would serve them (connecting to their ports) for
     // nothing.
-    let mut alarm_guard = None;
+    let mut _alarm_guard = None;
     let mut alarmed = false;
+    let mut had_clients = false;
     let mut house = House {
         next: Instant::now() + HOUSEKEEPING,
         trims: trim::Schedule::default(),
@@ -102,12 +103,16 @@ pub(super) fn serve(
         }
         consume_wake_ups(&listener, &worker_wake, &daemon.waker);
         daemon.serve_round();
-        if daemon.clients.is_empty() == alarm_guard.is_some() {
-            alarm_guard = match (&alarm, daemon.clients.is_empty()) {
-                (Some(alarm), false) => waitset.attach_notification(alarm).ok(),
+        // Attached when the first client comes (once: a WaitSet that refuses it leaves the
+        // loop looking at its period), detached when the last one goes.
+        let with_clients = !daemon.clients.is_empty();
+        if with_clients != had_clients {
+            had_clients = with_clients;
+            _alarm_guard = match (&alarm, with_clients) {
+                (Some(alarm), true) => waitset.attach_notification(alarm).ok(),
                 _ => None,
             };
-            alarmed = alarm_guard.is_some();
+            alarmed = _alarm_guard.is_some();
         }
         if Instant::now() >= house.next && !daemon.look_after(&mut house, trims, alarmed) {
             break;
