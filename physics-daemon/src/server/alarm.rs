@@ -1,13 +1,14 @@
 //! What wakes the request loop to look for gone clients: one epoll descriptor, watched by
 //! the loop's WaitSet, that becomes readable when a watched client process exits (its pidfd,
-//! [`super::pidwatch`]) or when an entry of the domain's node folder comes or goes (inotify,
-//! [`super::folder_watch`]: a client that closed its node but kept running). With it the
-//! loop of a daemon whose clients sit idle sleeps until something happens instead of
-//! looking twice a second; where it cannot be had, the loop keeps looking at its period.
+//! [`super::pidwatch`]). With it the loop of a daemon whose clients sit idle sleeps until
+//! one dies (or something else wakes it) instead of looking twice a second; where it cannot
+//! be had, the loop keeps looking at its period. The domain's node folder is deliberately
+//! not on it: any process of the user can make and remove nodes there as fast as it likes,
+//! and each change would wake the loop (a client that closes its node without a goodbye
+//! and keeps running is found by the loop's next look instead).
 //!
-//! Every descriptor is registered edge-triggered, so one exit or change wakes the loop
-//! once (a client that stays a zombie does not keep it awake); [`Alarm::drain`] takes what
-//! woke it.
+//! Every descriptor is registered edge-triggered, so one exit wakes the loop once (a client
+//! that stays a zombie does not keep it awake); [`Alarm::drain`] takes what woke it.
 
 use std::os::fd::{AsRawFd, FromRawFd, OwnedFd, RawFd};
 
@@ -20,7 +21,7 @@ pub struct Alarm {
 }
 
 /// The registering end (the same epoll instance through a second descriptor), kept by the
-/// loop's liveness schedule, which knows which processes and which folder to watch.
+/// loop's liveness schedule, which knows which processes to watch.
 #[derive(Debug)]
 pub struct Registry {
     epoll: OwnedFd,
@@ -47,8 +48,8 @@ impl Alarm {
         Some((Alarm { epoll, view }, Registry { epoll: second }))
     }
 
-    /// Takes what is ready; true when a watched process exited or the folder changed since
-    /// the last call.
+    /// Takes what is ready; true when a watched descriptor became readable (a process
+    /// exited) since the last call.
     pub fn drain(&self) -> bool {
         let mut events = [libc::epoll_event { events: 0, u64: 0 }; 32];
         let mut any = false;
@@ -82,8 +83,8 @@ impl iceoryx2_bb_posix::file_descriptor::FileDescriptorBased for Alarm {
 impl iceoryx2_bb_posix::file_descriptor_set::SynchronousMultiplexing for Alarm {}
 
 impl Registry {
-    /// Watches `fd` (readable when its process exits, or when its folder changed) until it
-    /// is closed: closing a descriptor that has no duplicate removes it from the alarm.
+    /// Watches `fd` (a pidfd: readable when its process exits; any pollable descriptor) until
+    /// it is closed: closing a descriptor that has no duplicate removes it from the alarm.
     /// False when the system refused.
     pub fn add(&self, fd: RawFd) -> bool {
         let mut event = libc::epoll_event {
@@ -111,7 +112,7 @@ mod tests {
     }
 
     #[test]
-    fn an_exit_or_a_folder_change_rings_once() {
+    fn an_exit_rings_once_and_any_watched_descriptor_rings() {
         let (alarm, registry) = Alarm::new().expect("epoll");
         // A process that exits: readable once, and not again while it stays a zombie.
         let mut child = std::process::Command::new("sleep")
@@ -137,7 +138,7 @@ mod tests {
             !readable(&alarm, Duration::from_millis(100)),
             "quiet once reaped"
         );
-        // A folder's entry made and removed: each rings.
+        // Any pollable descriptor: a folder's inotify watch, an entry made and removed.
         let dir = std::env::temp_dir().join(format!("alarm-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
         let folder = super::super::folder_watch::FolderWatch::new(dir.to_str().unwrap()).unwrap();

@@ -11,7 +11,6 @@
 use std::time::{Duration, Instant, SystemTime};
 
 use super::alarm::Registry;
-use super::folder_watch::FolderWatch;
 use super::pidwatch::{folder_stamp, PidWatch};
 
 /// The longest the loop goes without listing nodes while clients are connected.
@@ -42,8 +41,8 @@ pub struct Schedule {
     pids: PidWatch,
     /// The node folder's modification time at the last listing.
     stamp: Option<SystemTime>,
-    /// The loop's alarm and the node folder it watches, once [`Schedule::ring`] set them.
-    alarm: Option<(Registry, FolderWatch)>,
+    /// The loop's alarm, once [`Schedule::ring`] set it.
+    alarm: Option<Registry>,
     /// A watched process had exited at the last look (its client may not be released yet).
     exited: bool,
 }
@@ -61,25 +60,18 @@ impl Default for Schedule {
 }
 
 impl Schedule {
-    /// From now on rings `alarm` when a client's process exits or an entry of the node
-    /// folder at `folder` comes or goes (nothing when the folder cannot be watched).
-    pub fn ring(&mut self, alarm: Registry, folder: &str) {
-        if let Some(watch) = FolderWatch::new(folder) {
-            if alarm.add(watch.raw_fd()) {
-                self.alarm = Some((alarm, watch));
-            }
-        }
+    /// From now on rings `alarm` when a client's process exits.
+    pub fn ring(&mut self, alarm: Registry) {
+        self.alarm = Some(alarm);
     }
 
-    /// Whether the alarm rings for everything [`Schedule::list_now`] would find: every
-    /// client's exit and every change of the node folder. Only then may the loop look less
-    /// often than its period.
+    /// Whether the alarm rings for every client's exit (and no exit is still to be dealt
+    /// with). Only then may the loop look less often than its period. (A client that closes
+    /// its node without a goodbye and keeps running is found by the next look's folder
+    /// time: the node folder is not on the alarm, since any process can change it as often
+    /// as it likes.)
     pub fn alarmed(&self) -> bool {
-        self.alarm
-            .as_ref()
-            .is_some_and(|(_, folder)| folder.is_live())
-            && self.pids.all_alarmed()
-            && !self.exited
+        self.alarm.is_some() && self.pids.all_alarmed() && !self.exited
     }
 
     /// Whether to list nodes now; records the listing when it says yes. Yes when a client's
@@ -94,12 +86,7 @@ impl Schedule {
         all_alive: impl FnOnce() -> bool,
     ) -> bool {
         let now = Instant::now();
-        let alarm = self.alarm.as_ref().map(|(registry, folder)| {
-            // Its queued changes are read here; the folder's time says what changed.
-            folder.drain();
-            registry
-        });
-        self.pids.watch_with(pids, alarm);
+        self.pids.watch_with(pids, self.alarm.as_ref());
         let stamp = folder_stamp(folder);
         let exited = self.pids.any_exited();
         self.exited = exited == Some(true);

@@ -266,6 +266,13 @@ fn guard(config: &Config, limits: &Limits, watch: &Watch) -> Result<(), DaemonEr
                 e.reason
             );
         }
+        // A long look (many evictions) beats again at its end, so the silence a client sees
+        // is never a look plus a whole period.
+        if started.elapsed() >= PERIOD / 2 {
+            if let Some(heart) = heart.as_mut().filter(|_| watch.beating()) {
+                heart.beat();
+            }
+        }
         if !evictions.is_empty() {
             tracing::info!(
                 evictions = evictions.len(),

@@ -65,11 +65,10 @@ pub(super) fn serve(
     let mut starter_guard = starter
         .as_ref()
         .and_then(|s| waitset.attach_notification(s).ok());
-    // Clients' exits and the node folder's changes ring an alarm the WaitSet watches, so
-    // with idle clients the loop sleeps instead of looking at its period.
+    // Clients' exits ring an alarm the WaitSet watches, so with idle clients the loop
+    // sleeps instead of looking at its period.
     let alarm = alarm::Alarm::new().map(|(alarm, registry)| {
-        let folder = daemon.config.global.node_dir().to_string();
-        daemon.liveness.ring(registry, &folder);
+        daemon.liveness.ring(registry);
         alarm
     });
     // Watched only while clients are connected: without, nothing is looked for, and a loop
@@ -79,6 +78,7 @@ pub(super) fn serve(
     let mut alarmed = false;
     let mut had_clients = false;
     let mut house = House {
+        last: Instant::now(),
         next: Instant::now() + HOUSEKEEPING,
         trims: trim::Schedule::default(),
         busy: true,
@@ -98,8 +98,9 @@ pub(super) fn serve(
             house.next = now;
         }
         if alarm.as_ref().is_some_and(alarm::Alarm::drain) {
-            // A client's process exited or a node came or went: look now.
-            house.next = now;
+            // A client's process exited: look now, or a period after the last look (the
+            // looks, which list nodes, stay at most two a second however many exit).
+            house.next = house.next.min((house.last + HOUSEKEEPING).max(now));
         }
         consume_wake_ups(&listener, &worker_wake, &daemon.waker);
         daemon.serve_round();
@@ -255,6 +256,8 @@ const QUIET_LOOK: std::time::Duration = std::time::Duration::from_secs(5);
 
 /// When the house is next looked after, and when freed memory is next given back.
 struct House {
+    /// When the house was last looked after.
+    last: Instant,
     next: Instant,
     trims: trim::Schedule,
     /// Something woke the loop since the last look (a request, a worker, an alarm).
@@ -344,10 +347,11 @@ impl Daemon {
                 trims.request();
             }
         }
-        // Nothing happened since the last look and the alarm rings for every exit and node
-        // change: the next look can wait (it is a safety net then); else the period.
+        // Nothing happened since the last look and the alarm rings for every client's exit:
+        // the next look can wait (it is a safety net then); else the period.
         let quiet = !std::mem::take(&mut house.busy) && alarmed && self.liveness.alarmed();
-        house.next = Instant::now() + if quiet { QUIET_LOOK } else { HOUSEKEEPING };
+        house.last = Instant::now();
+        house.next = house.last + if quiet { QUIET_LOOK } else { HOUSEKEEPING };
         true
     }
 
