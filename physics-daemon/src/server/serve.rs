@@ -71,9 +71,7 @@ pub(super) fn serve(
         daemon.liveness.ring(registry);
         alarm
     });
-    // Watched only while clients are connected: without, nothing is looked for, and a loop
-    // woken by other processes' nodes would serve them (connecting to their ports) for
-    // nothing.
+    // Watched only while clients are connected (without, the loop looks for nothing).
     let mut _alarm_guard = None;
     let mut alarmed = false;
     let mut had_clients = false;
