@@ -35,9 +35,15 @@ thread_local! {
     static TOUCH_EPOCH: Cell<u64> = const { Cell::new(0) };
 }
 
-/// A part's touch handlers, or a plane's parts, changed (see `TOUCH_EPOCH`).
+/// A part's touch or CFrame handlers, or a plane's parts, changed (see `TOUCH_EPOCH`).
 pub(crate) fn touch_handlers_changed() {
     TOUCH_EPOCH.with(|e| e.set(e.get().wrapping_add(1)));
+}
+
+/// The count [`touch_handlers_changed`] bumps: an answer about a plane's parts' handlers
+/// kept with it stays true while the count is the same.
+pub(crate) fn handlers_epoch() -> u64 {
+    TOUCH_EPOCH.with(Cell::get)
 }
 
 /// Per plane: whether events are being read, and the `EventsLost` signal.

@@ -652,6 +652,8 @@ pub fn methods(lua: &Lua) -> mlua::Result<Table> {
             let (signal, created) = part.signal(row.name);
             if created && row.name == "CFrame" {
                 scheduler(lua).watch(part.clone());
+                // Its planes' post-tick pass asks their parts again (`PlaneState::after_tick`).
+                signal.on_listeners(|_| crate::api::contacts::touch_handlers_changed());
             }
             signal.userdata(lua)
         }
