@@ -40,10 +40,24 @@ pub(crate) fn touch_handlers_changed() {
     TOUCH_EPOCH.with(|e| e.set(e.get().wrapping_add(1)));
 }
 
-/// The count [`touch_handlers_changed`] bumps: an answer about a plane's parts' handlers
-/// kept with it stays true while the count is the same.
-pub(crate) fn handlers_epoch() -> u64 {
-    TOUCH_EPOCH.with(Cell::get)
+/// An answer about a plane's parts' handlers ("does any part have one?"), kept while
+/// [`touch_handlers_changed`] was not called since it was found.
+#[derive(Default)]
+pub(crate) struct HandlersAnswer(Cell<Option<(u64, bool)>>);
+
+impl HandlersAnswer {
+    /// The kept answer, or `find`'s when handlers or parts changed since.
+    pub(crate) fn get(&self, find: impl FnOnce() -> bool) -> bool {
+        let epoch = TOUCH_EPOCH.with(Cell::get);
+        match self.0.get() {
+            Some((seen, answer)) if seen == epoch => answer,
+            _ => {
+                let answer = find();
+                self.0.set(Some((epoch, answer)));
+                answer
+            }
+        }
+    }
 }
 
 /// Per plane: whether events are being read, and the `EventsLost` signal.
@@ -52,7 +66,7 @@ pub struct ContactPump {
     reading: Cell<bool>,
     /// Whether a part had touch handlers, as of a `TOUCH_EPOCH` (so a frame with nothing
     /// changed does not ask every part again).
-    parts_listen: Cell<Option<(u64, bool)>>,
+    parts_listen: HandlersAnswer,
     /// `plane.EventsLost`, created on first access.
     lost: RefCell<Option<Signal>>,
     /// `joint.Broke` of the joints whose signal was read, by joint handle.
@@ -63,7 +77,7 @@ impl Default for ContactPump {
     fn default() -> Self {
         ContactPump {
             reading: Cell::new(false),
-            parts_listen: Cell::new(None),
+            parts_listen: HandlersAnswer::default(),
             lost: RefCell::new(None),
             broke: RefCell::default(),
         }
@@ -134,15 +148,10 @@ impl PlaneState {
     /// Whether anyone listens to the plane's events: a part's touch handlers, a
     /// controller's signals or a joint's Broke.
     fn touch_handlers(&self) -> bool {
-        let epoch = TOUCH_EPOCH.with(Cell::get);
-        let parts = match self.contacts.parts_listen.get() {
-            Some((seen, listen)) if seen == epoch => listen,
-            _ => {
-                let listen = self.any_part(|p| p.touch_listeners() > 0);
-                self.contacts.parts_listen.set(Some((epoch, listen)));
-                listen
-            }
-        };
+        let parts = self
+            .contacts
+            .parts_listen
+            .get(|| self.any_part(|p| p.touch_listeners() > 0));
         parts
             || self.controller_listeners()
             || self

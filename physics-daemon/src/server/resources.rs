@@ -217,15 +217,18 @@ fn guard(config: &Config, limits: &Limits, watch: &Watch) -> Result<(), DaemonEr
             None
         }
     };
+    let beat = |heart: &mut Option<super::heartbeat::Heart>| {
+        if let Some(heart) = heart.as_mut().filter(|_| watch.beating()) {
+            heart.beat();
+        }
+    };
     // Watched from before the first listing, so no node created after it goes unnoticed.
     let folder_path = config.global.node_dir().to_string();
     let mut folder = FolderWatch::new(&folder_path);
     let mut quiet = false;
     while let Some(changed) = watch.wait(quiet, folder.as_ref()) {
         // The beat first: a long look must not delay it.
-        if let Some(heart) = heart.as_mut().filter(|_| watch.beating()) {
-            heart.beat();
-        }
+        beat(&mut heart);
         guard.folder_changed |= changed;
         if !folder.as_ref().is_some_and(FolderWatch::is_live) {
             // Removed and made again (or never watched): watch it anew, and look once. Where
@@ -269,9 +272,7 @@ fn guard(config: &Config, limits: &Limits, watch: &Watch) -> Result<(), DaemonEr
         // A long look (many evictions) beats again at its end, so the silence a client sees
         // is never a look plus a whole period.
         if started.elapsed() >= PERIOD / 2 {
-            if let Some(heart) = heart.as_mut().filter(|_| watch.beating()) {
-                heart.beat();
-            }
+            beat(&mut heart);
         }
         if !evictions.is_empty() {
             tracing::info!(

@@ -72,8 +72,7 @@ pub(super) fn serve(
         alarm
     });
     // Watched only while clients are connected (without, the loop looks for nothing).
-    let mut _alarm_guard = None;
-    let mut alarmed = false;
+    let mut attached = None;
     let mut had_clients = false;
     let mut house = House {
         last: Instant::now(),
@@ -107,13 +106,13 @@ pub(super) fn serve(
         let with_clients = !daemon.clients.is_empty();
         if with_clients != had_clients {
             had_clients = with_clients;
-            _alarm_guard = match (&alarm, with_clients) {
+            attached = match (&alarm, with_clients) {
                 (Some(alarm), true) => waitset.attach_notification(alarm).ok(),
                 _ => None,
             };
-            alarmed = _alarm_guard.is_some();
         }
-        if Instant::now() >= house.next && !daemon.look_after(&mut house, trims, alarmed) {
+        if Instant::now() >= house.next && !daemon.look_after(&mut house, trims, attached.is_some())
+        {
             break;
         }
     }

@@ -34,9 +34,9 @@ pub struct PlaneState {
     controllers: RefCell<HashMap<Handle, Rc<ControllerState>>>,
     /// Its maps by body handle (`map.rs`): hits and contacts on a map hand back its Map.
     pub(crate) maps: RefCell<HashMap<Handle, Rc<super::map::MapState>>>,
-    /// Whether a part had CFrame handlers, as of a [`super::contacts::handlers_epoch`] (so
-    /// a step with none connected does not copy and ask every part).
-    cframe_listen: Cell<Option<(u64, bool)>>,
+    /// Whether a part has CFrame handlers (so a step with none connected does not copy and
+    /// ask every part).
+    cframe_listen: super::contacts::HandlersAnswer,
 }
 
 impl PlaneState {
@@ -146,16 +146,10 @@ impl PlaneState {
     /// listeners announces its new pose (handlers run before `Step` returns).
     fn after_tick(&self, lua: &Lua) -> mlua::Result<()> {
         self.deliver_contacts(lua)?;
-        let epoch = super::contacts::handlers_epoch();
-        let listen = match self.cframe_listen.get() {
-            Some((seen, listen)) if seen == epoch => listen,
-            _ => {
-                let listen = self.any_part(|p| p.cframe_listeners() > 0);
-                self.cframe_listen.set(Some((epoch, listen)));
-                listen
-            }
-        };
-        if !listen {
+        if !self
+            .cframe_listen
+            .get(|| self.any_part(|p| p.cframe_listeners() > 0))
+        {
             return Ok(());
         }
         // A copy: handlers may add, unlink or destroy parts.
@@ -581,7 +575,7 @@ pub(crate) fn wrap_plane(lua: &Lua, plane: Plane) -> mlua::Result<mlua::AnyUserD
         contacts: ContactPump::default(),
         controllers: RefCell::default(),
         maps: RefCell::default(),
-        cframe_listen: Cell::new(None),
+        cframe_listen: Default::default(),
     });
     // Probed every frame; it costs one check while no part of it has touch handlers.
     scheduler(lua).watch(state.clone());
