@@ -4,7 +4,8 @@
 //! and counted), queries off the request loop and bounded per request, the quota race of
 //! many connections, controller paths counted against a quota, objects added to another's
 //! shared plane counted against the adder, planes slower than 1 Hz, `Threads` capped by
-//! cores, planes admitted within the daemon's memory, and fair CPU shares between clients.
+//! cores, planes admitted within the daemon's memory, fair CPU shares between clients, and
+//! a client connection's shared memory.
 
 use std::sync::{Arc, Barrier};
 use std::time::{Duration, Instant};
@@ -843,4 +844,51 @@ fn four_processes_of_sixteen_clients_leave_room_for_another() {
         let _ = child.kill();
         let _ = child.wait();
     }
+}
+
+/// Bytes of the domain's shared-memory files actually backed by memory (allocated blocks).
+fn shm_backed_bytes(domain: &str) -> u64 {
+    use std::os::unix::fs::MetadataExt;
+    integration_tests::domain_files(domain)
+        .iter()
+        .filter(|p| p.starts_with("/dev/shm"))
+        .filter_map(|p| std::fs::metadata(p).ok())
+        .map(|m| m.blocks() * 512)
+        .sum()
+}
+
+/// Each client's reply connection spans every growth segment of the daemon's reply memory
+/// (255) and every request slot (4), one flag per reply chunk: 31 MB, every byte written
+/// when the connection was made (and swept again when it closed). A process holding 16
+/// clients cost the machine ~490 MB of shared memory; 256 clients, 7.9 GB. Now a new
+/// connection's zeroed memory is left untouched (`tests/tests/connection_memory.rs` checks
+/// the connection itself, and the sweep).
+#[test]
+fn a_client_connection_costs_kilobytes_of_shared_memory() {
+    let daemon = TestDaemon::start_with("conn-cost", &["--max-clients-per-process", "32"], &[]);
+    let first = daemon.client();
+    let plane = first.create_plane(&PlaneOptions::manual()).unwrap();
+    plane.step(1.0 / 60.0).unwrap();
+    let before = shm_backed_bytes(&daemon.domain);
+    // 16 more clients, each with a plane: every reply connection carried replies.
+    let others: Vec<Client> = (0..16).map(|_| daemon.client()).collect();
+    let planes: Vec<_> = others
+        .iter()
+        .map(|c| c.create_plane(&PlaneOptions::manual()).unwrap())
+        .collect();
+    let grown = shm_backed_bytes(&daemon.domain).saturating_sub(before);
+    eprintln!(
+        "16 clients: {} KiB of shared memory backed ({} KiB each)",
+        grown / 1024,
+        grown / 16 / 1024
+    );
+    assert!(
+        grown < 16 * 1024 * 1024,
+        "16 clients backed {} KiB of shared memory ({} KiB each; 31 MB each before)",
+        grown / 1024,
+        grown / 16 / 1024
+    );
+    drop(planes);
+    drop(others);
+    plane.step(1.0 / 60.0).unwrap();
 }
