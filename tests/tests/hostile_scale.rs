@@ -654,7 +654,7 @@ fn rss_bytes(pid: u32) -> u64 {
     kib * 1024
 }
 
-/// Empty planes cost ~10 MB each (their shared-memory output), so many processes each
+/// Empty planes cost ~10 MB each (now ~1.8 MB: see `PLANE_BYTES`), so many processes each
 /// creating planes up to their quota took the daemon down long before its 1,024-plane cap.
 /// Now the daemon admits planes (and what they hold) only within `--max-memory-mb`, counting
 /// each plane as PLANE_BYTES, which the measured cost must stay under.

@@ -15,9 +15,11 @@ use shm_layout::{CommandError, ErrorKind, Handle, OpCost, PlaneId};
 use super::limits::{exceeded, Limits};
 use crate::backend::{Backend, Usage};
 
-/// Memory one empty plane costs the daemon, measured: its shared-memory output (the event
-/// service's per-reader queues, 64 readers × 64 ticks, are ~9 MB of it), node and engine.
-pub const PLANE_BYTES: u64 = 11 << 20;
+/// Memory one empty plane costs the daemon, measured: 1.8 MiB in a debug build (its worker
+/// thread, engine, node and output ports). It was 10.2 MiB while iceoryx2 kept a reference
+/// counter per chunk for each of the 255 segments the output's data may grow to, written at
+/// creation (`vendor/iceoryx2-0.10.0/PATCHED.md`, change 3).
+pub const PLANE_BYTES: u64 = 3 << 20;
 /// Memory one object costs, measured (~2.8 KB for a lone cube) plus room for its contacts.
 pub const OBJECT_BYTES: u64 = 4 << 10;
 /// Memory one mesh vertex (or triangle) costs: positions, indices and the BVH.
