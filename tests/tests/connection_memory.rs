@@ -3,9 +3,14 @@
 //! for every segment its sender's data may grow to (255) and every channel; the daemon's
 //! reply connections hold 12.5 million. Creating one wrote them all (31 MB backed per
 //! client) and closing one swapped them all back (~130 ms of the request loop per client
-//! that left). These tests build such a connection directly and check that neither touches
-//! the flags nobody used, and that a closed receiver's chunks still all come back.
+//! that left). The first test builds such a connection directly and checks that neither
+//! touches the flags nobody used, and that a closed receiver's chunks still all come back;
+//! the second checks, through a real daemon, that clients leaving no longer stall another
+//! client's requests. (A file of its own: its timing is not shared with other tests' load.)
 
+use std::time::{Duration, Instant};
+
+use client_sdk::{PlaneOptions, Pose, Shape};
 use iceoryx2::prelude::SemanticString;
 use iceoryx2_cal::named_concept::NamedConceptBuilder;
 use iceoryx2_cal::shm_allocator::pointer_offset::SegmentId;
@@ -14,6 +19,7 @@ use iceoryx2_cal::zero_copy_connection::{
     ChannelId, FileName, PointerOffset, ZeroCopyConnection, ZeroCopyConnectionBuilder,
     ZeroCopyReceiver, ZeroCopySender,
 };
+use integration_tests::TestDaemon;
 
 /// The daemon's reply connection: 512 client ports × 8 × 3 chunks a segment, 255 segments,
 /// 4 request slots.
@@ -108,4 +114,51 @@ fn a_connection_backs_only_what_it_uses_and_a_closed_receivers_chunks_all_come_b
         "the sweep backed {backed} of the connection's {size} bytes"
     );
     drop(sender);
+}
+
+/// Processes that connect, make a plane and leave, one after another, while another client
+/// steps. The daemon swept each departed client's reply connection (12.5 million flags) on
+/// the request loop: the other client's Step waited 266–268 ms (release) behind five of
+/// them. Now only the flags replies went to are swept.
+#[test]
+fn clients_that_come_and_go_do_not_stall_another_clients_step() {
+    let daemon = TestDaemon::start("come-and-go");
+    let victim = daemon.client();
+    let mine = victim.create_plane(&PlaneOptions::manual()).unwrap();
+    mine.add(Shape::Cube { size: [1.0; 3] }, Pose::IDENTITY, &[])
+        .unwrap();
+    let step = || {
+        let t = Instant::now();
+        mine.step(1.0 / 60.0).unwrap();
+        t.elapsed()
+    };
+    let alone = (0..100).map(|_| step()).max().unwrap();
+    let domain = daemon.domain.clone();
+    let visitors = std::thread::spawn(move || {
+        for _ in 0..5 {
+            let out = std::process::Command::new(env!("CARGO_BIN_EXE_test-client"))
+                .args(["hold-once", &domain])
+                .output()
+                .unwrap();
+            assert!(out.status.success(), "{out:?}");
+        }
+    });
+    // Step while they come and go, and until the daemon's next looks (twice a second
+    // while busy) have closed what they left.
+    let mut worst = Duration::ZERO;
+    let mut steps = 0;
+    let mut gone = None;
+    while gone.is_none_or(|g: Instant| g.elapsed() < Duration::from_millis(1500)) {
+        worst = worst.max(step());
+        steps += 1;
+        if gone.is_none() && visitors.is_finished() {
+            gone = Some(Instant::now());
+        }
+    }
+    visitors.join().unwrap();
+    eprintln!("worst step {worst:?} of {steps} beside 5 visiting processes (alone {alone:?})");
+    assert!(
+        worst < Duration::from_millis(120).max(alone * 2),
+        "a step waited {worst:?} while 5 processes came and went (alone: {alone:?})"
+    );
 }
