@@ -2,7 +2,8 @@
 //! verdict row per attack: reply amplification, a heavy query beside another client's
 //! steps, the quota race of many connections, controller paths, a plane slower than 1 Hz,
 //! `Threads` against cores, the cost of an empty plane against what the memory budget
-//! counts, and a process past its CPU share beside another client. Writes DIR/hostile.json
+//! counts, processes coming and going beside another client's steps, and a process past
+//! its CPU share beside another client. Writes DIR/hostile.json
 //! and DIR/hostile.md. The suite's `tests/tests/hostile_scale.rs` runs the same attacks at
 //! debug-build sizes.
 
@@ -35,6 +36,10 @@ pub struct HostileArgs {
     /// Internal: be the CPU hog of the fairness row on the daemon of this domain.
     #[arg(long, hide = true)]
     pub hog: Option<String>,
+    /// Internal: be a visiting client of the come-and-go row (connect to the daemon of this
+    /// domain, make a plane, leave).
+    #[arg(long, hide = true)]
+    pub visit: Option<String>,
 }
 
 /// The report: one goal per attack.
@@ -335,7 +340,63 @@ fn empty_planes() -> BenchResult<Goal> {
     ))
 }
 
-/// 10. A process ticking 64 planes at 10,000 Hz beside another client's steps.
+/// 10. Processes that connect, make a plane and leave, one after another, beside another
+/// client's steps. Each client that left used to hold the request loop ~130 ms while the
+/// daemon swept its reply connection.
+fn come_and_go() -> BenchResult<Goal> {
+    let daemon = DaemonProcess::start("hostile-churn")?;
+    let victim = Client::connect(&daemon.domain)?;
+    let mine = victim.create_plane(&PlaneOptions::manual())?;
+    send(&victim, add_cubes(mine.id(), 100, grid))?;
+    let alone = steps(&mine, 300)?;
+    let domain = daemon.domain.clone();
+    let exe = std::env::current_exe().map_err(BenchError::io("find physics-bench"))?;
+    let visitors = std::thread::spawn(move || -> BenchResult<()> {
+        for _ in 0..10 {
+            let out = std::process::Command::new(&exe)
+                .args(["hostile", "--visit", &domain])
+                .output()
+                .map_err(BenchError::io("run a visiting client"))?;
+            if !out.status.success() {
+                return Err(BenchError::Failed(format!(
+                    "a visiting client failed: {}",
+                    String::from_utf8_lossy(&out.stderr)
+                )));
+            }
+        }
+        Ok(())
+    });
+    // Step while they come and go, and until the daemon's next looks (twice a second while
+    // busy) have closed what they left.
+    let mut during = Vec::new();
+    let mut gone: Option<Instant> = None;
+    while gone.is_none_or(|g| g.elapsed() < Duration::from_millis(1500)) {
+        let t = Instant::now();
+        mine.step(1.0 / 60.0)?;
+        during.push(t.elapsed().as_secs_f64());
+        if gone.is_none() && visitors.is_finished() {
+            gone = Some(Instant::now());
+        }
+    }
+    visitors
+        .join()
+        .map_err(|_| BenchError::Failed("the visiting clients' thread panicked".into()))??;
+    let a99 = percentile(&alone, 0.99).unwrap_or(0.0);
+    let worst = during.iter().copied().fold(0.0, f64::max);
+    Ok(Goal::new(
+        "another client's worst Step while 10 processes connect, make a plane and leave ≤ one \
+         60 Hz frame (16.7 ms)",
+        format!(
+            "worst {} of {} steps (p99 alone {})",
+            ms(worst),
+            during.len(),
+            ms(a99)
+        ),
+        Some(worst <= 1.0 / 60.0),
+    ))
+}
+
+/// 11. A process ticking 64 planes at 10,000 Hz beside another client's steps.
 fn fairness() -> BenchResult<Goal> {
     let daemon = DaemonProcess::start("hostile-cpu")?;
     let victim = Client::connect(&daemon.domain)?;
@@ -422,7 +483,12 @@ pub fn run(args: &HostileArgs) -> BenchResult<()> {
     if let Some(domain) = &args.hog {
         return hog(domain);
     }
-    let rows: [(&str, Row); 8] = [
+    if let Some(domain) = &args.visit {
+        let client = Client::connect(domain)?;
+        client.create_plane(&PlaneOptions::manual())?;
+        return Ok(());
+    }
+    let rows: [(&str, Row); 9] = [
         ("reply amplification", amplification),
         ("queries beside steps", stall),
         ("quota race", quota_race),
@@ -430,6 +496,7 @@ pub fn run(args: &HostileArgs) -> BenchResult<()> {
         ("TickRate below 1", slow_plane),
         ("Threads", threads),
         ("empty planes", empty_planes),
+        ("clients coming and going", come_and_go),
         ("CPU shares", fairness),
     ];
     let mut goals = Vec::new();

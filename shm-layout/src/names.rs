@@ -58,8 +58,13 @@ pub const RUNTIME_DIR_ENV: &str = "PHYSICS_RUNTIME_DIR";
 /// The directory of the domain's sockets and node records, one that another local user
 /// cannot have created: `$PHYSICS_RUNTIME_DIR/iceoryx2/` when set; else
 /// `$XDG_RUNTIME_DIR/iceoryx2/` when that names a directory of this user that nobody else may
-/// write (the login manager makes `/run/user/UID` so, mode 0700); else `/tmp/iceoryx2-UID/`,
-/// which any user could create first (the daemon then refuses to start and says so).
+/// write (the login manager makes `/run/user/UID` so, mode 0700); else
+/// `/dev/shm/iceoryx2-UID/` (or `/tmp/iceoryx2-UID/` without a `/dev/shm`), which any user
+/// could create first (the daemon then refuses to start and says so).
+///
+/// The fallback is memory, not disk: iceoryx2 fsyncs every service description it writes
+/// (a plane's output, a client's reply event), which on a disk held the daemon's request
+/// loop ~30 ms each time a client came or went.
 pub fn root_path() -> String {
     if let Some(dir) = std::env::var_os(RUNTIME_DIR_ENV).filter(|d| !d.is_empty()) {
         return format!("{}/iceoryx2/", dir.to_string_lossy().trim_end_matches('/'));
@@ -70,6 +75,9 @@ pub fn root_path() -> String {
         if private_dir_of(std::path::Path::new(&dir), uid) {
             return format!("{}/iceoryx2/", dir.to_string_lossy().trim_end_matches('/'));
         }
+    }
+    if std::path::Path::new("/dev/shm").is_dir() {
+        return format!("/dev/shm/iceoryx2-{uid}/");
     }
     format!("/tmp/iceoryx2-{uid}/")
 }

@@ -103,7 +103,14 @@ pub fn restrict(domain: &str) {
 pub fn domain_files(domain: &str) -> Vec<PathBuf> {
     let prefix = names::prefix(domain);
     let mut found = Vec::new();
-    let mut dirs = vec![PathBuf::from("/dev/shm"), PathBuf::from(names::root_path())];
+    let shm = PathBuf::from("/dev/shm");
+    let root = PathBuf::from(names::root_path());
+    // A root inside /dev/shm is walked with it.
+    let mut dirs = if root.starts_with(&shm) {
+        vec![shm]
+    } else {
+        vec![shm, root]
+    };
     while let Some(dir) = dirs.pop() {
         let Ok(entries) = std::fs::read_dir(&dir) else {
             continue;
