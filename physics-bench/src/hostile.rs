@@ -92,6 +92,17 @@ fn steps(plane: &client_sdk::Plane, n: usize) -> BenchResult<Vec<f64>> {
     Ok(out)
 }
 
+/// A victim: a daemon of its own (named by `tag`), a manual plane of 100 cubes on it, and
+/// `n` steps timed alone.
+fn victim(tag: &str, n: usize) -> BenchResult<(DaemonProcess, client_sdk::Plane, Vec<f64>)> {
+    let daemon = DaemonProcess::start(tag)?;
+    let client = Client::connect(&daemon.domain)?;
+    let plane = client.create_plane(&PlaneOptions::manual())?;
+    send(&client, add_cubes(plane.id(), 100, grid))?;
+    let alone = steps(&plane, n)?;
+    Ok((daemon, plane, alone))
+}
+
 /// 1. A request of overlap queries over 10,000 objects: reply bytes against request bytes.
 fn amplification() -> BenchResult<Goal> {
     let daemon = DaemonProcess::start("hostile-reply")?;
@@ -126,11 +137,7 @@ fn amplification() -> BenchResult<Goal> {
 
 /// 2. Heavy raycasts on one client's plane beside another client's steps.
 fn stall() -> BenchResult<Goal> {
-    let daemon = DaemonProcess::start("hostile-stall")?;
-    let victim = Client::connect(&daemon.domain)?;
-    let mine = victim.create_plane(&PlaneOptions::manual())?;
-    send(&victim, add_cubes(mine.id(), 100, grid))?;
-    let alone = steps(&mine, 200)?;
+    let (daemon, mine, alone) = victim("hostile-stall", 200)?;
     let domain = daemon.domain.clone();
     let stop = Arc::new(std::sync::atomic::AtomicBool::new(false));
     let ready = Arc::new(Barrier::new(2));
@@ -345,11 +352,7 @@ fn empty_planes() -> BenchResult<Goal> {
 /// Each client that left used to hold the request loop ~130 ms while the daemon swept its
 /// reply connection, then ~30 ms while iceoryx2 fsynced service descriptions on a disk.
 fn come_and_go() -> BenchResult<Goal> {
-    let daemon = DaemonProcess::start("hostile-churn")?;
-    let victim = Client::connect(&daemon.domain)?;
-    let mine = victim.create_plane(&PlaneOptions::manual())?;
-    send(&victim, add_cubes(mine.id(), 100, grid))?;
-    let alone = steps(&mine, 300)?;
+    let (daemon, mine, alone) = victim("hostile-churn", 300)?;
     let domain = daemon.domain.clone();
     let exe = std::env::current_exe().map_err(BenchError::io("find physics-bench"))?;
     let visitors = std::thread::spawn(move || -> BenchResult<()> {
@@ -399,11 +402,7 @@ fn come_and_go() -> BenchResult<Goal> {
 
 /// 11. A process ticking 64 planes at 10,000 Hz beside another client's steps.
 fn fairness() -> BenchResult<Goal> {
-    let daemon = DaemonProcess::start("hostile-cpu")?;
-    let victim = Client::connect(&daemon.domain)?;
-    let mine = victim.create_plane(&PlaneOptions::manual())?;
-    send(&victim, add_cubes(mine.id(), 100, grid))?;
-    let alone = steps(&mine, 300)?;
+    let (daemon, mine, alone) = victim("hostile-cpu", 300)?;
     let exe = std::env::current_exe().map_err(BenchError::io("find physics-bench"))?;
     let mut hog = std::process::Command::new(exe)
         .args(["hostile", "--hog", &daemon.domain])
