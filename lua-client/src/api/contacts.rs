@@ -29,26 +29,26 @@ type TouchContact<'a> = (
 );
 
 thread_local! {
-    /// Counts every change that can change whether a plane's parts have touch handlers (a
-    /// part's Touched / TouchEnded handlers connected or gone, a part added to or removed
-    /// from a plane): a plane asks its parts again only after one.
-    static TOUCH_EPOCH: Cell<u64> = const { Cell::new(0) };
+    /// Counts every change that can change whether a plane's parts have touch or CFrame
+    /// handlers (a part's Touched / TouchEnded / CFrame-change handlers connected or gone, a
+    /// part added to or removed from a plane): a plane asks its parts again only after one.
+    static HANDLERS_EPOCH: Cell<u64> = const { Cell::new(0) };
 }
 
-/// A part's touch or CFrame handlers, or a plane's parts, changed (see `TOUCH_EPOCH`).
-pub(crate) fn touch_handlers_changed() {
-    TOUCH_EPOCH.with(|e| e.set(e.get().wrapping_add(1)));
+/// A part's touch or CFrame handlers, or a plane's parts, changed (see `HANDLERS_EPOCH`).
+pub(crate) fn handlers_changed() {
+    HANDLERS_EPOCH.with(|e| e.set(e.get().wrapping_add(1)));
 }
 
 /// An answer about a plane's parts' handlers ("does any part have one?"), kept while
-/// [`touch_handlers_changed`] was not called since it was found.
+/// [`handlers_changed`] was not called since it was found.
 #[derive(Default)]
 pub(crate) struct HandlersAnswer(Cell<Option<(u64, bool)>>);
 
 impl HandlersAnswer {
     /// The kept answer, or `find`'s when handlers or parts changed since.
     pub(crate) fn get(&self, find: impl FnOnce() -> bool) -> bool {
-        let epoch = TOUCH_EPOCH.with(Cell::get);
+        let epoch = HANDLERS_EPOCH.with(Cell::get);
         match self.0.get() {
             Some((seen, answer)) if seen == epoch => answer,
             _ => {
@@ -64,7 +64,7 @@ impl HandlersAnswer {
 pub struct ContactPump {
     /// True while some part of the plane has touch handlers (events are drained each frame).
     reading: Cell<bool>,
-    /// Whether a part had touch handlers, as of a `TOUCH_EPOCH` (so a frame with nothing
+    /// Whether a part had touch handlers, as of a `HANDLERS_EPOCH` (so a frame with nothing
     /// changed does not ask every part again).
     parts_listen: HandlersAnswer,
     /// `plane.EventsLost`, created on first access.

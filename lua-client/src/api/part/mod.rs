@@ -452,7 +452,7 @@ impl PartState {
         if created {
             let part = Rc::downgrade(self);
             signal.on_listeners(move |_| {
-                crate::api::contacts::touch_handlers_changed();
+                crate::api::contacts::handlers_changed();
                 if let Some(part) = part.upgrade() {
                     part.sync_contact_reports();
                 }
@@ -653,7 +653,7 @@ pub fn methods(lua: &Lua) -> mlua::Result<Table> {
             if created && row.name == "CFrame" {
                 scheduler(lua).watch(part.clone());
                 // Its planes' post-tick pass asks their parts again (`PlaneState::after_tick`).
-                signal.on_listeners(|_| crate::api::contacts::touch_handlers_changed());
+                signal.on_listeners(|_| crate::api::contacts::handlers_changed());
             }
             signal.userdata(lua)
         }

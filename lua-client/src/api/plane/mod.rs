@@ -71,7 +71,7 @@ impl PlaneState {
     pub fn forget(&self, part: &Rc<PartState>, handle: Handle) {
         self.parts.borrow_mut().retain(|p| !Rc::ptr_eq(p, part));
         self.by_handle.borrow_mut().remove(&handle);
-        crate::api::contacts::touch_handlers_changed();
+        crate::api::contacts::handlers_changed();
     }
 
     /// Makes `body` the simulated body of `part` in this plane.
@@ -80,7 +80,7 @@ impl PlaneState {
         part.link(body, reporting);
         self.parts.borrow_mut().push(part.clone());
         self.by_handle.borrow_mut().insert(handle, part.clone());
-        crate::api::contacts::touch_handlers_changed();
+        crate::api::contacts::handlers_changed();
     }
 
     /// Keeps a controller so its events reach it.
@@ -135,7 +135,7 @@ impl PlaneState {
         for part in self.parts.take() {
             part.unlink(Ended::PlaneDestroyed);
         }
-        crate::api::contacts::touch_handlers_changed();
+        crate::api::contacts::handlers_changed();
         self.by_handle.borrow_mut().clear();
         self.controllers.borrow_mut().clear();
         self.maps.borrow_mut().clear();
