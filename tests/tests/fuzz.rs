@@ -47,6 +47,11 @@ fn the_daemon_survives_fuzzed_requests_and_serves_on() {
             "{} in batch {} (client {}): {}",
             f.kind, f.batch, f.client, f.detail
         );
+        // What was asked, so a finding can be read without a replay.
+        match shm_layout::codec::decode_request(&f.frame) {
+            Ok(request) => eprintln!("  request: {:.4000}", format!("{request:?}")),
+            Err(e) => eprintln!("  request ({} bytes) does not decode: {e}", f.frame.len()),
+        }
     }
     assert_eq!(stats.crashes, 0, "seed {}", stats.seed);
     assert_eq!(stats.unanswered, 0, "seed {}", stats.seed);

@@ -406,6 +406,51 @@ fn nodes_that_never_say_hello_are_evicted() {
     serves_on(&mut daemon, &survivor);
 }
 
+#[test]
+fn a_client_that_says_goodbye_may_say_hello_again_on_its_node() {
+    let mut daemon = TestDaemon::start_with("hello-again", &["--hello-timeout-ms", "2000"], &[]);
+    let victim = daemon.client();
+    let survivor = victim.create_plane(&PlaneOptions::manual()).unwrap();
+    let hostile = Hostile::open(&daemon.domain);
+    hostile.hello();
+    // Its node is now older than the Hello timeout.
+    std::thread::sleep(Duration::from_millis(2500));
+    let goodbye = hostile.call(vec![Command::Goodbye], |_| {});
+    assert!(goodbye[0].is_ok(), "{goodbye:?}");
+    // A node that joins the domain makes the resource guard list the nodes at its next
+    // look (at most a period, 500 ms, later).
+    std::thread::sleep(Duration::from_millis(700));
+    let newcomer = open_control(&daemon.domain);
+    std::thread::sleep(Duration::from_millis(800));
+    // 1.5 s after its Goodbye, within the timeout: served. (When the Hello clock ran from
+    // the node's first sighting, the guard had cut the node off by now and this Hello
+    // went unanswered.)
+    hostile.hello();
+    assert!(hostile.call(vec![Command::ListPlanes], |_| {})[0].is_ok());
+    drop(newcomer);
+    serves_on(&mut daemon, &survivor);
+
+    // Without a Hello for the whole timeout after a Goodbye, its port goes.
+    let held = control_ports(&daemon.domain);
+    let goodbye = hostile.call(vec![Command::Goodbye], |_| {});
+    assert!(goodbye[0].is_ok(), "{goodbye:?}");
+    let left = Instant::now();
+    let mut last = held;
+    time_until(Duration::from_secs(20), || {
+        last = control_ports(&daemon.domain);
+        (last < held).then_some(())
+    })
+    .unwrap_or_else(|| panic!("the silent node was not evicted: {last} of {held} ports held"));
+    // Its clock ran from the Goodbye (2 s), not from its first sighting (long past); the
+    // daemon notes the Goodbye as it answers it, before `left`.
+    assert!(
+        left.elapsed() >= Duration::from_millis(1900),
+        "evicted {:?} after its Goodbye, before the Hello timeout",
+        left.elapsed()
+    );
+    serves_on(&mut daemon, &survivor);
+}
+
 /// The daemon's control service, as a process of the domain opens it.
 type ControlService = iceoryx2::service::port_factory::request_response::PortFactory<
     ipc::Service,

@@ -507,6 +507,9 @@ impl Daemon {
             self.remove_plane(*id);
         }
         self.clients.disconnect(client);
+        // The resource guard's Hello clock for its node starts again now (a Goodbye and a
+        // Hello again on the same node are not a node that never said Hello).
+        self.update_watch();
         // Its snapshot transfers (a half-sent restore, an unread download) go with it.
         self.transfers.remove(&client);
         tracing::info!(

@@ -110,6 +110,13 @@ impl Default for Watch {
 #[derive(Debug, Default)]
 struct WatchState {
     connected: HashSet<u128>,
+    /// Nodes that were connected and are no longer (a Goodbye, a released client), and when
+    /// the watch learnt it: their Hello clock starts again then, so a client that says
+    /// Goodbye and Hello again on the same node is not taken for one that never said Hello.
+    left: HashMap<u128, Instant>,
+    /// A node left since the guard last looked: list the nodes at its next look, so its
+    /// Hello verdict comes on time.
+    relist: bool,
     planes: Vec<PlaneId>,
     stop: bool,
 }
@@ -122,7 +129,22 @@ impl Watch {
         planes: impl Iterator<Item = PlaneId>,
     ) {
         if let Ok(mut state) = self.state.lock() {
-            state.connected = connected.collect();
+            let connected: HashSet<u128> = connected.collect();
+            let now = Instant::now();
+            let WatchState {
+                connected: before,
+                left,
+                relist,
+                ..
+            } = &mut *state;
+            for id in before.difference(&connected) {
+                left.insert(*id, now);
+                *relist = true;
+            }
+            for id in &connected {
+                left.remove(id);
+            }
+            state.connected = connected;
             state.planes = planes.collect();
         }
     }
@@ -246,8 +268,16 @@ fn guard(config: &Config, limits: &Limits, watch: &Watch) -> Result<(), DaemonEr
                 .ok();
         }
         let Some(control) = &control else { continue };
+        let hello_timeout = Duration::from_millis(limits.hello_timeout_ms);
         let (connected, planes) = match watch.state.lock() {
-            Ok(s) => (s.connected.clone(), s.planes.clone()),
+            Ok(mut s) => {
+                // A node that left longer ago than the Hello timeout is judged by when it
+                // was first seen again (which is earlier).
+                s.left.retain(|_, at| at.elapsed() < hello_timeout);
+                guard.left.clone_from(&s.left);
+                guard.folder_changed |= std::mem::take(&mut s.relist);
+                (s.connected.clone(), s.planes.clone())
+            }
             Err(_) => return Ok(()),
         };
         guard.planes.retain(|id, _| planes.contains(id));
@@ -298,6 +328,8 @@ fn guard(config: &Config, limits: &Limits, watch: &Watch) -> Result<(), DaemonEr
 struct Guard {
     /// Live nodes of other processes, and when the daemon first saw each.
     seen: HashMap<u128, Instant>,
+    /// Nodes that were connected and left recently, and when (`WatchState::left`).
+    left: HashMap<u128, Instant>,
     /// Nodes evicted, and when.
     evicted: HashMap<u128, Instant>,
     planes: HashMap<PlaneId, PlaneServices>,
@@ -422,7 +454,14 @@ impl Guard {
             .map(|(id, pid)| Seen {
                 id: *id,
                 pid: *pid,
-                first_seen: *self.seen.entry(id.value()).or_insert(now),
+                // The Hello clock: from when the node was first seen, or from when it
+                // stopped being connected, whichever is later.
+                first_seen: {
+                    let seen = *self.seen.entry(id.value()).or_insert(now);
+                    self.left
+                        .get(&id.value())
+                        .map_or(seen, |&left| left.max(seen))
+                },
                 connected: connected(id.value()),
             })
             .filter(|n| !self.evicted.contains_key(&n.id.value()))
