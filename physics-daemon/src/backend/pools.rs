@@ -65,6 +65,29 @@ pub fn shared(n: u32) -> Result<Arc<rayon::ThreadPool>, rayon::ThreadPoolBuildEr
     Ok(pool)
 }
 
+/// The lock the planes of a shared pool take turns with in rapier's step.
+///
+/// Rapier's step hands its broad phase's tree optimisation to another thread of the pool
+/// (`rayon::spawn`) and later waits for it on a channel, outside rayon. Two planes stepping
+/// in one pool at once could each hold a pool thread in that wait with their optimisations
+/// queued behind them, and stall for good (every request to them unanswered): `n` planes
+/// on a pool of `n` threads can. One step at a time leaves at most one thread of the pool
+/// waiting, and the others free to run the optimisation. What the pool runs besides (the
+/// plane's own passes, controllers) waits the rayon way, taking work while it waits, and
+/// needs no turn. Keyed by the pool's size, as [`shared`] keys the pools.
+pub fn turn(pool: &rayon::ThreadPool) -> &'static Mutex<()> {
+    static TURNS: OnceLock<Mutex<HashMap<usize, &'static Mutex<()>>>> = OnceLock::new();
+    let mut turns = TURNS
+        .get_or_init(Default::default)
+        .lock()
+        .unwrap_or_else(|p| p.into_inner());
+    // One small lock per pool size ever used (at most the machine's cores), kept for the
+    // life of the process.
+    turns
+        .entry(pool.current_num_threads())
+        .or_insert_with(|| Box::leak(Box::new(Mutex::new(()))))
+}
+
 /// The cores this thread may run on (its affinity mask), in order; empty when unknown.
 fn allowed_cores() -> Vec<usize> {
     // SAFETY: a zeroed cpu_set_t is a valid empty set, and sched_getaffinity writes at most

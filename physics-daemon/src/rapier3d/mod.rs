@@ -306,6 +306,13 @@ impl Plane {
             gravity: self.world.gravity,
         };
         self.held_before_step();
+        // Planes of a shared pool take turns in rapier's step (see `pools::turn`).
+        let pool = self.world.physics_pipeline.thread_pool();
+        let turn = pool.as_deref().map(|pool| {
+            crate::backend::pools::turn(pool)
+                .lock()
+                .unwrap_or_else(std::sync::PoisonError::into_inner)
+        });
         // Contacts of objects removed since the last step still end with an event.
         if self.reporting > 0 || !self.removed.is_empty() {
             let collector = ChannelEventCollector::new(
@@ -317,6 +324,7 @@ impl Plane {
         } else {
             self.world.step_with_events(&hooks, &());
         }
+        drop(turn);
         self.held_after_step();
         self.query_stale.clear();
         self.limit_speeds_after_step();
