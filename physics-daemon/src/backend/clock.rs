@@ -29,6 +29,23 @@ pub struct Clock {
     pub contact_pairs: u32,
 }
 
+/// Steps shorter than this (seconds) move nothing: the engine takes them as zero-length
+/// steps (ops applied, contacts updated, no dynamics) while the plane's clock still advances
+/// by them ([`engine_dt`]). A nanosecond is far below any game's time step, and the solver's
+/// rates are 1 / dt: a step of 1e-38 s overflowed f32 in an articulation's motor bounds
+/// (NaN) and panicked the solver.
+pub const MIN_DYNAMIC_DT: f32 = 1e-9;
+
+/// The time step the engine is given for a step of `dt` (checked): `dt`, or 0 below
+/// [`MIN_DYNAMIC_DT`].
+pub fn engine_dt(dt: f32) -> f32 {
+    if dt < MIN_DYNAMIC_DT {
+        0.0
+    } else {
+        dt
+    }
+}
+
 /// `dt` as every plane's step takes it: positive, finite and at most [`MAX_DT`] (errors
 /// name `dt` and the value).
 pub fn check_dt(dt: f32) -> Result<f32, CommandError> {

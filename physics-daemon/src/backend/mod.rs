@@ -18,7 +18,7 @@ pub(crate) mod snapshot_decode;
 
 use std::mem::MaybeUninit;
 
-pub use clock::{check_dt, Clock, HeaderFigures};
+pub use clock::{check_dt, engine_dt, Clock, HeaderFigures, MIN_DYNAMIC_DT};
 pub use dirty::Dirty;
 pub use marks::Marks;
 pub use object_op::{object_op, ObjectPlane};

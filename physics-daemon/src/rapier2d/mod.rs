@@ -269,7 +269,8 @@ impl Plane {
         }
         let started = Instant::now();
         self.events.clear();
-        self.world.integration_parameters.dt = dt;
+        // Below a nanosecond the engine takes a zero-length step (see `MIN_DYNAMIC_DT`).
+        self.world.integration_parameters.dt = crate::backend::engine_dt(dt);
         self.world.integration_parameters.num_solver_iterations =
             self.settings.solver_iterations as usize;
         self.drive_controllers(dt);

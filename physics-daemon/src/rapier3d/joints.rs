@@ -1042,6 +1042,82 @@ mod tests {
         assert!((vy - (-49.0 / 60.0)).abs() < 0.02, "vy {vy}");
     }
 
+    /// Articulated joints with motors and limits stepped with tiny time steps (found by the
+    /// fuzzer: an articulated joint with a motor target and limits, a step of 1e-38 s: the
+    /// solver's rates (1 / dt) overflowed into NaN motor bounds and panicked it). A step
+    /// under `MIN_DYNAMIC_DT` moves nothing; no step may panic, every body stays finite and
+    /// the plane's clock counts every step.
+    #[test]
+    fn articulations_with_motors_survive_tiny_steps() {
+        use shm_layout::JointKind;
+        let motor = [JointProp::MotorTarget(1.5), JointProp::MotorMaxForce(50.0)];
+        let cases = [
+            (
+                JointKind::Prismatic,
+                vec![JointProp::LowerDistance(0.5), JointProp::UpperDistance(3.0)],
+            ),
+            (
+                JointKind::Hinge,
+                vec![JointProp::LowerAngle(-0.5), JointProp::UpperAngle(0.5)],
+            ),
+            (JointKind::Ball, vec![JointProp::SwingLimit(1.0)]),
+            (
+                JointKind::ConeTwist,
+                vec![JointProp::SwingLimit(1.0), JointProp::TwistLimit(1.5)],
+            ),
+        ];
+        for (kind, limits) in cases {
+            let mut props = limits.clone();
+            if matches!(kind, JointKind::Prismatic | JointKind::Hinge) {
+                props.extend(motor.clone());
+            }
+            for tiny in [1e-45f32, 1e-38, 1e-30, 1e-20, 1e-12, 1e-9] {
+                let mut p = plane();
+                let a = ball(&mut p, [0.0, 0.0, 0.0], 1.0);
+                let b = ball(&mut p, [1.0, 0.0, 0.0], 1.0);
+                let c = ball(&mut p, [2.0, 0.5, 0.0], 1.0);
+                for (x, y) in [(a, b), (b, c)] {
+                    joint(
+                        &mut p,
+                        JointOp::Create {
+                            kind,
+                            a: x,
+                            b: Some(y),
+                            props: props.clone(),
+                        },
+                    );
+                }
+                let steps = [
+                    1.0 / 60.0,
+                    tiny,
+                    tiny,
+                    1.0 / 60.0,
+                    tiny,
+                    1.0 / 60.0,
+                    1.0 / 60.0,
+                ];
+                for dt in steps {
+                    let done =
+                        std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| p.step(dt)));
+                    assert!(
+                        matches!(done, Ok(Ok(true))),
+                        "{kind:?}: a step of {dt:e} s (tiny {tiny:e}) panicked or failed"
+                    );
+                }
+                assert_eq!(p.tick(), steps.len() as u64);
+                for h in [a, b, c] {
+                    let body = &p.world.bodies[p.bodies.get(h).unwrap().handle];
+                    assert!(
+                        body.translation().is_finite() && body.linvel().is_finite(),
+                        "{kind:?}, tiny {tiny:e}: {:?} {:?}",
+                        body.translation(),
+                        body.linvel()
+                    );
+                }
+            }
+        }
+    }
+
     /// Random sequences of joint, anchoring, waking, teleporting, forcing, destroying and
     /// stepping ops on a few objects: no step may panic (rapier's solver must never receive a joint
     /// whose two bodies are both world-attached).

@@ -296,7 +296,8 @@ impl Plane {
         let moving = self.clock.tick == 0
             || self.world.islands.num_active_bodies() > 0
             || !self.bodies.since_step().is_empty();
-        self.world.integration_parameters.dt = dt;
+        // Below a nanosecond the engine takes a zero-length step (see `MIN_DYNAMIC_DT`).
+        self.world.integration_parameters.dt = crate::backend::engine_dt(dt);
         self.tune_solver(dt);
         self.tick_controllers(dt);
         self.prepare_bodies(dt);
