@@ -1069,7 +1069,7 @@ mod tests {
         for (kind, limits) in cases {
             let mut props = limits.clone();
             if matches!(kind, JointKind::Prismatic | JointKind::Hinge) {
-                props.extend(motor.clone());
+                props.extend(motor);
             }
             for tiny in [1e-45f32, 1e-38, 1e-30, 1e-20, 1e-12, 1e-9] {
                 let mut p = plane();
