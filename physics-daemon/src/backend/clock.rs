@@ -29,21 +29,18 @@ pub struct Clock {
     pub contact_pairs: u32,
 }
 
-/// Steps shorter than this (seconds) move nothing: the engine takes them as zero-length
-/// steps (ops applied, contacts updated, no dynamics) while the plane's clock still advances
-/// by them ([`engine_dt`]). A nanosecond is far below any game's time step, and the solver's
-/// rates are 1 / dt: a step of 1e-38 s overflowed f32 in an articulation's motor bounds
-/// (NaN) and panicked the solver.
+/// The shortest time step the engine is given (seconds): a step shorter than this is
+/// simulated as this long ([`engine_dt`]), while the plane's clock advances by the step as
+/// asked. A nanosecond is far below any game's time step, and the solver's rates are
+/// 1 / dt: a step of 1e-38 s overflowed f32 in an articulation's motor bounds (NaN) and
+/// panicked the solver. (Not zero: rapier's zero-length step skips its island bookkeeping,
+/// and the next step then indexed past the islands' arrays.)
 pub const MIN_DYNAMIC_DT: f32 = 1e-9;
 
-/// The time step the engine is given for a step of `dt` (checked): `dt`, or 0 below
+/// The time step the engine is given for a step of `dt` (checked): at least
 /// [`MIN_DYNAMIC_DT`].
 pub fn engine_dt(dt: f32) -> f32 {
-    if dt < MIN_DYNAMIC_DT {
-        0.0
-    } else {
-        dt
-    }
+    dt.max(MIN_DYNAMIC_DT)
 }
 
 /// `dt` as every plane's step takes it: positive, finite and at most [`MAX_DT`] (errors

@@ -269,8 +269,11 @@ impl Plane {
         }
         let started = Instant::now();
         self.events.clear();
-        // Below a nanosecond the engine takes a zero-length step (see `MIN_DYNAMIC_DT`).
-        self.world.integration_parameters.dt = crate::backend::engine_dt(dt);
+        // The clock advances by the step as asked; the simulation takes at least a
+        // nanosecond (see `MIN_DYNAMIC_DT`).
+        let asked = dt;
+        let dt = crate::backend::engine_dt(dt);
+        self.world.integration_parameters.dt = dt;
         self.world.integration_parameters.num_solver_iterations =
             self.settings.solver_iterations as usize;
         self.drive_controllers(dt);
@@ -280,7 +283,7 @@ impl Plane {
         self.held_after_step();
         self.query_stale.clear();
         self.bodies.stepped();
-        self.clock.advance(dt);
+        self.clock.advance(asked);
         self.after_step_controllers();
         (self.clock.max_penetration, self.clock.contact_pairs) = self.contact_figures();
         self.clock.timed(started);

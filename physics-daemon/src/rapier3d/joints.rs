@@ -1045,8 +1045,8 @@ mod tests {
     /// Articulated joints with motors and limits stepped with tiny time steps (found by the
     /// fuzzer: an articulated joint with a motor target and limits, a step of 1e-38 s: the
     /// solver's rates (1 / dt) overflowed into NaN motor bounds and panicked it). A step
-    /// under `MIN_DYNAMIC_DT` moves nothing; no step may panic, every body stays finite and
-    /// the plane's clock counts every step.
+    /// under `MIN_DYNAMIC_DT` is simulated as that long; no step may panic, every body stays
+    /// finite and the plane's clock counts every step.
     #[test]
     fn articulations_with_motors_survive_tiny_steps() {
         use shm_layout::JointKind;

@@ -296,8 +296,11 @@ impl Plane {
         let moving = self.clock.tick == 0
             || self.world.islands.num_active_bodies() > 0
             || !self.bodies.since_step().is_empty();
-        // Below a nanosecond the engine takes a zero-length step (see `MIN_DYNAMIC_DT`).
-        self.world.integration_parameters.dt = crate::backend::engine_dt(dt);
+        // The clock advances by the step as asked; the simulation takes at least a
+        // nanosecond (see `MIN_DYNAMIC_DT`).
+        let asked = dt;
+        let dt = crate::backend::engine_dt(dt);
+        self.world.integration_parameters.dt = dt;
         self.tune_solver(dt);
         self.tick_controllers(dt);
         self.prepare_bodies(dt);
@@ -330,7 +333,7 @@ impl Plane {
         self.query_stale.clear();
         self.limit_speeds_after_step();
         self.bodies.stepped();
-        self.clock.advance(dt);
+        self.clock.advance(asked);
         self.collect_events();
         self.joints_after_step(dt);
         self.removed.clear();
