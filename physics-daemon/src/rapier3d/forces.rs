@@ -38,6 +38,8 @@ pub(super) struct Env {
     acceleration: Vector,
     force: Vector,
     gravity: Vector,
+    /// The plane's `MaxLinearSpeed`.
+    max_speed: f32,
 }
 
 impl Plane {
@@ -53,6 +55,7 @@ impl Plane {
             acceleration: Vector::new(0.0, s.buoyancy, 0.0),
             force: Vector::from(s.constant_force),
             gravity: self.world.gravity,
+            max_speed: s.max_linear_speed,
         };
         let idle = env.linear_keep == 1.0
             && env.angular_keep == 1.0
@@ -111,6 +114,20 @@ pub(super) fn drive(body: &RigidBody, part: &Part, env: &Env) -> (Vector, Push) 
         if part.locks[i + 3] {
             w[i] = w0[i];
         }
+    }
+    // A force so large on a light part that the velocity it asks for overflows f32: aim
+    // at the fastest the plane allows along each axis instead (the speed limit caps the
+    // step's end as it caps any other). A non-finite velocity made an articulated link's
+    // joint coordinates NaN within the step, and the solver panicked on them.
+    if !v.is_finite() {
+        let cap = |x: f32| {
+            if x.is_nan() {
+                0.0
+            } else {
+                x.clamp(-env.max_speed, env.max_speed)
+            }
+        };
+        v = Vector::new(cap(v.x), cap(v.y), cap(v.z));
     }
     let force = (v - v0) * (mass / dt);
     let push = if !force.is_finite() {
@@ -239,5 +256,39 @@ mod tests {
         assert!((e.y + 0.3).abs() < 1e-5, "{e:?}");
         let e = rotation_error(q, -t); // same orientation, other hemisphere
         assert!((e.y + 0.3).abs() < 1e-5, "{e:?}");
+    }
+    /// A ConstantForce of the largest f32 on a light part asks for a velocity past f32:
+    /// the part flies at the plane's speed limit instead of going non-finite (which made
+    /// rapier quarantine it for good, and panicked the solver on an articulated link).
+    #[test]
+    fn an_overflowing_force_drives_at_the_speed_limit() {
+        use crate::backend::Backend;
+        use shm_layout::{ObjectOp, ObjectProp, PlaneOp, PlaneProp, Pose, Shape};
+        let mut p = Plane::new(1, &[PlaneProp::TickRate(0.0)]).unwrap();
+        let h = p
+            .add_object(
+                &Shape::Sphere { radius: 0.25 },
+                Pose::at([0.0, 0.0, 0.0]),
+                &[ObjectProp::Weight(0.005)],
+            )
+            .unwrap();
+        p.apply(PlaneOp::Object {
+            handle: h,
+            op: ObjectOp::Set(ObjectProp::ConstantForce([f32::MAX, 0.0, -f32::MAX])),
+        })
+        .unwrap();
+        for _ in 0..3 {
+            p.step(1.0 / 60.0).unwrap();
+        }
+        let body = &p.world.bodies[p.bodies.get(h).unwrap().handle];
+        assert!(body.is_enabled(), "quarantined");
+        let (x, v) = (body.translation(), body.linvel());
+        assert!(x.is_finite() && v.is_finite(), "{x:?} {v:?}");
+        let limit = p.settings.max_linear_speed;
+        assert!(v.length() <= limit * 1.001, "{} over {limit}", v.length());
+        assert!(
+            v.x > 0.5 * limit / 2f32.sqrt() && v.z < -0.5 * limit / 2f32.sqrt(),
+            "{v:?}"
+        );
     }
 }
