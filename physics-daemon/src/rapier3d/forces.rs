@@ -257,6 +257,7 @@ mod tests {
         let e = rotation_error(q, -t); // same orientation, other hemisphere
         assert!((e.y + 0.3).abs() < 1e-5, "{e:?}");
     }
+
     /// A ConstantForce of the largest f32 on a light part asks for a velocity past f32:
     /// the part flies at the plane's speed limit instead of going non-finite (which made
     /// rapier quarantine it for good, and panicked the solver on an articulated link).
