@@ -864,6 +864,16 @@ mod tests {
         .unwrap()
     }
 
+    /// A xorshift generator from `seed`: `rnd(n)` is in `0..n` (the random-sequence tests).
+    fn xorshift(mut seed: u64) -> impl FnMut(u64) -> u64 {
+        move |n| {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            seed % n
+        }
+    }
+
     fn joint(p: &mut Plane, op: JointOp) -> shm_layout::Handle {
         match p.apply(PlaneOp::Joint(op)).unwrap() {
             Reply::Joint { handle, .. } => handle,
@@ -1127,13 +1137,7 @@ mod tests {
     #[test]
     fn random_articulations_under_extreme_pushes_never_panic() {
         use shm_layout::{JointKind, ObjectOp};
-        let mut seed: u64 = 0x2545_f491_4f6c_dd1d;
-        let mut rnd = move |n: u64| {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            seed % n
-        };
+        let mut rnd = xorshift(0x2545_f491_4f6c_dd1d);
         let huge = [1.0, 50.0, 1e20, f32::MAX];
         for round in 0..150 {
             let mut p = plane();
@@ -1232,13 +1236,7 @@ mod tests {
     #[test]
     fn random_joint_sequences_never_panic_the_solver() {
         use shm_layout::{JointKind, ObjectOp};
-        let mut seed: u64 = 0x9e37_79b9_7f4a_7c15;
-        let mut rnd = move |n: u64| {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            seed % n
-        };
+        let mut rnd = xorshift(0x9e37_79b9_7f4a_7c15);
         let kinds = [
             JointKind::Ball,
             JointKind::Hinge,
