@@ -44,6 +44,9 @@ use super::origin::ControlService;
 use super::Limits;
 use crate::DaemonError;
 
+/// Most departures a watch keeps for the guard's next look (see `WatchState::left`).
+const MAX_LEFT: usize = 4096;
+
 /// Time between two looks.
 pub const PERIOD: Duration = Duration::from_millis(500);
 
@@ -110,13 +113,10 @@ impl Default for Watch {
 #[derive(Debug, Default)]
 struct WatchState {
     connected: HashSet<u128>,
-    /// Nodes that were connected and are no longer (a Goodbye, a released client), and when
-    /// the watch learnt it: their Hello clock starts again then, so a client that says
+    /// Nodes that stopped being connected (a Goodbye, a released client) since the guard's
+    /// last look, and when: their Hello clock starts again then, so a client that says
     /// Goodbye and Hello again on the same node is not taken for one that never said Hello.
-    left: HashMap<u128, Instant>,
-    /// A node left since the guard last looked: list the nodes at its next look, so its
-    /// Hello verdict comes on time.
-    relist: bool,
+    left: Vec<(u128, Instant)>,
     planes: Vec<PlaneId>,
     stop: bool,
 }
@@ -134,16 +134,12 @@ impl Watch {
             let WatchState {
                 connected: before,
                 left,
-                relist,
                 ..
             } = &mut *state;
-            for id in before.difference(&connected) {
-                left.insert(*id, now);
-                *relist = true;
-            }
-            for id in &connected {
-                left.remove(id);
-            }
+            left.extend(before.difference(&connected).map(|id| (*id, now)));
+            // Unread only while the guard does not run (it could not start): keep the newest.
+            let excess = left.len().saturating_sub(MAX_LEFT);
+            left.drain(..excess);
             state.connected = connected;
             state.planes = planes.collect();
         }
@@ -268,14 +264,14 @@ fn guard(config: &Config, limits: &Limits, watch: &Watch) -> Result<(), DaemonEr
                 .ok();
         }
         let Some(control) = &control else { continue };
-        let hello_timeout = Duration::from_millis(limits.hello_timeout_ms);
         let (connected, planes) = match watch.state.lock() {
             Ok(mut s) => {
-                // A node that left longer ago than the Hello timeout is judged by when it
-                // was first seen again (which is earlier).
-                s.left.retain(|_, at| at.elapsed() < hello_timeout);
-                guard.left.clone_from(&s.left);
-                guard.folder_changed |= std::mem::take(&mut s.relist);
+                // A node that left is seen anew from then (its Hello clock), and the nodes
+                // are listed at this look, so its verdict comes on time.
+                for (id, at) in std::mem::take(&mut s.left) {
+                    guard.seen.insert(id, at);
+                    guard.folder_changed = true;
+                }
                 (s.connected.clone(), s.planes.clone())
             }
             Err(_) => return Ok(()),
@@ -326,10 +322,9 @@ fn guard(config: &Config, limits: &Limits, watch: &Watch) -> Result<(), DaemonEr
 /// The guard's view of who holds what.
 #[derive(Default)]
 struct Guard {
-    /// Live nodes of other processes, and when the daemon first saw each.
+    /// Live nodes of other processes, and when the daemon first saw each (or saw it stop
+    /// being connected, `WatchState::left`): their Hello clocks.
     seen: HashMap<u128, Instant>,
-    /// Nodes that were connected and left recently, and when (`WatchState::left`).
-    left: HashMap<u128, Instant>,
     /// Nodes evicted, and when.
     evicted: HashMap<u128, Instant>,
     planes: HashMap<PlaneId, PlaneServices>,
@@ -454,14 +449,7 @@ impl Guard {
             .map(|(id, pid)| Seen {
                 id: *id,
                 pid: *pid,
-                // The Hello clock: from when the node was first seen, or from when it
-                // stopped being connected, whichever is later.
-                first_seen: {
-                    let seen = *self.seen.entry(id.value()).or_insert(now);
-                    self.left
-                        .get(&id.value())
-                        .map_or(seen, |&left| left.max(seen))
-                },
+                first_seen: *self.seen.entry(id.value()).or_insert(now),
                 connected: connected(id.value()),
             })
             .filter(|n| !self.evicted.contains_key(&n.id.value()))
