@@ -70,7 +70,16 @@ pub struct ContactPump {
     /// `plane.EventsLost`, created on first access.
     lost: RefCell<Option<Signal>>,
     /// `joint.Broke` of the joints whose signal was read, by joint handle.
-    broke: RefCell<HashMap<Handle, Signal>>,
+    broke: RefCell<HashMap<Handle, Broke>>,
+}
+
+/// A joint's `Broke` signal and what it needs to fire again.
+struct Broke {
+    signal: Signal,
+    /// The objects the joint joins (the world is none): the joint goes with either.
+    ends: Vec<Handle>,
+    /// It fired: a joint breaks once.
+    fired: Cell<bool>,
 }
 
 impl Default for ContactPump {
@@ -84,9 +93,14 @@ impl Default for ContactPump {
     }
 }
 
-/// `joint.Broke` of joint `joint` of `plane`, created on first access; the plane starts
-/// reading its events when the signal gets its first handler.
-pub fn joint_broke_signal(plane: &Rc<PlaneState>, joint: Handle, name: &str) -> Signal {
+/// `joint.Broke` of joint `joint` of `plane` joining the objects `ends`, created on first
+/// access; the plane starts reading its events when the signal gets its first handler.
+pub fn joint_broke_signal(
+    plane: &Rc<PlaneState>,
+    joint: Handle,
+    ends: &[Handle],
+    name: &str,
+) -> Signal {
     let mut map = plane.contacts.broke.borrow_mut();
     map.entry(joint)
         .or_insert_with(|| {
@@ -99,16 +113,52 @@ pub fn joint_broke_signal(plane: &Rc<PlaneState>, joint: Handle, name: &str) -> 
                     }
                 }
             });
-            signal
+            Broke {
+                signal,
+                ends: ends.to_vec(),
+                fired: Cell::new(false),
+            }
         })
+        .signal
         .clone()
 }
 
 /// A destroyed joint's Broke signal goes (its handlers with it).
 pub fn forget_joint(plane: &PlaneState, joint: Handle) {
-    let signal = plane.contacts.broke.borrow_mut().remove(&joint);
-    if let Some(s) = signal {
-        s.disconnect_all();
+    let broke = plane.contacts.broke.borrow_mut().remove(&joint);
+    if let Some(b) = broke {
+        b.signal.disconnect_all();
+    }
+}
+
+/// The object `object` left the plane: its joints went with it, and so do their Broke
+/// signals and handlers (as on Roblox, where destroying an instance disconnects them).
+pub fn forget_joints_of(plane: &PlaneState, object: Handle) {
+    let gone: Vec<Broke> = {
+        let mut map = plane.contacts.broke.borrow_mut();
+        let joints: Vec<Handle> = map
+            .iter()
+            .filter(|(_, b)| b.ends.contains(&object))
+            .map(|(j, _)| *j)
+            .collect();
+        joints.iter().filter_map(|j| map.remove(j)).collect()
+    };
+    for b in gone {
+        b.signal.disconnect_all();
+    }
+}
+
+/// The plane went: every Broke signal and its handlers go with it.
+pub fn forget_all_joints(plane: &PlaneState) {
+    let gone: Vec<Broke> = plane
+        .contacts
+        .broke
+        .borrow_mut()
+        .drain()
+        .map(|(_, b)| b)
+        .collect();
+    for b in gone {
+        b.signal.disconnect_all();
     }
 }
 
@@ -159,7 +209,22 @@ impl PlaneState {
                 .broke
                 .borrow()
                 .values()
-                .any(|s| s.listeners() > 0)
+                .any(|b| b.signal.listeners() > 0)
+    }
+
+    /// Whether some handler of the plane can still fire: the plane lives and a simulated
+    /// part has touch handlers, a controller has handlers, or a joint that has not broken
+    /// yet has Broke handlers.
+    fn handlers_can_fire(&self) -> bool {
+        self.alive()
+            && (self.any_part(|p| p.touch_listeners() > 0)
+                || self.controller_listeners()
+                || self
+                    .contacts
+                    .broke
+                    .borrow()
+                    .values()
+                    .any(|b| b.signal.listeners() > 0 && !b.fired.get()))
     }
 
     /// Delivers the events published since the last call to the parts' touch handlers.
@@ -268,7 +333,10 @@ impl PlaneState {
 
     /// Fires the joint's Broke with the force that broke it and the world anchor on A.
     fn joint_broke(&self, lua: &Lua, broke: &JointBroke) -> mlua::Result<()> {
-        let signal = self.contacts.broke.borrow().get(&broke.joint).cloned();
+        let signal = self.contacts.broke.borrow().get(&broke.joint).map(|b| {
+            b.fired.set(true);
+            b.signal.clone()
+        });
         match signal {
             Some(s) if s.listeners() > 0 => s.fire(
                 lua,
@@ -308,5 +376,9 @@ impl Watched for PlaneState {
 
     fn fire_if_changed(&self, lua: &Lua) -> mlua::Result<()> {
         self.deliver_contacts(lua)
+    }
+
+    fn keeps_running(&self) -> bool {
+        self.handlers_can_fire()
     }
 }

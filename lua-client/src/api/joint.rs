@@ -159,14 +159,20 @@ fn info_value(lua: &Lua, info: &JointInfo, key: &str) -> mlua::Result<Value> {
     })
 }
 
-/// The Lua handle of a joint, with its plane (for its Broke signal) and whether this
-/// script destroyed it.
-pub struct LuaJoint(pub Joint, pub Rc<PlaneState>, std::cell::Cell<bool>);
+/// The Lua handle of a joint, with its plane (for its Broke signal), whether this script
+/// destroyed it, and the objects it joins (it goes with either).
+pub struct LuaJoint(
+    pub Joint,
+    pub Rc<PlaneState>,
+    std::cell::Cell<bool>,
+    Vec<client_sdk::Handle>,
+);
 
 impl LuaJoint {
-    /// The handle of `joint`, a joint of `plane`.
-    pub fn new(joint: Joint, plane: Rc<PlaneState>) -> LuaJoint {
-        LuaJoint(joint, plane, std::cell::Cell::new(false))
+    /// The handle of `joint`, a joint of `plane` between `a` and `b` (`None`: the world).
+    pub fn new(joint: Joint, plane: Rc<PlaneState>, a: &Object, b: Option<&Object>) -> LuaJoint {
+        let ends = std::iter::once(a).chain(b).map(Object::handle).collect();
+        LuaJoint(joint, plane, std::cell::Cell::new(false), ends)
     }
 
     /// What `tostring` and messages call it: its kind, and "(destroyed)" once it is.
@@ -225,7 +231,7 @@ impl UserData for LuaJoint {
                 )));
             }
             if key == "Broke" {
-                let signal = joint_broke_signal(&j.1, j.0.handle(), &j.name());
+                let signal = joint_broke_signal(&j.1, j.0.handle(), &j.3, &j.name());
                 return Ok(Value::UserData(signal.userdata(lua)?));
             }
             let info =
@@ -292,7 +298,7 @@ fn new_joint(
         .0
         .plane
         .joint(kind, &a, b.as_ref(), &props)
-        .map(|j| LuaJoint::new(j, plane.0.clone()))
+        .map(|j| LuaJoint::new(j, plane.0.clone(), &a, b.as_ref()))
         .map_err(|e| sdk_error(what, e))
 }
 

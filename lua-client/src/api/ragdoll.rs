@@ -147,7 +147,11 @@ fn new_ragdoll(lua: &Lua, plane: &PhysicsPlane, desc: Value) -> mlua::Result<Tab
                 .plane
                 .joint(JointKind::ConeTwist, &objects[i], Some(&objects[p]), &opts)
                 .map_err(|e| sdk_error(WHAT, e))?;
-            joints.set(b.name.as_str(), LuaJoint::new(j, plane.0.clone()))?;
+            let ends = (&objects[i], Some(&objects[p]));
+            joints.set(
+                b.name.as_str(),
+                LuaJoint::new(j, plane.0.clone(), ends.0, ends.1),
+            )?;
         }
     }
     let doll = lua.create_table()?;

@@ -507,7 +507,10 @@ fn frames(
         let mut next = last + frame;
         // With only waits pending, sleep until the earliest is due rather than spinning frames.
         if let (Some(wake_in), false) = (host.next_wake_in(), host.busy_every_frame()) {
-            next = next.max(Instant::now() + Duration::from_secs_f64(wake_in));
+            // A wait of years still wakes the loop hourly (a Duration or Instant that far
+            // ahead could overflow).
+            let wake_in = Duration::from_secs_f64(wake_in.min(3600.0));
+            next = next.max(Instant::now() + wake_in);
             if host.watching_daemon() {
                 // Stalled / Resumed must fire within a second of the daemon stopping.
                 next = next.min(Instant::now() + lua_client::WATCH_PERIOD);
@@ -516,12 +519,17 @@ fn frames(
         if deadline.is_some_and(|d| next > d) {
             break;
         }
+        // Frames skipped while only waits were pending are frames nobody needed, not one long
+        // frame: the frame that ends the quiet stretch is as long as the one it replaces (the
+        // frames before it ran, in the script's view, at `fps`), so `Heart` never sees the
+        // whole stretch as its dt.
+        let quiet_from = next.checked_sub(frame).unwrap_or(last).max(last);
         signals.sleep_until(next);
         if signals.stop_requested() {
             return Ok(Ended::Signalled);
         }
         let now = Instant::now();
-        let dt = (now - last).as_secs_f64();
+        let dt = (now - quiet_from).as_secs_f64();
         last = now;
         host.frame(dt)?;
     }

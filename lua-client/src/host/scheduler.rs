@@ -231,6 +231,10 @@ fn resume(
         (Some(Value::LightUserData(m)), Some(s)) if *m == wait_mark() => number(s).unwrap_or(0.0),
         _ => 0.0,
     };
+    if delay == f64::INFINITY {
+        // `wait(math.huge)`: the thread is never resumed, so nothing keeps it (nor the run).
+        return Ok(());
+    }
     let now = sched.clock();
     sched.waiting.borrow_mut().push(Waiting {
         wake_at: now + delay,
@@ -246,7 +250,8 @@ pub fn wait_function(lua: &Lua) -> mlua::Result<Function> {
     let check = lua.create_function(|_, s: Value| match s {
         Value::Nil => Ok(0.0),
         v => match number(&v) {
-            Some(n) if n.is_finite() && n >= 0.0 => Ok(n),
+            // math.huge waits forever, as Roblox's task.wait(math.huge) does.
+            Some(n) if n >= 0.0 => Ok(n),
             _ => Err(expected(
                 "wait",
                 "a non-negative number of seconds (or nothing)",

@@ -294,7 +294,12 @@ impl UserData for LuaController {
             |lua, c, (key, value): (Value, Value)| CONTROLLER.set(lua, c, &key, &value),
         );
         methods.add_meta_method(MetaMethod::ToString, |_, c, ()| {
-            Ok(format!("Controller \"{}\"", c.0.part.name()))
+            let gone = if c.0.body.ended().is_some() {
+                " (destroyed)"
+            } else {
+                ""
+            };
+            Ok(format!("Controller \"{}\"{gone}", c.0.part.name()))
         });
         methods.add_meta_method(MetaMethod::Eq, |_, c, other: Value| {
             Ok(match other {

@@ -94,6 +94,17 @@ impl PhysicsObject {
     pub fn describe(&self) -> String {
         format!("PhysicsObject \"{}\"", self.part.name())
     }
+
+    /// What `tostring` shows: [`describe`](Self::describe), then "(destroyed)" once the
+    /// object was destroyed (itself, its part or its plane) or "(unlinked)" once unlinked,
+    /// as a destroyed joint, plane or map shows.
+    pub fn tostring(&self) -> String {
+        match self.body.ended() {
+            None => self.describe(),
+            Some(Ended::Unlinked) => format!("{} (unlinked)", self.describe()),
+            Some(_) => format!("{} (destroyed)", self.describe()),
+        }
+    }
 }
 
 impl Target for PhysicsObject {
@@ -281,7 +292,7 @@ impl UserData for PhysicsObject {
             MetaMethod::NewIndex,
             |lua, o, (key, value): (Value, Value)| OBJECT.set(lua, o, &key, &value),
         );
-        methods.add_meta_method(MetaMethod::ToString, |_, o, ()| Ok(o.describe()));
+        methods.add_meta_method(MetaMethod::ToString, |_, o, ()| Ok(o.tostring()));
         methods.add_meta_method(DESCRIBE, |_, o, ()| Ok(o.describe()));
         // Two handles on the same body (e.g. `plane:Add`'s and a raycast's) are equal.
         methods.add_meta_method(MetaMethod::Eq, |_, o, other: Value| {

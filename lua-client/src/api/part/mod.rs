@@ -402,6 +402,10 @@ impl PartState {
             object
                 .set(ObjectProp::Size(size))
                 .map_err(|e| sdk_error(what, e))?;
+        } else {
+            // A free part takes only a size a plane would (checked here, not first at Add).
+            client_sdk::validate::size("Size", size.into())
+                .map_err(|e| mlua::Error::runtime(format!("{what}: {}", e.message)))?;
         }
         self.size.set(size);
         self.changed(lua, "Size", new_vector(size))
@@ -611,6 +615,12 @@ impl Watched for PartState {
     fn fire_if_changed(&self, lua: &Lua) -> mlua::Result<()> {
         self.fire_cframe_if_moved(lua)
     }
+
+    /// Only a simulated part moves by itself: once its body ended (unlinked, destroyed,
+    /// its plane destroyed), its CFrame handlers wait for writes the script itself makes.
+    fn keeps_running(&self) -> bool {
+        self.object().is_some()
+    }
 }
 
 /// The Lua handle of a part.
@@ -693,7 +703,14 @@ impl UserData for BasePart {
             MetaMethod::NewIndex,
             |lua, part, (key, value): (Value, Value)| PART.set(lua, part, &key, &value),
         );
-        methods.add_meta_method(MetaMethod::ToString, |_, part, ()| Ok(part.describe()));
+        methods.add_meta_method(MetaMethod::ToString, |_, part, ()| {
+            let gone = if part.0.is_destroyed() {
+                " (destroyed)"
+            } else {
+                ""
+            };
+            Ok(format!("{}{gone}", part.describe()))
+        });
         methods.add_meta_method(DESCRIBE, |_, part, ()| Ok(part.describe()));
         methods.add_meta_method(MetaMethod::Eq, |_, part, other: Value| {
             Ok(match other {

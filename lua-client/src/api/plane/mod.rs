@@ -71,6 +71,7 @@ impl PlaneState {
     pub fn forget(&self, part: &Rc<PartState>, handle: Handle) {
         self.parts.borrow_mut().retain(|p| !Rc::ptr_eq(p, part));
         self.by_handle.borrow_mut().remove(&handle);
+        crate::api::contacts::forget_joints_of(self, handle);
         crate::api::contacts::handlers_changed();
     }
 
@@ -135,6 +136,7 @@ impl PlaneState {
         for part in self.parts.take() {
             part.unlink(Ended::PlaneDestroyed);
         }
+        crate::api::contacts::forget_all_joints(self);
         crate::api::contacts::handlers_changed();
         self.by_handle.borrow_mut().clear();
         self.controllers.borrow_mut().clear();

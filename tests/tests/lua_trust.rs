@@ -1,0 +1,96 @@
+//! What a script trips on, through the real `physics-lua` runner and a real daemon: a run
+//! ends once nothing can fire its handlers again, Heart's dt after a quiet stretch, tostring
+//! of destroyed things, `wait(math.huge)`, Size limits of a free part.
+
+use std::process::Output;
+use std::time::{Duration, Instant};
+
+use integration_tests::{physics_lua, TestDaemon};
+
+/// Runs `script` with `--seconds 30`; returns its output and how long it ran, or panics
+/// after `limit` with what it printed.
+fn run(daemon: &TestDaemon, script: &str, limit: Duration) -> (Output, Duration) {
+    let started = Instant::now();
+    let mut child = physics_lua(&daemon.domain, script, &["--seconds", "30"])
+        .spawn()
+        .expect("spawn physics-lua");
+    while child.try_wait().expect("wait physics-lua").is_none() {
+        if started.elapsed() > limit {
+            let _ = child.kill();
+            let out = child.wait_with_output().expect("collect output");
+            panic!(
+                "{script} still running after {limit:?}: the run did not end\nstdout:\n{}\nstderr:\n{}",
+                String::from_utf8_lossy(&out.stdout),
+                String::from_utf8_lossy(&out.stderr)
+            );
+        }
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    let out = child.wait_with_output().expect("collect output");
+    assert!(
+        out.status.success(),
+        "{script} failed\nstdout:\n{}\nstderr:\n{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    (out, started.elapsed())
+}
+
+fn stdout(out: &Output) -> String {
+    String::from_utf8_lossy(&out.stdout).into_owned()
+}
+
+#[test]
+fn a_run_ends_when_a_broke_handler_lost_its_joint_with_the_object() {
+    let daemon = TestDaemon::start("trust-joint");
+    let (out, _) = run(
+        &daemon,
+        "tests/lua/run_ends_joint.luau",
+        Duration::from_secs(15),
+    );
+    assert!(stdout(&out).contains("run ends joint: destroyed"));
+}
+
+#[test]
+fn a_run_ends_when_its_plane_went_under_broke_and_cframe_handlers() {
+    let daemon = TestDaemon::start("trust-plane");
+    let (out, _) = run(
+        &daemon,
+        "tests/lua/run_ends_plane.luau",
+        Duration::from_secs(15),
+    );
+    assert!(stdout(&out).contains("run ends plane: destroyed"));
+}
+
+#[test]
+fn a_live_cframe_handler_keeps_the_run_going() {
+    let daemon = TestDaemon::start("trust-goes-on");
+    let started = Instant::now();
+    let out = physics_lua(
+        &daemon.domain,
+        "tests/lua/run_goes_on.luau",
+        &["--seconds", "2"],
+    )
+    .output()
+    .expect("run physics-lua");
+    let took = started.elapsed();
+    assert!(out.status.success(), "{out:?}");
+    assert!(stdout(&out).contains("run goes on: listening"));
+    assert!(
+        took >= Duration::from_millis(1900),
+        "the run ended after {took:?} while a live part's CFrame handler listened"
+    );
+}
+
+#[test]
+fn heart_dt_tostring_wait_forever_and_free_part_sizes() {
+    let daemon = TestDaemon::start("trust-small");
+    let (out, took) = run(
+        &daemon,
+        "tests/lua/trust_small.luau",
+        Duration::from_secs(20),
+    );
+    assert!(stdout(&out).contains("trust small ok"), "{}", stdout(&out));
+    // The thread parked in wait(math.huge) does not keep the run going.
+    assert!(took < Duration::from_secs(15), "took {took:?}");
+}
