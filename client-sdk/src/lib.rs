@@ -83,6 +83,7 @@ pub use shm_layout::{
 };
 pub use shm_layout::{AxisMotor, ContactInfo, ContactPoint, MAX_CONTACT_POINTS};
 pub use shm_layout::{NamedPlane, PlaneName};
+pub use transport::quiet_transport_logs;
 pub use spawn::{
     connect_or_start, daemon_executable, interrupt_child, sibling_executable, start_daemon,
     start_daemon_with, DaemonChild, Session,

@@ -18,6 +18,13 @@ use shm_layout::{names, BodyState, EventRecord, PlaneId, TickHeader};
 
 use crate::Error;
 
+/// Lets only iceoryx2's errors reach stderr (`IOX2_LOG_LEVEL` still overrides): a game or
+/// a script runner prints what it prints, not the transport's notes about dead nodes or a
+/// missing config file, which the SDK handles itself.
+pub fn quiet_transport_logs() {
+    iceoryx2::prelude::set_log_level_from_env_or(LogLevel::Error);
+}
+
 /// How many ticks' worth of event samples a reader's queue holds (one sample per tick that
 /// had events); past it the oldest are dropped and reported as lost.
 pub const EVENT_BUFFER_TICKS: usize = 64;

@@ -81,7 +81,8 @@ impl CommandError {
 
 impl core::fmt::Display for CommandError {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        write!(f, "{:?}: {}", self.kind, self.message)
+        // The message is complete on its own; the kind is data (`kind`), not words for people.
+        f.write_str(&self.message)
     }
 }
 

@@ -227,7 +227,10 @@ impl JointProp {
                 if !(len > 1e-6 && len.is_finite()) {
                     return Err(CommandError::invalid_field(
                         name,
-                        format!("Axis must be a non-zero finite vector, got {v:?}"),
+                        format!(
+                            "Axis must be a non-zero finite vector, got {}",
+                            crate::validate::show_vector(v)
+                        ),
                     ));
                 }
                 JointProp::Axis([v[0] / len, v[1] / len, v[2] / len])

@@ -26,6 +26,16 @@ pub enum PlaneKind {
     Gui2d,
 }
 
+impl PlaneKind {
+    /// The kind in the API's words, for messages: "3D", "GUI".
+    pub fn words(self) -> &'static str {
+        match self {
+            PlaneKind::Rapier3d => "3D",
+            PlaneKind::Gui2d => "GUI",
+        }
+    }
+}
+
 /// An op on one plane.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub enum PlaneOp {

@@ -161,8 +161,9 @@ pub fn decode<'a>(
     let (header, body) = verify(bytes)?;
     if header.kind != kind {
         return Err(bad(format!(
-            "it holds a {:?} plane, not a {kind:?} one",
-            header.kind
+            "it holds a {} plane, not a {} one",
+            header.kind.words(),
+            kind.words()
         )));
     }
     if header.engine != engine {

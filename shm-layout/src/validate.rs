@@ -24,6 +24,11 @@ pub const MAX_MESH_VERTICES: usize = 1 << 16;
 /// Most triangles one mesh part may carry.
 pub const MAX_MESH_TRIANGLES: usize = 1 << 17;
 
+/// `Vector(x, y, z)`: a vector as the API prints it (Luau's `tostring`), for messages.
+pub fn show_vector(v: [f32; 3]) -> String {
+    format!("Vector({}, {}, {})", v[0], v[1], v[2])
+}
+
 /// A vector with finite components.
 pub fn finite3(field: &str, v: Vec3) -> Result<Vec3, CommandError> {
     if v.iter().all(|c| c.is_finite()) {
@@ -31,7 +36,10 @@ pub fn finite3(field: &str, v: Vec3) -> Result<Vec3, CommandError> {
     } else {
         Err(CommandError::invalid_field(
             field,
-            format!("{field} must have finite components, got {v:?}"),
+            format!(
+                "{field} must have finite components, got {}",
+                show_vector(v)
+            ),
         ))
     }
 }
@@ -76,7 +84,10 @@ pub fn bounded3(field: &str, v: Vec3, max: f32) -> Result<Vec3, CommandError> {
     } else {
         Err(CommandError::invalid_field(
             field,
-            format!("{field} must have finite components within [-{max}, {max}], got {v:?}"),
+            format!(
+                "{field} must have finite components within [-{max}, {max}], got {}",
+                show_vector(v)
+            ),
         ))
     }
 }
@@ -120,7 +131,10 @@ pub fn rotation(field: &str, q: [f32; 4]) -> Result<[f32; 4], CommandError> {
     if !q.iter().all(|c| c.is_finite()) || norm < 1e-6 {
         return Err(CommandError::invalid_field(
             field,
-            format!("{field} must be a finite non-zero quaternion, got {q:?}"),
+            format!(
+                "{field} must be a finite non-zero quaternion, got ({}, {}, {}, {})",
+                q[0], q[1], q[2], q[3]
+            ),
         ));
     }
     Ok(q.map(|c| c / norm))

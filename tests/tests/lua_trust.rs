@@ -94,3 +94,52 @@ fn heart_dt_tostring_wait_forever_and_free_part_sizes() {
     // The thread parked in wait(math.huge) does not keep the run going.
     assert!(took < Duration::from_secs(15), "took {took:?}");
 }
+
+#[test]
+fn dyn_mesh_welds_follow_every_step_of_a_loop() {
+    let daemon = TestDaemon::start("trust-welds");
+    let (out, _) = run(
+        &daemon,
+        "tests/lua/weld_steps.luau",
+        Duration::from_secs(20),
+    );
+    assert!(stdout(&out).contains("weld steps ok"), "{}", stdout(&out));
+}
+
+#[test]
+fn errors_speak_the_api_words_not_rust() {
+    let daemon = TestDaemon::start("trust-words");
+    let (out, _) = run(
+        &daemon,
+        "tests/lua/error_words.luau",
+        Duration::from_secs(30),
+    );
+    assert!(stdout(&out).contains("error words ok"), "{}", stdout(&out));
+}
+
+/// Runs with a daemon the runner starts itself (and a GPU plane where there is an adapter):
+/// stderr carries nothing, since the script prints nothing there (iceoryx2's notes and a
+/// GPU driver's probe lines stay out of the run's output). Several runs, as the notes came
+/// in a few runs of a hundred.
+#[test]
+fn an_ordinary_run_prints_nothing_on_stderr() {
+    for i in 0..6 {
+        let domain = integration_tests::unique_domain("trust-quiet");
+        let out = physics_lua(&domain, "tests/lua/quiet_run.luau", &[])
+            .output()
+            .expect("run physics-lua");
+        let _ =
+            std::fs::remove_file(std::env::temp_dir().join(format!("physics-daemon-{domain}.log")));
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(out.status.success(), "run {i}: {out:?}");
+        assert!(
+            stdout(&out).contains("quiet ok"),
+            "run {i}: {}",
+            stdout(&out)
+        );
+        assert!(
+            stderr.trim().is_empty(),
+            "run {i} printed on stderr:\n{stderr}"
+        );
+    }
+}

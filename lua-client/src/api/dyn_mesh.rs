@@ -1,12 +1,13 @@
 //! `DynMesh`: decorative geometry welded to a part, on the host. `DynMesh.new(part)` wraps
 //! a driving part (a controller's `BasePart()`, any part); `mesh:Weld(other, {Offset =
-//! CFrame})` makes `other` ride along: at the start of every frame (before `Heart`) its
-//! CFrame becomes the driver's CFrame times the offset. No daemon cost and no physics body:
+//! CFrame})` makes `other` ride along: at the start of every frame (before `Heart`) and
+//! after every `plane:Step` (before its CFrame signals fire) its CFrame becomes the
+//! driver's CFrame times the offset. No daemon cost and no physics body:
 //! welded parts are for hats, arms, weapons, billboards. Deforming a mesh belongs to the
 //! host's renderer, not to this service.
 
 use std::cell::{Cell, RefCell};
-use std::rc::Rc;
+use std::rc::{Rc, Weak};
 
 use mlua::{Lua, MetaMethod, Table, UserData, UserDataMethods, Value};
 
@@ -65,6 +66,30 @@ impl Watched for MeshState {
     fn keeps_running(&self) -> bool {
         false
     }
+}
+
+/// Every DynMesh of a Lua state, for the welds to follow after each `plane:Step`.
+#[derive(Default)]
+struct Meshes(RefCell<Vec<Weak<MeshState>>>);
+
+/// Moves the welded parts of every DynMesh to their drivers (after a `plane:Step`, whose
+/// ticks moved the drivers; a script stepping in a loop without yielding sees its welds
+/// follow each step). Costs one length check while no DynMesh exists.
+pub(crate) fn follow_all(lua: &Lua) -> mlua::Result<()> {
+    let meshes: Vec<Rc<MeshState>> = match lua.app_data_ref::<Meshes>() {
+        Some(m) => {
+            let mut list = m.0.borrow_mut();
+            list.retain(|w| w.strong_count() > 0);
+            list.iter().filter_map(Weak::upgrade).collect()
+        }
+        None => return Ok(()),
+    };
+    for mesh in meshes {
+        if !mesh.destroyed.get() {
+            mesh.follow(lua)?;
+        }
+    }
+    Ok(())
 }
 
 /// The Lua value of a `DynMesh`.
@@ -183,6 +208,12 @@ pub fn module(lua: &Lua) -> mlua::Result<Table> {
             });
             // Probed every frame; it costs one length check while nothing is welded.
             scheduler(lua).watch(state.clone());
+            if lua.app_data_ref::<Meshes>().is_none() {
+                lua.set_app_data(Meshes::default());
+            }
+            if let Some(meshes) = lua.app_data_ref::<Meshes>() {
+                meshes.0.borrow_mut().push(Rc::downgrade(&state));
+            }
             Ok(DynMesh(state))
         })?,
     )?;

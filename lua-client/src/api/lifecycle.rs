@@ -38,6 +38,8 @@ pub(crate) fn add_methods<P: LuaPlane, M: UserDataMethods<P>>(methods: &mut M) {
         p.sdk_plane()
             .step(dt as f32)
             .map_err(|e| sdk_error(&what, e))?;
+        // Welds ride along before the step's CFrame signals fire, so handlers see them.
+        super::dyn_mesh::follow_all(lua)?;
         p.after_tick(lua)
     });
     methods.add_method("Destroy", |lua, p, ()| p.destroy(lua));

@@ -268,7 +268,13 @@ fn connect(args: &Args, timeout: Duration) -> Result<Session, client_sdk::Error>
             daemon: None,
         }),
         Err(client_sdk::Error::NoDaemon { .. }) => {
-            let (daemon, started_with) = client_sdk::start_daemon(domain)?;
+            // The daemon started for the run writes its log to a file, not into the run's
+            // output (its transport notes, a GPU driver's probe lines).
+            let log = std::env::temp_dir().join(format!("physics-daemon-{domain}.log"));
+            let stderr = std::fs::File::create(&log)
+                .map(std::process::Stdio::from)
+                .unwrap_or_else(|_| std::process::Stdio::inherit());
+            let (daemon, started_with) = client_sdk::start_daemon_with(domain, &[], stderr)?;
             drop(started_with);
             Ok(Session {
                 client: Client::connect_with(options)?,
@@ -570,6 +576,8 @@ fn failed(args: &Args, host: &Host, signals: &Signals, e: mlua::Error) -> Result
 
 fn main() -> ExitCode {
     let args = Args::parse();
+    // A run prints what the script prints and the runner's own warnings.
+    client_sdk::quiet_transport_logs();
     let signals = Signals::install();
     let code = match run(&args, &signals) {
         Ok(Ended::Finished) => ExitCode::SUCCESS,

@@ -104,13 +104,26 @@ impl Kind {
 
     /// What the error message says was expected.
     pub fn expected(&self) -> String {
+        /// A bound as written in the settings table: the shortest decimal of the `f32` it
+        /// came from (1e-4, not 0.00009999999747378752).
+        fn shortest(x: f64) -> String {
+            let narrow = x as f32;
+            if narrow as f64 == x {
+                narrow.to_string()
+            } else {
+                x.to_string()
+            }
+        }
         match *self {
-            Kind::Number { min, max } => match (min.is_finite(), max.is_finite()) {
-                (false, false) => "a finite number".into(),
-                (true, false) => format!("a finite number >= {min}"),
-                (false, true) => format!("a finite number <= {max}"),
-                (true, true) => format!("a number in [{min}, {max}]"),
-            },
+            Kind::Number { min, max } => {
+                let (lo, hi) = (shortest(min), shortest(max));
+                match (min.is_finite(), max.is_finite()) {
+                    (false, false) => "a finite number".into(),
+                    (true, false) => format!("a finite number >= {lo}"),
+                    (false, true) => format!("a finite number <= {hi}"),
+                    (true, true) => format!("a number in [{lo}, {hi}]"),
+                }
+            }
             Kind::Positive => "a finite number > 0".into(),
             Kind::Integer { min, max } => match (min > i64::MIN, max < i64::MAX) {
                 (false, false) => "an integer".into(),

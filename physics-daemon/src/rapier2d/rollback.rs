@@ -84,7 +84,7 @@ impl Plane {
                 "Rewind",
                 format!(
                     "Rewind({n}) goes further back than the plane keeps: RollbackTicks = {k}, \
-                     ticks {oldest}..={} kept",
+                     ticks {oldest} to {} kept",
                     self.clock.tick
                 ),
             ));

@@ -245,8 +245,8 @@ impl Daemon {
         let entry = self.plane(id)?;
         if entry.kind != PlaneKind::Rapier3d {
             return Err(move_error(format!(
-                "plane {id} is a {:?} plane (NewGUI), which cannot move: only 3D planes move",
-                entry.kind
+                "plane {id} is a {} plane (NewGUI), which cannot move: only 3D planes move",
+                entry.kind.words()
             )));
         }
         if daemon == migration.me {
@@ -393,7 +393,7 @@ impl Daemon {
 
     fn arrive_plane(&mut self, moving: MovingPlane) -> MoveAnswer {
         if moving.kind != PlaneKind::Rapier3d {
-            return Err(format!("a {:?} plane cannot move", moving.kind));
+            return Err(format!("a {} plane cannot move", moving.kind.words()));
         }
         if self.planes.len() >= MAX_PLANES {
             return Err(format!("the daemon already hosts {MAX_PLANES} planes"));

@@ -77,7 +77,8 @@ fn check_bounds((min, max): (Vec2, Vec2)) -> Result<(Vec2, Vec2), CommandError> 
             "BoundsMax",
             format!(
                 "BoundsMax must be at least 1 px right of and below BoundsMin, got BoundsMin \
-                 {min:?}, BoundsMax {max:?}"
+                 Dim({}, {}), BoundsMax Dim({}, {})",
+                min[0], min[1], max[0], max[1]
             ),
         ));
     }
@@ -118,8 +119,9 @@ impl GuiPlaneSettings {
                 return Err(CommandError::invalid_field(
                     "Bounds",
                     format!(
-                        "BoundsMin / BoundsMax are construction-only (tried to set {min:?} .. \
-                         {max:?})"
+                        "BoundsMin / BoundsMax are construction-only (tried to set \
+                         Dim({}, {}) to Dim({}, {}))",
+                        min[0], min[1], max[0], max[1]
                     ),
                 ));
             }
