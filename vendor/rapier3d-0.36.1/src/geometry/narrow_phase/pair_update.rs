@@ -444,6 +444,27 @@ pub(super) fn process_pair(
             &mut rigid.manifolds,
             &mut rigid.workspace,
         );
+        // PATCH(physics-service): parry's polygonal-feature manifolds (cylinders, cones,
+        // convex hulls against boxes and each other) append GJK's deepest point, with unknown
+        // feature ids, after the clipped feature points. Over a face contact (three or more
+        // clipped points) that point adds nothing (the depth is linear over the face, so its
+        // deepest point is one of the polygon's corners) but puts a second contact at one
+        // corner or edge: a flat landing's impulse goes lopsided and the body spins (an
+        // upright cylinder dropped flat tipped over).
+        for manifold in rigid.manifolds.iter_mut() {
+            let n = manifold.points.len();
+            if n >= 4 {
+                let last = &manifold.points[n - 1];
+                if last.fid1 == parry::shape::PackedFeatureId::UNKNOWN
+                    && last.fid2 == parry::shape::PackedFeatureId::UNKNOWN
+                    && manifold.points[..n - 1]
+                        .iter()
+                        .all(|p| p.fid1 != parry::shape::PackedFeatureId::UNKNOWN)
+                {
+                    manifold.points.pop();
+                }
+            }
+        }
 
         if let Some(soft) =
             soft.filter(|_| co1.deformable_mesh_ref.is_some() || co2.deformable_mesh_ref.is_some())
