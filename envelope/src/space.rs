@@ -1,0 +1,219 @@
+//! The parameter ranges of every family, as data: [`FULL`] is what `physics-bench
+//! envelope` explores; [`HOLDS`] is the documented envelope, where every oracle holds at
+//! the time of writing (tests/tests/envelope.rs asserts it). Widen a family's `HOLDS` entry
+//! as fixes land; narrow it (and say so in docs/stability.md) when a change breaks it.
+
+use crate::families::chain::{Kind, Solver, StartPose};
+use crate::families::drop::{DropShape, ALL_SHAPES};
+use crate::families::projectile::Target;
+use crate::families::spring::SpringKind;
+use crate::families::stack::Order;
+use crate::Span;
+
+/// Ranges of the solver knobs.
+#[derive(Debug, Clone, Copy, serde::Serialize)]
+pub struct SettingRanges {
+    /// Ticks per second, log-uniform.
+    pub tick_rate: Span,
+    /// SolverIterations, inclusive.
+    pub iterations: (u32, u32),
+    /// HitBoxQuality, inclusive.
+    pub quality: (u32, u32),
+}
+
+#[derive(Debug, Clone, Copy, serde::Serialize)]
+pub struct StackRanges {
+    pub setting: SettingRanges,
+    pub count: (u32, u32),
+    pub ratio: Span,
+    pub size: Span,
+    pub orders: &'static [Order],
+}
+
+#[derive(Debug, Clone, Copy, serde::Serialize)]
+pub struct ChainRanges {
+    pub setting: SettingRanges,
+    pub links: (u32, u32),
+    pub ratio: Span,
+    pub link: Span,
+    pub poses: &'static [StartPose],
+    pub kinds: &'static [Kind],
+    pub solvers: &'static [Solver],
+}
+
+#[derive(Debug, Clone, Copy, serde::Serialize)]
+pub struct ProjectileRanges {
+    /// The ball's quality is `setting.quality`.
+    pub setting: SettingRanges,
+    pub targets: &'static [Target],
+    pub speed: Span,
+    pub radius: Span,
+    pub thickness: Span,
+    pub target_quality: (u32, u32),
+    /// Degrees off the target's normal, uniform.
+    pub angle: Span,
+    /// Target weight / ball weight (free bodies).
+    pub mass_ratio: Span,
+}
+
+#[derive(Debug, Clone, Copy, serde::Serialize)]
+pub struct DropRanges {
+    pub setting: SettingRanges,
+    pub shapes: &'static [DropShape],
+    pub size: Span,
+    pub aspect: Span,
+    pub height: Span,
+}
+
+#[derive(Debug, Clone, Copy, serde::Serialize)]
+pub struct SpringRanges {
+    pub setting: SettingRanges,
+    pub kinds: &'static [SpringKind],
+    pub stiffness: Span,
+    pub mass: Span,
+    pub amplitude: Span,
+}
+
+#[derive(Debug, Clone, Copy, serde::Serialize)]
+pub struct PileRanges {
+    pub setting: SettingRanges,
+    pub count: (u32, u32),
+    pub size: Span,
+    /// Distance of the floor from the origin along each axis, log-uniform ...
+    pub offset: Span,
+    /// ... except this share of cases, at the origin.
+    pub at_origin: f64,
+    /// Whether the pile has round parts (spheres, cylinders).
+    pub round: &'static [bool],
+}
+
+/// One range set per family.
+#[derive(Debug, Clone, Copy, serde::Serialize)]
+pub struct Space {
+    pub stack: StackRanges,
+    pub chain: ChainRanges,
+    pub projectile: ProjectileRanges,
+    pub drop: DropRanges,
+    pub spring: SpringRanges,
+    pub pile: PileRanges,
+}
+
+const WIDE: SettingRanges = SettingRanges {
+    tick_rate: Span(30.0, 240.0),
+    iterations: (1, 16),
+    quality: (1, 32),
+};
+
+const DEFAULTS: SettingRanges = SettingRanges {
+    tick_rate: Span::at(60.0),
+    iterations: (4, 4),
+    quality: (1, 1),
+};
+
+/// What the fuzzer explores: the ranges.
+pub const FULL: Space = Space {
+    stack: StackRanges {
+        setting: WIDE,
+        count: (2, 6),
+        ratio: Span(1.0, 1e4),
+        size: Span(0.05, 100.0),
+        orders: &[Order::HeavyTop, Order::HeavyBottom, Order::Alternating],
+    },
+    chain: ChainRanges {
+        setting: WIDE,
+        links: (2, 30),
+        ratio: Span(1.0, 1e4),
+        link: Span(0.1, 10.0),
+        poses: &[StartPose::Hanging, StartPose::Horizontal, StartPose::Coiled],
+        kinds: &[Kind::Ball, Kind::Hinge],
+        solvers: &[Solver::Articulation, Solver::Impulse],
+    },
+    projectile: ProjectileRanges {
+        setting: WIDE,
+        targets: &[Target::Wall, Target::Body],
+        speed: Span(10.0, 10_000.0),
+        radius: Span(0.05, 1.0),
+        thickness: Span(0.01, 10.0),
+        target_quality: (1, 32),
+        angle: Span(0.0, 60.0),
+        mass_ratio: Span(0.1, 100.0),
+    },
+    drop: DropRanges {
+        setting: WIDE,
+        shapes: &ALL_SHAPES,
+        size: Span(0.05, 100.0),
+        aspect: Span(0.5, 3.0),
+        height: Span(0.01, 20.0),
+    },
+    spring: SpringRanges {
+        setting: WIDE,
+        kinds: &[SpringKind::Spring, SpringKind::AxisSpring],
+        stiffness: Span(1.0, 1e5),
+        mass: Span(0.1, 100.0),
+        amplitude: Span(0.05, 1.5),
+    },
+    pile: PileRanges {
+        setting: SettingRanges {
+            tick_rate: Span(30.0, 480.0),
+            ..WIDE
+        },
+        count: (1, 40),
+        size: Span(0.05, 100.0),
+        offset: Span(1.0, 1e5),
+        at_origin: 0.3,
+        round: &[false, true],
+    },
+};
+
+/// The documented envelope: where every oracle holds today at the defaults (plus the
+/// knobs named), the ranges tests/tests/envelope.rs draws from.
+pub const HOLDS: Space = Space {
+    stack: StackRanges {
+        setting: DEFAULTS,
+        count: (2, 4),
+        ratio: Span(1.0, 100.0),
+        size: Span(0.2, 10.0),
+        orders: &[Order::HeavyTop, Order::HeavyBottom, Order::Alternating],
+    },
+    chain: ChainRanges {
+        setting: DEFAULTS,
+        links: (2, 20),
+        ratio: Span(1.0, 100.0),
+        link: Span(0.5, 2.0),
+        poses: &[StartPose::Hanging],
+        kinds: &[Kind::Ball, Kind::Hinge],
+        solvers: &[Solver::Articulation],
+    },
+    projectile: ProjectileRanges {
+        setting: DEFAULTS,
+        targets: &[Target::Wall],
+        speed: Span(10.0, 1000.0),
+        radius: Span(0.1, 1.0),
+        thickness: Span(0.5, 10.0),
+        target_quality: (1, 1),
+        angle: Span(0.0, 45.0),
+        mass_ratio: Span(1.0, 1.0),
+    },
+    drop: DropRanges {
+        setting: DEFAULTS,
+        shapes: &[DropShape::Cube, DropShape::Sphere],
+        size: Span(0.2, 10.0),
+        aspect: Span(0.5, 2.0),
+        height: Span(0.01, 10.0),
+    },
+    spring: SpringRanges {
+        setting: DEFAULTS,
+        kinds: &[SpringKind::AxisSpring],
+        stiffness: Span(1.0, 100.0),
+        mass: Span(1.0, 10.0),
+        amplitude: Span(0.1, 1.0),
+    },
+    pile: PileRanges {
+        setting: DEFAULTS,
+        count: (1, 20),
+        size: Span(0.2, 10.0),
+        offset: Span(1.0, 1e3),
+        at_origin: 0.5,
+        round: &[false, true],
+    },
+};
