@@ -29,6 +29,8 @@ mod adaptive;
 mod articulations;
 mod axis_motors;
 mod capsule_contact;
+#[cfg(test)]
+mod ccd_tests;
 mod contact_points;
 mod joints;
 mod limits;

@@ -10,8 +10,8 @@ use crate::prelude::{ActiveEvents, CollisionEventFlags};
 use parry::query::sweep_toi::Sweep;
 
 use super::sweeps::{
-    BodyContinuousResult, CcdTargets, PseudoHitMode, collect_fixed_targets, collect_soft_targets,
-    is_bullet, map_bodies_parallel, sweep_fast_body,
+    BodyContinuousResult, CcdTargets, PseudoHitMode, collect_fixed_targets, collect_movers,
+    collect_soft_targets, is_bullet, map_bodies_parallel, sweep_fast_body,
 };
 
 /// Continuous Collision Detection solver preventing fast objects from tunneling:
@@ -20,8 +20,11 @@ use super::sweeps::{
 /// residual approach resolves next step via speculative contacts.
 ///
 /// Fast dynamic bodies sweep against fixed colliders and soft-body meshes; `ccd_enabled` makes a
-/// bullet that also sweeps kinematic/dynamic bodies (never other bullets); mesh-like colliders are
-/// never the moving shape; compounds sweep per convex child; `max_ccd_substeps = 0` disables CCD.
+/// bullet: it sweeps kinematic/dynamic bodies too, and every fast body sweeps it (bullets hit
+/// bullets); a fast body whose motion outruns its soft-CCD prediction sweeps every body
+/// (PATCH(physics-service), see `sweeps::tier_allows`); moving targets are swept along their own
+/// motion; mesh-like colliders are never the moving shape; compounds sweep per convex child;
+/// `max_ccd_substeps = 0` disables CCD.
 #[derive(Clone, Default)]
 #[cfg_attr(feature = "serde-serialize", derive(Serialize, Deserialize))]
 pub struct CCDSolver {
@@ -132,6 +135,9 @@ impl CCDSolver {
             .active_bodies()
             .filter(|h| bodies[*h].ccd.ccd_active)
             .collect();
+        // PATCH(physics-service): fast targets are found by their swept boxes (see
+        // `sweeps::collect_movers`; here from the last solved end poses).
+        let movers = collect_movers(&fast_bodies, bodies, colliders);
 
         let fractions = map_bodies_parallel(&fast_bodies, hooks, |handle, hooks| {
             let rb1 = &bodies[handle];
@@ -145,6 +151,7 @@ impl CCDSolver {
                 colliders,
                 predicted_body_pos,
                 CcdTargets::FullBvh(bvh),
+                &movers,
                 dispatcher,
                 hooks,
                 dt,
@@ -160,8 +167,9 @@ impl CCDSolver {
 
     /// Runs the continuous-collision pass on all fast bodies and clamps their `next_position`
     /// to their earliest time of impact: non-bullets sweep the automatic targets (fixed
-    /// colliders and soft-body collision meshes) first, then bullets sweep every (possibly
-    /// already clamped) body; velocities are never modified. Sensor
+    /// colliders and soft-body collision meshes) and the moving bodies `sweeps::tier_allows`
+    /// admits, bullets sweep every body; every sweep sees the other bodies' unclamped motion
+    /// and the clamps are applied at the end; velocities are never modified. Sensor
     /// crossings the narrow phase would miss entirely emit paired `Started`/`Stopped`
     /// intersection events.
     #[profiling::function]
@@ -188,11 +196,17 @@ impl CCDSolver {
             .active_bodies()
             .filter(|h| bodies[*h].ccd.ccd_active)
             .partition(|h| !is_bullet(&bodies[*h]));
+        // PATCH(physics-service): every fast body's swept box, for the others' sweeps.
+        let movers = {
+            let mut fast = non_bullets.clone();
+            fast.extend_from_slice(&bullets);
+            collect_movers(&fast, bodies, colliders)
+        };
 
         let mut all_results = Vec::new();
 
-        // Pass 1: fast non-bullet bodies vs fixed targets (all targets are stationary, so
-        // the bodies are independent and can run in parallel).
+        // Pass 1: fast non-bullet bodies vs fixed targets and the moving bodies the tier rule
+        // admits (the sweeps only read, so the bodies are independent and run in parallel).
         {
             let query_pipeline = broad_phase.as_query_pipeline(
                 narrow_phase.query_dispatcher(),
@@ -201,8 +215,8 @@ impl CCDSolver {
                 QueryFilter::default(),
             );
             let (bvh, dispatcher) = (query_pipeline.bvh, query_pipeline.dispatcher);
-            // Non-bullet fast bodies only hit fixed targets: sweep against the (small) cached
-            // fixed-collider list instead of the full BVH.
+            // Non-bullet fast bodies hit fixed targets from the (small) cached fixed-collider
+            // list instead of the full BVH, and moving ones from the BVH.
             let prediction = params.prediction_distance();
             let cache_valid = self
                 .fixed_targets_cache
@@ -218,7 +232,11 @@ impl CCDSolver {
             // gathered fresh (one AABB per mesh, not a collider scan).
             let soft = collect_soft_targets(soft_bodies, colliders, prediction);
             let targets = match &self.fixed_targets_cache.as_ref().unwrap().1 {
-                Some(fixed) => CcdTargets::Lists { fixed, soft: &soft },
+                Some(fixed) => CcdTargets::Lists {
+                    fixed,
+                    soft: &soft,
+                    bvh,
+                },
                 None => CcdTargets::FullBvh(bvh),
             };
             let results = map_bodies_parallel(&non_bullets, hooks, |handle, hooks| {
@@ -228,6 +246,7 @@ impl CCDSolver {
                     colliders,
                     bodies[handle].pos.next_position,
                     targets,
+                    &movers,
                     dispatcher,
                     hooks,
                     dt,
@@ -237,10 +256,12 @@ impl CCDSolver {
             });
             all_results.extend(results);
         }
-        Self::apply_clamps(bodies, &all_results);
+        // PATCH(physics-service): the clamps of pass 1 wait for pass 2. Each sweep follows its
+        // moving targets along their solved motion: a target already clamped would have been
+        // swept along a shortened (slower) path, and two fast bodies meeting head-on, one
+        // clamped before the other swept, ended past each other.
 
-        // Pass 2: bullets vs everything except other bullets. Targets read the (already
-        // clamped) `next_position` from pass 1 (deferred bullet stage).
+        // Pass 2: bullets vs everything.
         if !bullets.is_empty() {
             let bullet_results = {
                 let query_pipeline = broad_phase.as_query_pipeline(
@@ -257,6 +278,7 @@ impl CCDSolver {
                         colliders,
                         bodies[handle].pos.next_position,
                         CcdTargets::FullBvh(bvh),
+                        &movers,
                         dispatcher,
                         hooks,
                         dt,
@@ -265,9 +287,9 @@ impl CCDSolver {
                     )
                 })
             };
-            Self::apply_clamps(bodies, &bullet_results);
             all_results.extend(bullet_results);
         }
+        Self::apply_clamps(bodies, &all_results);
 
         // Emit intersection events for sensor crossings that happened strictly before each
         // body's final solid impact and that the narrow phase would never observe (no

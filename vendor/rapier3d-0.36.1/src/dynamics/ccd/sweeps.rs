@@ -32,21 +32,29 @@ fn is_auto_target(rb: Option<&RigidBody>, co: &Collider) -> bool {
     is_fixed_target(rb) || co.is_deformable_collider()
 }
 
-/// Is `rb` a bullet (a dynamic body with the full-CCD upgrade)? Bullets never sweep against
-/// other bullets.
+/// Is `rb` a bullet (a dynamic body with the full-CCD upgrade)?
 pub(super) fn is_bullet(rb: &RigidBody) -> bool {
     rb.is_dynamic() && rb.ccd.ccd_enabled
 }
 
-/// The target-selection rule for a fast body `rb1`: a non-bullet fast body only sweeps
-/// against automatic targets (fixed geometry and soft-body meshes); a bullet sweeps against
-/// every body type except other bullets.
+// PATCH(physics-service): full CCD is a property of the pair, not only of the fast body.
+/// The target-selection rule for a fast body `rb1`: automatic targets (fixed geometry and
+/// soft-body meshes) always; a moving (dynamic or kinematic) body when either side is a bullet
+/// (a bullet sweeps every body, and every fast body sweeps a bullet: bullets hit bullets, a
+/// fast body hits a resting bullet), or when `rb1` moves farther this step than its soft-CCD
+/// prediction reaches (the speculative contacts that soft CCD predicts cannot catch it).
 fn tier_allows(rb1: &RigidBody, rb2: Option<&RigidBody>, co2: &Collider) -> bool {
-    if is_bullet(rb1) {
-        !rb2.map(is_bullet).unwrap_or(false)
-    } else {
-        is_auto_target(rb2, co2)
+    if is_auto_target(rb2, co2) || is_bullet(rb1) || rb2.is_some_and(is_bullet) {
+        return true;
     }
+    outruns_soft_ccd(rb1)
+}
+
+/// Whether the centre of mass of `rb` moves farther this step than its soft-CCD prediction.
+fn outruns_soft_ccd(rb: &RigidBody) -> bool {
+    let com = rb.mprops.local_mprops.local_com;
+    let travel = (rb.pos.next_position * com - rb.pos.position * com).length();
+    travel > rb.soft_ccd_prediction()
 }
 
 /// Returns `true` if the user's `filter_contact_pair` hook rejected this pair. Mirrors the
@@ -105,13 +113,33 @@ pub(crate) fn shape_never_ccd_swept(shape: &dyn Shape) -> bool {
     )
 }
 
-/// The pose a target collider holds during the continuous pass. Targets are stationary at
-/// their end-of-step pose (static targets trivially; dynamic/kinematic targets of bullets
-/// read the — possibly already clamped — solved `next_position`).
+/// The pose a target collider holds at the end of the step: its solved `next_position` (the
+/// clamps are applied after every sweep of the pass, so this is the unclamped motion).
 fn target_collider_pose(co: &Collider, rb: Option<&RigidBody>) -> Pose {
     match (rb, co.parent.as_ref()) {
         (Some(rb), Some(parent)) => rb.pos.next_position * parent.pos_wrt_parent,
         _ => co.pos.0,
+    }
+}
+
+// PATCH(physics-service): moving targets are swept along their own motion.
+/// The target collider's motion during the step: stationary for fixed targets, from its pose at
+/// the start of the step to its solved end pose for a moving body. Sweeping a moving target at
+/// its end pose only let two bodies approaching each other pass (each saw the other ahead of
+/// where it was when they met).
+fn target_collider_sweep(co: &Collider, rb: Option<&RigidBody>) -> Sweep {
+    match (rb, co.parent.as_ref()) {
+        (Some(rb), Some(parent)) if !rb.is_fixed() => {
+            let local_com = parent
+                .pos_wrt_parent
+                .inverse_transform_point(rb.mprops.local_mprops.local_com);
+            Sweep::from_poses(
+                &(rb.pos.position * parent.pos_wrt_parent),
+                &(rb.pos.next_position * parent.pos_wrt_parent),
+                local_com,
+            )
+        }
+        _ => Sweep::constant(&target_collider_pose(co, rb), Vector::ZERO),
     }
 }
 
@@ -133,6 +161,44 @@ fn intersect_swept_aabb<'a>(
         })
 }
 
+// PATCH(physics-service): the fast bodies, for each other's sweeps.
+/// The swept box (start and end poses of all its colliders) of every fast body of the pass.
+/// A fast target's broad-phase box holds where it started, not the path it sweeps this step, so
+/// fast bodies find each other here rather than in the BVH: two bodies crossing each other's
+/// path within a step are in neither's box at the other's start.
+pub(super) fn collect_movers(
+    fast: &[RigidBodyHandle],
+    bodies: &RigidBodySet,
+    colliders: &ColliderSet,
+) -> Vec<(RigidBodyHandle, Aabb)> {
+    let mut movers = Vec::with_capacity(fast.len());
+    for handle in fast {
+        let rb = &bodies[*handle];
+        let mut swept: Option<Aabb> = None;
+        for ch in &rb.colliders.0 {
+            let co = &colliders[*ch];
+            let Some(parent) = co.parent.as_ref() else {
+                continue;
+            };
+            let start = co.shape.compute_aabb(&(rb.pos.position * parent.pos_wrt_parent));
+            let end = co
+                .shape
+                .compute_aabb(&(rb.pos.next_position * parent.pos_wrt_parent));
+            let both = start.merged(&end);
+            swept = Some(swept.map_or(both, |s| s.merged(&both)));
+        }
+        if let Some(swept) = swept {
+            movers.push((*handle, swept));
+        }
+    }
+    movers
+}
+
+/// Whether `rb` is one of the fast bodies of the pass (an awake body flagged CCD-active).
+fn is_mover(rb: Option<&RigidBody>) -> bool {
+    rb.is_some_and(|rb| rb.ccd.ccd_active && !rb.is_sleeping())
+}
+
 /// The targets a fast body sweeps against. Non-bullets only hit automatic targets, so flat AABB
 /// lists skip walking the shared BVH; bullets and fixed-heavy worlds use the full BVH.
 #[derive(Copy, Clone)]
@@ -144,6 +210,8 @@ pub(super) enum CcdTargets<'a> {
         fixed: &'a [(ColliderHandle, Aabb)],
         /// The soft-body collision meshes.
         soft: &'a [(ColliderHandle, Aabb)],
+        /// The broad phase, for the moving targets the tier rule admits (PATCH(physics-service)).
+        bvh: &'a Bvh,
     },
     /// The full broad-phase BVH.
     FullBvh(&'a Bvh),
@@ -240,13 +308,21 @@ impl<'a> FastColliderInfo<'a> {
         start: &Pose,
         end: &Pose,
         local_com: Vector,
+        linear_slop: Real,
     ) -> Option<Self> {
         let shape = collider.shape.as_ref();
         if shape_never_ccd_swept(shape) {
             return None;
         }
 
-        let kind = if let Some(proxy) = ToiProxy::from_shape(shape) {
+        // PATCH(physics-service): the fast shape is swept inflated by twice the slop, so the
+        // sweep stops at `linear_slop` of separation rather than `linear_slop` deep (parry's
+        // target is `radius_a + radius_b - linear_slop`; see `CLAMP_SEPARATION`).
+        let inflated = |mut proxy: ToiProxy<'a>| {
+            proxy.radius += CLAMP_SEPARATION * linear_slop;
+            proxy
+        };
+        let kind = if let Some(proxy) = ToiProxy::from_shape(shape).map(inflated) {
             FastShapeKind::Convex(FastSubShape {
                 proxy,
                 sweep: Sweep::from_poses(start, end, local_com),
@@ -258,7 +334,7 @@ impl<'a> FastColliderInfo<'a> {
                 .shapes()
                 .iter()
                 .filter_map(|(child_pose, child_shape)| {
-                    let proxy = ToiProxy::from_shape(child_shape.as_ref())?;
+                    let proxy = ToiProxy::from_shape(child_shape.as_ref()).map(inflated)?;
                     Some(FastSubShape {
                         proxy,
                         sweep: Sweep::from_poses(
@@ -286,6 +362,18 @@ impl<'a> FastColliderInfo<'a> {
         })
     }
 }
+
+// PATCH(physics-service): a clamped body ends apart from its target, not inside it.
+/// How far the fast shape's sweep proxy is inflated, in `linear_slop`s. Parry stops a sweep at
+/// a core separation of `radius_a + radius_b - linear_slop`: a ball clamped against a wall
+/// ended `linear_slop` inside it. The contact of the next step was then a penetrating one,
+/// which the solver treats as soft (its CFM lets a few percent of the approach velocity
+/// through each substep: at 3,200 units/s about 90, 0.4 units in a 1/240 s substep), and the
+/// next step's sweep ignores a pair that starts touching: a 0.2 ball at 3,200 units/s crossed
+/// a 0.1 wall on the step after its clamp. Inflated by two slops the sweep stops at
+/// `linear_slop` of separation; the next step's contact is speculative, which the solver
+/// solves rigidly (the body reaches the surface and stops there).
+const CLAMP_SEPARATION: Real = 2.0;
 
 /// A target collider's shape, classified once per pair before the per-piece casts.
 // Stack-local per pair, like [`FastShapeKind`] — indirection would only add an allocation.
@@ -328,6 +416,7 @@ fn cast_collider_pair(
     is_pseudo: bool,
 ) -> Option<Real> {
     let target_pose = target_collider_pose(co2, rb2);
+    let target_sweep = target_collider_sweep(co2, rb2);
 
     let sub_shapes: &[FastSubShape] = match &fast.kind {
         FastShapeKind::Convex(sub) => core::slice::from_ref(sub),
@@ -337,9 +426,11 @@ fn cast_collider_pair(
                 dispatcher,
                 fast,
                 co2,
+                rb2,
                 &target_pose,
                 max_fraction,
                 dt,
+                linear_slop,
                 is_pseudo,
             );
         }
@@ -356,9 +447,11 @@ fn cast_collider_pair(
                 dispatcher,
                 fast,
                 co2,
+                rb2,
                 &target_pose,
                 max_fraction,
                 dt,
+                linear_slop,
                 is_pseudo,
             );
         }
@@ -375,6 +468,7 @@ fn cast_collider_pair(
             &target,
             shape2,
             &target_pose,
+            &target_sweep,
             max_fraction,
             linear_slop,
             is_pseudo,
@@ -393,16 +487,16 @@ fn cast_sub_shape(
     target: &TargetKind,
     shape2: &dyn Shape,
     target_pose: &Pose,
+    target_sweep: &Sweep,
     max_fraction: Real,
     linear_slop: Real,
     is_pseudo: bool,
 ) -> Option<Real> {
     let output = match target {
         TargetKind::Proxy(target_proxy) => {
-            let target_sweep = Sweep::constant(target_pose, Vector::ZERO);
             sweep_time_of_impact(
                 target_proxy,
-                &target_sweep,
+                target_sweep,
                 &sub.proxy,
                 &sub.sweep,
                 max_fraction,
@@ -459,10 +553,9 @@ fn cast_sub_shape(
         // so a body already touching a surface isn't pinned at fraction 0.
         if let TargetKind::Proxy(target_proxy) = target {
             let core = ToiProxy::point(sub.local_centroid, CORE_FRACTION * sub.min_extent);
-            let target_sweep = Sweep::constant(target_pose, Vector::ZERO);
             let output = sweep_time_of_impact(
                 target_proxy,
-                &target_sweep,
+                target_sweep,
                 &core,
                 &sub.sweep,
                 max_fraction,
@@ -480,13 +573,16 @@ fn cast_sub_shape(
 /// Nonlinear shape-cast fallback for pairs the proxy sweep can't handle (cylinder, cone or
 /// custom fast shapes; cylinder, cone, voxels or custom targets). Motion is derived from
 /// the solved effective velocities, like rapier's historical CCD.
+#[allow(clippy::too_many_arguments)]
 fn fallback_nonlinear_fraction(
     dispatcher: &dyn QueryDispatcher,
     fast: &FastColliderInfo,
     co2: &Collider,
+    rb2: Option<&RigidBody>,
     target_pose: &Pose,
     max_fraction: Real,
     dt: Real,
+    linear_slop: Real,
     is_pseudo: bool,
 ) -> Option<Real> {
     if dt == 0.0 {
@@ -502,7 +598,16 @@ fn fallback_nonlinear_fraction(
         rb1.ccd_vels.angvel,
     )
     .prepend(parent1.pos_wrt_parent);
-    let motion2 = NonlinearRigidMotion::constant_position(*target_pose);
+    // PATCH(physics-service): a moving target moves (see `target_collider_sweep`).
+    let motion2 = match (rb2, co2.parent.as_ref()) {
+        (Some(rb2), Some(parent2)) if !rb2.is_fixed() => {
+            let com2 = rb2.mprops.local_mprops.local_com;
+            let vels2 = rb2.pos.interpolate_velocity(1.0 / dt, com2);
+            NonlinearRigidMotion::new(rb2.pos.position, com2, vels2.linvel, vels2.angvel)
+                .prepend(parent2.pos_wrt_parent)
+        }
+        _ => NonlinearRigidMotion::constant_position(*target_pose),
+    };
 
     let hit = dispatcher
         .cast_shapes_nonlinear(
@@ -519,8 +624,18 @@ fn fallback_nonlinear_fraction(
     let fraction = hit.time_of_impact / dt;
     if is_pseudo {
         (fraction <= max_fraction).then_some(fraction)
+    } else if 0.0 < fraction && fraction < max_fraction {
+        // PATCH(physics-service): this cast stops at contact; back off to `CLAMP_SEPARATION`
+        // slops of separation along the relative motion (see `CLAMP_SEPARATION`).
+        let travel = (motion1.linvel - motion2.linvel).length() * dt;
+        let back = if travel > 0.0 {
+            CLAMP_SEPARATION * linear_slop / travel
+        } else {
+            0.0
+        };
+        Some((fraction - back).max(0.0))
     } else {
-        (0.0 < fraction && fraction < max_fraction).then_some(fraction)
+        None
     }
 }
 
@@ -545,6 +660,7 @@ pub(super) fn sweep_fast_body(
     colliders: &ColliderSet,
     end_body_pose: Pose,
     targets: CcdTargets,
+    movers: &[(RigidBodyHandle, Aabb)],
     dispatcher: &dyn QueryDispatcher,
     hooks: &dyn PhysicsHooks,
     dt: Real,
@@ -569,7 +685,8 @@ pub(super) fn sweep_fast_body(
         let local_com = parent1
             .pos_wrt_parent
             .inverse_transform_point(rb1.mprops.local_mprops.local_com);
-        let Some(fast) = FastColliderInfo::new(co1, rb1, &start, &end, local_com) else {
+        let Some(fast) = FastColliderInfo::new(co1, rb1, &start, &end, local_com, linear_slop)
+        else {
             // Never-swept shape (mesh, heightfield, polyline, voxels): no CCD.
             continue;
         };
@@ -629,16 +746,35 @@ pub(super) fn sweep_fast_body(
         };
 
         match targets {
-            CcdTargets::Lists { fixed, soft } => {
+            CcdTargets::Lists { fixed, soft, bvh } => {
                 for (ch2, aabb2) in fixed.iter().chain(soft.iter()) {
                     if aabb2.intersects(&swept_aabb) {
                         handle_candidate(*ch2, &colliders[*ch2]);
                     }
                 }
+                // PATCH(physics-service): the moving targets the tier rule admits (the lists
+                // hold the automatic ones).
+                for (ch2, co2) in intersect_swept_aabb(bvh, colliders, swept_aabb) {
+                    let rb2 = co2.parent.and_then(|p| bodies.get(p.handle));
+                    if !is_auto_target(rb2, co2) && !is_mover(rb2) {
+                        handle_candidate(ch2, co2);
+                    }
+                }
             }
             CcdTargets::FullBvh(bvh) => {
                 for (ch2, co2) in intersect_swept_aabb(bvh, colliders, swept_aabb) {
-                    handle_candidate(ch2, co2);
+                    let rb2 = co2.parent.and_then(|p| bodies.get(p.handle));
+                    if !is_mover(rb2) {
+                        handle_candidate(ch2, co2);
+                    }
+                }
+            }
+        }
+        // PATCH(physics-service): the other fast bodies, by their swept boxes.
+        for (h2, aabb2) in movers {
+            if *h2 != handle && aabb2.intersects(&swept_aabb) {
+                for ch2 in &bodies[*h2].colliders.0 {
+                    handle_candidate(*ch2, &colliders[*ch2]);
                 }
             }
         }
