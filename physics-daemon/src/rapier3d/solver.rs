@@ -40,8 +40,9 @@ const MAX_WORK_FACTOR: f32 = 2.5;
 const REFERENCE_DT: f32 = 1.0 / 60.0;
 /// Contact natural frequency as a fraction of the substep rate, once that exceeds the base.
 const SUBSTEPS_PER_CONTACT_PERIOD: f32 = 8.0;
-/// How far ahead soft CCD predicts contacts: 2 units, 120 units/s at 60 Hz. Faster bodies
-/// are CCD's (HitBoxQuality > 1 sweeps them).
+/// How far ahead soft CCD predicts contacts: 2 units, 120 units/s at 60 Hz. A body that moves
+/// farther in a step is swept by rapier's CCD against moving bodies too, whatever its
+/// HitBoxQuality (the vendored rapier's pair rule, vendor/rapier3d-0.36.1/PATCHED.md).
 const SOFT_CCD_REACH: f32 = 2.0;
 /// Internal PGS sweeps per substep when any object rotates freely (HitBoxQuality > 1).
 const FREE_ROTATION_PGS: usize = 4;
