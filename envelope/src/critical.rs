@@ -274,7 +274,8 @@ pub struct GoalResult {
 }
 
 fn crit<'a>(c: &'a [CriticalValue], probe: &str, s: Setting) -> Option<&'a CriticalValue> {
-    c.iter().find(|v| v.probe.starts_with(probe) && v.setting == s)
+    c.iter()
+        .find(|v| v.probe.starts_with(probe) && v.setting == s)
 }
 
 fn show(v: Option<&CriticalValue>) -> String {

@@ -363,8 +363,7 @@ pub fn fuzz(cfg: &FuzzConfig, mut progress: impl FnMut(usize, &Case, &[Violation
     let mut shrunk: BTreeMap<(&'static str, &'static str), usize> = BTreeMap::new();
     let mut i = 0usize;
     loop {
-        if cfg.cases.is_some_and(|n| i >= n) || cfg.time.is_some_and(|t| started.elapsed() >= t)
-        {
+        if cfg.cases.is_some_and(|n| i >= n) || cfg.time.is_some_and(|t| started.elapsed() >= t) {
             break;
         }
         let case = Case::draw(i, &mut rng, &cfg.space);
@@ -567,4 +566,40 @@ print("envelope repro: every oracle holds")
 /// A Luau `Vector.new(...)`.
 pub fn lv(v: [f64; 3]) -> String {
     format!("Vector.new({}, {}, {})", v[0], v[1], v[2])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_same_seed_draws_the_same_cases() {
+        let draw = |seed| {
+            let mut rng = Rng::new(seed);
+            (0..12)
+                .map(|i| Case::draw(i, &mut rng, &space::FULL))
+                .collect::<Vec<_>>()
+        };
+        assert_eq!(draw(7), draw(7));
+        assert_ne!(draw(7), draw(8));
+    }
+
+    #[test]
+    fn draws_stay_inside_their_ranges() {
+        let mut rng = Rng::new(3);
+        for _ in 0..1000 {
+            let v = rng.log_uniform(Span(0.05, 100.0));
+            assert!((0.05..=100.0).contains(&v), "{v}");
+            let q = rng.int_log(1, 32);
+            assert!((1..=32).contains(&q), "{q}");
+        }
+    }
+
+    #[test]
+    fn shrinking_steps_move_toward_the_simple_value() {
+        assert_eq!(toward(1000.0, 1.0), vec![1.0, 31.6]);
+        assert_eq!(toward(1.0, 1.0), Vec::<f64>::new());
+        assert_eq!(toward_int(20, 2), vec![2, 11]);
+        assert_eq!(round3(0.813_000_000_1), 0.813);
+    }
 }

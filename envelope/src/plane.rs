@@ -6,8 +6,8 @@
 use physics_daemon::backend::Backend;
 use physics_scenes::LocalPlane;
 use shm_layout::{
-    BodyState, Handle, JointKind, JointOp, JointProp, ObjectProp, PlaneOp, PlaneProp, Pose,
-    Reply, Shape,
+    BodyState, Handle, JointKind, JointOp, JointProp, ObjectProp, PlaneOp, PlaneProp, Pose, Reply,
+    Shape,
 };
 
 use crate::Setting;
@@ -71,9 +71,7 @@ impl Run {
 
     /// One tick; records non-finite bodies and folds the state hash.
     pub fn step(&mut self) -> BuildResult<()> {
-        self.plane
-            .step(self.dt)
-            .map_err(|e| format!("step: {e}"))?;
+        self.plane.step(self.dt).map_err(|e| format!("step: {e}"))?;
         self.ticks += 1;
         let header = self.plane.header();
         self.hash = (self.hash ^ header.state_hash).wrapping_mul(0x0100_0000_01b3);

@@ -145,7 +145,10 @@ pub fn run(args: &EnvelopeArgs) -> BenchResult<()> {
     eprintln!("envelope: wrote {} and {}", j.display(), m.display());
     if let Some(docs) = &args.docs {
         replace_section(docs, &section)?;
-        eprintln!("envelope: replaced the envelope section of {}", docs.display());
+        eprintln!(
+            "envelope: replaced the envelope section of {}",
+            docs.display()
+        );
     }
     Ok(())
 }
@@ -185,7 +188,9 @@ fn critical_cell(c: Option<&CriticalValue>) -> String {
         None => "—".into(),
         Some(c) => match (&c.first_failure, c.value) {
             (None, _) => format!("≥ {} (whole grid)", fig(c.value.unwrap_or(f64::NAN))),
-            (Some((f, o)), Some(v)) => format!("**{}** (fails at {}: {})", fig(v), fig(*f), o.join(", ")),
+            (Some((f, o)), Some(v)) => {
+                format!("**{}** (fails at {}: {})", fig(v), fig(*f), o.join(", "))
+            }
             (Some((f, o)), None) => format!("none (fails at {}: {})", fig(*f), o.join(", ")),
         },
     }
@@ -269,7 +274,11 @@ fn section(goals: &[Goal], crit: &[CriticalValue], fuzz: &FuzzReport, space: &st
     let mut t = Table::new(&["family", "cases", "failing", "by oracle", "wall s"]);
     for f in FAMILIES {
         if let Some(s) = fuzz.families.get(f) {
-            let by: Vec<String> = s.by_oracle.iter().map(|(o, n)| format!("{o} {n}")).collect();
+            let by: Vec<String> = s
+                .by_oracle
+                .iter()
+                .map(|(o, n)| format!("{o} {n}"))
+                .collect();
             t.row(&[
                 f.to_string(),
                 s.cases.to_string(),
@@ -303,4 +312,30 @@ fn section(goals: &[Goal], crit: &[CriticalValue], fuzz: &FuzzReport, space: &st
         }
     }
     md
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_section_is_replaced_in_place_or_appended() {
+        let dir = std::env::temp_dir().join(format!("envelope-docs-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("stability.md");
+        std::fs::write(&path, "# Stability\n\ntable\n").unwrap();
+        replace_section(&path, "first\n").unwrap();
+        let once = std::fs::read_to_string(&path).unwrap();
+        assert_eq!(
+            once,
+            format!("# Stability\n\ntable\n\n{BEGIN}\nfirst\n{END}\n")
+        );
+        std::fs::write(&path, once.replace("table", "new table") + "after\n").unwrap();
+        replace_section(&path, "second\n").unwrap();
+        assert_eq!(
+            std::fs::read_to_string(&path).unwrap(),
+            format!("# Stability\n\nnew table\n\n{BEGIN}\nsecond\n{END}\nafter\n")
+        );
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
 }

@@ -26,7 +26,11 @@ fn every_case_inside_the_documented_envelope_holds() {
     };
     let report = fuzz(&cfg, |i, case, v| {
         if !v.is_empty() {
-            eprintln!("case {i} ({}) fails {v:?}: {}", case.family(), case.describe());
+            eprintln!(
+                "case {i} ({}) fails {v:?}: {}",
+                case.family(),
+                case.describe()
+            );
         }
     });
     eprintln!(

@@ -1,6 +1,7 @@
-//! Chains: `links` spheres (radius 0.4 · `link`) `link` apart, the first pinned to the world
-//! at its centre, each next one joined to the one before by a `Ball` or `Hinge` (axis z)
-//! joint, the last link `ratio` times heavier. Start pose: hanging straight down, horizontal
+//! Chains: `links` spheres (radius 0.4 · `link`) `link` apart, each joined to the one
+//! before at the midpoint between them by a `Ball` or `Hinge` (axis z) joint, the first to
+//! the world half a link before it (the issue's chain: anchors ±0.5 at link 1), the last
+//! link `ratio` times heavier. Start pose: hanging straight down, horizontal
 //! along +x, or coiled (folded in the xy plane, rows of 5 links one link apart). Solver:
 //! what the plane chooses for a tree of such joints (an articulation), or impulse joints
 //! (every joint given a BreakForce of 1e12, which it never reaches). Default gravity and
@@ -15,7 +16,7 @@ use super::{draw_setting, plane_opts};
 use crate::plane::{BuildResult, Run};
 use crate::space::ChainRanges;
 use crate::{
-    at_most, finish, lv, luau_prelude, toward, toward_int, Outcome, Rng, Setting, LUAU_END,
+    at_most, finish, luau_prelude, lv, toward, toward_int, Outcome, Rng, Setting, LUAU_END,
 };
 
 /// Simulated seconds a chain runs.
@@ -72,7 +73,10 @@ impl Chain {
 
     /// Link centres; the world anchor is the first.
     pub fn positions(&self) -> Vec<[f64; 3]> {
-        let (l, y0) = (self.link, 20.0 * self.link.max(1.0) + self.links as f64 * self.link);
+        let (l, y0) = (
+            self.link,
+            20.0 * self.link.max(1.0) + self.links as f64 * self.link,
+        );
         (0..self.links as usize)
             .map(|i| match self.pose {
                 StartPose::Hanging => [0.0, y0 - i as f64 * l, 0.0],
@@ -84,6 +88,19 @@ impl Chain {
                 }
             })
             .collect()
+    }
+
+    /// The point link `i` is joined to: the link before, or for the first a point one link
+    /// back (above a hanging chain, behind a horizontal or coiled one).
+    fn before(&self, i: usize, pos: &[[f64; 3]]) -> [f64; 3] {
+        if i > 0 {
+            return pos[i - 1];
+        }
+        let p = pos[0];
+        match self.pose {
+            StartPose::Hanging => [p[0], p[1] + self.link, p[2]],
+            _ => [p[0] - self.link, p[1], p[2]],
+        }
     }
 
     fn kind_name(&self) -> &'static str {
@@ -110,15 +127,19 @@ impl Chain {
                     ObjectProp::Weight(w as f32),
                 ],
             )?;
+            let q = self.before(i, &pos);
+            let mid = [
+                (p[0] + q[0]) / 2.0,
+                (p[1] + q[1]) / 2.0,
+                (p[2] + q[2]) / 2.0,
+            ];
+            let anchor_a = [mid[0] - p[0], mid[1] - p[1], mid[2] - p[2]];
             let anchor_b = match prev {
-                None => *p,
-                Some(_) => {
-                    let q = pos[i - 1];
-                    [p[0] - q[0], p[1] - q[1], p[2] - q[2]]
-                }
+                None => mid,
+                Some(_) => [mid[0] - q[0], mid[1] - q[1], mid[2] - q[2]],
             };
             let mut props = vec![
-                JointProp::AnchorA([0.0; 3]),
+                JointProp::AnchorA(anchor_a.map(|v| v as f32)),
                 JointProp::AnchorB(anchor_b.map(|v| v as f32)),
             ];
             if self.kind == Kind::Hinge {
@@ -224,11 +245,13 @@ impl Chain {
         s += &format!(
             r#"local L, Q, RATIO, TOL = {link}, {q}, {ratio}, {tol}
 local at = {{ {list} }}
+local before = {before0}
 local links, joints = {{}}, {{}}
 for i, p in at do
 	links[i] = basic("Sphere", Vector.new(0.8 * L, 0.8 * L, 0.8 * L), CFrame.new(p.X, p.Y, p.Z), {{ {{ "HitBoxQuality", Q }}, {{ "Weight", if i == #at then RATIO else 1 }} }})
-	local anchorB = if i == 1 then p else p - at[i - 1]
-	joints[i] = world:NewJoint("{kind}", links[i], if i == 1 then nil else links[i - 1], {{ AnchorA = Vector.new(0, 0, 0), AnchorB = anchorB{extra} }})
+	local q = if i == 1 then before else at[i - 1]
+	local mid = (p + q) * 0.5
+	joints[i] = world:NewJoint("{kind}", links[i], if i == 1 then nil else links[i - 1], {{ AnchorA = mid - p, AnchorB = if i == 1 then mid else mid - q{extra} }})
 end
 local worst, nonFinite = 0, 0
 for _ = 1, {ticks} do
@@ -253,6 +276,7 @@ check("worst joint error", worst, TOL)
             ratio = self.ratio,
             tol = self.tol(),
             list = list.join(", "),
+            before0 = lv(self.before(0, &pos)),
             kind = self.kind_name(),
             ticks = (RUN_S * self.setting.tick_rate).round() as u64,
         );

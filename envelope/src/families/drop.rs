@@ -189,7 +189,12 @@ impl Drop {
             (p[0] * p[0] + p[2] * p[2]).sqrt(),
             self.tol_side(),
         );
-        at_most(&mut v, "rests", (p[1] - self.rest()).abs(), self.tol_height());
+        at_most(
+            &mut v,
+            "rests",
+            (p[1] - self.rest()).abs(),
+            self.tol_height(),
+        );
         Ok(finish(&run, v))
     }
 

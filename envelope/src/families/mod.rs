@@ -30,5 +30,8 @@ pub fn plane_opts(s: &Setting, extra: &str) -> String {
 /// Degrees between the body's up axis (`local_up` in its own frame) and world up.
 pub fn tilt_deg(rotation: [f32; 4], local_up: [f32; 3]) -> f64 {
     let up = crate::plane::rotate(rotation, local_up);
-    (up[1] / crate::plane::norm(up)).clamp(-1.0, 1.0).acos().to_degrees()
+    (up[1] / crate::plane::norm(up))
+        .clamp(-1.0, 1.0)
+        .acos()
+        .to_degrees()
 }

@@ -15,7 +15,9 @@ use shm_layout::{ObjectProp, Pose, Shape};
 use super::{draw_setting, plane_opts};
 use crate::plane::{BuildResult, Run};
 use crate::space::PileRanges;
-use crate::{at_most, finish, lv, luau_prelude, toward, toward_int, Outcome, Rng, Setting, LUAU_END};
+use crate::{
+    at_most, finish, luau_prelude, lv, toward, toward_int, Outcome, Rng, Setting, LUAU_END,
+};
 
 /// Simulated seconds a pile has to settle and sleep.
 pub const SETTLE_S: f32 = 8.0;
@@ -103,7 +105,11 @@ impl Pile {
             };
             parts.push(run.add(
                 shape,
-                Pose::at([(o[0] + p[0]) as f32, (o[1] + p[1]) as f32, (o[2] + p[2]) as f32]),
+                Pose::at([
+                    (o[0] + p[0]) as f32,
+                    (o[1] + p[1]) as f32,
+                    (o[2] + p[2]) as f32,
+                ]),
                 &[ObjectProp::HitBoxQuality(self.setting.quality)],
             )?);
         }
@@ -116,7 +122,10 @@ impl Pile {
                 .filter(|h| (run.state(**h).position[1] as f64) < floor_top)
                 .count();
         }
-        let awake = parts.iter().filter(|h| !run.state(**h).is_sleeping()).count();
+        let awake = parts
+            .iter()
+            .filter(|h| !run.state(**h).is_sleeping())
+            .count();
         let mut v = Vec::new();
         at_most(&mut v, "passes the floor", below as f64, 0.0);
         at_most(

@@ -6,8 +6,8 @@
 //! the run lasts twice its flight to the target's centre plus 0.5 s.
 //!
 //! Oracles: the swept check (`passes through`): between every two ticks the ball's centre,
-//! in the target's frame, must not cross the target's mid-plane within its face (nor end
-//! past it); the ball and target end with at most 1 % more kinetic energy than the ball
+//! in the target's frame, must not cross the target's mid-plane within its face's extent
+//! (where the centre would be inside the target), nor end there past it; the ball and target end with at most 1 % more kinetic energy than the ball
 //! brought (`no energy gain`); against a free body, the total momentum changes by at most
 //! 1 % of the ball's (`momentum`).
 
@@ -16,7 +16,7 @@ use shm_layout::{ObjectProp, PlaneProp, Pose, Shape};
 use super::{draw_setting, plane_opts};
 use crate::plane::{norm, sub, unrotate, BuildResult, Run};
 use crate::space::ProjectileRanges;
-use crate::{at_most, finish, lv, luau_prelude, toward, Outcome, Rng, Setting, LUAU_END};
+use crate::{at_most, finish, luau_prelude, lv, toward, Outcome, Rng, Setting, LUAU_END};
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
 pub enum Target {
@@ -115,12 +115,10 @@ impl Projectile {
         )?;
         let rel = |run: &Run| {
             let (b, tg) = (run.state(ball), run.state(target));
-            unrotate(
-                tg.rotation,
-                sub(b.position, tg.position).map(|v| v as f32),
-            )
+            unrotate(tg.rotation, sub(b.position, tg.position).map(|v| v as f32))
         };
-        let half = h as f64 / 2.0 + self.radius;
+        // The ball's centre inside the face's extent at the mid-plane: inside the target.
+        let half = h as f64 / 2.0;
         let mut crossings = 0usize;
         let mut prev = rel(&run);
         for _ in 0..ticks {
@@ -285,7 +283,7 @@ print(string.format("ball ends at (%.3f, %.3f, %.3f), velocity (%.1f, %.1f, %.1f
 check("non-finite ticks", nonFinite, 0)
 check("crossings through the target", crossings, 0)
 "#,
-            half = h / 2.0 + self.radius,
+            half = h / 2.0,
             t = self.thickness,
             h = h,
             qt = self.target_quality,

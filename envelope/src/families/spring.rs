@@ -133,10 +133,14 @@ impl Spring {
             let p = b.position.map(|c| c as f64);
             let v = b.linear_velocity.map(|c| c as f64);
             let stretch = match self.kind {
-                SpringKind::Spring => (p[0] * p[0] + (p[1] - 5.0).powi(2) + p[2] * p[2]).sqrt() - rest,
+                SpringKind::Spring => {
+                    (p[0] * p[0] + (p[1] - 5.0).powi(2) + p[2] * p[2]).sqrt() - rest
+                }
                 SpringKind::AxisSpring => p[0] - rest,
             };
-            energy.push(0.5 * m * (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]) + 0.5 * kk * stretch * stretch);
+            energy.push(
+                0.5 * m * (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]) + 0.5 * kk * stretch * stretch,
+            );
         }
         let averages: Vec<f64> = energy
             .chunks_exact(per)
