@@ -32,11 +32,115 @@ use shm_layout::joint_op::{JointKind, JointSettings};
 use super::Plane;
 
 /// Rotor inertia (rapier's per-coordinate "armature") of every joint coordinate, per unit
-/// of the tree's heaviest link mass (units²). Without it rapier's articulation integration
-/// lets light links whipping under a heavy one gain energy: the 1,000:1 chain of point-like
-/// links diverged after 2.9 s at 60 Hz (armature 0.01 still did, 0.1 held for 15 s). It
-/// lengthens a unit-mass pendulum of length 2 by 0.001 %.
+/// of the tree's heaviest link mass (units²): the least each coordinate gets (see
+/// [`set_armature`] for what a loaded joint gets on top). Without it rapier's articulation
+/// integration lets light links whipping under a heavy one gain energy: the 1,000:1 chain
+/// of point-like links diverged after 2.9 s at 60 Hz (armature 0.01 still did, 0.1 held
+/// for 15 s). It lengthens a unit-mass pendulum of length 2 by 0.001 %.
 const ARMATURE_PER_MASS: f32 = 1.0e-4;
+
+/// Rapier damps every free rotation of an articulation by 0.1 N·m·s/rad (its
+/// `default_damping`): an undamped hinge spring of k = 50 on a 2 kg ball lost all its
+/// energy in 10 s. The coordinates of joints with a spring (a force-based motor with a
+/// stiffness) lose that damping; a spring's damping is its `Damping`.
+pub(super) fn undamp_springs(mb: &mut Multibody) {
+    let spans: Vec<(usize, usize)> = mb
+        .links()
+        .filter(|l| {
+            l.joint()
+                .data
+                .motors
+                .iter()
+                .any(|m| m.model == MotorModel::ForceBased && m.stiffness > 0.0)
+        })
+        .map(|l| (l.assembly_id(), l.joint().ndofs()))
+        .collect();
+    let damping = mb.damping_mut();
+    for (at, n) in spans {
+        for k in at..(at + n).min(damping.len()) {
+            damping[k] = 0.0;
+        }
+    }
+}
+
+/// Sets each joint coordinate's armature for a step of substeps `dt_sub` under gravity `g`.
+///
+/// Rapier integrates an articulation semi-implicitly (symplectic Euler per substep): the
+/// inertia is implicit, but the forces the links pass along are explicit in the joint
+/// coordinates. A link pulled by a tension `T` at a lever `ℓ` from its joint is a spring of
+/// stiffness `T·ℓ` on its joint's rotation, stable only while `ω·dt_sub < 2`, `ω² = T·ℓ / I`
+/// (`I` the rotation's inertia). A light link holding a heavy one breaks that: the
+/// 20-link chain with a 1,000× end released from horizontal at 60 Hz carries
+/// `T ≈ 3·m·g ≈ 1.5·10⁵` on links of `I ≈ 0.4`, `ω·dt_sub ≈ 2.5`; its energy grew
+/// 10⁸-fold within a second after the first swing and its positions went NaN. Each
+/// coordinate gets the armature that makes `ω·dt_sub ≤ √2` (a factor 2 on `ω²` below the
+/// limit): `a = ½·T·ℓ·dt_sub² − I`, with `T` the larger of `3·g·M` (`M` the mass the joint
+/// holds: the tension of a pendulum swinging from horizontal) and the force it carried
+/// the step before (`loads`, keyed by the child body), `ℓ` the child link's farthest load
+/// point (its centre of mass, its children's joints) from the joint, `I` the child's own
+/// inertia about the joint (its least principal one plus `m·r²`), and at least
+/// `ARMATURE_PER_MASS · heaviest`. Unloaded and evenly loaded chains get (almost) only
+/// that least armature; what the step pays is one pass over the links.
+fn set_armature(
+    mb: &mut Multibody,
+    bodies: &RigidBodySet,
+    heaviest: f32,
+    g: f32,
+    dt_sub: f32,
+    loads: &std::collections::HashMap<RigidBodyHandle, f32>,
+) {
+    let n = mb.num_links();
+    let mut held = vec![0.0f32; n];
+    let mut lever = vec![0.0f32; n];
+    let mut own = vec![0.0f32; n];
+    let anchor = |l: &MultibodyLink| l.joint().data.local_frame2.translation;
+    for (i, l) in mb.links().enumerate() {
+        let Some(rb) = bodies.get(l.rigid_body_handle()).filter(|b| b.is_dynamic()) else {
+            continue;
+        };
+        let mp = rb.mass_properties().local_mprops;
+        let r = (mp.local_com - anchor(l)).length();
+        held[i] = rb.mass();
+        lever[i] = r;
+        own[i] = mp.principal_inertia().min_element() + rb.mass() * r * r;
+    }
+    // Children after their parents: the mass each joint holds, and each link's lever to its
+    // children's joints.
+    let links: Vec<(Option<usize>, Vector)> = mb
+        .links()
+        .map(|l| (l.parent_id(), l.joint().data.local_frame1.translation))
+        .collect();
+    for i in (0..n).rev() {
+        if let Some(p) = links[i].0 {
+            held[p] += held[i];
+            let parent_anchor = mb.link(p).map(anchor).unwrap_or(Vector::ZERO);
+            lever[p] = lever[p].max((links[i].1 - parent_anchor).length());
+        }
+    }
+    let least = ARMATURE_PER_MASS * heaviest;
+    let spans: Vec<(usize, usize, f32)> = mb
+        .links()
+        .enumerate()
+        .filter(|(_, l)| !l.is_root())
+        .map(|(i, l)| {
+            let tension =
+                (3.0 * g * held[i]).max(loads.get(&l.rigid_body_handle()).copied().unwrap_or(0.0));
+            let need = 0.5 * tension * lever[i] * dt_sub * dt_sub - own[i];
+            let a = if need.is_finite() {
+                need.max(least)
+            } else {
+                least
+            };
+            (l.assembly_id(), l.joint().ndofs(), a)
+        })
+        .collect();
+    let armature = mb.armature_mut();
+    for (at, n, a) in spans {
+        for k in at..(at + n).min(armature.len()) {
+            armature[k] = a;
+        }
+    }
+}
 
 /// The fastest a joint of an articulation turns (rad/s, relative to its parent), as PhysX's
 /// articulations' default `maxJointVelocity` (100): rapier integrates a joint's rotation
@@ -354,6 +458,7 @@ impl Plane {
                     .map(|b| b.mass())
                     .fold(0.0f32, f32::max);
                 mb.armature_mut().fill(ARMATURE_PER_MASS * heaviest);
+                undamp_springs(mb);
                 coordinates_from_bodies(mb, &self.world.bodies);
                 // Velocities from the bodies' (zero at first).
                 let dv: Vec<(Vector, Vector)> = mb
@@ -382,9 +487,39 @@ impl Plane {
         handles
     }
 
+    /// Before a step: every joint coordinate's armature for this step's substeps (see
+    /// [`set_armature`]).
+    fn size_armatures(&mut self) {
+        let loads = self.articulated_loads();
+        let p = &self.world.integration_parameters;
+        let dt_sub = p.dt / p.num_solver_iterations.max(1) as f32;
+        let g = self.world.gravity.length();
+        for t in &self.joints.articulations.trees {
+            let heaviest = t
+                .links
+                .iter()
+                .filter_map(|(b, ..)| self.world.bodies.get(*b))
+                .map(|b| b.mass())
+                .fold(0.0f32, f32::max);
+            let Some(link) = self.world.multibody_joints.rigid_body_link(t.root).copied() else {
+                continue;
+            };
+            if let Some(mb) = self
+                .world
+                .multibody_joints
+                .get_multibody_mut(link.multibody)
+            {
+                set_armature(mb, &self.world.bodies, heaviest, g, dt_sub, &loads);
+            }
+        }
+    }
+
     /// Before a step: writes to articulated bodies since the last step (poses, velocities)
     /// are taken into their articulations, and private roots follow their fixed ends.
     pub(super) fn articulations_before_step(&mut self) {
+        if !self.joints.articulations.trees.is_empty() {
+            self.size_armatures();
+        }
         for t in &self.joints.articulations.trees {
             if let Some(f) = t.fixed_end {
                 if let Some(pose) = self.world.bodies.get(f).map(|b| *b.position()) {

@@ -141,6 +141,23 @@ impl Plane {
             .collect()
     }
 
+    /// The force each articulated joint carried over the last step, keyed by its child body
+    /// (what `articulations::set_armature` sizes a joint's armature for).
+    pub(super) fn articulated_loads(&self) -> std::collections::HashMap<RigidBodyHandle, f32> {
+        (0..self.joints.table.slot_count())
+            .filter_map(|i| {
+                let j = self.joints.table.at(i)?;
+                let link = j.link?;
+                let child = if link.0 == j.body_a.0 {
+                    j.body_a
+                } else {
+                    j.body_b
+                };
+                Some((child, j.force))
+            })
+            .collect()
+    }
+
     /// Forgets every joint's articulation (the trees were torn down): companions go, and
     /// each joint is looked at again before the next step.
     pub(super) fn forget_articulated(&mut self) {
@@ -412,7 +429,14 @@ impl Plane {
         let j = self.joints.table.get_mut(handle)?;
         j.settings = settings;
         j.dirty = true;
+        let ends = [Some(j.a), j.b];
         self.joints.articulations.dirty |= structural;
+        // A joint write wakes both ends, as an object write does: a sleeping door at its
+        // limit must feel a new motor or limit (rapier wakes a body's whole island, an
+        // articulation's links with it, at the next step).
+        for object in ends.into_iter().flatten() {
+            self.wake(object)?;
+        }
         Ok(())
     }
 
@@ -650,6 +674,7 @@ impl Plane {
             if let Some(l) = mb.link_mut(id) {
                 l.joint.data = articulations::multibody_data(data, three, flip);
             }
+            articulations::undamp_springs(mb);
         }
         if let Some(l) = limit {
             if let Some(ij) = self.world.impulse_joints.get_mut(l, true) {

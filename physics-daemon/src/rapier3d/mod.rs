@@ -32,6 +32,8 @@ mod capsule_contact;
 #[cfg(test)]
 mod ccd_tests;
 mod contact_points;
+#[cfg(test)]
+mod joint_edge_tests;
 mod joints;
 mod limits;
 mod map_store;

@@ -245,6 +245,14 @@ impl JointMotor {
             target_pos: self.target_pos,
             target_vel: self.target_vel,
             max_impulse: Self::max_impulse(self.max_force, dt),
+            // PATCH(physics-service): see `MotorParameters::spring_stiffness`.
+            spring_stiffness: if self.model == MotorModel::ForceBased {
+                self.stiffness
+            } else {
+                0.0
+            },
+            spring_damping: self.damping,
+            dt,
         }
     }
 

@@ -182,6 +182,30 @@ pub fn unit_joint_motor_constraint(
 
     rhs_wo_bias += -target_vel;
 
+    // PATCH(physics-service): a force-based spring the step resolves is integrated
+    // explicitly (symplectic Euler: an undamped spring keeps its energy), with an implicit
+    // damper; see `JointConstraint::explicit_spring`, whose rule this is with `lhs` the
+    // coordinate's inverse effective mass.
+    let mut impulse_bounds = impulse_bounds;
+    let mut cfm_gain = cfm_gain;
+    let (k, c, dt) = (
+        motor_params.spring_stiffness,
+        motor_params.spring_damping,
+        motor_params.dt,
+    );
+    if k > 0.0 && dt * dt * k * lhs <= 1.0 {
+        let err = curr_pos - motor_params.target_pos;
+        if c > 0.0 {
+            rhs_wo_bias = err * k / c - target_vel;
+            cfm_gain = crate::utils::inv(c * dt);
+        } else {
+            let spring = (dt * k * err).max(impulse_bounds[0]).min(impulse_bounds[1]);
+            rhs_wo_bias = 0.0;
+            cfm_gain = 0.0;
+            impulse_bounds = [spring, spring];
+        }
+    }
+
     let constraint = GenericJointConstraint {
         is_rigid_body1: false,
         solver_vel1: u32::MAX,

@@ -446,6 +446,10 @@ impl JointConstraintBuilderSimd {
                 } else {
                     self.motor_max_force * dt
                 },
+                // PATCH(physics-service): 2D wide rows keep the implicit spring.
+                spring_stiffness: zero,
+                spring_damping: zero,
+                dt,
             }
         });
         #[cfg(feature = "dim3")]

@@ -327,6 +327,9 @@ impl<N: ScalarType> JointConstraintHelper<N> {
         constraint.impulse_bounds = [-motor_params.max_impulse, motor_params.max_impulse];
         constraint.rhs = rhs_wo_bias;
         constraint.rhs_wo_bias = rhs_wo_bias;
+        // PATCH(physics-service): an undamped spring keeps its energy.
+        let dist = self.lin_err.gdot(constraint.lin_jac);
+        constraint.explicit_spring(motor_params, dist - motor_params.target_pos, target_vel);
         constraint
     }
 
@@ -386,7 +389,7 @@ impl<N: ScalarType> JointConstraintHelper<N> {
         let ii_ang_jac1 = body1.ii.transform_vector(ang_jac1);
         let ii_ang_jac2 = body2.ii.transform_vector(ang_jac2);
 
-        JointConstraint {
+        let mut constraint = JointConstraint {
             joint_id,
             solver_vel1: body1.solver_vel,
             solver_vel2: body2.solver_vel,
@@ -405,7 +408,10 @@ impl<N: ScalarType> JointConstraintHelper<N> {
             rhs: rhs_wo_bias,
             rhs_wo_bias,
             writeback_id,
-        }
+        };
+        // PATCH(physics-service): an undamped spring keeps its energy.
+        constraint.explicit_spring(motor_params, dist - motor_params.target_pos, target_vel);
+        constraint
     }
 
     pub fn lock_linear<const LANES: usize>(
@@ -578,6 +584,7 @@ impl<N: ScalarType> JointConstraintHelper<N> {
         let ang_jac = self.basis.column(_motor_axis).into();
 
         let mut rhs_wo_bias = N::zero();
+        let mut spring_err = N::zero();
         if motor_params.erp_inv_dt != N::zero() {
             let ang_dist;
 
@@ -594,8 +601,8 @@ impl<N: ScalarType> JointConstraintHelper<N> {
             }
 
             let target_ang = motor_params.target_pos;
-            rhs_wo_bias += utils::smallest_abs_diff_between_angles(ang_dist, target_ang)
-                * motor_params.erp_inv_dt;
+            spring_err = utils::smallest_abs_diff_between_angles(ang_dist, target_ang);
+            rhs_wo_bias += spring_err * motor_params.erp_inv_dt;
         }
 
         rhs_wo_bias += -motor_params.target_vel;
@@ -603,7 +610,7 @@ impl<N: ScalarType> JointConstraintHelper<N> {
         let ii_ang_jac1 = body1.ii.transform_vector(ang_jac);
         let ii_ang_jac2 = body2.ii.transform_vector(ang_jac);
 
-        JointConstraint {
+        let mut constraint = JointConstraint {
             joint_id,
             solver_vel1: body1.solver_vel,
             solver_vel2: body2.solver_vel,
@@ -622,7 +629,10 @@ impl<N: ScalarType> JointConstraintHelper<N> {
             rhs: rhs_wo_bias,
             rhs_wo_bias,
             writeback_id,
-        }
+        };
+        // PATCH(physics-service): an undamped spring keeps its energy.
+        constraint.explicit_spring(motor_params, spring_err, motor_params.target_vel);
+        constraint
     }
 
     pub fn lock_angular<const LANES: usize>(
