@@ -49,6 +49,8 @@ mod queries;
 mod rollback;
 mod snapshot;
 mod solver;
+#[cfg(test)]
+mod stack_tests;
 mod thin;
 #[cfg(test)]
 mod unstepped;
