@@ -75,16 +75,16 @@ pub use shm_layout::{
     AxisMode, BodyState, CollisionGroups, CommandError, ControllerInfo, ControllerProp,
     ControllerSettings, ErrorKind, EventRecord, FilterType, GuiControllerProp, GuiHit,
     GuiObjectProp, GuiPlaneProp, GuiShape, Handle, Hit, JointInfo, JointKind, JointProp,
-    JointSettings, MapReport, ObjectInfo, ObjectOp, ObjectProp, ObjectSettings, Pin, PlaneId,
-    PlaneInfo, PlaneKind, PlaneOp, PlaneProp, PlaneSettings, Pose, Ray, Restraint, RotateTo, Shape,
-    ShapeKind, StateHasher, TickHeader, Vec2, Vec3, EVENT_CONTROLLER_JUMPED,
+    JointSettings, MapReport, ObjectInfo, ObjectOp, ObjectProp, ObjectSettings, OptionalJointProp,
+    Pin, PlaneId, PlaneInfo, PlaneKind, PlaneOp, PlaneProp, PlaneSettings, Pose, Ray, Restraint,
+    RotateTo, Shape, ShapeKind, StateHasher, TickHeader, Vec2, Vec3, EVENT_CONTROLLER_JUMPED,
     EVENT_CONTROLLER_LANDED, EVENT_CONTROLLER_MOVED, EVENT_PATH_FINISHED, EVENT_WAYPOINT_REACHED,
     FLAG_ON_GROUND,
 };
 pub use shm_layout::{AxisMotor, ContactInfo, ContactPoint, MAX_CONTACT_POINTS};
 pub use shm_layout::{NamedPlane, PlaneName};
-pub use transport::quiet_transport_logs;
 pub use spawn::{
     connect_or_start, daemon_executable, interrupt_child, sibling_executable, start_daemon,
     start_daemon_with, DaemonChild, Session,
 };
+pub use transport::quiet_transport_logs;

@@ -8,9 +8,9 @@
 use shm_layout::{
     AxisMode, CollisionGroups, Command, ControllerOp, ControllerProp, FilterType, GuiControllerOp,
     GuiControllerProp, GuiObjectOp, GuiObjectProp, GuiOp, GuiPlaneProp, GuiShape, Handle,
-    JointKind, JointOp, JointProp, MapOp, ObjectOp, ObjectProp, Pin, PlaneId, PlaneKind, PlaneOp,
-    PlaneProp, Pose, QueryFilter, QueryOp, Ray, Restraint, RotateTo, Shape, TransferOp, Vec3,
-    CRATE_VERSION,
+    JointKind, JointOp, JointProp, MapOp, ObjectOp, ObjectProp, OptionalJointProp, Pin, PlaneId,
+    PlaneKind, PlaneOp, PlaneProp, Pose, QueryFilter, QueryOp, Ray, Restraint, RotateTo, Shape,
+    TransferOp, Vec3, CRATE_VERSION,
 };
 
 use super::rng::Rng;
@@ -700,7 +700,7 @@ impl<'a> Gen<'a> {
         let angle = f(self.rng, 1.5);
         let dist = f(self.rng, 3.0);
         let v = self.rng.vec3(wild, 2.0);
-        match self.rng.below(18) {
+        match self.rng.below(19) {
             0 => JointProp::AnchorA(v),
             1 => JointProp::AnchorB(v),
             2 => JointProp::Axis(v),
@@ -721,6 +721,7 @@ impl<'a> Gen<'a> {
                 JointProp::Axes(std::array::from_fn(|_| *self.rng.pick(&modes)))
             }
             16 => JointProp::BreakForce(f(self.rng, 500.0).abs()),
+            17 => JointProp::Unset(*self.rng.pick(&OptionalJointProp::ALL)),
             _ => JointProp::CollideConnected(self.rng.chance(0.5)),
         }
     }

@@ -153,6 +153,63 @@ pub enum JointProp {
         /// The motor, or None for none.
         motor: Option<AxisMotor>,
     },
+    /// Removes an optional limit or motor (Luau `joint.LowerAngle = nil`).
+    Unset(OptionalJointProp),
+}
+
+/// The joint options that may be absent (no limit, no motor): what [`JointProp::Unset`]
+/// removes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum OptionalJointProp {
+    /// `LowerAngle` (see [`JointProp::LowerAngle`]).
+    LowerAngle,
+    /// `UpperAngle` (see [`JointProp::UpperAngle`]).
+    UpperAngle,
+    /// `SwingLimit` (see [`JointProp::SwingLimit`]).
+    SwingLimit,
+    /// `TwistLimit` (see [`JointProp::TwistLimit`]).
+    TwistLimit,
+    /// `LowerDistance` (see [`JointProp::LowerDistance`]).
+    LowerDistance,
+    /// `UpperDistance` (see [`JointProp::UpperDistance`]).
+    UpperDistance,
+    /// `MotorSpeed` (see [`JointProp::MotorSpeed`]).
+    MotorSpeed,
+    /// `MotorTarget` (see [`JointProp::MotorTarget`]).
+    MotorTarget,
+}
+
+impl OptionalJointProp {
+    /// Every optional option, in declaration order.
+    pub const ALL: [OptionalJointProp; 8] = [
+        OptionalJointProp::LowerAngle,
+        OptionalJointProp::UpperAngle,
+        OptionalJointProp::SwingLimit,
+        OptionalJointProp::TwistLimit,
+        OptionalJointProp::LowerDistance,
+        OptionalJointProp::UpperDistance,
+        OptionalJointProp::MotorSpeed,
+        OptionalJointProp::MotorTarget,
+    ];
+
+    /// The API name of the option.
+    pub fn name(self) -> &'static str {
+        match self {
+            OptionalJointProp::LowerAngle => "LowerAngle",
+            OptionalJointProp::UpperAngle => "UpperAngle",
+            OptionalJointProp::SwingLimit => "SwingLimit",
+            OptionalJointProp::TwistLimit => "TwistLimit",
+            OptionalJointProp::LowerDistance => "LowerDistance",
+            OptionalJointProp::UpperDistance => "UpperDistance",
+            OptionalJointProp::MotorSpeed => "MotorSpeed",
+            OptionalJointProp::MotorTarget => "MotorTarget",
+        }
+    }
+
+    /// The optional option called `name`, if `name` is one.
+    pub fn from_name(name: &str) -> Option<OptionalJointProp> {
+        Self::ALL.into_iter().find(|o| o.name() == name)
+    }
 }
 
 impl JointProp {
@@ -178,6 +235,7 @@ impl JointProp {
             JointProp::BreakForce(_) => "BreakForce",
             JointProp::CollideConnected(_) => "CollideConnected",
             JointProp::AxisMotor { .. } => "AxisMotor",
+            JointProp::Unset(o) => o.name(),
         }
     }
 
@@ -278,7 +336,7 @@ impl JointProp {
             JointProp::MotorTarget(v) => JointProp::MotorTarget(distance(v)?),
             JointProp::MotorMaxForce(v) => JointProp::MotorMaxForce(amount(v)?),
             JointProp::BreakForce(v) => JointProp::BreakForce(amount(v)?),
-            p @ (JointProp::Axes(_) | JointProp::CollideConnected(_)) => p,
+            p @ (JointProp::Axes(_) | JointProp::CollideConnected(_) | JointProp::Unset(_)) => p,
             JointProp::AxisMotor { axis, motor } => JointProp::AxisMotor {
                 axis,
                 motor: match motor {
@@ -386,6 +444,18 @@ impl JointSettings {
                 if let Some(slot) = self.axis_motors.get_mut(axis as usize) {
                     *slot = motor;
                 }
+            }
+            JointProp::Unset(o) => {
+                *match o {
+                    OptionalJointProp::LowerAngle => &mut self.lower_angle,
+                    OptionalJointProp::UpperAngle => &mut self.upper_angle,
+                    OptionalJointProp::SwingLimit => &mut self.swing_limit,
+                    OptionalJointProp::TwistLimit => &mut self.twist_limit,
+                    OptionalJointProp::LowerDistance => &mut self.lower_distance,
+                    OptionalJointProp::UpperDistance => &mut self.upper_distance,
+                    OptionalJointProp::MotorSpeed => &mut self.motor_speed,
+                    OptionalJointProp::MotorTarget => &mut self.motor_target,
+                } = None
             }
         }
     }
@@ -599,6 +669,35 @@ mod tests {
         for k in JointKind::ALL {
             assert_eq!(JointKind::from_name(k.name()), Some(k));
         }
+    }
+
+    #[test]
+    fn unset_removes_each_optional_limit_and_motor() {
+        let mut s = JointSettings::default();
+        for (o, v) in OptionalJointProp::ALL.into_iter().zip(1..) {
+            let v = v as f32 * 0.1;
+            let set = match o {
+                OptionalJointProp::LowerAngle => JointProp::LowerAngle(-v),
+                OptionalJointProp::UpperAngle => JointProp::UpperAngle(v),
+                OptionalJointProp::SwingLimit => JointProp::SwingLimit(v),
+                OptionalJointProp::TwistLimit => JointProp::TwistLimit(v),
+                OptionalJointProp::LowerDistance => JointProp::LowerDistance(-v),
+                OptionalJointProp::UpperDistance => JointProp::UpperDistance(v),
+                OptionalJointProp::MotorSpeed => JointProp::MotorSpeed(v),
+                OptionalJointProp::MotorTarget => JointProp::MotorTarget(v),
+            };
+            assert_eq!(set.name(), o.name());
+            assert_eq!(OptionalJointProp::from_name(o.name()), Some(o));
+            s.store(set.checked().unwrap());
+        }
+        assert_ne!(s, JointSettings::default());
+        for o in OptionalJointProp::ALL {
+            let unset = JointProp::Unset(o).checked().unwrap();
+            assert_eq!(unset.name(), o.name());
+            s.store(unset);
+        }
+        assert_eq!(s, JointSettings::default());
+        assert_eq!(OptionalJointProp::from_name("AnchorA"), None);
     }
 
     #[test]

@@ -52,7 +52,9 @@ pub use contact_points::{ContactInfo, ContactPoint, MAX_CONTACT_POINTS};
 pub use controller_op::{ControllerInfo, ControllerOp};
 pub use error::{CommandError, ErrorKind};
 pub use gui_op::{GuiControllerOp, GuiControllerProp, GuiHit, GuiObjectOp, GuiOp, GuiReply};
-pub use joint_op::{AxisMode, JointInfo, JointKind, JointOp, JointProp, JointSettings};
+pub use joint_op::{
+    AxisMode, JointInfo, JointKind, JointOp, JointProp, JointSettings, OptionalJointProp,
+};
 pub use map_op::{MapInfo, MapOp, MapReport};
 pub use object_op::ObjectOp;
 pub use object_op_of::ObjectOpOf;

@@ -143,3 +143,14 @@ fn an_ordinary_run_prints_nothing_on_stderr() {
         );
     }
 }
+
+#[test]
+fn nil_removes_joint_limits_and_motors() {
+    let daemon = TestDaemon::start("trust-unset");
+    let (out, _) = run(
+        &daemon,
+        "tests/lua/joint_unset.luau",
+        Duration::from_secs(30),
+    );
+    assert!(stdout(&out).contains("joint unset ok"), "{}", stdout(&out));
+}

@@ -39,6 +39,10 @@ const OPTIONS: [&str; 18] = [
 
 /// One option from its name and Lua value; errors name the option and the value.
 fn joint_prop(name: &str, value: &Value) -> mlua::Result<JointProp> {
+    // nil removes a limit or motor (its type is `number?`).
+    if let (Value::Nil, Some(o)) = (value, client_sdk::OptionalJointProp::from_name(name)) {
+        return Ok(JointProp::Unset(o));
+    }
     let what = format!("Joint.{name}");
     let num = || finite_number(&what, value).map(|v| v as f32);
     let vec = || finite_vector(&what, value);
