@@ -141,10 +141,7 @@ fn box_case(r: f32, speed: f32, q_ball: u32, q_box: u32, depth: f32, weight: f32
                 size: [depth, 2.0, 2.0],
             },
             Pose::at([half, 0.0, 0.0]),
-            &[
-                ObjectProp::HitBoxQuality(q_box),
-                ObjectProp::Weight(weight),
-            ],
+            &[ObjectProp::HitBoxQuality(q_box), ObjectProp::Weight(weight)],
         )
         .unwrap();
     let h = ball(&mut p, r, -r - gap, speed, q_ball);

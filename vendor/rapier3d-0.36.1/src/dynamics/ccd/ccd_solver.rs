@@ -1,5 +1,8 @@
 use crate::alloc_prelude::*;
-use crate::dynamics::{IntegrationParameters, IslandManager, RigidBodySet, SoftBodySet};
+use crate::dynamics::{
+    ImpulseJointSet, IntegrationParameters, IslandManager, MultibodyJointSet, RigidBodySet,
+    SoftBodySet,
+};
 use crate::geometry::{
     BroadPhaseBvh, Collider, ColliderHandle, ColliderSet, CollisionEvent, NarrowPhase,
 };
@@ -10,7 +13,7 @@ use crate::prelude::{ActiveEvents, CollisionEventFlags};
 use parry::query::sweep_toi::Sweep;
 
 use super::sweeps::{
-    BodyContinuousResult, CcdTargets, PseudoHitMode, collect_fixed_targets, collect_movers,
+    BodyContinuousResult, CcdJoints, CcdTargets, PseudoHitMode, collect_fixed_targets, collect_movers,
     collect_soft_targets, is_bullet, map_bodies_parallel, sweep_fast_body,
 };
 
@@ -117,8 +120,14 @@ impl CCDSolver {
         colliders: &ColliderSet,
         broad_phase: &mut BroadPhaseBvh,
         narrow_phase: &NarrowPhase,
+        impulse_joints: &ImpulseJointSet,
+        multibody_joints: &MultibodyJointSet,
         hooks: &dyn PhysicsHooks,
     ) -> Option<Real> {
+        let joints = CcdJoints {
+            impulse: impulse_joints,
+            multibody: multibody_joints,
+        };
         // NOTE: broad-phase AABBs are NOT enlarged to the swept volumes: only the fast body's
         // query box is swept (per collider, below); targets keep their regular fat AABBs.
         // Swept AABBs written into the tree would leak into the next step (pair explosion).
@@ -152,6 +161,7 @@ impl CCDSolver {
                 predicted_body_pos,
                 CcdTargets::FullBvh(bvh),
                 &movers,
+                joints,
                 dispatcher,
                 hooks,
                 dt,
@@ -183,9 +193,15 @@ impl CCDSolver {
         soft_bodies: &SoftBodySet,
         broad_phase: &mut BroadPhaseBvh,
         narrow_phase: &NarrowPhase,
+        impulse_joints: &ImpulseJointSet,
+        multibody_joints: &MultibodyJointSet,
         hooks: &dyn PhysicsHooks,
         events: &dyn EventHandler,
     ) {
+        let joints = CcdJoints {
+            impulse: impulse_joints,
+            multibody: multibody_joints,
+        };
         let dt = params.dt;
         let linear_slop = params.allowed_linear_error();
 
@@ -247,6 +263,7 @@ impl CCDSolver {
                     bodies[handle].pos.next_position,
                     targets,
                     &movers,
+                    joints,
                     dispatcher,
                     hooks,
                     dt,
@@ -279,6 +296,7 @@ impl CCDSolver {
                         bodies[handle].pos.next_position,
                         CcdTargets::FullBvh(bvh),
                         &movers,
+                        joints,
                         dispatcher,
                         hooks,
                         dt,

@@ -3,7 +3,9 @@
 //! and the per-body continuous solve.
 
 use crate::alloc_prelude::*;
-use crate::dynamics::{RigidBody, RigidBodyHandle, RigidBodySet, SoftBodySet};
+use crate::dynamics::{
+    ImpulseJointSet, MultibodyJointSet, RigidBody, RigidBodyHandle, RigidBodySet, SoftBodySet,
+};
 use crate::geometry::{Collider, ColliderHandle, ColliderSet};
 use crate::math::{Pose, Real, Vector};
 use crate::parry::bounding_volume::Aabb;
@@ -48,6 +50,49 @@ fn tier_allows(rb1: &RigidBody, rb2: Option<&RigidBody>, co2: &Collider) -> bool
         return true;
     }
     outruns_soft_ccd(rb1)
+}
+
+// PATCH(physics-service): jointed bodies that do not collide are not swept either.
+/// The joint sets, for the rule the narrow phase applies: no contacts between two bodies
+/// joined with contacts disabled, nor inside a multibody without self-contacts.
+#[derive(Copy, Clone)]
+pub struct CcdJoints<'a> {
+    /// The impulse joints.
+    pub impulse: &'a ImpulseJointSet,
+    /// The multibody joints.
+    pub multibody: &'a MultibodyJointSet,
+}
+
+impl CcdJoints<'_> {
+    /// Whether the narrow phase makes no contacts between `b1` and `b2` for their joints.
+    fn contacts_disabled(&self, b1: RigidBodyHandle, b2: RigidBodyHandle) -> bool {
+        if self
+            .impulse
+            .joints_between(b1, b2)
+            .any(|(_, j)| !j.data.contacts_enabled)
+        {
+            return true;
+        }
+        let (Some(l1), Some(l2)) = (
+            self.multibody.rigid_body_link(b1),
+            self.multibody.rigid_body_link(b2),
+        ) else {
+            return false;
+        };
+        if l1.multibody != l2.multibody {
+            return false;
+        }
+        if self
+            .multibody
+            .get_multibody(l1.multibody)
+            .is_some_and(|mb| !mb.self_contacts_enabled())
+        {
+            return true;
+        }
+        self.multibody
+            .joint_between(b1, b2)
+            .is_some_and(|(_, _, link)| !link.joint.data.contacts_enabled)
+    }
 }
 
 /// Whether the centre of mass of `rb` moves farther this step than its soft-CCD prediction.
@@ -162,19 +207,23 @@ fn intersect_swept_aabb<'a>(
 }
 
 // PATCH(physics-service): the fast bodies, for each other's sweeps.
-/// The swept box (start and end poses of all its colliders) of every fast body of the pass.
-/// A fast target's broad-phase box holds where it started, not the path it sweeps this step, so
-/// fast bodies find each other here rather than in the BVH: two bodies crossing each other's
-/// path within a step are in neither's box at the other's start.
+/// The swept box (start and end poses of all its colliders) of every fast body of the pass,
+/// its start and end boxes and the displacement of its centre of mass. A fast
+/// target's broad-phase box holds where it started, not the path it sweeps this step, so fast
+/// bodies find each other here rather than in the BVH: two bodies crossing each other's path
+/// within a step are in neither's box at the other's start.
+pub(super) type Mover = (RigidBodyHandle, Aabb, Aabb, Aabb, Vector);
+
+/// See [`Mover`].
 pub(super) fn collect_movers(
     fast: &[RigidBodyHandle],
     bodies: &RigidBodySet,
     colliders: &ColliderSet,
-) -> Vec<(RigidBodyHandle, Aabb)> {
+) -> Vec<Mover> {
     let mut movers = Vec::with_capacity(fast.len());
     for handle in fast {
         let rb = &bodies[*handle];
-        let mut swept: Option<Aabb> = None;
+        let mut boxes: Option<(Aabb, Aabb)> = None;
         for ch in &rb.colliders.0 {
             let co = &colliders[*ch];
             let Some(parent) = co.parent.as_ref() else {
@@ -184,14 +233,22 @@ pub(super) fn collect_movers(
             let end = co
                 .shape
                 .compute_aabb(&(rb.pos.next_position * parent.pos_wrt_parent));
-            let both = start.merged(&end);
-            swept = Some(swept.map_or(both, |s| s.merged(&both)));
+            boxes = Some(boxes.map_or((start, end), |(s, e)| (s.merged(&start), e.merged(&end))));
         }
-        if let Some(swept) = swept {
-            movers.push((*handle, swept));
+        if let Some((start, end)) = boxes {
+            let com = rb.mprops.local_mprops.local_com;
+            let shift = rb.pos.next_position * com - rb.pos.position * com;
+            movers.push((*handle, start.merged(&end), start, end, shift));
         }
     }
     movers
+}
+
+/// The box a body sweeps from `start` to `end` as seen from a frame that moves by `shift`
+/// during the step: the start box and the end box moved back by `shift` (exact for
+/// translations; as good as rapier's swept boxes for turns).
+fn relative_box(start: &Aabb, end: &Aabb, shift: Vector) -> Aabb {
+    start.merged(&Aabb::new(end.mins - shift, end.maxs - shift))
 }
 
 /// Whether `rb` is one of the fast bodies of the pass (an awake body flagged CCD-active).
@@ -660,7 +717,8 @@ pub(super) fn sweep_fast_body(
     colliders: &ColliderSet,
     end_body_pose: Pose,
     targets: CcdTargets,
-    movers: &[(RigidBodyHandle, Aabb)],
+    movers: &[Mover],
+    joints: CcdJoints,
     dispatcher: &dyn QueryDispatcher,
     hooks: &dyn PhysicsHooks,
     dt: Real,
@@ -706,6 +764,9 @@ pub(super) fn sweep_fast_body(
             }
             let rb2 = bh2.and_then(|h| bodies.get(h));
             if !tier_allows(rb1, rb2, co2) {
+                return;
+            }
+            if bh2.is_some_and(|h2| joints.contacts_disabled(handle, h2)) {
                 return;
             }
             if !co1.flags.collision_groups.test(co2.flags.collision_groups) {
@@ -771,8 +832,14 @@ pub(super) fn sweep_fast_body(
             }
         }
         // PATCH(physics-service): the other fast bodies, by their swept boxes.
-        for (h2, aabb2) in movers {
-            if *h2 != handle && aabb2.intersects(&swept_aabb) {
+        // Pairs that move together (a salvo) are skipped by their relative motion: in the
+        // frame that moves with the other body, both sweep their relative boxes.
+        for (h2, aabb2, start2, end2, shift2) in movers {
+            if *h2 != handle
+                && aabb2.intersects(&swept_aabb)
+                && relative_box(start2, end2, *shift2)
+                    .intersects(&relative_box(&start_aabb, &end_aabb, *shift2))
+            {
                 for ch2 in &bodies[*h2].colliders.0 {
                     handle_candidate(*ch2, &colliders[*ch2]);
                 }

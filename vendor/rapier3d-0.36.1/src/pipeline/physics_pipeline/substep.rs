@@ -50,6 +50,8 @@ impl PhysicsPipeline {
         modified_bodies.clear();
     }
 
+    // PATCH(physics-service): the joint sets reach the CCD, which skips jointed bodies that
+    // do not collide (see `dynamics::ccd::sweeps::CcdJoints`).
     #[allow(clippy::too_many_arguments)]
     fn run_ccd_motion_clamping(
         &mut self,
@@ -61,6 +63,8 @@ impl PhysicsPipeline {
         broad_phase: &mut BroadPhaseBvh,
         narrow_phase: &NarrowPhase,
         ccd_solver: &mut CCDSolver,
+        impulse_joints: &ImpulseJointSet,
+        multibody_joints: &MultibodyJointSet,
         hooks: &dyn PhysicsHooks,
         events: &dyn EventHandler,
     ) {
@@ -75,6 +79,8 @@ impl PhysicsPipeline {
             soft_bodies,
             broad_phase,
             narrow_phase,
+            impulse_joints,
+            multibody_joints,
             hooks,
             events,
         );
@@ -525,6 +531,8 @@ impl PhysicsPipeline {
                         colliders,
                         broad_phase,
                         narrow_phase,
+                        impulse_joints,
+                        multibody_joints,
                         hooks,
                     )
                 } else {
@@ -605,6 +613,8 @@ impl PhysicsPipeline {
                         broad_phase,
                         narrow_phase,
                         ccd_solver,
+                        impulse_joints,
+                        multibody_joints,
                         hooks,
                         events,
                     );
