@@ -57,9 +57,7 @@ pub(super) fn undamp_springs(mb: &mut Multibody) {
         .collect();
     let damping = mb.damping_mut();
     for (at, n) in spans {
-        for k in at..(at + n).min(damping.len()) {
-            damping[k] = 0.0;
-        }
+        damping.iter_mut().skip(at).take(n).for_each(|d| *d = 0.0);
     }
 }
 
@@ -136,9 +134,7 @@ fn set_armature(
         .collect();
     let armature = mb.armature_mut();
     for (at, n, a) in spans {
-        for k in at..(at + n).min(armature.len()) {
-            armature[k] = a;
-        }
+        armature.iter_mut().skip(at).take(n).for_each(|x| *x = a);
     }
 }
 

@@ -219,7 +219,20 @@ fn spring_energy(kind: Spring, k: f32, m: f32, rate: f32, secs: f32) -> (f32, f3
     };
     let dt = 1.0 / rate;
     let steps = (secs * rate).round() as usize;
-    let window = rate.round() as usize;
+    let inertia = {
+        let b = rb(&p, ball);
+        match kind {
+            Spring::SixDofRotY | Spring::Hinge => {
+                b.mass_properties().local_mprops.principal_inertia().y
+            }
+            _ => b.mass(),
+        }
+    };
+    // Whole periods (at least a second's worth, at most the run): a symplectic step's
+    // energy oscillates within each period, so only whole periods compare.
+    let period = std::f32::consts::TAU / (k / inertia).sqrt();
+    let periods = (1.0 / period).ceil().max(1.0);
+    let window = ((periods * period * rate).round() as usize).clamp(1, steps);
     let (mut first, mut last) = (0.0f64, 0.0f64);
     for s in 0..steps {
         p.step(dt).unwrap();
@@ -253,13 +266,6 @@ fn spring_energy(kind: Spring, k: f32, m: f32, rate: f32, secs: f32) -> (f32, f3
             last += e as f64;
         }
     }
-    let b = rb(&p, ball);
-    let inertia = match kind {
-        Spring::SixDofRotY | Spring::Hinge => {
-            b.mass_properties().local_mprops.principal_inertia().y
-        }
-        _ => b.mass(),
-    };
     (
         (first / window as f64) as f32,
         (last / window as f64) as f32,
@@ -292,7 +298,10 @@ fn undamped_springs_keep_their_energy() {
             for rate in [60.0f32, 240.0] {
                 let (first, last, k_over_i) = spring_energy(kind, k, m, rate, 10.0);
                 let kept = last / first;
-                let resolved = k_over_i <= (4.0 * rate) * (4.0 * rate);
+                // Within the explicit limit, and sampled ≥ 6 times a period (the energy read
+                // once a tick aliases on faster springs: the k/m = 2·10⁴ spring at 60 Hz reads
+                // 0.989 while it keeps 1.0001 read at 240 Hz).
+                let resolved = k_over_i <= (4.0 * rate) * (4.0 * rate) && k_over_i.sqrt() <= rate;
                 println!("{kind:?} k {k} m {m} (k/I {k_over_i:.0}) {rate} Hz: kept {kept:.4}");
                 assert!(
                     kept <= 1.01,
