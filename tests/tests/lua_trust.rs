@@ -154,3 +154,18 @@ fn nil_removes_joint_limits_and_motors() {
     );
     assert!(stdout(&out).contains("joint unset ok"), "{}", stdout(&out));
 }
+
+#[test]
+fn joint_coordinates_follow_the_one_documented_rule() {
+    let daemon = TestDaemon::start("trust-conventions");
+    let (out, _) = run(
+        &daemon,
+        "tests/lua/joint_conventions.luau",
+        Duration::from_secs(30),
+    );
+    assert!(
+        stdout(&out).contains("joint conventions ok"),
+        "{}",
+        stdout(&out)
+    );
+}
