@@ -207,7 +207,7 @@ mod tests {
         assert!(decode(&bytes, PlaneKind::Gui2d, "rapier3d 0.36")
             .unwrap_err()
             .message
-            .contains("not a Gui2d"));
+            .contains("not a GUI one"));
         assert!(decode(&bytes, PlaneKind::Rapier3d, "rapier3d 0.37")
             .unwrap_err()
             .message

@@ -378,7 +378,7 @@ fn damaged_or_foreign_snapshots_are_refused_and_change_nothing() {
     let gui = client.create_gui_plane(&GuiPlaneOptions::manual()).unwrap();
     let foreign = gui.plane().take_snapshot().unwrap();
     let e = plane.restore(&foreign).unwrap_err().to_string();
-    assert!(e.contains("Gui2d"), "{e}");
+    assert!(e.contains("a GUI plane, not a 3D one"), "{e}");
     // Nothing changed, and the plane and daemon go on.
     assert_eq!(plane.state_hash().unwrap(), hash);
     plane.step(DT).unwrap();

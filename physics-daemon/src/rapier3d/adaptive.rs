@@ -90,6 +90,11 @@ impl Plane {
         // high-ratio pair) for the dominance pass below.
         let down = self.world.gravity.normalize_or_zero();
         let mut supports = Vec::new();
+        // Dynamic bodies resting on anchored geometry: only such a light body carries a heavy
+        // one as a floor would. Higher in a column the extra substeps hold the pair (a light
+        // box given the heavy one's weight to nobody above the floor let a 1,000:1 box on a
+        // column of four sink through it).
+        let mut grounded = std::collections::BTreeSet::new();
         for pair in self.world.narrow_phase.contact_pairs() {
             let Some((manifold, contact)) = pair.find_deepest_contact() else {
                 continue;
@@ -108,6 +113,19 @@ impl Plane {
                 let (m1, m2) = (b1.mass(), b2.mass());
                 m1.max(m2) >= RATIO * m1.min(m2)
             };
+            if b1.is_dynamic() != b2.is_dynamic() {
+                // The manifold's normal points from body 1 toward body 2.
+                let along = manifold.data.normal.dot(down);
+                let on_top = if b1.is_dynamic() {
+                    along > SUPPORT_COS
+                } else {
+                    along < -SUPPORT_COS
+                };
+                if on_top {
+                    let h = if b1.is_dynamic() { h1 } else { h2 };
+                    grounded.insert(h.into_raw_parts());
+                }
+            }
             if b1.is_dynamic() && b2.is_dynamic() {
                 // The manifold's normal points from body 1 toward body 2.
                 let along = manifold.data.normal.dot(down);
@@ -145,6 +163,9 @@ impl Plane {
         let was_stiffened = self.stiffened;
         self.stiffened = stiffened;
         if stiffened || was_stiffened {
+            for s in supports.iter_mut() {
+                s.2 &= grounded.contains(&s.0);
+            }
             set_dominance(&mut self.world.bodies, &supports);
         }
         // Each body takes the largest request of its pairs.
