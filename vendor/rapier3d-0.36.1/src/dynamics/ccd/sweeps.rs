@@ -41,12 +41,17 @@ pub(super) fn is_bullet(rb: &RigidBody) -> bool {
 
 // PATCH(physics-service): full CCD is a property of the pair, not only of the fast body.
 /// The target-selection rule for a fast body `rb1`: automatic targets (fixed geometry and
-/// soft-body meshes) always; a moving (dynamic or kinematic) body when either side is a bullet
-/// (a bullet sweeps every body, and every fast body sweeps a bullet: bullets hit bullets, a
-/// fast body hits a resting bullet), or when `rb1` moves farther this step than its soft-CCD
-/// prediction reaches (the speculative contacts that soft CCD predicts cannot catch it).
+/// soft-body meshes) always; a moving (dynamic or kinematic) non-bullet body when `rb1` is a
+/// bullet; any moving body (bullets too: bullets hit bullets, a fast body hits a resting
+/// bullet) when `rb1` moves farther this step than soft CCD reaches (the speculative contacts
+/// that soft CCD predicts cannot catch it).
 fn tier_allows(rb1: &RigidBody, rb2: Option<&RigidBody>, co2: &Collider) -> bool {
-    if is_auto_target(rb2, co2) || is_bullet(rb1) || rb2.is_some_and(is_bullet) {
+    // Rapier's own rule (a bullet sweeps every moving body but another bullet) at any speed;
+    // beyond it, bullets sweep each other and fast bodies sweep bullets only when the sweeping
+    // body outruns soft CCD: slow bullets in contact (the 40 cards of a card house at
+    // HitBoxQuality 4, each wobbling more than its 0.002 thickness) clamped each other
+    // mid-step and the house fell.
+    if is_auto_target(rb2, co2) || (is_bullet(rb1) && !rb2.is_some_and(is_bullet)) {
         return true;
     }
     outruns_soft_ccd(rb1)
@@ -99,8 +104,14 @@ impl CcdJoints<'_> {
 fn outruns_soft_ccd(rb: &RigidBody) -> bool {
     let com = rb.mprops.local_mprops.local_com;
     let travel = (rb.pos.next_position * com - rb.pos.position * com).length();
-    travel > rb.soft_ccd_prediction()
+    travel > rb.soft_ccd_prediction().max(OUTRUN_FLOOR)
 }
+
+/// PATCH(physics-service): the least travel in one step that counts as outrunning soft CCD
+/// (2 units: the reach the service gives fast bodies' soft CCD). A slow body's prediction is
+/// a skin (0.02): measured against it, a wobbling card of a card house or a box sliding at
+/// 20 units/s swept its neighbours from contact and was clamped where it stood.
+const OUTRUN_FLOOR: Real = 2.0;
 
 /// Returns `true` if the user's `filter_contact_pair` hook rejected this pair. Mirrors the
 /// narrow-phase filter in `NarrowPhase::compute_contacts` so CCD respects the same user-level
@@ -375,8 +386,14 @@ impl<'a> FastColliderInfo<'a> {
         // PATCH(physics-service): the fast shape is swept inflated by twice the slop, so the
         // sweep stops at `linear_slop` of separation rather than `linear_slop` deep (parry's
         // target is `radius_a + radius_b - linear_slop`; see `CLAMP_SEPARATION`).
+        // Only a body that travels farther in the step than soft CCD reaches is inflated: a
+        // slower one (a card of a card house, a box sliding over a map's seams) starts inside
+        // the inflated margin of what it rests on, and its sweep clamped it where it stood.
+        let fast_enough = (end.translation - start.translation).length() > OUTRUN_FLOOR;
         let inflated = |mut proxy: ToiProxy<'a>| {
-            proxy.radius += CLAMP_SEPARATION * linear_slop;
+            if fast_enough {
+                proxy.radius += CLAMP_SEPARATION * linear_slop;
+            }
             proxy
         };
         let kind = if let Some(proxy) = ToiProxy::from_shape(shape).map(inflated) {

@@ -451,7 +451,18 @@ pub(super) fn process_pair(
         // deepest point is one of the polygon's corners) but puts a second contact at one
         // corner or edge: a flat landing's impulse goes lopsided and the body spins (an
         // upright cylinder dropped flat tipped over).
-        for manifold in rigid.manifolds.iter_mut() {
+        // Only where a rounded or hull shape takes part: boxes and triangles (a card house,
+        // a box sliding over a map's seams) keep parry's manifold as it is.
+        let polygonal = |s: &dyn parry::shape::Shape| {
+            matches!(
+                s.shape_type(),
+                parry::shape::ShapeType::Cylinder
+                    | parry::shape::ShapeType::Cone
+                    | parry::shape::ShapeType::ConvexPolyhedron
+            )
+        };
+        let drop_gjk_point = polygonal(&*co1.shape) || polygonal(&*co2.shape);
+        for manifold in rigid.manifolds.iter_mut().filter(|_| drop_gjk_point) {
             let n = manifold.points.len();
             if n >= 4 {
                 let last = &manifold.points[n - 1];
