@@ -207,10 +207,7 @@ fn solver_options_are_clamped_reported_and_buy_accuracy() {
     // off: it would give the pair its own substeps and carry the heavy box whatever the
     // plane's setting.
     let sink = |options: PlaneOptions| {
-        let scene = Scene::new(
-            "solver",
-            options.with(PlaneProp::AdaptiveSolving(false)),
-        );
+        let scene = Scene::new("solver", options.with(PlaneProp::AdaptiveSolving(false)));
         scene.floor();
         cube(&scene, [0.0, 0.5, 0.0], &[]);
         let top = cube(&scene, [0.0, 1.5, 0.0], &[ObjectProp::Weight(100.0)]);
@@ -282,7 +279,11 @@ fn setters_name_the_property_and_the_value() {
             "ImpulseDirection",
             "inf",
         ),
-        (b.rotate_to([0.0; 4], 8.0), "RotateTo.target", "(0, 0, 0, 0)"),
+        (
+            b.rotate_to([0.0; 4], 8.0),
+            "RotateTo.target",
+            "(0, 0, 0, 0)",
+        ),
         (
             scene.plane.set(PlaneProp::LinearDamping(-0.1)),
             "LinearDamping",
