@@ -367,7 +367,7 @@ pub fn fuzz(cfg: &FuzzConfig, mut progress: impl FnMut(usize, &Case, &[Violation
             break;
         }
         let case = Case::draw(i, &mut rng, &cfg.space);
-        let determinism = cfg.determinism_every > 0 && i % cfg.determinism_every == 0;
+        let determinism = cfg.determinism_every > 0 && i.is_multiple_of(cfg.determinism_every);
         let t0 = Instant::now();
         let v = judge(&case, determinism);
         let stats = report

@@ -56,6 +56,10 @@ const SUPPORT_COS: f32 = 0.7;
 /// Highest dominance level the pass gives (rapier's groups are i8).
 const MAX_LEVEL: i32 = 100;
 
+/// A support edge: (lower body, upper body, whether the upper is the heavy one of a
+/// high-ratio pair), bodies as raw handle parts.
+type Support = ((u32, u32), (u32, u32), bool);
+
 impl Plane {
     /// After a step: boosts the bodies of the pairs that need more substeps and lets the
     /// others' boosts go (see the module doc).
@@ -234,7 +238,7 @@ fn set_extra(bodies: &mut RigidBodySet, raw: (u32, u32), extra: usize) {
 /// dynamic body goes back to level 0. What it gives up: for that contact the heavy body
 /// cannot push the light one (it is on something anyway), and a light body pushed sideways
 /// drags the heavy one without feeling its inertia.
-fn set_dominance(bodies: &mut RigidBodySet, supports: &[((u32, u32), (u32, u32), bool)]) {
+fn set_dominance(bodies: &mut RigidBodySet, supports: &[Support]) {
     let mut level: std::collections::BTreeMap<(u32, u32), i32> = Default::default();
     if supports.iter().any(|s| s.2) {
         // Relax the "lower ≥ upper + step" constraints; a column settles in its height in

@@ -404,7 +404,7 @@ impl PartState {
                 .map_err(|e| sdk_error(what, e))?;
         } else {
             // A free part takes only a size a plane would (checked here, not first at Add).
-            client_sdk::validate::size("Size", size.into())
+            client_sdk::validate::size("Size", size)
                 .map_err(|e| mlua::Error::runtime(format!("{what}: {}", e.message)))?;
         }
         self.size.set(size);
