@@ -508,3 +508,31 @@ pub mod cluster {
         TestDaemon::start_with(&format!("cl-{name}"), &args, &[])
     }
 }
+
+/// Runs `physics-lua script --domain domain extra...` to its end and returns its output and
+/// how long it ran; kills it and panics with what it printed once it runs past `limit`.
+pub fn run_lua(
+    domain: &str,
+    script: &str,
+    extra: &[&str],
+    limit: Duration,
+) -> (std::process::Output, Duration) {
+    let started = Instant::now();
+    let mut child = physics_lua(domain, script, extra)
+        .spawn()
+        .expect("spawn physics-lua");
+    while child.try_wait().expect("wait physics-lua").is_none() {
+        if started.elapsed() > limit {
+            let _ = child.kill();
+            let out = child.wait_with_output().expect("collect output");
+            panic!(
+                "{script} still running after {limit:?}\nstdout:\n{}\nstderr:\n{}",
+                String::from_utf8_lossy(&out.stdout),
+                String::from_utf8_lossy(&out.stderr)
+            );
+        }
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    let output = child.wait_with_output().expect("collect output");
+    (output, started.elapsed())
+}

@@ -3,9 +3,9 @@
 //! check the runner's exit status and what the scripts printed.
 
 use std::process::Output;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
-use integration_tests::{domain_files, physics_lua, unique_domain, TestDaemon};
+use integration_tests::{domain_files, run_lua, unique_domain, TestDaemon};
 
 struct Run {
     output: Output,
@@ -37,27 +37,8 @@ impl Run {
 
 /// Runs `physics-lua script --domain domain extra...`, killing it after `limit`.
 fn run_in(domain: &str, script: &str, extra: &[&str], limit: Duration) -> Run {
-    let started = Instant::now();
-    let mut child = physics_lua(domain, script, extra)
-        .spawn()
-        .expect("spawn physics-lua");
-    while child.try_wait().expect("wait physics-lua").is_none() {
-        if started.elapsed() > limit {
-            let _ = child.kill();
-            let out = child.wait_with_output().expect("collect output");
-            panic!(
-                "{script} still running after {limit:?}\nstdout:\n{}\nstderr:\n{}",
-                String::from_utf8_lossy(&out.stdout),
-                String::from_utf8_lossy(&out.stderr)
-            );
-        }
-        std::thread::sleep(Duration::from_millis(10));
-    }
-    let output = child.wait_with_output().expect("collect output");
-    Run {
-        output,
-        took: started.elapsed(),
-    }
+    let (output, took) = run_lua(domain, script, extra, limit);
+    Run { output, took }
 }
 
 fn run(daemon: &TestDaemon, script: &str) -> Run {

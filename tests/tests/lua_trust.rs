@@ -5,35 +5,19 @@
 use std::process::Output;
 use std::time::{Duration, Instant};
 
-use integration_tests::{physics_lua, TestDaemon};
+use integration_tests::{physics_lua, run_lua, TestDaemon};
 
-/// Runs `script` with `--seconds 30`; returns its output and how long it ran, or panics
-/// after `limit` with what it printed.
+/// Runs `script` with `--seconds 30` and asserts it succeeded; returns its output and how
+/// long it ran, or panics after `limit` (the run did not end) with what it printed.
 fn run(daemon: &TestDaemon, script: &str, limit: Duration) -> (Output, Duration) {
-    let started = Instant::now();
-    let mut child = physics_lua(&daemon.domain, script, &["--seconds", "30"])
-        .spawn()
-        .expect("spawn physics-lua");
-    while child.try_wait().expect("wait physics-lua").is_none() {
-        if started.elapsed() > limit {
-            let _ = child.kill();
-            let out = child.wait_with_output().expect("collect output");
-            panic!(
-                "{script} still running after {limit:?}: the run did not end\nstdout:\n{}\nstderr:\n{}",
-                String::from_utf8_lossy(&out.stdout),
-                String::from_utf8_lossy(&out.stderr)
-            );
-        }
-        std::thread::sleep(Duration::from_millis(10));
-    }
-    let out = child.wait_with_output().expect("collect output");
+    let (out, took) = run_lua(&daemon.domain, script, &["--seconds", "30"], limit);
     assert!(
         out.status.success(),
         "{script} failed\nstdout:\n{}\nstderr:\n{}",
         String::from_utf8_lossy(&out.stdout),
         String::from_utf8_lossy(&out.stderr)
     );
-    (out, started.elapsed())
+    (out, took)
 }
 
 fn stdout(out: &Output) -> String {

@@ -134,27 +134,22 @@ pub fn forget_joint(plane: &PlaneState, joint: Handle) {
 /// The object `object` left the plane: its joints went with it, and so do their Broke
 /// signals and handlers (as on Roblox, where destroying an instance disconnects them).
 pub fn forget_joints_of(plane: &PlaneState, object: Handle) {
-    let gone: Vec<Broke> = {
-        let mut map = plane.contacts.broke.borrow_mut();
-        let joints: Vec<Handle> = map
-            .iter()
-            .filter(|(_, b)| b.ends.contains(&object))
-            .map(|(j, _)| *j)
-            .collect();
-        joints.iter().filter_map(|j| map.remove(j)).collect()
-    };
-    for b in gone {
-        b.signal.disconnect_all();
-    }
+    forget_broke(plane, |b| b.ends.contains(&object));
 }
 
 /// The plane went: every Broke signal and its handlers go with it.
 pub fn forget_all_joints(plane: &PlaneState) {
+    forget_broke(plane, |_| true);
+}
+
+/// Removes the Broke signals `which` picks and disconnects their handlers (after the map is
+/// released: a handler's finaliser may reach the plane).
+fn forget_broke(plane: &PlaneState, which: impl Fn(&Broke) -> bool) {
     let gone: Vec<Broke> = plane
         .contacts
         .broke
         .borrow_mut()
-        .drain()
+        .extract_if(|_, b| which(b))
         .map(|(_, b)| b)
         .collect();
     for b in gone {
@@ -198,6 +193,19 @@ impl PlaneState {
     /// Whether anyone listens to the plane's events: a part's touch handlers, a
     /// controller's signals or a joint's Broke.
     fn touch_handlers(&self) -> bool {
+        self.listening(|_| true)
+    }
+
+    /// Whether some handler of the plane can still fire: the plane lives and a simulated
+    /// part has touch handlers, a controller has handlers, or a joint that has not broken
+    /// yet has Broke handlers.
+    fn handlers_can_fire(&self) -> bool {
+        self.alive() && self.listening(|b| !b.fired.get())
+    }
+
+    /// A part's touch handlers (the cached answer), a controller's signals, or the Broke
+    /// handlers of a joint `counts`.
+    fn listening(&self, counts: impl Fn(&Broke) -> bool) -> bool {
         let parts = self
             .contacts
             .parts_listen
@@ -209,22 +217,7 @@ impl PlaneState {
                 .broke
                 .borrow()
                 .values()
-                .any(|b| b.signal.listeners() > 0)
-    }
-
-    /// Whether some handler of the plane can still fire: the plane lives and a simulated
-    /// part has touch handlers, a controller has handlers, or a joint that has not broken
-    /// yet has Broke handlers.
-    fn handlers_can_fire(&self) -> bool {
-        self.alive()
-            && (self.any_part(|p| p.touch_listeners() > 0)
-                || self.controller_listeners()
-                || self
-                    .contacts
-                    .broke
-                    .borrow()
-                    .values()
-                    .any(|b| b.signal.listeners() > 0 && !b.fired.get()))
+                .any(|b| b.signal.listeners() > 0 && counts(b))
     }
 
     /// Delivers the events published since the last call to the parts' touch handlers.
