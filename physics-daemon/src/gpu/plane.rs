@@ -20,8 +20,10 @@ use shm_layout::{
     PlaneKind, PlaneOp, PlaneProp, Reply, StateHasher, TickHeader,
 };
 
+use super::broadphase::PairMode;
+use super::context::context;
+use super::world::{GpuWorld, StepEnv};
 use crate::backend::{Backend, SlotFilter, SnapshotJob, Usage};
-use crate::gpu::{self, GpuWorld, PairMode, StepEnv};
 use crate::rapier3d::{self, GpuSaved};
 
 fn unsupported(what: &str) -> CommandError {
@@ -75,7 +77,7 @@ fn flip(
                     ),
                 ));
             }
-            let ctx = gpu::context().map_err(|e| {
+            let ctx = context().map_err(|e| {
                 CommandError::invalid_field("DeferGpu", format!("DeferGpu = true failed: {e}"))
             })?;
             let mut world = GpuWorld::new(ctx);
@@ -122,7 +124,7 @@ fn from_saved(saved: Option<GpuSaved>, defer_gpu: bool) -> Result<Option<GpuWorl
     if !defer_gpu {
         return Err(refused("it holds GPU bodies for a plane not on the GPU"));
     }
-    let ctx = gpu::context().map_err(|e| {
+    let ctx = context().map_err(|e| {
         CommandError::invalid_field(
             "DeferGpu",
             format!("the snapshot is of a DeferGpu plane and this daemon cannot run it: {e}"),

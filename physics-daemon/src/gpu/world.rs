@@ -10,7 +10,7 @@ use std::time::Instant;
 use bytemuck::{Pod, Zeroable};
 
 use super::broadphase::{grid, scan_levels, table_size, PairMode, SCAN_BLOCK};
-use super::Context;
+use super::context::Context;
 
 const WG: u32 = 128;
 
