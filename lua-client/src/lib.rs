@@ -31,6 +31,7 @@ use mlua::{Lua, Table, Value};
 pub use host::assets::AssetRoots;
 pub use host::errors::colon_hint;
 use host::scheduler::{self, Scheduler};
+use host::signal::Signal;
 pub use host::{Host, Stop, WATCH_PERIOD};
 #[doc(hidden)]
 pub use members::property_rows;
@@ -58,6 +59,7 @@ pub fn set_cluster(lua: &Lua, cluster: client_sdk::remote::RemoteOptions) {
 /// strings. Call it before `lua.sandbox(true)`: it sets globals and replaces builtins.
 pub fn install(lua: &Lua, client: Client) -> mlua::Result<Host> {
     let scheduler = Rc::new(Scheduler::new());
+    let heart = Signal::new("Heart");
     lua.set_app_data(scheduler.clone());
     scheduler.watchdog.install(lua);
     host::errors::install(lua)?;
@@ -81,13 +83,13 @@ pub fn install(lua: &Lua, client: Client) -> mlua::Result<Host> {
     })?;
     let globals = lua.globals();
     globals.set("import", import)?;
-    globals.set("Heart", scheduler.heart.clone())?;
+    globals.set("Heart", heart.clone())?;
     // The reference's controller snippet uses DynMesh without importing it.
     let dyn_mesh: Table = globals.get::<mlua::Function>("import")?.call("DynMesh")?;
     globals.set("DynMesh", dyn_mesh)?;
     globals.set("wait", scheduler::wait_function(lua)?)?;
     let daemon = api::plane::context(lua);
-    Ok(Host::new(lua, scheduler, client, daemon))
+    Ok(Host::new(lua, scheduler, heart, client, daemon))
 }
 
 /// Restores the snapshot file `path` into a new plane of the installed client, which the

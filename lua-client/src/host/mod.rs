@@ -9,6 +9,7 @@ pub(crate) mod identity;
 pub mod scheduler;
 pub mod signal;
 pub mod watchdog;
+pub mod watched;
 
 use std::rc::Rc;
 use std::sync::atomic::AtomicBool;
@@ -16,44 +17,23 @@ use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use client_sdk::Client;
-use mlua::{Function, Lua, MultiValue};
+use mlua::{Function, Lua, MultiValue, Value};
 
 use crate::values::sdk_error;
 use scheduler::Scheduler;
+use signal::Signal;
 pub use watchdog::Stop;
+pub use watched::{DaemonWatch, Watched};
 
 /// The longest a host should sleep between frames while [`Host::watching_daemon`].
 pub const WATCH_PERIOD: Duration = Duration::from_millis(100);
-
-/// Something with a per-frame change signal: probed each frame, fired when it changed.
-pub trait Watched {
-    /// How many handlers listen; at zero the frame skips it.
-    fn listeners(&self) -> usize;
-    /// Fires the change signal if the value moved since it last fired.
-    fn fire_if_changed(&self, lua: &Lua) -> mlua::Result<()>;
-    /// Whether its listeners keep a script's frames running (a script's change handlers
-    /// do; work the host does for the script, such as welds, does not).
-    fn keeps_running(&self) -> bool {
-        true
-    }
-}
-
-/// The API's watch on the daemon's health, run once per frame (`PhysicsService.Stalled` /
-/// `Resumed`).
-pub trait DaemonWatch {
-    /// Fires the stall / resume signals when the daemon's health changed.
-    fn watch(&self, lua: &Lua) -> mlua::Result<()>;
-    /// Whether a script listens (the host then keeps running frames while it only waits).
-    fn watching(&self) -> bool;
-    /// Connections to other daemons the script's planes live on (`Placement`): each frame
-    /// begins and flushes on them too.
-    fn placed(&self) -> Vec<Client>;
-}
 
 /// A host's handle on the installed API: drives frames.
 pub struct Host {
     lua: Lua,
     scheduler: Rc<Scheduler>,
+    /// The global `Heart` signal, fired once per frame with dt.
+    heart: Signal,
     client: Client,
     daemon: Rc<dyn DaemonWatch>,
 }
@@ -63,12 +43,14 @@ impl Host {
     pub(crate) fn new(
         lua: &Lua,
         scheduler: Rc<Scheduler>,
+        heart: Signal,
         client: Client,
         daemon: Rc<dyn DaemonWatch>,
     ) -> Host {
         Host {
             lua: lua.clone(),
             scheduler,
+            heart,
             client,
             daemon,
         }
@@ -87,7 +69,9 @@ impl Host {
             c.begin_frame();
         }
         self.daemon.watch(&self.lua)?;
-        self.scheduler.frame(&self.lua, dt)?;
+        self.scheduler.frame(&self.lua)?;
+        self.heart
+            .fire(&self.lua, MultiValue::from_iter([Value::Number(dt)]))?;
         self.flush()
     }
 
@@ -108,14 +92,14 @@ impl Host {
 
     /// Whether frames still have work: `Heart` handlers, pending waits, or change listeners.
     pub fn busy(&self) -> bool {
-        self.scheduler.heart.listeners() > 0
+        self.heart.listeners() > 0
             || self.scheduler.pending_waits() > 0
             || self.scheduler.change_listeners()
     }
 
     /// Whether the next frame is needed regardless of waits (Heart or change listeners).
     pub fn busy_every_frame(&self) -> bool {
-        self.scheduler.heart.listeners() > 0 || self.scheduler.change_listeners()
+        self.heart.listeners() > 0 || self.scheduler.change_listeners()
     }
 
     /// Seconds until the earliest pending `wait` is due.

@@ -9,9 +9,8 @@ use std::time::Instant;
 
 use mlua::{Function, LightUserData, Lua, MultiValue, Thread, ThreadStatus, Value};
 
-use super::signal::Signal;
 use super::watchdog::Watchdog;
-use super::Watched;
+use super::watched::Watched;
 use crate::values::{expected, number};
 
 static WAIT_MARK: u8 = 0;
@@ -36,12 +35,10 @@ pub(crate) struct Handler {
     function: Function,
 }
 
-/// The frame loop's state: pending waits, `Heart`, and what is watched each frame.
+/// The frame loop's state: pending waits and what is watched each frame.
 pub struct Scheduler {
     started: Instant,
     waiting: RefCell<Vec<Waiting>>,
-    /// The global `Heart` signal, fired once per frame with dt.
-    pub heart: Signal,
     /// Values with per-frame change signals (simulated parts' CFrame); probed each frame
     /// for listeners.
     watched: RefCell<Vec<Weak<dyn Watched>>>,
@@ -55,7 +52,6 @@ impl Scheduler {
         Scheduler {
             started: Instant::now(),
             waiting: RefCell::default(),
-            heart: Signal::new("Heart"),
             watched: RefCell::default(),
             watchdog: Rc::new(Watchdog::new()),
         }
@@ -94,10 +90,10 @@ impl Scheduler {
             .any(|w| w.listeners() > 0 && w.keeps_running())
     }
 
-    /// One frame. Physics results come first: the change signals of simulated parts with
-    /// listeners fire when their pose moved; then due waits resume and `Heart` fires with
-    /// `dt`, so scripts see this frame's poses.
-    pub fn frame(&self, lua: &Lua, dt: f64) -> mlua::Result<()> {
+    /// One frame's scheduling. Physics results come first: the change signals of simulated
+    /// parts with listeners fire when their pose moved; then due waits resume, so scripts
+    /// see this frame's poses (the host fires `Heart` next).
+    pub fn frame(&self, lua: &Lua) -> mlua::Result<()> {
         let watched: Vec<Rc<dyn Watched>> = {
             let mut watched = self.watched.borrow_mut();
             watched.retain(|w| w.strong_count() > 0);
@@ -128,8 +124,7 @@ impl Scheduler {
             );
             contain(lua, self, resumed, &w.thread, handler.as_deref())?;
         }
-        self.heart
-            .fire(lua, Value::Number(dt).into_lua_multi_value())
+        Ok(())
     }
 }
 

@@ -12,6 +12,7 @@
 //! recognised by the tag in Luau's userdata header (see [`cframe_of_userdata`]); scripts cannot
 //! make a userdata of this tag (`newproxy` makes tag 0), so the tag is proof of the type.
 
+use std::cell::RefCell;
 use std::mem::size_of;
 use std::os::raw::c_int;
 
@@ -211,13 +212,44 @@ impl mlua::IntoLua for CFrame {
     }
 }
 
-impl mlua::FromLua for CFrame {
-    fn from_lua(value: Value, _: &Lua) -> mlua::Result<Self> {
-        match &value {
+/// The Lua value of a CFrame that something (a part, an object) hands out again and again:
+/// its last value, returned as long as the pose is bit for bit the same, so reading the pose
+/// of a body that did not move since the last read (a second read in the same tick, a body
+/// at rest) allocates nothing. CFrame values are immutable, so a script cannot tell a
+/// returned value from a fresh equal one (except by `rawequal`).
+#[derive(Default)]
+pub struct CFrameCache(RefCell<Option<(CFrame, AnyUserData)>>);
+
+impl CFrameCache {
+    /// `cf` as a Lua value: the cached one when it is the same pose, else a new one (which
+    /// the cache keeps).
+    pub fn value(&self, lua: &Lua, cf: CFrame) -> mlua::Result<Value> {
+        if let Some(ud) = self.cached(&cf) {
+            return Ok(Value::UserData(ud));
+        }
+        let Value::UserData(ud) = cf.into_value(lua)? else {
+            unreachable!("a CFrame is a userdata")
+        };
+        *self.0.borrow_mut() = Some((cf, ud.clone()));
+        Ok(Value::UserData(ud))
+    }
+
+    /// The value handed out last, if it holds `cf` bit for bit.
+    pub fn cached(&self, cf: &CFrame) -> Option<AnyUserData> {
+        match &*self.0.borrow() {
+            Some((cached, ud)) if cached.same_bits(cf) => Some(ud.clone()),
+            _ => None,
+        }
+    }
+}
+
+impl CFrame {
+    /// The CFrame `value` holds, if it is one.
+    pub fn from_value(value: &Value) -> Option<CFrame> {
+        match value {
             Value::UserData(ud) => cframe_of_userdata(ud),
             _ => None,
         }
-        .ok_or_else(|| super::expected("a CFrame argument", "a CFrame", &value))
     }
 }
 

@@ -1,67 +1,6 @@
-//! Lua values to Rust values, and the error messages that name what was expected and what
-//! was given.
+//! Lua values to Rust values and back: numbers and vectors.
 
-use mlua::{AnyUserData, Error as LuaError, Function, Value};
-
-use super::Dim;
-
-/// The metatable field of a userdata type that describes its values in error messages: a
-/// function of the value returning a string (e.g. `BasePart "Ball"`). Types without one are
-/// described by their type name.
-pub const DESCRIBE: &str = "__describe";
-
-/// What a userdata type's [`DESCRIBE`] entry says about `ud`, if it has one.
-fn described(ud: &AnyUserData) -> Option<String> {
-    let describe = ud
-        .metatable()
-        .ok()?
-        .get::<Option<Function>>(DESCRIBE)
-        .ok()??;
-    describe.call::<String>(ud.clone()).ok()
-}
-
-/// A short description of a Lua value for error messages: its type and, when small, itself.
-pub fn describe(value: &Value) -> String {
-    match value {
-        Value::Nil => "nil".into(),
-        Value::Boolean(b) => format!("boolean {b}"),
-        Value::Integer(i) => format!("number {i}"),
-        Value::Number(n) => format!("number {n}"),
-        Value::Vector(v) => format!("Vector({}, {}, {})", v.x(), v.y(), v.z()),
-        Value::String(s) => {
-            let s = s.to_string_lossy();
-            if s.chars().count() > 40 {
-                let short: String = s.chars().take(40).collect();
-                format!("string \"{short}…\"")
-            } else {
-                format!("string \"{s}\"")
-            }
-        }
-        Value::Table(_) => "table".into(),
-        Value::Function(_) => "function".into(),
-        Value::Thread(_) => "thread".into(),
-        Value::UserData(ud) => {
-            if let Some(cf) = super::cframe_ud::cframe_of_userdata(ud) {
-                cf.to_string()
-            } else if let Ok(d) = ud.borrow::<Dim>() {
-                d.to_string()
-            } else if let Some(text) = described(ud) {
-                text
-            } else {
-                match ud.type_name() {
-                    Ok(Some(name)) => name,
-                    _ => "userdata".into(),
-                }
-            }
-        }
-        other => other.type_name().to_string(),
-    }
-}
-
-/// `"{what} expects {expected}, got {value}"`.
-pub fn expected(what: &str, expected: &str, got: &Value) -> LuaError {
-    LuaError::runtime(format!("{what} expects {expected}, got {}", describe(got)))
-}
+use mlua::{Error as LuaError, Value};
 
 /// A Lua number (integer or float) as `f64`.
 pub fn number(value: &Value) -> Option<f64> {
@@ -77,23 +16,6 @@ pub fn vector(value: &Value) -> Option<[f32; 3]> {
     match value {
         Value::Vector(v) => Some([v.x(), v.y(), v.z()]),
         _ => None,
-    }
-}
-
-/// A finite vector, or an error naming `what`.
-pub fn finite_vector(what: &str, value: &Value) -> Result<[f32; 3], LuaError> {
-    match vector(value) {
-        Some(v) if v.iter().all(|c| c.is_finite()) => Ok(v),
-        Some(_) => Err(expected(what, "a Vector with finite components", value)),
-        None => Err(expected(what, "a Vector", value)),
-    }
-}
-
-/// A finite number, or an error naming `what`.
-pub fn finite_number(what: &str, value: &Value) -> Result<f64, LuaError> {
-    match number(value) {
-        Some(n) if n.is_finite() => Ok(n),
-        _ => Err(expected(what, "a finite number", value)),
     }
 }
 
@@ -164,7 +86,7 @@ macro_rules! lua_integer {
 lua_integer!(u8, u16, u32, u64, i32, i64, usize);
 
 #[cfg(test)]
-mod lua_number_tests {
+mod tests {
     use super::*;
 
     #[test]

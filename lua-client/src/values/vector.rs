@@ -3,7 +3,8 @@
 
 use mlua::{Lua, Table, Value};
 
-use super::convert::{expected, finite_number, new_vector, vector};
+use super::convert::{lua_number, new_vector, vector};
+use super::describe::{expected, finite_number};
 
 /// Builds the `Primitives.Vector` table and installs the vector metatable.
 pub fn module(lua: &Lua) -> mlua::Result<Table> {
@@ -54,7 +55,7 @@ fn install_metatable(lua: &Lua) -> mlua::Result<()> {
             b"X" | b"x" => Ok(Value::Number(f64::from(v[0]))),
             b"Y" | b"y" => Ok(Value::Number(f64::from(v[1]))),
             b"Z" | b"z" => Ok(Value::Number(f64::from(v[2]))),
-            b"Magnitude" => Ok(crate::values::lua_number(len)),
+            b"Magnitude" => Ok(lua_number(len)),
             b"Unit" if len > 0.0 => Ok(new_vector(v.map(|c| c / len))),
             b"Unit" => Ok(new_vector([0.0; 3])),
             b"Dot" => Ok(Value::Function(dot.clone())),
