@@ -5,9 +5,9 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::joint_op::{AXIS_NAMES, MAX_ANGLE, MAX_JOINT_VALUE};
+use crate::error::CommandError;
+use crate::joint_limits::{AXIS_NAMES, MAX_ANGLE, MAX_JOINT_VALUE};
 use crate::validate::{finite, non_negative, MAX_COORDINATE};
-use crate::CommandError;
 
 /// A motor on one axis of a SixDof joint.
 ///

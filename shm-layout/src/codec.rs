@@ -7,7 +7,8 @@
 
 use serde::{de::DeserializeOwned, Serialize};
 
-use crate::{Request, Response, CRATE_VERSION, LAYOUT_VERSION};
+use crate::command::{CommandResult, Request, Response};
+use crate::version::{CRATE_VERSION, LAYOUT_VERSION};
 
 /// The four bytes every frame starts with.
 pub const MAGIC: [u8; 4] = *b"PHYS";
@@ -145,7 +146,7 @@ pub fn encode_request_with_version(request: &Request, version: u32) -> Vec<u8> {
 
 /// How many bytes `result` takes in an encoded response (what the daemon counts against a
 /// request's reply budget). Never fails: a value postcard cannot size counts as huge.
-pub fn result_size(result: &crate::CommandResult) -> usize {
+pub fn result_size(result: &CommandResult) -> usize {
     postcard::experimental::serialized_size(result).unwrap_or(usize::MAX)
 }
 

@@ -4,7 +4,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::CommandError;
+use crate::error::CommandError;
 
 /// Most groups a table holds, "Default" included (Roblox's limit).
 pub const MAX_COLLISION_GROUPS: usize = 32;

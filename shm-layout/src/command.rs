@@ -7,51 +7,18 @@
 
 use serde::{Deserialize, Serialize};
 
+pub use crate::geometry::{Pose, Vec3};
+pub use crate::ids::PlaneId;
+
 use crate::error::CommandError;
+use crate::ids::Handle;
 use crate::joint_op::JointInfo;
 use crate::map_op::MapInfo;
 use crate::object_op::ObjectOp;
 use crate::plane_op::{PlaneKind, PlaneOp};
 use crate::query::Hit;
-use crate::records::Handle;
 use crate::settings::{ObjectSettings, PlaneProp, PlaneSettings};
 use crate::shape::ShapeKind;
-
-/// Identifies a plane within one daemon.
-pub type PlaneId = u32;
-/// A 3D vector on the wire.
-pub type Vec3 = [f32; 3];
-
-/// Position plus unit quaternion `[x, y, z, w]`.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct Pose {
-    /// Position.
-    pub position: Vec3,
-    /// Unit quaternion `[x, y, z, w]`.
-    pub rotation: [f32; 4],
-}
-
-impl Pose {
-    /// The origin, unrotated.
-    pub const IDENTITY: Pose = Pose {
-        position: [0.0; 3],
-        rotation: [0.0, 0.0, 0.0, 1.0],
-    };
-
-    /// Unrotated at `position`.
-    pub fn at(position: Vec3) -> Pose {
-        Pose {
-            position,
-            ..Pose::IDENTITY
-        }
-    }
-}
-
-impl Default for Pose {
-    fn default() -> Self {
-        Pose::IDENTITY
-    }
-}
 
 /// One command of a request.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -258,9 +225,9 @@ pub enum Reply {
     /// [`crate::snapshot`] (header readable with [`crate::snapshot::header`]).
     Snapshot(Vec<u8>),
     /// The named planes, by name ([`Command::ListNamedPlanes`]).
-    NamedPlanes(Vec<crate::NamedPlane>),
+    NamedPlanes(Vec<crate::plane_name::NamedPlane>),
     /// A named plane opened ([`Command::OpenPlane`]).
-    Opened(crate::OpenedPlane),
+    Opened(crate::plane_name::OpenedPlane),
     /// A persistent plane was written to its file ([`PlaneOp::Save`]) at this tick.
     Saved {
         /// The tick the file holds.

@@ -9,8 +9,8 @@
 use iceoryx2::prelude::ZeroCopySend;
 use serde::{Deserialize, Serialize};
 
-use crate::records::Handle;
-use crate::Vec3;
+use crate::geometry::Vec3;
+use crate::ids::Handle;
 
 /// Most points reported per touching pair. A pair whose manifolds hold more keeps the
 /// deepest point and the three that span the largest area with it; the impulse of every

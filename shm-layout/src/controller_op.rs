@@ -5,10 +5,11 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::records::Handle;
+use crate::error::CommandError;
+use crate::geometry::{Pose, Vec3};
+use crate::ids::Handle;
 use crate::settings::{ControllerProp, ControllerSettings};
 use crate::validate::{bounded3, pose, size, MAX_COORDINATE};
-use crate::{CommandError, Pose, Vec3};
 
 /// Most waypoints one path may hold.
 pub const MAX_WAYPOINTS: usize = 65_536;

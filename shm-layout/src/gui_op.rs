@@ -13,11 +13,13 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::records::Handle;
+use crate::error::CommandError;
+use crate::geometry::Vec2;
+use crate::ids::Handle;
+use crate::object_op_of::ObjectOpOf;
 use crate::settings::gui_object::{GuiObjectProp, GuiObjectSettings, GuiShape};
-use crate::settings::gui_plane::{finite2, GuiPlaneSettings, Vec2};
-use crate::validate::{finite, non_negative, positive};
-use crate::CommandError;
+use crate::settings::gui_plane::GuiPlaneSettings;
+use crate::validate::{finite, finite2, non_negative, positive};
 
 pub use crate::records::{
     EVENT_GUI_GROUND_CHANGED, EVENT_GUI_MOVED, EVENT_GUI_PATH_FINISHED, EVENT_GUI_WAYPOINT_REACHED,
@@ -70,11 +72,11 @@ pub enum GuiOp {
 }
 
 /// An op on one GUI object: the object op every plane kind shares
-/// ([`ObjectOpOf`](crate::ObjectOpOf)) over the GUI object properties and 2D impulses. `Set`
+/// ([`ObjectOpOf`]) over the GUI object properties and 2D impulses. `Set`
 /// replies `Reply::Applied`, `ApplyImpulse` (`Δv = impulse / Mass` now; wakes the body)
 /// `Reply::Velocity`, `Info` [`GuiReply::Object`], `Wake` and `Destroy` (the body and its
 /// controller) `Reply::Applied`.
-pub type GuiObjectOp = crate::ObjectOpOf<GuiObjectProp, Vec2>;
+pub type GuiObjectOp = ObjectOpOf<GuiObjectProp, Vec2>;
 
 /// A tunable of a GUI controller.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]

@@ -5,9 +5,11 @@
 use serde::{Deserialize, Serialize};
 
 pub use crate::axis_motor::AxisMotor;
-use crate::records::Handle;
+use crate::error::CommandError;
+use crate::geometry::Vec3;
+use crate::ids::Handle;
+pub use crate::joint_limits::{AXIS_NAMES, MAX_ANGLE, MAX_JOINT_VALUE};
 use crate::validate::{finite, finite3, non_negative, MAX_COORDINATE};
-use crate::{CommandError, Vec3};
 
 /// Which constraint a joint is.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -95,14 +97,6 @@ impl AxisMode {
             .find(|m| m.name() == name)
     }
 }
-
-/// The axis names of [`JointProp::Axes`], in order.
-pub const AXIS_NAMES: [&str; 6] = ["X", "Y", "Z", "RotX", "RotY", "RotZ"];
-
-/// Largest angle limit (radians): a few turns, beyond which a limit means nothing.
-pub const MAX_ANGLE: f32 = 4.0 * std::f32::consts::PI;
-/// Largest force, stiffness, damping or motor value accepted.
-pub const MAX_JOINT_VALUE: f32 = 1e12;
 
 /// One joint option. Each is checked on its own ([`JointProp::checked`]) and against the
 /// others once all are applied ([`JointSettings::check`]).

@@ -1,17 +1,24 @@
 //! The wire between the physics daemon and its clients.
 //!
+//! Layered bottom to top (each file imports only files below it; this file only declares
+//! and re-exports):
+//!
+//! - primitives: [`geometry`] (vectors, poses), [`ids`] (plane ids, handles), [`version`],
+//!   [`error`] (command errors that name their field), [`plane_kind`], [`joint_limits`],
+//!   [`validate`] (the checks and limits shared by both sides).
+//! - [`settings`]: every plane option and object property with its default and its check,
+//!   defined once for the SDK and the daemon ([`settings::row`]: what a row says,
+//!   [`settings::table`]: the table machinery, then one file per family of rows).
 //! - [`records`]: `#[repr(C)]` zero-copy records published every tick in shared memory.
+//! - the op families: [`object_op`], [`joint_op`], [`controller_op`], [`gui_op`],
+//!   [`map_op`]; [`query`]: scene queries (rays, sweeps, overlaps); [`probe`]: proximity
+//!   queries and explosions; [`collision_groups`]: named groups and which pairs collide;
+//!   [`shape`]: collision shapes.
 //! - [`command`]: the request / reply enums carried over request-response, nested by target:
 //!   [`Command`] → [`PlaneOp`] ([`plane_op`]) → [`ObjectOp`] ([`object_op`]).
-//! - [`settings`]: every plane option and object property with its default and its check,
-//!   defined once for the SDK and the daemon.
-//! - [`query`]: scene queries (rays, sweeps, overlaps); [`probe`]: proximity queries and
-//!   explosions; [`collision_groups`]: named groups
-//!   and which pairs collide.
-//! - [`shape`]: collision shapes; [`error`]: command errors that name their field.
-//! - [`codec`]: framing of those enums into bytes (version header + postcard body).
+//! - [`codec`]: framing of those enums into bytes (version header + postcard body);
+//!   [`snapshot`]: the framing of a plane's saved state.
 //! - [`names`]: domain validation and the iceoryx2 service names of one deployment.
-//! - [`validate`]: the checks and limits shared by both sides.
 //!
 //! No simulation code and no I/O live here, so both sides agree on one definition.
 
@@ -25,13 +32,17 @@ pub mod command;
 pub mod contact_points;
 pub mod controller_op;
 pub mod error;
+pub mod geometry;
 pub mod gui_op;
+pub mod ids;
+pub mod joint_limits;
 pub mod joint_op;
 pub mod map_op;
 pub mod migrate;
 pub mod names;
 pub mod object_op;
 pub mod object_op_of;
+pub mod plane_kind;
 pub mod plane_name;
 pub mod plane_op;
 pub mod probe;
@@ -43,6 +54,7 @@ pub mod shape;
 pub mod snapshot;
 pub mod snapshot_transfer;
 pub mod validate;
+pub mod version;
 
 pub use axis_motor::AxisMotor;
 pub use codec::{DecodeError, Frame};
@@ -70,10 +82,4 @@ pub use settings::{
 pub use shape::{Shape, ShapeKind};
 pub use snapshot::SnapshotHeader;
 pub use snapshot_transfer::{TransferOp, TransferReply};
-
-/// Bumped whenever a record layout or the command encoding changes. Client and daemon must
-/// agree on it; the handshake reports both values when they differ.
-pub const LAYOUT_VERSION: u32 = 11;
-
-/// The crate version both sides were built from; also checked by the handshake.
-pub const CRATE_VERSION: &str = env!("CARGO_PKG_VERSION");
+pub use version::{CRATE_VERSION, LAYOUT_VERSION};

@@ -6,9 +6,10 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::records::Handle;
+use crate::error::CommandError;
+use crate::geometry::{Pose, Vec3};
+use crate::ids::Handle;
 use crate::validate::{bounded3, pose, MAX_SIZE};
-use crate::{CommandError, Pose, Vec3};
 
 /// Most vertices plus triangles of one upload piece (the SDK's piece size; the daemon's
 /// `--max-mesh-vertices` quota applies to each piece too).

@@ -7,7 +7,8 @@
 use iceoryx2::config::Config;
 use iceoryx2::prelude::{FileName, SemanticString, ServiceName};
 
-use crate::{PlaneId, LAYOUT_VERSION};
+use crate::ids::PlaneId;
+use crate::version::LAYOUT_VERSION;
 
 /// The domain used when neither `--domain` nor [`DOMAIN_ENV`] names one.
 pub const DEFAULT_DOMAIN: &str = "physics";

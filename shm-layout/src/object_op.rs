@@ -2,8 +2,8 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::geometry::Vec3;
 use crate::settings::ObjectProp;
-use crate::Vec3;
 
 /// An op on one object.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

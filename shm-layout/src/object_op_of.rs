@@ -6,8 +6,9 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::geometry::Vec3;
+use crate::object_op::ObjectOp;
 use crate::settings::ObjectProp;
-use crate::{ObjectOp, Vec3};
 
 /// An op on one object of a plane whose properties are `P` and whose impulses are `V`
 /// (`Vec3` in 3D, `Vec2` on GUI planes). The variant order is the wire order.

@@ -5,8 +5,10 @@
 
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
-use crate::settings::table::{PropKind, PropValue, Range};
-use crate::{CommandError, PlaneId, PlaneKind};
+use crate::error::CommandError;
+use crate::ids::PlaneId;
+use crate::plane_kind::PlaneKind;
+use crate::settings::row::{PropKind, PropValue, Range};
 
 /// Longest plane name, in bytes.
 pub const MAX_NAME_LEN: usize = 32;

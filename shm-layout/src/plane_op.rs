@@ -1,40 +1,23 @@
-//! What a command does to a plane: the plane kinds, and the ops every kind understands.
+//! What a command does to a plane: the ops every kind understands (the kinds themselves
+//! are [`crate::plane_kind`]).
 //! The server handles only the lifecycle ops (`Step`, `Destroy`); everything else is handed
 //! to the plane's backend unread.
 
 use serde::{Deserialize, Serialize};
 
+pub use crate::plane_kind::PlaneKind;
+
 use crate::collision_groups::CollisionGroups;
 use crate::controller_op::ControllerOp;
+use crate::geometry::Pose;
 use crate::gui_op::GuiOp;
+use crate::ids::Handle;
 use crate::joint_op::JointOp;
 use crate::map_op::MapOp;
 use crate::object_op::ObjectOp;
 use crate::query::QueryOp;
-use crate::records::Handle;
 use crate::settings::{ObjectProp, PlaneProp};
 use crate::shape::Shape;
-use crate::Pose;
-
-/// Which backend simulates a plane. Chosen at creation.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
-pub enum PlaneKind {
-    /// A 3D plane simulated by rapier3d on the CPU.
-    #[default]
-    Rapier3d,
-    /// A 2D pixel-space plane for GUI primitives, simulated by rapier2d (`PhysicsService.NewGUI`).
-    Gui2d,
-}
-
-impl PlaneKind {
-    /// The kind in the API's words, for messages: "3D", "GUI".
-    pub fn words(self) -> &'static str {
-        match self {
-            PlaneKind::Rapier3d => "3D",
-            PlaneKind::Gui2d => "GUI",
-        }
-    }
-}
 
 /// An op on one plane.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

@@ -7,11 +7,12 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::query::{QueryFilter, MAX_QUERY_DISTANCE};
-use crate::records::Handle;
+use crate::error::CommandError;
+use crate::geometry::Vec3;
+use crate::ids::Handle;
+use crate::query::{QueryFilter, QueryOp, MAX_QUERY_DISTANCE};
 use crate::settings::controller::MAX_SLOPE_LIMIT;
 use crate::validate::{bounded3, extent, in_range, non_negative, pose, MAX_COORDINATE};
-use crate::{CommandError, QueryOp, Vec3};
 
 /// The walkable-slope limit (degrees) probes use when none is given: the controllers'
 /// `MaxSlope` default.

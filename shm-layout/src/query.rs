@@ -4,9 +4,10 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::records::Handle;
+use crate::error::CommandError;
+use crate::geometry::{Pose, Vec3};
+use crate::ids::Handle;
 use crate::validate::{bounded3, extent, pose, size, MAX_COORDINATE};
-use crate::{CommandError, Pose, Vec3};
 
 /// Most rays one [`QueryOp::Raycast`] may carry (bounds the work of one request).
 pub const MAX_RAYS: usize = 65_536;
@@ -170,7 +171,7 @@ pub enum QueryOp {
     /// `max_distance`; replies [`crate::Reply::Probe`] (negative distance: overlapping).
     Clearance {
         /// The shape (a mesh counts as the convex hull of its vertices).
-        shape: crate::Shape,
+        shape: crate::shape::Shape,
         /// Where the shape is.
         pose: Pose,
         /// Farthest object considered.

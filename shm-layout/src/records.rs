@@ -3,6 +3,8 @@
 use iceoryx2::prelude::ZeroCopySend;
 
 use crate::contact_points::{ContactPoint, MAX_CONTACT_POINTS};
+use crate::geometry::Pose;
+pub use crate::ids::Handle;
 
 /// Body flag: the slot holds a live body.
 pub const FLAG_ALIVE: u32 = 1 << 0;
@@ -14,25 +16,6 @@ pub const FLAG_ANCHORED: u32 = 1 << 2;
 pub const FLAG_ON_GROUND: u32 = 1 << 3;
 /// Body flag: the body is a character controller's capsule.
 pub const FLAG_CONTROLLER: u32 = 1 << 4;
-
-/// A stable reference to one body: the slot indexes the published array, the generation
-/// tells a reused slot from the body that used to live there.
-#[derive(
-    Debug, Clone, Copy, PartialEq, Eq, Hash, Default, serde::Serialize, serde::Deserialize,
-)]
-pub struct Handle {
-    /// Index of the body's slot in the published array.
-    pub slot: u32,
-    /// Generation of the body in that slot.
-    pub generation: u32,
-}
-
-/// `#slot.generation` (`#3.1`): how messages name an object, with no Rust syntax.
-impl core::fmt::Display for Handle {
-    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        write!(f, "#{}.{}", self.slot, self.generation)
-    }
-}
 
 /// The state of one slot after a tick. 64 bytes: one cache line per body.
 #[derive(
@@ -59,8 +42,8 @@ pub struct BodyState {
 
 impl BodyState {
     /// Its position and rotation.
-    pub fn pose(&self) -> crate::Pose {
-        crate::Pose {
+    pub fn pose(&self) -> Pose {
+        Pose {
             position: self.position,
             rotation: self.rotation,
         }

@@ -2,8 +2,9 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::error::CommandError;
+use crate::geometry::Vec3;
 use crate::validate::{bounded3, extent, size, MAX_MESH_TRIANGLES, MAX_MESH_VERTICES, MAX_SIZE};
-use crate::{CommandError, Vec3};
 
 /// Collision shape of an object.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

@@ -13,8 +13,9 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::plane_op::PlaneKind;
-use crate::{CommandError, ErrorKind, LAYOUT_VERSION};
+use crate::error::{CommandError, ErrorKind};
+use crate::plane_kind::PlaneKind;
+use crate::version::LAYOUT_VERSION;
 
 /// The eight bytes every snapshot starts with.
 pub const SNAPSHOT_MAGIC: [u8; 8] = *b"PHYSNAP1";

@@ -3,7 +3,8 @@
 //! API documents clamping) or an error; the SDK runs it to fail early, the daemon again
 //! because it trusts no client.
 
-use crate::{CommandError, Pose, Vec3};
+use crate::error::CommandError;
+use crate::geometry::{Pose, Vec3};
 
 /// Most worker threads one plane may ask for.
 pub const MAX_THREADS: u32 = 64;
@@ -172,6 +173,19 @@ pub fn finite(field: &str, v: f32) -> Result<f32, CommandError> {
             format!("{field} must be a finite number, got {v}"),
         ))
     }
+}
+
+/// Checks a 2D value: both components finite (and within the coordinate range).
+pub fn finite2(field: &str, v: [f32; 2]) -> Result<[f32; 2], CommandError> {
+    for (c, axis) in v.iter().zip(["X", "Y"]) {
+        if !c.is_finite() || c.abs() > MAX_COORDINATE {
+            return Err(CommandError::invalid_field(
+                format!("{field}.{axis}"),
+                format!("{field}.{axis} must be a finite number within ±{MAX_COORDINATE}, got {c}"),
+            ));
+        }
+    }
+    Ok(v)
 }
 
 #[cfg(test)]

@@ -3,16 +3,17 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::table::Range;
+use super::row::Range;
+use crate::error::CommandError;
+use crate::geometry::Vec3;
 use crate::validate::{in_range, MAX_COORDINATE, MAX_SIZE, MIN_SIZE};
-use crate::{CommandError, Vec3};
 
 /// Steepest `MaxSlope` (degrees): a wall is never walkable.
 pub const MAX_SLOPE_LIMIT: f32 = 89.0;
 /// Largest speed-like option (units/s).
 pub const MAX_CONTROLLER_SPEED: f32 = 10_000.0;
 
-crate::settings_table! {
+super::table::settings_table! {
     /// A controller property. Options of `NewController` are the same values. One row each:
     /// wire variant (row order is wire order: new rows go last), API name, default, range,
     /// stored field and flags (see [`super::table`]). The capsule's defaults follow the

@@ -3,10 +3,10 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::gui_plane::Vec2;
-use super::table::Range;
+use super::row::Range;
+use crate::error::CommandError;
+use crate::geometry::Vec2;
 use crate::validate::MIN_MASS;
-use crate::CommandError;
 
 /// The shape of a GUI primitive. Every shape fills its `Size` box centred on `Position`.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -49,7 +49,7 @@ impl GuiShape {
 /// Largest Friction.
 pub const MAX_GUI_FRICTION: f32 = 4.0;
 
-crate::settings_table! {
+super::table::settings_table! {
     /// A property of a GUI object. One row each: wire variant (row order is wire order: new
     /// rows go last), API name, default, range, stored field and flags (see
     /// [`super::table`]).

@@ -6,17 +6,16 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::table::Range;
-use crate::validate::MAX_COORDINATE;
-use crate::CommandError;
+use super::row::{structured_value, Range};
+use crate::error::CommandError;
 
-/// A 2D vector on the wire (pixels, pixels/s, ...).
-pub type Vec2 = [f32; 2];
+pub use crate::geometry::Vec2;
+pub use crate::validate::finite2;
 
 /// Largest `SolverIterations` of a GUI plane (the reference clamps to 1..32).
 pub const MAX_GUI_SOLVER_ITERATIONS: u32 = 32;
 
-crate::settings_table! {
+super::table::settings_table! {
     /// An option of a GUI plane.
     #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
     pub enum GuiPlaneProp;
@@ -68,6 +67,9 @@ crate::settings_table! {
     }
 }
 
+// Structured payloads: their rows check them with a `check:` function.
+structured_value!((Vec2, Vec2), GuiPlaneProp);
+
 /// `Bounds`: both corners finite, `max` at least 1 px right of and below `min`.
 fn check_bounds((min, max): (Vec2, Vec2)) -> Result<(Vec2, Vec2), CommandError> {
     let min = finite2("BoundsMin", min)?;
@@ -92,19 +94,6 @@ fn store_bounds(field: &mut Option<(Vec2, Vec2)>, v: (Vec2, Vec2)) {
 
 /// Seconds a body must stay below `RestThreshold` before it sleeps.
 pub const GUI_TIME_UNTIL_SLEEP: f32 = 0.5;
-
-/// Checks a 2D value: both components finite (and within the coordinate range).
-pub fn finite2(field: &str, v: Vec2) -> Result<Vec2, CommandError> {
-    for (c, axis) in v.iter().zip(["X", "Y"]) {
-        if !c.is_finite() || c.abs() > MAX_COORDINATE {
-            return Err(CommandError::invalid_field(
-                format!("{field}.{axis}"),
-                format!("{field}.{axis} must be a finite number within ±{MAX_COORDINATE}, got {c}"),
-            ));
-        }
-    }
-    Ok(v)
-}
 
 impl GuiPlaneSettings {
     /// Checks `prop` and stores it; `creating` allows `Bounds`. Returns the option as stored.

@@ -12,6 +12,7 @@ pub mod gui_object;
 pub mod gui_plane;
 pub mod object;
 pub mod plane;
+pub mod row;
 pub mod table;
 
 pub use controller::{ControllerProp, ControllerSettings};

@@ -3,12 +3,13 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::table::Range;
+use super::row::{structured_value, Range};
 use crate::collision_groups::MAX_COLLISION_GROUPS;
+use crate::error::CommandError;
+use crate::geometry::{Pose, Vec3};
 use crate::validate::{
     bounded3, non_negative, pose, rotation, MAX_HIT_BOX_QUALITY, MAX_SIZE, MIN_MASS,
 };
-use crate::{CommandError, Pose, Vec3};
 
 /// `FieldRestraint`: which axes an object may move along / rotate around. `None` leaves a
 /// flag as it is.
@@ -73,7 +74,10 @@ pub struct Pin {
     pub target: Pose,
 }
 
-crate::settings_table! {
+// Structured payloads: their rows check them with a `check:` function.
+structured_value!(Restraint, Option<RotateTo>, Option<Pin>);
+
+super::table::settings_table! {
     /// An object property. One row each: wire variant (row order is wire order: new rows go
     /// last), API name, default, range, stored field and flags (see [`super::table`]).
     #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]

@@ -4,12 +4,14 @@
 use serde::{Deserialize, Serialize};
 
 use super::gui_plane::GuiPlaneProp;
-use super::table::Range;
+use super::row::Range;
+use crate::error::CommandError;
+use crate::geometry::Vec3;
+use crate::plane_kind::PlaneKind;
 use crate::plane_name::PlaneName;
 use crate::validate::{MAX_SOLVER_ITERATIONS, MAX_THREADS, MAX_TICK_RATE, MIN_TICK_RATE};
-use crate::{CommandError, Vec3};
 
-crate::settings_table! {
+super::table::settings_table! {
     /// A plane option. One row each: wire variant (row order is wire order: new rows go
     /// last), API name, default, range, stored field and flags (see [`super::table`]).
     /// Options flagged `creation_only` are rejected by a later `Set`.
@@ -101,7 +103,7 @@ crate::settings_table! {
         #[derive(Debug, Clone, Default)]
         pub struct PlaneOptions {
             /// Which backend simulates the plane (default: rapier3d).
-            pub kind: Option<crate::PlaneKind>,
+            pub kind: Option<PlaneKind>,
         }
     }
 }
