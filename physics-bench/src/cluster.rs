@@ -22,7 +22,7 @@ use zenoh::Wait;
 
 use super::daemon::DaemonProcess;
 use super::error::{BenchError, BenchResult};
-use super::report::{self, goals_table, num, Goal, Table};
+use super::report::{self, num, Goal, Table};
 use super::stats::percentile;
 
 /// Options of the `cluster` subcommand.
@@ -520,7 +520,7 @@ pub fn run(args: &ClusterArgs) -> BenchResult<()> {
     };
     let md = markdown(&report);
     let (json, md_path) = report::write(&args.out, "cluster", &report, &md)?;
-    println!("{md}");
+    report::print(&md_path);
     println!("wrote {} and {}", json.display(), md_path.display());
     Ok(())
 }
@@ -560,9 +560,8 @@ fn markdown(r: &ClusterReport) -> String {
          tick's frame (changed slots only). Failover: a persistent plane on a second pair of \
          members (state folders, snapshots every 0.5 s), its daemon SIGKILLed after 2 s. \
          Migration: a 60 Hz plane moved between two members with MoveTo; the pause from \
-         tick ends.\n\n{}\n\n{}",
+         tick ends.\n\n{}",
         r.seconds,
         t.finish(),
-        goals_table(&r.goals)
     )
 }

@@ -20,7 +20,7 @@ use physics_scenes::LocalPlane;
 use shm_layout::{ControllerOp, ObjectProp, PlaneProp, Reply, Restraint};
 
 use super::error::{BenchError, BenchResult};
-use super::report::{self, goals_table, num, Goal};
+use super::report::{self, num, Goal};
 use super::scene::DT;
 
 /// Options of the `controllers` subcommand.
@@ -356,7 +356,7 @@ pub fn run(args: &ControllersArgs) -> BenchResult<()> {
     };
     let md = markdown(&report);
     let (json, md_path) = report::write(&args.out, "controllers", &report, &md)?;
-    println!("{md}");
+    report::print(&md_path);
     println!("wrote {} and {}", json.display(), md_path.display());
     Ok(())
 }
@@ -464,6 +464,5 @@ fn markdown(r: &ControllersReport) -> String {
         ]);
     }
     md.push_str(&t.finish());
-    let _ = writeln!(md, "\n{}", goals_table(&r.goals));
     md
 }

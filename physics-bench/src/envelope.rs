@@ -114,9 +114,10 @@ pub fn run(args: &EnvelopeArgs) -> BenchResult<()> {
         .iter()
         .map(|g: &GoalResult| Goal::new(g.goal.clone(), g.value.clone(), g.met))
         .collect();
-    let section = section(&goals, &crit, &fuzz, space_name);
+    // The docs section carries its goals; the page shows them in its header instead.
+    let section_docs = section(&goals, &crit, &fuzz, space_name);
     let mut md = String::from("# Envelope: the physics fuzzer\n\n");
-    md.push_str(&section);
+    md.push_str(&section(&[], &crit, &fuzz, space_name));
     md.push_str("\n## Repros\n");
     for f in &fuzz.findings {
         let _ = write!(
@@ -144,7 +145,7 @@ pub fn run(args: &EnvelopeArgs) -> BenchResult<()> {
     }
     eprintln!("envelope: wrote {} and {}", j.display(), m.display());
     if let Some(docs) = &args.docs {
-        replace_section(docs, &section)?;
+        replace_section(docs, &section_docs)?;
         eprintln!(
             "envelope: replaced the envelope section of {}",
             docs.display()

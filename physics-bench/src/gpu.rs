@@ -18,7 +18,7 @@ use physics_scenes::LocalPlane;
 use shm_layout::PlaneProp;
 
 use super::error::{BenchError, BenchResult};
-use super::report::{self, goals_table, num, Goal};
+use super::report::{self, num, Goal};
 use super::scene::DT;
 
 /// Options of the `gpu` subcommand.
@@ -132,6 +132,7 @@ pub struct GpuReport {
     pub accuracy: Vec<Accuracy>,
     /// Per-stage times (`--stages`), empty otherwise.
     pub stages: Vec<Stage>,
+    pub goals: Vec<Goal>,
 }
 
 /// The accuracy report's scenes at the plane defaults (60 Hz, 4 iterations), on the CPU and
@@ -390,17 +391,19 @@ pub fn run(args: &GpuArgs) -> BenchResult<()> {
         }
     }
     let containment = containment(if args.quick { 1_000 } else { 100_000 })?;
-    let report = GpuReport {
+    let mut report = GpuReport {
         adapter,
         cells,
         ratios,
         containment: Some(containment),
         accuracy: accuracy(),
         stages: Vec::new(),
+        goals: Vec::new(),
     };
+    report.goals = goals(&report);
     let md = markdown(&report);
     let (json, md_path) = report::write(&args.out, "gpu", &report, &md)?;
-    println!("{md}");
+    report::print(&md_path);
     println!("wrote {} and {}", json.display(), md_path.display());
     Ok(())
 }
@@ -410,7 +413,7 @@ fn run_stages(adapter: &str, out: &std::path::Path) -> BenchResult<()> {
     let rows = stages()?;
     let ratio = interleaved_ratio(Path::GpuHash, 10_000)?;
     println!("GPU, spatial hash 10000 → 40000: ×{}", num(Some(ratio)));
-    let report = GpuReport {
+    let mut report = GpuReport {
         adapter: adapter.into(),
         cells: Vec::new(),
         ratios: vec![Ratio {
@@ -422,12 +425,42 @@ fn run_stages(adapter: &str, out: &std::path::Path) -> BenchResult<()> {
         containment: None,
         accuracy: Vec::new(),
         stages: rows,
+        goals: Vec::new(),
     };
+    report.goals = goals(&report);
     let md = markdown(&report);
     let (json, md_path) = report::write(out, "gpu-stages", &report, &md)?;
-    println!("{md}");
+    report::print(&md_path);
     println!("wrote {} and {}", json.display(), md_path.display());
     Ok(())
+}
+
+/// The goals: O(N) scaling of the hash path, and the container keeping its bodies.
+fn goals(r: &GpuReport) -> Vec<Goal> {
+    let mut goals = Vec::new();
+    if let Some(x) = r
+        .ratios
+        .iter()
+        .filter(|x| x.path == Path::GpuHash)
+        .max_by_key(|x| x.to)
+    {
+        goals.push(Goal::new(
+            format!("GPU hash scales as O(N): time(4N)/time(N) ≤ {GOAL_RATIO} at the largest N"),
+            format!("{} ({} → {})", num(Some(x.ratio)), x.from, x.to),
+            Some(x.ratio <= GOAL_RATIO),
+        ));
+    }
+    if let Some(c) = &r.containment {
+        goals.push(Goal::new(
+            format!(
+                "{} bodies stay finite and inside the box for 10 s",
+                c.bodies
+            ),
+            format!("finite: {}, outside: {}", c.finite, c.escaped),
+            Some(c.finite && c.escaped == 0),
+        ));
+    }
+    goals
 }
 
 fn markdown(r: &GpuReport) -> String {
@@ -485,19 +518,6 @@ fn markdown(r: &GpuReport) -> String {
         ]);
     }
     md.push_str(&t.finish());
-    let mut goals = Vec::new();
-    if let Some(x) = r
-        .ratios
-        .iter()
-        .filter(|x| x.path == Path::GpuHash)
-        .max_by_key(|x| x.to)
-    {
-        goals.push(Goal::new(
-            format!("GPU hash scales as O(N): time(4N)/time(N) ≤ {GOAL_RATIO} at the largest N"),
-            format!("{} ({} → {})", num(Some(x.ratio)), x.from, x.to),
-            Some(x.ratio <= GOAL_RATIO),
-        ));
-    }
     if let Some(c) = &r.containment {
         let _ = writeln!(
             md,
@@ -510,14 +530,6 @@ fn markdown(r: &GpuReport) -> String {
             c.max_penetration,
             num(Some(c.tick_ms))
         );
-        goals.push(Goal::new(
-            format!(
-                "{} bodies stay finite and inside the box for 10 s",
-                c.bodies
-            ),
-            format!("finite: {}, outside: {}", c.finite, c.escaped),
-            Some(c.finite && c.escaped == 0),
-        ));
     }
     if !r.stages.is_empty() {
         let _ = writeln!(
@@ -552,7 +564,6 @@ fn markdown(r: &GpuReport) -> String {
         }
         md.push_str(&t.finish());
     }
-    let _ = writeln!(md, "\n{}", goals_table(&goals));
     let _ = writeln!(
         md,
         "\n## Accuracy: the accuracy report's scenes at the defaults (60 Hz, 4 iterations)\n"

@@ -16,7 +16,7 @@ use client_sdk::{Client, Error, Handle, PlaneOptions, Pose, Shape};
 
 use super::daemon::DaemonProcess;
 use super::error::{BenchError, BenchResult};
-use super::report::{self, goals_table, num, Goal};
+use super::report::{self, num, Goal};
 use super::stats::{self, Spread};
 
 /// Options of the `load` subcommand.
@@ -147,7 +147,7 @@ pub fn run(args: &LoadArgs) -> BenchResult<()> {
     report.goals = goals(&report);
     let md = render(&report);
     let (json, md_path) = report::write(&args.out, "load", &report, &md)?;
-    println!("{md}");
+    report::print(&md_path);
     eprintln!("wrote {} and {}", json.display(), md_path.display());
     let errors: Vec<&str> = report
         .per_client
@@ -498,8 +498,6 @@ fn render(r: &LoadReport) -> String {
         r.cpus,
         r.seconds
     );
-    md.push_str("## Goals\n\n");
-    md.push_str(&goals_table(&r.goals));
     let spread = |s: &Option<Spread>| {
         s.map_or("—".into(), |s| {
             format!(

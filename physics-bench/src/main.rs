@@ -14,6 +14,11 @@
 //! `physics-bench envelope [--seed N] [--minutes M | --cases N] [--out DIR] [--docs FILE]`
 //! writes DIR/envelope.json, DIR/envelope.md and the failures' Luau repros (the physics
 //! fuzzer, crate `physics-envelope`); `--docs` replaces FILE's envelope section.
+//! `physics-bench render [--to DIR] FILE.json...` renders report pages from their JSON into
+//! DIR (default docs/reports) with an index, without rerunning.
+//!
+//! Every page has a header (machine, date, build, command line) and the goals table, both
+//! rendered from the report's JSON (see [`report`]).
 //!
 //! Its parts, shared by the subcommands:
 //!
@@ -22,7 +27,8 @@
 //! - [`scene`]: the benchmark scenes, built identically in the daemon and in process.
 //! - [`stats`]: medians and percentiles.
 //! - [`progress`]: the progress bar and its log lines.
-//! - [`report`]: writing the JSON and markdown reports.
+//! - [`report`]: writing the JSON reports and rendering their pages.
+//! - [`render`]: the `render` subcommand (pages and their index from stored JSON).
 //! - [`ipc`]: the `ipc` subcommand (daemon overhead, delivery, requests, idle, memory).
 //! - [`sim`]: an in-process plane stepped at a fixed dt with its step time accumulated.
 //! - [`accuracy`]: the `accuracy` subcommand (error against run time).
@@ -45,6 +51,7 @@ mod persist;
 mod procfs;
 mod progress;
 mod queries;
+mod render;
 mod report;
 mod scene;
 mod sim;
@@ -117,6 +124,10 @@ enum Bench {
     /// drops, springs, piles) judged by physical-law oracles, failures shrunk to Luau
     /// repros, and each family's critical value at the defaults and a strong setting.
     Envelope(envelope::EnvelopeArgs),
+    /// Renders report pages from the JSON a bench wrote (header: machine, date, build,
+    /// command; the goals; the bench's tables) into a folder, docs/reports by default, with
+    /// its index README.md, without rerunning the bench.
+    Render(render::RenderArgs),
 }
 
 fn main() -> ExitCode {
@@ -148,6 +159,7 @@ fn main() -> ExitCode {
         Bench::Cluster(args) => cluster::run(args),
         Bench::Frame(args) => frame::run(args),
         Bench::Envelope(args) => envelope::run(args),
+        Bench::Render(args) => render::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -172,7 +172,7 @@ pub fn run(args: &MapsArgs) -> BenchResult<()> {
     };
     let md = markdown(&report);
     let (json, md_path) = report::write(&args.out, "maps", &report, &md)?;
-    println!("{md}");
+    report::print(&md_path);
     println!("wrote {} and {}", json.display(), md_path.display());
     Ok(())
 }

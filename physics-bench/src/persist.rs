@@ -13,7 +13,7 @@ use client_sdk::{Client, Plane, PlaneName, PlaneOptions, PlaneProp, Pose, Shape}
 
 use super::daemon::DaemonProcess;
 use super::error::{BenchError, BenchResult};
-use super::report::{self, goals_table, num, Goal, Table};
+use super::report::{self, num, Goal, Table};
 
 /// Options of the `persist` subcommand.
 #[derive(Debug, Clone, clap::Args)]
@@ -154,7 +154,7 @@ pub fn run(args: &PersistArgs) -> BenchResult<()> {
     };
     let md = markdown(&report);
     let (json, md_path) = report::write(&args.out, "persist", &report, &md)?;
-    println!("{md}");
+    report::print(&md_path);
     println!("wrote {} and {}", json.display(), md_path.display());
     Ok(())
 }
@@ -172,11 +172,10 @@ fn markdown(r: &PersistReport) -> String {
     }
     format!(
         "# Persistence\n\n{} awake bodies, the persistent plane written every {} s ({} KiB a \
-         file); client-observed Step times, the two planes stepped alternately.\n\n{}\n\n{}",
+         file); client-observed Step times, the two planes stepped alternately.\n\n{}",
         r.bodies,
         r.every_s,
         r.file_bytes / 1024,
         t.finish(),
-        goals_table(&r.goals)
     )
 }

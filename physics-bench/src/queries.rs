@@ -12,7 +12,7 @@ use shm_layout::{QueryFilter, QueryOp, Reply};
 
 use super::daemon::DaemonProcess;
 use super::error::{BenchError, BenchResult};
-use super::report::{self, goals_table, num, Goal};
+use super::report::{self, num, Goal};
 use super::scene::{Kind, Scene};
 
 /// Options of the `queries` subcommand.
@@ -52,6 +52,7 @@ pub struct Row {
 pub struct QueriesReport {
     pub bodies: usize,
     pub rows: Vec<Row>,
+    pub goals: Vec<Goal>,
 }
 
 /// Deterministic rays through the scene's box: from a random point, a random direction,
@@ -154,11 +155,12 @@ pub fn run(args: &QueriesArgs) -> BenchResult<()> {
     }
     let report = QueriesReport {
         bodies: args.bodies,
+        goals: goals(&rows),
         rows,
     };
     let md = markdown(&report);
     let (json, md_path) = report::write(&args.out, "queries", &report, &md)?;
-    println!("{md}");
+    report::print(&md_path);
     println!("wrote {} and {}", json.display(), md_path.display());
     Ok(())
 }
@@ -178,6 +180,30 @@ fn check_same(local: &[Option<Hit>], remote: &[Option<Hit>]) -> BenchResult<()> 
         }
     }
     Ok(())
+}
+
+/// One goal per batch size, judged on the large batch only.
+fn goals(rows: &[Row]) -> Vec<Goal> {
+    // The goal is judged on the large batch; smaller ones are dominated by the fixed cost of
+    // one round trip (shown in the table) and carry no verdict.
+    rows.iter()
+        .map(|row| {
+            let judged = row.batch == GOAL_BATCH;
+            Goal::new(
+                format!(
+                    "RaycastMany of {} rays within {GOAL_RATIO}× of in-process throughput{}",
+                    row.batch,
+                    if judged {
+                        ""
+                    } else {
+                        " (reported, not judged)"
+                    }
+                ),
+                format!("{}×", num(Some(row.ratio))),
+                judged.then_some(row.ratio <= GOAL_RATIO),
+            )
+        })
+        .collect()
 }
 
 fn markdown(r: &QueriesReport) -> String {
@@ -207,29 +233,6 @@ fn markdown(r: &QueriesReport) -> String {
         ]);
     }
     md.push_str(&t.finish());
-    // The goal is judged on the large batch; smaller ones are dominated by the fixed cost of
-    // one round trip (shown in the table) and carry no verdict.
-    let goals: Vec<Goal> = r
-        .rows
-        .iter()
-        .map(|row| {
-            let judged = row.batch == GOAL_BATCH;
-            Goal::new(
-                format!(
-                    "RaycastMany of {} rays within {GOAL_RATIO}× of in-process throughput{}",
-                    row.batch,
-                    if judged {
-                        ""
-                    } else {
-                        " (reported, not judged)"
-                    }
-                ),
-                format!("{}×", num(Some(row.ratio))),
-                judged.then_some(row.ratio <= GOAL_RATIO),
-            )
-        })
-        .collect();
-    let _ = writeln!(md, "\n{}", goals_table(&goals));
     let _ = writeln!(
         md,
         "\nA batch pays one round trip (about {} µs here) however many rays it carries: below a \

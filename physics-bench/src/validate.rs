@@ -140,7 +140,7 @@ pub fn run(
         Some((_, what)) => format!("# Snapshot validation\n\nThe replay diverged: {what}.\n"),
     };
     let (json, md_path) = report::write(out, "snapshot-validate", &report, &md)?;
-    println!("{md}");
+    report::print(&md_path);
     println!("wrote {} and {}", json.display(), md_path.display());
     match found {
         None => Ok(()),

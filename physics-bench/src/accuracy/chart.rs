@@ -6,8 +6,8 @@ use std::path::{Path, PathBuf};
 
 use plotters::prelude::*;
 
+use super::point::Point;
 use super::sweep::Family;
-use super::Point;
 use crate::error::{BenchError, BenchResult};
 
 const COLORS: [RGBColor; 3] = [

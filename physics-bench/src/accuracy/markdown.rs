@@ -3,7 +3,7 @@
 
 use std::fmt::Write as _;
 
-use super::{scene_info, Point};
+use super::point::{scene_info, Point};
 use crate::report::Table;
 
 /// Three significant digits, scientific: errors and costs span many decades.

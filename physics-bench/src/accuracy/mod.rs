@@ -5,6 +5,7 @@
 mod chart;
 pub mod markdown;
 mod pareto;
+mod point;
 pub(crate) mod scenes;
 mod scenes_2d;
 pub mod sweep;
@@ -17,6 +18,7 @@ use super::report;
 use super::sim::Config;
 use super::stability::adaptive_cost;
 use super::stats::median;
+use point::Point;
 
 /// Options of the `accuracy` subcommand.
 #[derive(Debug, Clone, clap::Args)]
@@ -30,20 +32,15 @@ pub struct AccuracyArgs {
     pub out: PathBuf,
 }
 
-/// One scene at one configuration.
-#[derive(Debug, Clone, serde::Serialize)]
-pub struct Point {
-    pub scene: &'static str,
-    #[serde(flatten)]
-    pub config: Config,
-    pub dt: f32,
-    /// NaN (null in JSON) when a body went non-finite.
-    pub error: f64,
-    pub error_unit: &'static str,
-    /// Median wall seconds of step calls per simulated second.
-    pub cost: f64,
-    pub pareto: bool,
-    pub is_default: bool,
+/// accuracy.json: every point, and the cost of adaptive solving with its goals (the only
+/// goals of this report: error against cost is a trade-off, not a verdict).
+#[derive(serde::Serialize)]
+struct AccuracyReport<'a> {
+    quick: bool,
+    repeats: usize,
+    points: &'a [Point],
+    adaptive: &'a adaptive_cost::CostReport,
+    goals: &'a [report::Goal],
 }
 
 pub fn run(args: &AccuracyArgs) -> BenchResult<()> {
@@ -123,19 +120,18 @@ pub fn run(args: &AccuracyArgs) -> BenchResult<()> {
         &cost,
         &adaptive_cost::markdown(&cost),
     )?;
-    let (json, md_path) = report::write(&args.out, "accuracy", &points, &md)?;
+    let report = AccuracyReport {
+        quick: args.quick,
+        repeats,
+        points: &points,
+        adaptive: &cost,
+        goals: &cost.goals,
+    };
+    let (json, md_path) = report::write(&args.out, "accuracy", &report, &md)?;
     let charts = chart::draw_all(&args.out, &points)?;
     println!("wrote {}, {}", json.display(), md_path.display());
     for c in charts {
         println!("wrote {}", c.display());
     }
     Ok(())
-}
-
-/// The reference scenes, for the report's headings.
-pub fn scene_info(name: &str) -> Option<&'static scenes::Scene> {
-    scenes::SCENES
-        .iter()
-        .chain(scenes_2d::SCENES_2D)
-        .find(|s| s.name == name)
 }

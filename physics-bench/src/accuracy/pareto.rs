@@ -1,7 +1,7 @@
 //! Pareto-optimal points: no other point of the scene is at least as accurate and as cheap
 //! and strictly better in one of the two.
 
-use super::Point;
+use super::point::Point;
 
 pub fn mark(points: &mut [Point]) {
     let flags: Vec<bool> = points

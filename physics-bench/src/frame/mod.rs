@@ -32,7 +32,7 @@ use physics_scenes::{LocalPlane, SceneTarget};
 
 use super::daemon::DaemonProcess;
 use super::error::{BenchError, BenchResult};
-use super::report::{self, goals_table, num, Goal, Table};
+use super::report::{self, num, Goal, Table};
 use super::scene::{asleep_fraction, touch, DT};
 use super::stats::{percentile, spread, Spread};
 
@@ -543,7 +543,7 @@ pub fn run(args: &FrameArgs) -> BenchResult<()> {
     };
     let md = markdown(&report);
     let (json, md_path) = report::write(&args.out, "frame", &report, &md)?;
-    println!("{md}");
+    report::print(&md_path);
     println!("wrote {} and {}", json.display(), md_path.display());
     Ok(())
 }
@@ -583,7 +583,7 @@ fn markdown(r: &FrameReport) -> String {
          a settled pile, {:.0} % asleep at the end) and writing {} velocities. The daemon's \
          plane stepped in {} ms on its timer and {} ms stepped after each frame (median tick \
          headers) on the other core. {} blocks of {} frames per mode, alternating; load \
-         average {:.2} → {:.2}.\n\n{}\n\n{}",
+         average {:.2} → {:.2}.\n\n{}",
         r.bodies,
         num(Some(r.game_work_ms)),
         r.bodies,
@@ -596,6 +596,5 @@ fn markdown(r: &FrameReport) -> String {
         r.load_average[0],
         r.load_average[1],
         t.finish(),
-        goals_table(&r.goals)
     )
 }

@@ -3,8 +3,8 @@
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 
-use super::FuzzReport;
-use crate::report::{goals_table, mib, num, Table};
+use super::fuzz_report::FuzzReport;
+use crate::report::{mib, num, Table};
 
 /// How the run is made (also stored in the JSON).
 pub fn method() -> BTreeMap<&'static str, &'static str> {
@@ -74,8 +74,6 @@ pub fn render(r: &FuzzReport) -> String {
         r.seconds,
         r.daemon_flags.join(" ")
     );
-    md.push_str("## Goals\n\n");
-    md.push_str(&goals_table(&r.goals));
 
     let _ = writeln!(
         md,

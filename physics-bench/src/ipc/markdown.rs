@@ -3,8 +3,9 @@
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 
-use super::{IpcReport, GOAL_BODIES};
-use crate::report::{num, verdict, Table};
+use super::ipc_report::IpcReport;
+use super::plan::GOAL_BODIES;
+use crate::report::{num, Table};
 use crate::scene::Kind;
 
 /// How each figure is obtained (also stored in the JSON).
@@ -115,14 +116,7 @@ pub fn render(r: &IpcReport) -> String {
         r.seconds
     );
 
-    md.push_str("## Goals\n\n");
-    let mut t = Table::new(&["goal", "measured", "verdict"]);
-    for g in &r.goals {
-        t.row(&[g.goal.clone(), g.value.clone(), verdict(g.met).into()]);
-    }
-    md.push_str(&t.finish());
-
-    md.push_str("\n## Overhead and delivery per scene\n\n");
+    md.push_str("## Overhead and delivery per scene\n\n");
     let mut t = Table::new(&[
         "bodies",
         "scene",

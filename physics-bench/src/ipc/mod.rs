@@ -2,9 +2,11 @@
 //! game process, and how delivery compares with the usual serialise-over-a-socket way.
 
 mod idle;
+mod ipc_report;
 mod lua;
 mod many_planes;
 mod markdown;
+mod plan;
 mod planes;
 mod scene_run;
 mod socket;
@@ -18,14 +20,10 @@ use super::error::{BenchError, BenchResult};
 use super::progress::Progress;
 use super::report::{self, Goal};
 use super::scene::{Kind, Scene};
-use super::stats::Spread;
-
-pub use idle::IdleCpu;
-pub use lua::LuaReads;
-pub use many_planes::ManyPlanes;
-pub use planes::{HeadOfLine, MultiPlane};
-pub use scene_run::{Delivery, Memory, Overhead, Requests};
-pub use threads::{Threads, ThreadsScene};
+use ipc_report::{IpcReport, SizeReport};
+use many_planes::ManyPlanes;
+use plan::{Plan, GOAL_BODIES};
+use threads::ThreadsScene;
 
 /// Options of the `ipc` subcommand.
 #[derive(Debug, Clone, clap::Args)]
@@ -39,97 +37,6 @@ pub struct IpcArgs {
     /// Only the many-planes row (writes ipc-many-planes.json and .md).
     #[arg(long)]
     pub many_planes_only: bool,
-}
-
-/// The size at which the goals are judged (and the only size of `--quick`).
-pub const GOAL_BODIES: usize = 10_000;
-
-/// How much to measure.
-#[derive(Debug, Clone, serde::Serialize)]
-pub struct Plan {
-    pub sizes: Vec<usize>,
-    /// Timed blocks per scene and side (the figure is the median).
-    pub repeats: usize,
-    pub delivery_ticks: usize,
-    #[serde(skip)]
-    pub delivery_time_cap: Duration,
-    pub round_trips: usize,
-    pub batch_size: usize,
-    pub batches: usize,
-    pub idle_window_s: u64,
-    /// Round trips per side of the head-of-line figure.
-    pub head_of_line_round_trips: usize,
-    /// Seconds per side of the multi-plane figure.
-    pub multi_plane_s: f64,
-    /// Seconds of ticking per side of the many-planes figure.
-    pub many_planes_s: f64,
-}
-
-impl Plan {
-    pub fn new(quick: bool) -> Plan {
-        if quick {
-            Plan {
-                sizes: vec![GOAL_BODIES],
-                repeats: 3,
-                delivery_ticks: 30,
-                delivery_time_cap: Duration::from_secs(4),
-                round_trips: 1_000,
-                batch_size: 1_000,
-                batches: 10,
-                idle_window_s: 10,
-                head_of_line_round_trips: 1_000,
-                multi_plane_s: 3.0,
-                many_planes_s: 5.0,
-            }
-        } else {
-            Plan {
-                sizes: vec![100, 1_000, GOAL_BODIES, 50_000],
-                repeats: 7,
-                delivery_ticks: 60,
-                delivery_time_cap: Duration::from_secs(8),
-                round_trips: 5_000,
-                batch_size: 1_000,
-                batches: 30,
-                idle_window_s: 60,
-                head_of_line_round_trips: 3_000,
-                multi_plane_s: 6.0,
-                many_planes_s: 10.0,
-            }
-        }
-    }
-}
-
-/// Figures of one scene size, per scene kind.
-#[derive(Debug, Clone, serde::Serialize)]
-pub struct SizeReport {
-    pub bodies: usize,
-    pub overhead_ratio: BTreeMap<Kind, f64>,
-    pub delivery: BTreeMap<Kind, Delivery>,
-    /// Tick times behind the ratio.
-    pub ticks: BTreeMap<Kind, Overhead>,
-}
-
-#[derive(Debug, Clone, serde::Serialize)]
-pub struct IpcReport {
-    pub quick: bool,
-    pub plan: Plan,
-    pub method: BTreeMap<&'static str, &'static str>,
-    pub scenes: Vec<SizeReport>,
-    pub round_trip_us: Spread,
-    pub batched_writes_per_s: f64,
-    pub requests: Requests,
-    /// Threads = 2 against 1, one entry per scene (see `threads`).
-    pub threads: Vec<Threads>,
-    pub head_of_line: HeadOfLine,
-    pub multi_plane: MultiPlane,
-    pub lua: LuaReads,
-    pub idle_cpu_percent: IdleCpu,
-    pub memory: Vec<Memory>,
-    pub goals: Vec<Goal>,
-    pub cpus: usize,
-    pub seconds: f64,
-    /// 100 planes × 1,000 bodies at 60 Hz against one plane of 100,000 (see `many_planes`).
-    pub many_planes: ManyPlanes,
 }
 
 pub fn run(args: &IpcArgs) -> BenchResult<()> {
@@ -279,7 +186,7 @@ pub fn run(args: &IpcArgs) -> BenchResult<()> {
     report.seconds = started.elapsed().as_secs_f64();
     let md = markdown::render(&report);
     let (json, md_path) = report::write(&args.out, "ipc", &report, &md)?;
-    println!("{md}");
+    report::print(&md_path);
     eprintln!(
         "wrote {} and {} in {:.0} s",
         json.display(),
@@ -355,16 +262,13 @@ fn many_planes_only(args: &IpcArgs, plan: &Plan) -> BenchResult<()> {
         goals: Vec<Goal>,
     }
     let goals = many_planes_goals(&m);
-    let md = format!(
-        "# physics-bench ipc --many-planes-only\n\n{}",
-        report::goals_table(&goals)
-    );
+    let md = "# physics-bench ipc --many-planes-only\n".to_string();
     let only = Only {
         many_planes: &m,
         goals,
     };
     let (json, md_path) = report::write(&args.out, "ipc-many-planes", &only, &md)?;
-    println!("{md}");
+    report::print(&md_path);
     eprintln!("wrote {} and {}", json.display(), md_path.display());
     Ok(())
 }

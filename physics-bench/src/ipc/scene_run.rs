@@ -10,7 +10,8 @@ use physics_daemon::publish::PlaneOutput;
 use physics_scenes::LocalPlane;
 use shm_layout::{monotonic_ns, names};
 
-use super::{socket, Plan};
+use super::plan::Plan;
+use super::socket;
 use crate::daemon::{unique_domain, DaemonProcess};
 use crate::error::{BenchError, BenchResult};
 use crate::procfs;

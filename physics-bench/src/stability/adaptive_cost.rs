@@ -9,7 +9,7 @@ use client_sdk::{ObjectProp, PlaneProp};
 use physics_scenes::{column, floor, pile, pyramid};
 
 use crate::error::BenchResult;
-use crate::report::{self, Goal, Table};
+use crate::report::{Goal, Table};
 use crate::sim::{Config, Sim};
 
 /// One scene's cost with and without adaptive solving.
@@ -185,10 +185,8 @@ pub fn markdown(r: &CostReport) -> String {
     }
     format!(
         "# Adaptive solving: what it costs\n\nEach scene twice (AdaptiveSolving on and off, \
-         the defaults otherwise), stepped in alternating blocks in one run; median step.\n\n{}\n\
-         ## Goals\n\n{}",
+         the defaults otherwise), stepped in alternating blocks in one run; median step.\n\n{}",
         t.finish(),
-        report::goals_table(&r.goals)
     )
 }
 

@@ -3,7 +3,7 @@
 
 use std::fmt::Write as _;
 
-use super::Entry;
+use super::entry::Entry;
 use crate::accuracy::markdown::sci;
 use crate::report::Table;
 use crate::sim::Config;

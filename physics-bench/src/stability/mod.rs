@@ -3,6 +3,8 @@
 
 pub(crate) mod adaptive_cost;
 mod before;
+mod check;
+mod entry;
 mod markdown;
 pub mod scenes;
 mod stress;
@@ -15,7 +17,8 @@ use super::error::BenchResult;
 use super::progress::Progress;
 use super::report;
 use super::sim::Config;
-use scenes::Check;
+use check::Check;
+use entry::{Entry, Remedy};
 use sweeps::SweepPoint;
 
 /// Options of the `stability` subcommand.
@@ -33,45 +36,6 @@ pub struct StabilityArgs {
     pub quick: bool,
 }
 
-/// A configuration that makes a failing scene pass, and what it costs.
-#[derive(Debug, Clone, serde::Serialize)]
-pub struct Remedy {
-    #[serde(flatten)]
-    pub config: Config,
-    pub figure: f64,
-    pub cost: f64,
-}
-
-/// One line of stability.json: a scene, or a sweep judged by its critical value.
-#[derive(Debug, Clone, serde::Serialize)]
-pub struct Entry {
-    pub scene: &'static str,
-    pub criterion: String,
-    pub pass: bool,
-    pub figure: f64,
-    pub bound: f64,
-    pub unit: &'static str,
-    pub config: Config,
-    pub finite: bool,
-    pub cost: f64,
-    /// For a scene failing at its configuration: the cheapest candidate that passes
-    /// (`None` with `remedy_searched` when none does).
-    pub remedy: Option<Remedy>,
-    /// Configurations tried for a remedy (0: the scene passed).
-    pub remedy_candidates: usize,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub critical_default: Option<f64>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub critical_strongest: Option<f64>,
-    #[serde(skip_serializing_if = "Vec::is_empty")]
-    pub points: Vec<SweepPoint>,
-    /// The scene's figure before articulations, in words (see `before`).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub before: Option<&'static str>,
-    /// Wall seconds the scene took (its remedy search included).
-    pub wall_s: f64,
-}
-
 /// Configurations tried on a scene failing at `at`: the whole TickRate × SolverIterations ×
 /// HitBoxQuality grid of the accuracy bench (the strongest configuration included). A scene
 /// about a tick rate keeps its tick rate.
@@ -85,6 +49,15 @@ fn candidates(at: Config) -> Vec<Config> {
         v.dedup();
     }
     v
+}
+
+/// stability.json: one entry per scene and sweep, and the goal they add up to.
+#[derive(serde::Serialize)]
+struct StabilityReport<'a> {
+    quick: bool,
+    only: Option<&'a str>,
+    entries: &'a [Entry],
+    goals: Vec<report::Goal>,
 }
 
 pub fn run(args: &StabilityArgs) -> BenchResult<()> {
@@ -213,7 +186,19 @@ pub fn run(args: &StabilityArgs) -> BenchResult<()> {
     }
     progress.finish();
     let md = markdown::render(&entries);
-    let (json, md_path) = report::write(&args.out, "stability", &entries, &md)?;
+    let passed = entries.iter().filter(|e| e.pass).count();
+    let goals = vec![report::Goal::new(
+        "every stress scene and sweep passes its criterion",
+        format!("{passed} of {} pass", entries.len()),
+        Some(passed == entries.len()),
+    )];
+    let json = StabilityReport {
+        quick: args.quick,
+        only: args.only.as_deref(),
+        entries: &entries,
+        goals,
+    };
+    let (json, md_path) = report::write(&args.out, "stability", &json, &md)?;
     println!("wrote {}, {}", json.display(), md_path.display());
     let cost = adaptive_cost::measure(args.quick)?;
     let (json, md_path) = report::write(

@@ -8,33 +8,10 @@ use client_sdk::{Handle, ObjectProp, Pin, PlaneProp, Pose};
 use physics_scenes::{ball, column, floor, launched_box, overlapping_pile, thin_wall};
 use shm_layout::settings::plane::DEFAULT_MAX_LINEAR_SPEED;
 
+use super::check::Check;
 use super::stress;
 use crate::error::BenchResult;
 use crate::sim::{distance, Config, Sim};
-
-/// What one run of a scene measured.
-#[derive(Debug, Clone, Copy, serde::Serialize)]
-pub struct Check {
-    pub figure: f64,
-    pub bound: f64,
-    pub pass: bool,
-    pub finite: bool,
-    pub cost: f64,
-}
-
-impl Check {
-    /// Pass when the scene stayed finite and `figure <= bound`.
-    pub(super) fn at_most(sim: &Sim, figure: f64, bound: f64) -> Check {
-        let finite = !sim.went_nonfinite;
-        Check {
-            figure,
-            bound,
-            pass: finite && figure <= bound,
-            finite,
-            cost: sim.cost(),
-        }
-    }
-}
 
 /// A scene at one configuration.
 pub struct Scene {

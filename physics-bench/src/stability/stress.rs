@@ -7,7 +7,7 @@ use physics_scenes::{
     anchored_box, cube, determinism_scene, floor, pyramid, thin_wall, CARD_HOUSE_SETTLE,
 };
 
-use super::scenes::Check;
+use super::check::Check;
 use crate::error::BenchResult;
 use crate::sim::{about_z, distance, Config, Sim};
 

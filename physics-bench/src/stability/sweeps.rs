@@ -1,7 +1,8 @@
 //! Sweeps for critical values: the tallest stack, the largest mass ratio, the highest speed
 //! that still pass, at the defaults and at the strongest configuration.
 
-use super::scenes::{fast_box, heavy_on_light, stack, Check};
+use super::check::Check;
+use super::scenes::{fast_box, heavy_on_light, stack};
 use crate::error::BenchResult;
 use crate::sim::Config;
 

@@ -1,0 +1,84 @@
+//! `physics-bench render --to DIR FILE.json...`: renders report pages from their JSON
+//! alone, without rerunning a bench. Each FILE.json (written by a bench into its --out
+//! folder) is copied into DIR as NAME.json beside its page NAME.md, and DIR/README.md, the
+//! index, is rendered from every report JSON in DIR. `physics-bench render --to
+//! docs/reports docs/reports/*.json` renders the stored pages again.
+
+use std::path::{Path, PathBuf};
+
+use super::error::{BenchError, BenchResult};
+use super::report::page::{self, Parts};
+
+/// Options of the `render` subcommand.
+#[derive(Debug, Clone, clap::Args)]
+pub struct RenderArgs {
+    /// Report JSON files, as a bench wrote them (NAME.json in its --out folder).
+    #[arg(required = true)]
+    pub from: Vec<PathBuf>,
+    /// Folder receiving NAME.json, NAME.md and README.md.
+    #[arg(long, default_value = "docs/reports")]
+    pub to: PathBuf,
+}
+
+pub fn run(args: &RenderArgs) -> BenchResult<()> {
+    std::fs::create_dir_all(&args.to)
+        .map_err(BenchError::io(format!("create {}", args.to.display())))?;
+    for from in &args.from {
+        let (text, json) = read(from)?;
+        let markdown = page::render(&json).map_err(|e| failed(from, e))?;
+        let bench = Parts::from_json(&json)
+            .map_err(|e| failed(from, e))?
+            .run
+            .bench;
+        let json_to = args.to.join(format!("{bench}.json"));
+        if !same_file(from, &json_to) {
+            std::fs::write(&json_to, &text)
+                .map_err(BenchError::io(format!("write {}", json_to.display())))?;
+        }
+        let md_to = args.to.join(format!("{bench}.md"));
+        std::fs::write(&md_to, markdown)
+            .map_err(BenchError::io(format!("write {}", md_to.display())))?;
+        println!("wrote {} and {}", json_to.display(), md_to.display());
+    }
+    let index = args.to.join("README.md");
+    std::fs::write(&index, page::index(&reports_in(&args.to)?))
+        .map_err(BenchError::io(format!("write {}", index.display())))?;
+    println!("wrote {}", index.display());
+    Ok(())
+}
+
+fn failed(path: &Path, e: String) -> BenchError {
+    BenchError::Failed(format!("{}: {e}", path.display()))
+}
+
+fn read(path: &Path) -> BenchResult<(String, serde_json::Value)> {
+    let text = std::fs::read_to_string(path)
+        .map_err(BenchError::io(format!("read {}", path.display())))?;
+    let json = serde_json::from_str(&text).map_err(|e| failed(path, e.to_string()))?;
+    Ok((text, json))
+}
+
+fn same_file(a: &Path, b: &Path) -> bool {
+    match (a.canonicalize(), b.canonicalize()) {
+        (Ok(a), Ok(b)) => a == b,
+        _ => false,
+    }
+}
+
+/// Every report in `dir` (the JSON files with a `run`), by name.
+fn reports_in(dir: &Path) -> BenchResult<Vec<Parts>> {
+    let entries =
+        std::fs::read_dir(dir).map_err(BenchError::io(format!("list {}", dir.display())))?;
+    let mut paths: Vec<PathBuf> = entries
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|x| x == "json"))
+        .collect();
+    paths.sort();
+    let mut reports = Vec::new();
+    for path in paths {
+        if let Ok(parts) = Parts::from_json(&read(&path)?.1) {
+            reports.push(parts);
+        }
+    }
+    Ok(reports)
+}
