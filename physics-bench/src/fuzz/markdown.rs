@@ -74,10 +74,9 @@ pub fn render(r: &FuzzReport) -> String {
         r.seconds,
         r.daemon_flags.join(" ")
     );
-
     let _ = writeln!(
         md,
-        "\n## Frames\n\n\
+        "## Frames\n\n\
          - batches: {}\n\
          - frames: {} ({} frames/s): {} structured, {} raw, {} in quota rounds, {} probes\n\
          - commands (in frames the daemon decoded, each with its own result): {} ({} \
