@@ -40,10 +40,6 @@ const MAX_WORK_FACTOR: f32 = 2.5;
 const REFERENCE_DT: f32 = 1.0 / 60.0;
 /// Contact natural frequency as a fraction of the substep rate, once that exceeds the base.
 const SUBSTEPS_PER_CONTACT_PERIOD: f32 = 8.0;
-/// How far ahead soft CCD predicts contacts: 2 units, 120 units/s at 60 Hz. A body that moves
-/// farther in a step is swept by rapier's CCD against moving bodies too, whatever its
-/// HitBoxQuality (the vendored rapier's pair rule, vendor/rapier3d-0.36.1/PATCHED.md).
-const SOFT_CCD_REACH: f32 = 2.0;
 /// Internal PGS sweeps per substep when any object rotates freely (HitBoxQuality > 1).
 const FREE_ROTATION_PGS: usize = 4;
 
@@ -129,44 +125,5 @@ impl Plane {
         p.contact_softness.natural_frequency = s.contact_frequency;
         p.static_contact_softness.natural_frequency =
             s.contact_frequency * base_static.natural_frequency / base.natural_frequency;
-    }
-
-    /// What decides each body's contact prediction this step (read after `tune_solver`).
-    pub(super) fn prediction(&self, dt: f32) -> Prediction {
-        let p = &self.world.integration_parameters;
-        Prediction {
-            threshold: 0.5 * p.prediction_distance(),
-            g_dt: self.world.gravity.length() * dt,
-            dt,
-        }
-    }
-}
-
-/// Soft CCD for the bodies a step moves by more than half the prediction distance
-/// (gravity's share included), none for the others.
-#[derive(Debug, Clone, Copy)]
-pub(super) struct Prediction {
-    threshold: f32,
-    g_dt: f32,
-    dt: f32,
-}
-
-impl Prediction {
-    /// The soft-CCD reach a dynamic body moving at `linvel` gets for the step.
-    pub(super) fn reach(&self, linvel: Vector) -> f32 {
-        // Gravity's share of the tick counts, except for a body standing exactly still
-        // (one that just landed): it keeps the plain prediction, whose contact rapier's
-        // soft-CCD pair test would drop (its contact events would stop and start again).
-        let speed = linvel.length();
-        let travel = if speed > 0.0 {
-            (speed + self.g_dt) * self.dt
-        } else {
-            0.0
-        };
-        if travel > self.threshold {
-            SOFT_CCD_REACH
-        } else {
-            0.0
-        }
     }
 }

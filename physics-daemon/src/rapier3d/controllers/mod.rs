@@ -33,9 +33,9 @@ use shm_layout::{
     EVENT_PATH_FINISHED, EVENT_WAYPOINT_REACHED,
 };
 
-use super::part::Part;
-use super::{Body, Plane};
 use crate::backend::counted::{CountedVec, Counter};
+use crate::rapier3d::objects::body::Body;
+use crate::rapier3d::objects::part::Part;
 
 mod ground;
 mod movement;
@@ -46,7 +46,7 @@ mod push;
 mod tick;
 mod walls;
 
-use movement::{accelerate, apply_friction};
+use movement::{accelerate, apply_friction, horizontal};
 
 /// Gap kept between the capsule and what it touches (units).
 const SKIN: f32 = 0.01;
@@ -102,10 +102,6 @@ fn yaw_rotation(yaw: f32) -> Rotation {
 fn angle_diff(a: f32, b: f32) -> f32 {
     let tau = std::f32::consts::TAU;
     (b - a + std::f32::consts::PI).rem_euclid(tau) - std::f32::consts::PI
-}
-
-fn horizontal(v: Vector) -> Vector {
-    Vector::new(v.x, 0.0, v.z)
 }
 
 impl Controller {

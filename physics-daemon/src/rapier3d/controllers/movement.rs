@@ -1,7 +1,7 @@
 //! Quake's movement model on the horizontal velocity: ground friction with a stop speed
 //! and acceleration toward the wish speed.
 
-use super::*;
+use rapier3d::prelude::*;
 
 /// Quake's PM_Friction on the horizontal velocity: speed drops by
 /// friction × max(speed, stop_speed) × dt, never below zero.
@@ -25,4 +25,9 @@ pub(super) fn accelerate(v: Vector, dir: Vector, wish_speed: f32, accel: f32, dt
         return v;
     }
     v + dir * (accel * wish_speed * dt).min(add)
+}
+
+/// `v` without its vertical part.
+pub(super) fn horizontal(v: Vector) -> Vector {
+    Vector::new(v.x, 0.0, v.z)
 }

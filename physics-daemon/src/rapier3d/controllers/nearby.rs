@@ -4,7 +4,7 @@
 //! instead of the plane's whole tree.
 //!
 //! The queries answer exactly as the plane's query pipeline would (the same dispatcher,
-//! [`crate::rapier3d::clipped::ClippedQueries`], the same frames: a cast's `witness1` /
+//! [`crate::rapier3d::contacts::clipped::ClippedQueries`], the same frames: a cast's `witness1` /
 //! `normal1` in world space, `witness2` / `normal2` in the cast shape's own frame), so the
 //! mover behaves as it did on the whole scene, as long as the region holds everything the
 //! tick reaches (each stage asks [`Nearby::ensure`] for the region it reads, which gathers
@@ -24,7 +24,7 @@ use rapier3d::parry::query::{
 use rapier3d::parry::shape::Capsule;
 use rapier3d::prelude::*;
 
-use crate::rapier3d::clipped::ClippedQueries;
+use crate::rapier3d::contacts::clipped::ClippedQueries;
 
 /// A collider near the controller: its handle, pose, body and AABB now, and its half
 /// extents when it is a box.
@@ -174,7 +174,7 @@ impl<'a> Nearby<'a> {
     }
 
     /// The contact of `capsule` with candidate `c` placed at `pos12` in the capsule's
-    /// frame, as [`crate::rapier3d::clipped::contact`] answers it.
+    /// frame, as [`crate::rapier3d::contacts::clipped::contact`] answers it.
     pub fn contact(
         &self,
         c: &Candidate,
@@ -186,12 +186,12 @@ impl<'a> Nearby<'a> {
             let (a, b) = (capsule.segment.a, capsule.segment.b);
             let radius = capsule.radius;
             if let Some(found) =
-                crate::rapier3d::capsule_contact::capsule_box(pos12, a, b, radius, he, prediction)
+                crate::rapier3d::contacts::capsule::capsule_box(pos12, a, b, radius, he, prediction)
             {
                 return Ok(found);
             }
         }
-        crate::rapier3d::clipped::contact(pos12, capsule, self.shape(c), prediction)
+        crate::rapier3d::contacts::clipped::contact(pos12, capsule, self.shape(c), prediction)
     }
 
     /// The first collider `capsule` at `pose` hits moving along the unit `dir` (or any
@@ -230,7 +230,7 @@ impl<'a> Nearby<'a> {
             let found = match c.cuboid {
                 // The plane's dispatcher on a box and a capsule (the same contacts, to f32
                 // rounding, in the same order) without asking the shapes what they are.
-                Some(he) => crate::rapier3d::clipped::cast_convex_with(
+                Some(he) => crate::rapier3d::contacts::clipped::cast_convex_with(
                     &pos12,
                     vel12,
                     self.shape(c),
@@ -238,13 +238,16 @@ impl<'a> Nearby<'a> {
                     options,
                     |at, reach| {
                         let (a, b, radius) = (capsule.segment.a, capsule.segment.b, capsule.radius);
-                        match crate::rapier3d::capsule_contact::box_capsule(
+                        match crate::rapier3d::contacts::capsule::box_capsule(
                             at, a, b, radius, he, reach,
                         ) {
                             Some(found) => Ok(found),
-                            None => {
-                                crate::rapier3d::clipped::contact(at, self.shape(c), capsule, reach)
-                            }
+                            None => crate::rapier3d::contacts::clipped::contact(
+                                at,
+                                self.shape(c),
+                                capsule,
+                                reach,
+                            ),
                         }
                     },
                 ),

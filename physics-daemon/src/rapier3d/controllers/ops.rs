@@ -1,6 +1,7 @@
 //! Controller ops: create, set, path, jump, teleport, info, destroy.
 
 use super::*;
+use crate::rapier3d::plane::Plane;
 
 impl Plane {
     /// Runs one controller op.

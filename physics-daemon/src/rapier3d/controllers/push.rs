@@ -2,6 +2,7 @@
 
 use super::tick::{Push, Scene};
 use super::*;
+use crate::rapier3d::plane::Plane;
 
 impl Scene<'_> {
     /// Dynamic bodies the move ran into get an impulse along the push, capped at

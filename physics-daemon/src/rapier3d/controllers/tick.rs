@@ -26,6 +26,7 @@ use rapier3d::parry::shape::Capsule;
 
 use super::nearby::{capsule_aabb, Nearby, SceneRefs};
 use super::*;
+use crate::rapier3d::plane::Plane;
 
 /// Fewest controllers handed to the plane's pool (fewer are ticked on the plane's thread).
 const PARALLEL_FROM: usize = 8;

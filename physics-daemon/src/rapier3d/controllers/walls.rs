@@ -1,6 +1,7 @@
 //! Wall detection beside the capsule (`WallNormal` / `OnWall`).
 
 use super::*;
+use crate::rapier3d::plane::Plane;
 
 impl Plane {
     /// The wall beside controller `c` (object `handle`) where it stands now, or zero.
@@ -48,13 +49,13 @@ impl Plane {
             self.each_piece(co, &**shape, &pose, WALL_SKIN, |piece, piece_pose| {
                 let pos12 = pose.inv_mul(&piece_pose);
                 let Ok(Some(contact)) =
-                    crate::rapier3d::clipped::contact(&pos12, &**shape, piece, WALL_SKIN)
+                    crate::rapier3d::contacts::clipped::contact(&pos12, &**shape, piece, WALL_SKIN)
                 else {
                     return;
                 };
                 let normal = (piece_pose.rotation * contact.normal2).normalize_or_zero();
                 if contact.dist <= WALL_SKIN
-                    && crate::rapier3d::probes::is_wall(normal, max_slope)
+                    && crate::rapier3d::queries::probes::is_wall(normal, max_slope)
                     && best.is_none_or(|(d, _)| contact.dist < d)
                 {
                     best = Some((contact.dist, normal));

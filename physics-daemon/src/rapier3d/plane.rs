@@ -1,0 +1,426 @@
+//! The 3D plane: the rapier world, the plane's options and clock, and the parts it owns
+//! (objects, joints, controllers, contact events, history). [`Plane::step`] calls them in
+//! one visible order. The ops that reach the parts are `impl Plane` blocks in the parts'
+//! folders (`objects/ops.rs`, `joints/ops.rs`, ...), which nothing here imports.
+
+use std::sync::mpsc;
+
+use std::time::Instant;
+
+use rapier3d::prelude::*;
+use shm_layout::validate::MAX_HIT_BOX_QUALITY;
+use shm_layout::{
+    BodyState, CollisionGroups, CommandError, EventRecord, PlaneId, PlaneInfo, PlaneKind,
+    PlaneSettings, StateHasher, TickHeader,
+};
+
+use crate::backend::{HeaderFigures, SlotTable};
+use crate::rapier3d::contacts::figures::contact_figures;
+use crate::rapier3d::contacts::hooks::RestThreshold;
+use crate::rapier3d::controllers::Controllers;
+use crate::rapier3d::history::pose_mirror::PoseMirror;
+use crate::rapier3d::history::publish;
+use crate::rapier3d::history::rollback::Ring;
+use crate::rapier3d::joints::table::Joints;
+use crate::rapier3d::objects::body::{body_state, Body, MAX_SLOTS};
+use crate::rapier3d::objects::body_pass::{self, Scratch};
+use crate::rapier3d::objects::maps::PendingMap;
+
+mod held {
+    //! Held objects: see `crate::backend::held`.
+    crate::backend::held::held_bodies!(rapier3d);
+}
+
+/// One rapier3d plane.
+pub struct Plane {
+    /// The plane's id (stamped into its tick headers).
+    pub id: PlaneId,
+    pub(super) settings: PlaneSettings,
+    pub(super) world: PhysicsWorld,
+    pub(super) bodies: SlotTable<Body>,
+    /// Objects per HitBoxQuality value: the plane-wide solver scales with the maximum.
+    pub(super) quality_counts: [u32; MAX_HIT_BOX_QUALITY as usize + 1],
+    /// Objects with a drive of their own (ImpulseDirection, ConstantForce, RotateTo, SetPin).
+    pub(super) driven: u32,
+    /// Mesh vertices of all parts (for quotas).
+    pub(super) mesh_vertices: u64,
+    /// Buffers of the per-body passes.
+    pub(super) pass: Scratch,
+    /// Objects a step must leave where it found them (see `held`).
+    held: Vec<held::HeldBody>,
+    /// The tick clock and the last step's figures (see `backend::clock`).
+    pub(super) clock: crate::backend::Clock,
+    /// Bodies the last adaptive pass gave extra substeps (see `adaptive`).
+    pub(super) boosted: u32,
+    /// Whether the last adaptive pass found a pair of a high mass ratio (see `adaptive`).
+    pub(super) stiffened: bool,
+    /// Objects asking for contact events; the event collector runs only when > 0.
+    pub(super) reporting: u32,
+    pub(super) collision_tx: mpsc::Sender<CollisionEvent>,
+    pub(super) collision_rx: mpsc::Receiver<CollisionEvent>,
+    pub(super) force_tx: mpsc::Sender<ContactForceEvent>,
+    pub(super) tear_tx: mpsc::Sender<SoftBodyTearEvent>,
+    pub(super) events: Vec<EventRecord>,
+    /// Running number of the next event (EventRecord::seq).
+    pub(super) event_seq: u64,
+    /// Colliders removed since the last step with the object they belonged to, so their
+    /// contact-stopped events still name it.
+    pub(super) removed: Vec<(ColliderHandle, shm_layout::Handle)>,
+    /// Character controllers by slot; ticked before each step (none: nothing to do).
+    pub(super) controllers: Controllers,
+    /// Events produced before the step (controllers), published with the step's events.
+    pub(super) pending_events: Vec<EventRecord>,
+    /// The collision-group table objects' CollisionGroup indexes into.
+    pub(super) groups: CollisionGroups,
+    /// Bodies an op added, moved or reshaped since the last step: a query first brings their
+    /// colliders' poses and broad-phase boxes up to date, so it sees the change.
+    pub(super) query_stale: crate::backend::Marks<RigidBodyHandle>,
+    /// Joints (see `joints`).
+    pub(super) joints: Joints,
+    /// Map pieces uploaded since the last build (see `maps`).
+    pub(super) map_pending: PendingMap,
+    /// [`StateHasher`] over every slot as the last step left it (the tick header's).
+    pub(super) state_hash: u64,
+    /// Bytes of controller paths (counted against the owner's quota).
+    pub(super) state_bytes: crate::backend::counted::Counter,
+    /// States of the last ticks while RollbackTicks > 0 (see `rollback`).
+    pub(super) rollback: Ring<State>,
+    /// Every slot's state as the last step left it, for the publisher (see `pose_mirror`).
+    pub(super) mirror: PoseMirror,
+}
+
+impl Plane {
+    /// A plane with default options.
+    pub(super) fn empty(id: PlaneId) -> Plane {
+        let settings = PlaneSettings::default();
+        let mut world = PhysicsWorld::new();
+        world.gravity = Vector::from(settings.gravity);
+        let (collision_tx, collision_rx) = mpsc::channel();
+        let (force_tx, _) = mpsc::channel();
+        let (tear_tx, _) = mpsc::channel();
+        Plane {
+            id,
+            settings,
+            world,
+            bodies: SlotTable::tracked("object", MAX_SLOTS),
+            quality_counts: [0; MAX_HIT_BOX_QUALITY as usize + 1],
+            driven: 0,
+            mesh_vertices: 0,
+            pass: Scratch::default(),
+            held: Vec::new(),
+            clock: Default::default(),
+            boosted: 0,
+            stiffened: false,
+            reporting: 0,
+            collision_tx,
+            collision_rx,
+            force_tx,
+            tear_tx,
+            events: Vec::new(),
+            event_seq: 0,
+            removed: Vec::new(),
+            groups: CollisionGroups::default(),
+            controllers: Default::default(),
+            pending_events: Vec::new(),
+            query_stale: Default::default(),
+            joints: Joints::default(),
+            map_pending: PendingMap::default(),
+            state_hash: 0,
+            state_bytes: Default::default(),
+            rollback: Default::default(),
+            mirror: Default::default(),
+        }
+    }
+
+    /// Automatic ticks per second (0 = manual).
+    pub fn tick_rate(&self) -> f32 {
+        self.settings.tick_rate
+    }
+
+    /// Whether the plane advances.
+    pub fn enabled(&self) -> bool {
+        self.settings.enabled
+    }
+
+    /// Ticks stepped so far.
+    pub fn tick(&self) -> u64 {
+        self.clock.tick
+    }
+
+    /// Every option and figure of the plane.
+    pub fn info(&self) -> PlaneInfo {
+        PlaneInfo {
+            id: self.id,
+            kind: PlaneKind::Rapier3d,
+            settings: self.settings,
+            tick: self.clock.tick,
+            object_count: self.bodies.live(),
+            effective_solver_iterations: self.solver_settings(self.nominal_dt()).iterations as u32,
+            max_hit_box_quality: self.max_quality(),
+        }
+    }
+
+    /// Advances by `dt`. Returns false (and does nothing) when the plane is disabled.
+    pub fn step(&mut self, dt: f32) -> Result<bool, CommandError> {
+        // The last tick is kept before this one changes anything.
+        if !self.begin_step(dt)? {
+            return Ok(false);
+        }
+        let started = Instant::now();
+        // Whether this step can change any published state: bodies awake, or ops since the
+        // last step. A settled plane keeps its hash without rehashing every slot.
+        let moving = self.clock.tick == 0
+            || self.world.islands.num_active_bodies() > 0
+            || !self.bodies.since_step().is_empty();
+        // The clock advances by the step as asked; the simulation takes at least a
+        // nanosecond (see `MIN_DYNAMIC_DT`).
+        let asked = dt;
+        let dt = crate::backend::engine_dt(dt);
+        self.world.integration_parameters.dt = dt;
+        self.tune_solver(dt);
+        self.tick_controllers(dt);
+        self.prepare_bodies(dt);
+        self.joints_before_step();
+        let hooks = RestThreshold {
+            threshold: self.settings.rest_threshold,
+            gravity: self.world.gravity,
+        };
+        self.held_before_step();
+        // Planes of a shared pool take turns in rapier's step (see `pools::turn`).
+        let pool = self.world.physics_pipeline.thread_pool();
+        let turn = pool.as_deref().map(|pool| {
+            crate::backend::pools::turn(pool)
+                .lock()
+                .unwrap_or_else(std::sync::PoisonError::into_inner)
+        });
+        // Contacts of objects removed since the last step still end with an event.
+        if self.reporting > 0 || !self.removed.is_empty() {
+            let collector = ChannelEventCollector::new(
+                self.collision_tx.clone(),
+                self.force_tx.clone(),
+                self.tear_tx.clone(),
+            );
+            self.world.step_with_events(&hooks, &collector);
+        } else {
+            self.world.step_with_events(&hooks, &());
+        }
+        drop(turn);
+        self.held_after_step();
+        self.query_stale.clear();
+        self.limit_speeds_after_step();
+        self.bodies.stepped();
+        self.clock.advance(asked);
+        self.collect_events();
+        self.joints_after_step(dt);
+        self.removed.clear();
+        let rehash = moving || self.awake_count() > 0;
+        let mut mirror = std::mem::take(&mut self.mirror);
+        if rehash {
+            self.list_moved(&mut mirror.moved);
+        }
+        let (figures, hash) = self.figures_and_hash(rehash, &mut mirror);
+        self.mirror = mirror;
+        (self.clock.max_penetration, self.clock.contact_pairs) = figures;
+        if let Some(hash) = hash {
+            self.state_hash = hash;
+        }
+        self.adapt_solving();
+        self.clock.timed(started);
+        // Kept for Rewind off the tick's path (see `rollback`).
+        self.rollback.note_step();
+        Ok(true)
+    }
+
+    /// Events of the last step (contact started / stopped).
+    pub fn events(&self) -> &[EventRecord] {
+        &self.events
+    }
+
+    /// The header of the newest tick.
+    pub fn header(&self) -> TickHeader {
+        self.clock.header(
+            self.id,
+            HeaderFigures {
+                slot_count: self.bodies.slot_count() as u32,
+                body_count: self.bodies.live(),
+                max_joint_error: self.joints.max_error,
+                event_count: self.event_seq,
+                state_hash: self.state_hash,
+            },
+        )
+    }
+
+    /// After a step: the contact figures of the tick header and, when `rehash`, the state
+    /// hash. The hash is one sequential chain over every slot; on the plane's pool it runs
+    /// beside the contact figures (themselves split over the pool), not after them.
+    fn figures_and_hash(&self, rehash: bool, mirror: &mut PoseMirror) -> ((f32, u32), Option<u64>) {
+        let (slots, bodies, narrow_phase) =
+            (&self.bodies, &self.world.bodies, &self.world.narrow_phase);
+        let marks = slots.marks_made();
+        let hash = move || rehash.then(move || mirror.rehash(slots, bodies, marks));
+        let pairs = narrow_phase.contact_graph().raw_graph().raw_edges().len();
+        let work = pairs + if rehash { slots.slot_count() } else { 0 };
+        match self.pool_for(work) {
+            Some(pool) => pool.install(|| {
+                let split = pairs >= body_pass::PARALLEL_FROM;
+                rayon::join(|| contact_figures(narrow_phase, split), hash)
+            }),
+            None => (contact_figures(narrow_phase, false), hash()),
+        }
+    }
+
+    /// The slots this step can have changed without an op marking them, for the pose
+    /// mirror's rehash: the bodies awake before the step (the body pass's list) and after
+    /// it (a body outside both has not moved), and the controllers (their published flags
+    /// change in the controllers' tick).
+    fn list_moved(&self, moved: &mut Vec<u32>) {
+        moved.clear();
+        let bodies = &self.world.bodies;
+        moved.extend(
+            self.pass
+                .handles
+                .iter()
+                .filter_map(|h| bodies.get(*h))
+                .map(|b| b.user_data as u32),
+        );
+        moved.extend(self.awake_slots().map(|s| s as u32));
+        moved.extend(self.controllers.keys().copied());
+    }
+
+    /// [`StateHasher`] over every slot's state now, in slot order. The tick header carries
+    /// it as the last step left it (0 before the first step): right after a step any
+    /// reader recomputes it from the sample's bodies; ops applied since show in the next
+    /// tick's.
+    pub fn state_hash(&self) -> u64 {
+        let mut h = StateHasher::new();
+        for i in 0..self.slot_count() {
+            h.add(&self.body_state(i));
+        }
+        h.finish()
+    }
+
+    /// Length of the published body array.
+    pub fn slot_count(&self) -> usize {
+        self.bodies.slot_count()
+    }
+
+    /// Slots of the bodies rapier simulates now (awake dynamic and kinematic ones). A body
+    /// outside this set has not moved since the step that put it to sleep.
+    pub fn awake_slots(&self) -> impl Iterator<Item = usize> + '_ {
+        // Every body carries its slot in user_data (set in add_object).
+        self.world
+            .active_bodies()
+            .map(|(_, body)| body.user_data as usize)
+    }
+
+    /// Number of bodies in [`Plane::awake_slots`].
+    pub fn awake_count(&self) -> usize {
+        self.world.islands.num_active_bodies()
+    }
+
+    /// Holds (`on`) or releases the rapier body `h` (see `held`).
+    pub(super) fn set_held(&mut self, h: RigidBodyHandle, on: bool) {
+        self.hold(h, on);
+    }
+
+    /// The published state of slot `i` (dead slots carry only their generation).
+    pub fn body_state(&self, i: usize) -> BodyState {
+        body_state(&self.bodies, &self.world.bodies, i)
+    }
+
+    /// [`crate::backend::Backend::write_states`] of this plane.
+    pub(super) fn write_sample(
+        &self,
+        out: &mut [std::mem::MaybeUninit<BodyState>],
+        filter: crate::backend::SlotFilter<'_>,
+    ) {
+        publish::write_sample(&self.mirror, &self.bodies, &self.world, out, filter);
+    }
+}
+
+/// The plane's state, field list written once: `StateRef` borrows it to encode, `State`
+/// owns it decoded, `clone_state` copies it (Rewind). The engine's world comes first; the
+/// other fields are the plane's own and `Clone`.
+macro_rules! plane_state {
+    (world, $($vis:vis $field:ident: $ty:ty,)*) => {
+        #[derive(serde::Serialize)]
+        pub(super) struct StateRef<'a> {
+            world: &'a PhysicsWorld,
+            $($field: &'a $ty,)*
+        }
+
+        #[derive(serde::Deserialize)]
+        pub(super) struct State {
+            pub(super) world: PhysicsWorld,
+            $($vis $field: $ty,)*
+        }
+
+        impl Plane {
+            /// The state as an owned copy (what Rewind keeps): the engine's sets cloned, its
+            /// per-step workspaces fresh.
+            pub(super) fn clone_state(&self) -> State {
+                State { world: copy_world(&self.world), $($field: self.$field.clone(),)* }
+            }
+
+            pub(super) fn state_ref(&self) -> StateRef<'_> {
+                StateRef { world: &self.world, $($field: &self.$field,)* }
+            }
+
+            pub(super) fn take_state(&mut self, state: State) {
+                self.world = state.world;
+                $(self.$field = state.$field;)*
+            }
+        }
+
+        impl State {
+            /// Another copy of a kept state (a second rewind to the same tick).
+            pub(super) fn duplicate(&self) -> State {
+                State { world: copy_world(&self.world), $($field: self.$field.clone(),)* }
+            }
+
+            /// The copy borrowed to encode (`Plane::snapshot_later`).
+            pub(super) fn as_ref(&self) -> StateRef<'_> {
+                StateRef { world: &self.world, $($field: &self.$field,)* }
+            }
+        }
+    };
+}
+
+/// A copy of `w`: the engine's sets cloned (shapes shared), its per-step workspaces fresh.
+fn copy_world(w: &PhysicsWorld) -> PhysicsWorld {
+    PhysicsWorld {
+        gravity: w.gravity,
+        integration_parameters: w.integration_parameters,
+        physics_pipeline: PhysicsPipeline::new(),
+        collision_pipeline: CollisionPipeline::new(),
+        islands: w.islands.clone(),
+        broad_phase: w.broad_phase.clone(),
+        narrow_phase: w.narrow_phase.clone(),
+        bodies: w.bodies.clone(),
+        colliders: w.colliders.clone(),
+        impulse_joints: w.impulse_joints.clone(),
+        multibody_joints: w.multibody_joints.clone(),
+        soft_bodies: w.soft_bodies.clone(),
+        ccd_solver: CCDSolver::new(),
+    }
+}
+
+plane_state! {
+    world,
+    pub(super) settings: PlaneSettings,
+    pub(super) bodies: SlotTable<Body>,
+    pub(super) driven: u32,
+    pub(super) mesh_vertices: u64,
+    held: Vec<held::HeldBody>,
+    pub(super) clock: crate::backend::Clock,
+    pub(super) boosted: u32,
+    pub(super) stiffened: bool,
+    pub(super) reporting: u32,
+    pub(super) event_seq: u64,
+    pub(super) removed: Vec<(ColliderHandle, shm_layout::Handle)>,
+    pub(super) controllers: Controllers,
+    pub(super) groups: CollisionGroups,
+    pub(super) query_stale: crate::backend::Marks<RigidBodyHandle>,
+    pub(super) joints: Joints,
+    pub(super) state_hash: u64,
+}
