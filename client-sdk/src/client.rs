@@ -671,7 +671,7 @@ impl Client {
             };
             match wait {
                 true => Some(self.inner.await_reply(local, &f.pending, f.since)),
-                false => local.try_reply(&f.pending).transpose(),
+                false => local.try_reply(&f.pending).map_err(Error::from).transpose(),
             }
         };
         let Some(reply) = reply else {

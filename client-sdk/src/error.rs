@@ -99,3 +99,17 @@ impl Error {
         Error::Ipc(format!("{what}: {e:?}"))
     }
 }
+
+impl From<local_transport::TransportError> for Error {
+    fn from(e: local_transport::TransportError) -> Error {
+        use local_transport::TransportError;
+        match e {
+            TransportError::NoDaemon { domain, detail } => Error::NoDaemon { domain, detail },
+            TransportError::InvalidDomain(message) => Error::Invalid {
+                field: "domain".into(),
+                message,
+            },
+            TransportError::Ipc(message) => Error::Ipc(message),
+        }
+    }
+}

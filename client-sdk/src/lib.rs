@@ -38,7 +38,6 @@ mod plane_snapshot;
 mod probe;
 mod query;
 pub mod ragdoll;
-pub mod relay;
 pub mod remote;
 mod replay_check;
 mod snapshot_transfer;

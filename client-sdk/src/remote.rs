@@ -1,6 +1,7 @@
 //! A client of a daemon on another host (docs/cluster.md, "Remote clients"): the same
 //! requests, replies and ticks as a local client, carried by Zenoh to the daemon's relay
-//! ([`crate::relay`]) instead of by shared memory. The wire is `shm_layout::remote`.
+//! (`physics_daemon::cluster::relay`) instead of by shared memory. The wire is
+//! `shm_layout::remote`.
 //!
 //! - Requests are Zenoh queries whose payload is the request frame a local client sends;
 //!   the relay answers with the daemon's response frame.

@@ -386,7 +386,7 @@ fn each_remote_client_is_its_own_owner_for_quotas() {
 
 #[test]
 fn a_session_and_a_plane_stream_within_the_relays_bounds() {
-    use client_sdk::relay::{MAX_SESSIONS_PER_PLANE, MAX_WATCHES_PER_SESSION};
+    use physics_daemon::cluster::relay::{MAX_SESSIONS_PER_PLANE, MAX_WATCHES_PER_SESSION};
     let two = two("rc-bounds");
     let remote = two.remote();
     let manual = || PlaneOptions {

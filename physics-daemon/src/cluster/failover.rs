@@ -27,7 +27,7 @@ use zenoh::liveliness::LivelinessToken;
 use zenoh::sample::{Sample, SampleKind};
 use zenoh::{Session, Wait};
 
-use super::ClusterError;
+use super::error::ClusterError;
 use crate::server::persist::{Adoptions, Loaded, EXTENSION};
 
 /// How often the state folder is looked at for changed files.

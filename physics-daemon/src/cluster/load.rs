@@ -15,7 +15,7 @@ use std::time::{Duration, Instant};
 use shm_layout::cluster::{self as keys, LoadReport};
 use zenoh::Wait;
 
-use super::ClusterError;
+use super::error::ClusterError;
 use crate::server::gauge::stepped_nanos;
 pub use crate::server::gauge::Gauge;
 

@@ -13,7 +13,7 @@ use std::time::Duration;
 use shm_layout::cluster as keys;
 use zenoh::Wait;
 
-use super::ClusterError;
+use super::error::ClusterError;
 
 /// How long the name check waits for answers from the members already connected.
 const NAME_CHECK: Duration = Duration::from_millis(1500);

@@ -11,7 +11,7 @@ use shm_layout::migrate::{migrate_key, MoveAnswer, MovingPlane};
 use zenoh::query::Query;
 use zenoh::{Session, Wait};
 
-use super::ClusterError;
+use super::error::ClusterError;
 use crate::server::moves::{Courier, Migration, RESTORE_WAIT};
 
 /// How long a liveliness question about the target waits.

@@ -12,48 +12,24 @@
 //!   of them when their daemon leaves.
 //! - [`migrate`]: planes moving to and arriving from other members (`MoveTo`).
 //! - [`rebalance`]: `--rebalance`, planes moved off a daemon over its tick budget.
-//! - remote clients: [`client_sdk::relay`] answers them as local clients of this daemon,
-//!   one per remote session (started by [`Cluster::serve_remote`]).
+//! - [`relay`]: remote clients, answered as local clients of this daemon, one per remote
+//!   session (started by [`Cluster::serve_remote`]).
 //!
 //! Local clients keep iceoryx2 zero-copy: Zenoh carries only what crosses hosts.
 
+mod error;
 pub mod failover;
 pub mod load;
 pub mod membership;
 pub mod migrate;
 pub mod rebalance;
+pub mod relay;
 pub mod session;
 
 use std::sync::Arc;
 
+pub use error::ClusterError;
 pub use session::ClusterArgs;
-
-/// Why the daemon cannot join its cluster.
-#[derive(Debug, thiserror::Error)]
-pub enum ClusterError {
-    /// A flag is missing, malformed or unsafe; the message names it.
-    #[error("{0}")]
-    Flags(String),
-    /// A name is unusable.
-    #[error(transparent)]
-    Name(#[from] shm_layout::cluster::NameError),
-    /// An endpoint is malformed.
-    #[error(transparent)]
-    Endpoint(#[from] shm_layout::cluster::EndpointError),
-    /// Another daemon of the cluster already has the name.
-    #[error(
-        "a daemon named {name:?} is already alive in cluster {cluster:?}: choose another --name"
-    )]
-    NameTaken {
-        /// The cluster.
-        cluster: String,
-        /// The name.
-        name: String,
-    },
-    /// Zenoh failed (a port in use, a certificate that does not load, ...).
-    #[error("cluster transport: {0}")]
-    Zenoh(String),
-}
 
 /// A daemon's membership of its cluster: alive while this value lives (its token is
 /// undeclared and its reports stop when it is dropped or the process dies).
@@ -63,7 +39,7 @@ pub struct Cluster {
     session: zenoh::Session,
     cluster: String,
     name: String,
-    relay: Option<client_sdk::relay::Relay>,
+    relay: Option<relay::Relay>,
     failover: Option<failover::Failover>,
     /// An endpoint clients of a plane that moved away connect through (the first listened).
     endpoint: String,
@@ -142,19 +118,18 @@ impl Cluster {
         Ok(())
     }
 
-    /// Starts serving remote clients of this daemon ([`client_sdk::relay`]): they reach the
-    /// daemon of `domain` as local clients, at most `max_sessions` at once.
+    /// Starts serving remote clients of this daemon ([`relay`]): they reach the daemon of
+    /// `domain` as local clients, at most `max_sessions` at once.
     pub fn serve_remote(&mut self, domain: &str, max_sessions: usize) -> Result<(), ClusterError> {
-        let relay = client_sdk::relay::Relay::start(
+        let relay = relay::Relay::start(
             &self.session,
-            client_sdk::relay::RelayOptions {
+            relay::RelayOptions {
                 cluster: self.cluster.clone(),
                 daemon: self.name.clone(),
                 domain: domain.to_string(),
                 max_sessions,
             },
-        )
-        .map_err(|e| ClusterError::Zenoh(e.to_string()))?;
+        )?;
         self.relay = Some(relay);
         Ok(())
     }

@@ -15,7 +15,7 @@ use std::time::{Duration, Instant};
 use shm_layout::cluster::{self as keys, LoadReport};
 use zenoh::{Session, Wait};
 
-use super::ClusterError;
+use super::error::ClusterError;
 use crate::server::moves::{Migration, RebalanceRequest};
 
 /// How often the loads are looked at (the load report's period).

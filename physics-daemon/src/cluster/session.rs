@@ -12,7 +12,7 @@ use std::path::PathBuf;
 use shm_layout::cluster::{self as keys, Endpoint};
 use zenoh::Wait;
 
-use super::ClusterError;
+use super::error::ClusterError;
 
 /// Where a cluster listens when `--listen` is not given.
 pub const DEFAULT_LISTEN: &str = "tcp/127.0.0.1:7447";

@@ -23,8 +23,20 @@ use zenoh::query::{Query, Queryable};
 use zenoh::sample::{Sample, SampleKind};
 use zenoh::{Session, Wait};
 
-use crate::transport::{LocalTransport, ShmBodySubscriber, ShmEventSubscriber};
-use crate::Error;
+use local_transport::{LocalTransport, ShmBodySubscriber, ShmEventSubscriber, TransportError};
+
+use super::error::ClusterError;
+
+/// Why a relayed exchange with the daemon failed.
+#[derive(Debug, thiserror::Error)]
+enum Error {
+    /// The local transport failed.
+    #[error(transparent)]
+    Transport(#[from] TransportError),
+    /// No reply came within the given time.
+    #[error("timed out after {0:?}")]
+    Timeout(Duration),
+}
 
 /// How often a session thread looks for new ticks while no request arrives (it waits on
 /// its request queue meanwhile; a request wakes it at once).
@@ -87,10 +99,10 @@ pub struct Relay {
 
 impl Relay {
     /// Starts answering remote clients of daemon `options.daemon` on `session`.
-    pub fn start(session: &Session, options: RelayOptions) -> Result<Relay, Error> {
+    pub fn start(session: &Session, options: RelayOptions) -> Result<Relay, ClusterError> {
         let stop = Arc::new(AtomicBool::new(false));
         let sessions: Sessions = Arc::default();
-        let zerr = |e: zenoh::Error| Error::Cluster(format!("relay: {e}"));
+        let zerr = |e: zenoh::Error| ClusterError::Zenoh(format!("cluster: relay: {e}"));
         let shared = Arc::new(Shared {
             session: session.clone(),
             options: options.clone(),
