@@ -1,7 +1,8 @@
 //! `physics-bench render --to DIR FILE.json...`: renders report pages from their JSON
 //! alone, without rerunning a bench. Each FILE.json (written by a bench into its --out
-//! folder) is copied into DIR as NAME.json beside its page NAME.md, and DIR/README.md, the
-//! index, is rendered from every report JSON in DIR. `physics-bench render --to
+//! folder) is copied into DIR as NAME.json beside its page NAME.md (with the charts the page
+//! links, NAME-*.svg beside the JSON), and DIR/README.md, the index, is rendered from every
+//! report JSON in DIR. `physics-bench render --to
 //! docs/reports docs/reports/*.json` renders the stored pages again.
 
 use std::path::{Path, PathBuf};
@@ -35,6 +36,7 @@ pub fn run(args: &RenderArgs) -> BenchResult<()> {
             std::fs::write(&json_to, &text)
                 .map_err(BenchError::io(format!("write {}", json_to.display())))?;
         }
+        copy_charts(from, &bench, &args.to)?;
         let md_to = args.to.join(format!("{bench}.md"));
         std::fs::write(&md_to, markdown)
             .map_err(BenchError::io(format!("write {}", md_to.display())))?;
@@ -44,6 +46,33 @@ pub fn run(args: &RenderArgs) -> BenchResult<()> {
     std::fs::write(&index, page::index(&reports_in(&args.to)?))
         .map_err(BenchError::io(format!("write {}", index.display())))?;
     println!("wrote {}", index.display());
+    Ok(())
+}
+
+/// Copies the charts a page links (`NAME-*.svg` beside its JSON) into `to`.
+fn copy_charts(json: &Path, bench: &str, to: &Path) -> BenchResult<()> {
+    let from = json.parent().unwrap_or(Path::new("."));
+    if same_file(from, to) {
+        return Ok(());
+    }
+    let Ok(entries) = std::fs::read_dir(from) else {
+        return Ok(());
+    };
+    let prefix = format!("{bench}-");
+    for path in entries.filter_map(|e| e.ok().map(|e| e.path())) {
+        let name = path
+            .file_name()
+            .and_then(|n| n.to_str())
+            .unwrap_or_default();
+        if name.starts_with(&prefix) && name.ends_with(".svg") {
+            let target = to.join(name);
+            std::fs::copy(&path, &target).map_err(BenchError::io(format!(
+                "copy {} to {}",
+                path.display(),
+                target.display()
+            )))?;
+        }
+    }
     Ok(())
 }
 

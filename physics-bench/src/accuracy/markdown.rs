@@ -107,7 +107,7 @@ pub fn render(points: &[Point], quick: bool, repeats: usize) -> String {
         if let Some(s) = scene_info(name) {
             let _ = writeln!(
                 md,
-                "error: {} ({unit}). Chart: `accuracy-{name}.svg`.\n",
+                "error: {} ({unit}). Chart: [accuracy-{name}.svg](accuracy-{name}.svg).\n",
                 s.measures
             );
         }
