@@ -510,7 +510,7 @@ fn render(r: &LoadReport) -> String {
     };
     let _ = writeln!(
         md,
-        "\n## Throughput\n\n\
+        "## Throughput\n\n\
          - commands: {} sent, {} acked, {} refused, {} unanswered\n\
          - all clients: {} commands/s\n\
          - per client (p50 / p99 / max): {} commands/s\n\
