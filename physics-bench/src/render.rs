@@ -111,3 +111,47 @@ fn reports_in(dir: &Path) -> BenchResult<Vec<Parts>> {
     }
     Ok(reports)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::report::{self, Goal};
+
+    #[test]
+    fn render_puts_the_page_its_json_its_charts_and_the_index_into_the_folder() {
+        let root = std::env::temp_dir().join(format!("render-{}", std::process::id()));
+        let (out, docs) = (root.join("out"), root.join("docs"));
+        #[derive(serde::Serialize)]
+        struct Tiny {
+            goals: Vec<Goal>,
+        }
+        let tiny = Tiny {
+            goals: vec![Goal::new("tiny goal", "1", Some(false))],
+        };
+        let (json, md) = report::write(&out, "tiny", &tiny, "# Tiny bench\n\nbody\n").unwrap();
+        std::fs::write(out.join("tiny-chart.svg"), "<svg/>").unwrap();
+        run(&RenderArgs {
+            from: vec![json.clone()],
+            to: docs.clone(),
+        })
+        .unwrap();
+        let page = std::fs::read_to_string(docs.join("tiny.md")).unwrap();
+        assert_eq!(page, std::fs::read_to_string(&md).unwrap());
+        assert_eq!(
+            std::fs::read_to_string(docs.join("tiny.json")).unwrap(),
+            std::fs::read_to_string(&json).unwrap()
+        );
+        assert!(docs.join("tiny-chart.svg").is_file());
+        let index = std::fs::read_to_string(docs.join("README.md")).unwrap();
+        assert!(index.contains("[Tiny bench](tiny.md)"), "{index}");
+        assert!(index.contains("**1 not met**"), "{index}");
+        // Rendering the folder's own JSON again leaves the page as it was.
+        run(&RenderArgs {
+            from: vec![docs.join("tiny.json")],
+            to: docs.clone(),
+        })
+        .unwrap();
+        assert_eq!(std::fs::read_to_string(docs.join("tiny.md")).unwrap(), page);
+        let _ = std::fs::remove_dir_all(&root);
+    }
+}
