@@ -9,10 +9,14 @@
 pub mod clock;
 pub mod counted;
 mod dirty;
-pub(crate) mod held;
+pub mod held;
 pub mod marks;
 pub mod object_op;
+#[cfg(feature = "gui")]
+pub(crate) mod plane_state;
 pub mod pools;
+pub mod rapier_world;
+pub mod rollback;
 mod slot_table;
 pub(crate) mod snapshot_decode;
 

@@ -5,7 +5,7 @@ use shm_layout::{
     GuiOp, GuiReply, Handle, ObjectOp, PlaneKind, PlaneOp, Reply, TickHeader, Vec2, Vec3,
 };
 
-use super::Plane;
+use super::plane::Plane;
 use crate::backend::{Backend, ObjectPlane, Usage};
 
 impl Plane {

@@ -17,37 +17,15 @@ use shm_layout::gui_op::{
     GuiControllerInfo, GuiControllerOp, GuiControllerSettings, EVENT_GUI_GROUND_CHANGED,
     EVENT_GUI_MOVED, EVENT_GUI_PATH_FINISHED, EVENT_GUI_WAYPOINT_REACHED,
 };
-use shm_layout::settings::Vec2;
 use shm_layout::{CommandError, EventRecord, Handle, Reply};
 
+use super::controller::Controller;
 use super::hooks::{on_layer, CONTROLLED};
-use super::Plane;
+use super::plane::Plane;
 use crate::backend::counted::CountedVec;
 
 /// Movement below this (px) in a tick is not a `Moved`.
 const MOVED_EPSILON: f32 = 1e-3;
-
-/// One controller (lives in its body).
-#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
-pub struct Controller {
-    settings: GuiControllerSettings,
-    uncontrolled: bool,
-    move_direction: Vec2,
-    jump: bool,
-    /// Counted in the plane's state bytes (a client's quota).
-    waypoints: CountedVec<Vec2>,
-    next: usize,
-    on_ground: bool,
-    last_position: Vec2,
-}
-
-impl Controller {
-    /// Moves the count of the waypoints to `counter` (a controller restored from a
-    /// snapshot counts in its new plane).
-    pub fn count_in(&mut self, counter: &crate::backend::counted::Counter) {
-        self.waypoints.count_in(counter);
-    }
-}
 
 impl Plane {
     /// Applies a controller op on the body `handle`.

@@ -7,7 +7,8 @@
 
 use rapier2d::prelude::*;
 
-use super::Plane;
+use super::body::unlocked;
+use super::plane::Plane;
 
 impl Plane {
     pub(super) fn apply_forces(&mut self, dt: f32) {
@@ -42,7 +43,7 @@ impl Plane {
             let Some(body) = self.bodies.at_mut(rb.user_data as usize) else {
                 continue;
             };
-            let mut v = super::objects::unlocked(&body.settings, rb.linvel()) * lin;
+            let mut v = unlocked(&body.settings, rb.linvel()) * lin;
             if s.drag > 0.0 {
                 v /= 1.0 + s.drag * v.length() * dt / rb.mass();
             }
@@ -56,7 +57,7 @@ impl Plane {
             let j = std::mem::take(&mut body.settings.impulse_direction);
             if j != [0.0; 2] {
                 let v = rb.linvel() + Vector::from(j) / rb.mass();
-                rb.set_linvel(super::objects::unlocked(&body.settings, v), true);
+                rb.set_linvel(unlocked(&body.settings, v), true);
                 if body.settings.constant_force == [0.0; 2] {
                     self.driven -= 1;
                 }

@@ -8,15 +8,17 @@ use shm_layout::settings::gui_plane::finite2;
 use shm_layout::settings::{GuiObjectProp, GuiObjectSettings, GuiShape, Vec2};
 use shm_layout::{CommandError, ErrorKind, Handle};
 
+use super::body::{unlocked, Body, MAX_SLOTS, WALLS_SLOT};
 use super::hooks::{layer, CONTROLLED, WALL};
-use super::{Body, Plane, MAX_SLOTS, WALLS_SLOT};
+use super::plane::Plane;
+use crate::backend::held;
 
 /// Thickness of each bounds wall (px): thick enough that nothing tunnels through.
 const WALL_THICKNESS: f32 = 10_000.0;
 
 /// The collision shape of a primitive of `shape` filling a `size` box centred on its origin
 /// (+Y down: a triangle's apex is at the top).
-pub fn collider_shape(shape: GuiShape, size: Vec2) -> SharedShape {
+fn collider_shape(shape: GuiShape, size: Vec2) -> SharedShape {
     let (hx, hy) = (size[0] * 0.5, size[1] * 0.5);
     match shape {
         GuiShape::Square | GuiShape::Image | GuiShape::Text => SharedShape::cuboid(hx, hy),
@@ -165,7 +167,7 @@ impl Plane {
                     rb.set_angvel(0.0, true);
                 }
             }
-            Held(on) => self.hold(h, on),
+            Held(on) => held::hold(&mut self.held, h, on),
             Mass(m) => {
                 self.world.colliders[c].set_mass(m);
                 self.refresh_mass(h);
@@ -297,20 +299,5 @@ impl Plane {
                 .build();
             self.world.insert_collider(wall, Some(body));
         }
-    }
-}
-
-/// `v` with the components of locked axes zeroed (the reference zeroes them every tick).
-pub(super) fn unlocked(settings: &GuiObjectSettings, v: Vector) -> Vector {
-    Vector::new(
-        if settings.locked_x { 0.0 } else { v.x },
-        if settings.locked_y { 0.0 } else { v.y },
-    )
-}
-
-impl Body {
-    /// Whether the force pass must visit it for its own sake.
-    pub(super) fn is_driven(&self) -> bool {
-        self.settings.constant_force != [0.0; 2] || self.settings.impulse_direction != [0.0; 2]
     }
 }

@@ -6,33 +6,14 @@ use shm_layout::gui_op::{check_ray, GuiHit};
 use shm_layout::settings::Vec2;
 use shm_layout::CommandError;
 
-use super::{Plane, WALLS_SLOT};
+use super::body::WALLS_SLOT;
+use super::plane::Plane;
+use crate::backend::rapier_world::RapierWorld;
 
 impl Plane {
     /// Brings the colliders of bodies changed since the last step up to date for queries.
     pub(super) fn refresh_scene(&mut self) {
-        if self.query_stale.is_empty() {
-            return;
-        }
-        let stale = std::mem::take(&mut self.query_stale);
-        let world = &mut self.world;
-        for h in stale {
-            let Some(body) = world.bodies.get(h) else {
-                continue;
-            };
-            let pose = *body.position();
-            for c in body.colliders() {
-                let Some(co) = world.colliders.get_mut(*c) else {
-                    continue;
-                };
-                let local = co.position_wrt_parent().copied().unwrap_or_default();
-                co.set_position(pose * local);
-                let aabb = co.compute_aabb();
-                world
-                    .broad_phase
-                    .set_aabb(&world.integration_parameters, *c, aabb);
-            }
-        }
+        self.world.refresh_colliders(&mut self.query_stale);
     }
 
     /// The first collidable body (any ZIndex; walls excluded) the ray meets.

@@ -1,88 +1,68 @@
 //! A GUI plane's whole state as bytes, and back (see `rapier3d/snapshot.rs`, which this
-//! follows): rapier2d's world and the plane's own tables, so that a restored plane
-//! continues bit for bit. The id, the quota counter and the scratch stay with the plane.
+//! follows): its `State` (rapier2d's world and the plane's own tables), so that a restored
+//! plane continues bit for bit. The id, the quota counter and the scratch stay with the
+//! plane.
 
-use rapier2d::prelude::*;
-use shm_layout::settings::{GuiPlaneProp, GuiPlaneSettings};
+use shm_layout::settings::GuiPlaneProp;
 use shm_layout::{snapshot, CommandError, ErrorKind, PlaneKind, PlaneProp, SnapshotHeader};
 
-use super::{held, Body, Plane, MAX_SLOTS};
+use super::body::MAX_SLOTS;
+use super::plane::Plane;
+use super::state::{State, StateRef};
 use crate::backend::counted::Counter;
-use crate::backend::{Backend, SlotTable};
+use crate::backend::Backend;
 
 /// The engine named in the snapshot header.
 pub const ENGINE: &str = "rapier2d 0.36 / physics-daemon gui state 2";
 
-macro_rules! plane_state {
-    (world, $($field:ident: $ty:ty,)*) => {
-        #[derive(serde::Serialize)]
-        struct StateRef<'a> {
-            world: &'a PhysicsWorld,
-            $($field: &'a $ty,)*
+impl Plane {
+    /// The state borrowed (to encode).
+    fn state_ref(&self) -> StateRef<'_> {
+        StateRef {
+            world: &self.world,
+            settings: &self.settings,
+            bodies: &self.bodies,
+            controlled: &self.controlled,
+            driven: &self.driven,
+            query_stale: &self.query_stale,
+            held: &self.held,
+            clock: &self.clock,
+            event_seq: &self.event_seq,
+            rollback_ticks: &self.rollback_ticks,
         }
-
-        #[derive(serde::Deserialize)]
-        pub(super) struct State {
-            world: PhysicsWorld,
-            $($field: $ty,)*
-        }
-
-        impl Plane {
-            fn state_ref(&self) -> StateRef<'_> {
-                StateRef { world: &self.world, $($field: &self.$field,)* }
-            }
-
-            fn take_state(&mut self, state: State) {
-                self.world = state.world;
-                $(self.$field = state.$field;)*
-            }
-
-            /// The state as an owned copy (what Rewind keeps): the engine's sets cloned,
-            /// its per-step workspaces fresh.
-            pub(super) fn clone_state(&self) -> State {
-                State { world: copy_world(&self.world), $($field: self.$field.clone(),)* }
-            }
-        }
-
-        impl State {
-            /// Another copy of a kept state (a second rewind to the same tick).
-            pub(super) fn duplicate(&self) -> State {
-                State { world: copy_world(&self.world), $($field: self.$field.clone(),)* }
-            }
-        }
-    };
-}
-
-/// A copy of `w`: the engine's sets cloned (shapes shared), its per-step workspaces fresh.
-fn copy_world(w: &PhysicsWorld) -> PhysicsWorld {
-    PhysicsWorld {
-        gravity: w.gravity,
-        integration_parameters: w.integration_parameters,
-        physics_pipeline: PhysicsPipeline::new(),
-        collision_pipeline: CollisionPipeline::new(),
-        islands: w.islands.clone(),
-        broad_phase: w.broad_phase.clone(),
-        narrow_phase: w.narrow_phase.clone(),
-        bodies: w.bodies.clone(),
-        colliders: w.colliders.clone(),
-        impulse_joints: w.impulse_joints.clone(),
-        multibody_joints: w.multibody_joints.clone(),
-        soft_bodies: w.soft_bodies.clone(),
-        ccd_solver: CCDSolver::new(),
     }
-}
 
-plane_state! {
-    world,
-    settings: GuiPlaneSettings,
-    bodies: SlotTable<Body>,
-    controlled: Vec<u32>,
-    driven: u32,
-    query_stale: crate::backend::Marks<RigidBodyHandle>,
-    held: Vec<held::HeldBody>,
-    clock: crate::backend::Clock,
-    event_seq: u64,
-    rollback_ticks: u32,
+    /// Becomes `state` (decoded and checked, or a copy).
+    fn take_state(&mut self, state: State) {
+        let State {
+            world,
+            settings,
+            bodies,
+            controlled,
+            driven,
+            query_stale,
+            held,
+            clock,
+            event_seq,
+            rollback_ticks,
+        } = state;
+        self.world = world;
+        self.settings = settings;
+        self.bodies = bodies;
+        self.controlled = controlled;
+        self.driven = driven;
+        self.query_stale = query_stale;
+        self.held = held;
+        self.clock = clock;
+        self.event_seq = event_seq;
+        self.rollback_ticks = rollback_ticks;
+    }
+
+    /// The state as an owned copy (what Rewind keeps): the engine's sets cloned, its
+    /// per-step workspaces fresh.
+    pub(super) fn clone_state(&self) -> State {
+        self.state_ref().to_state()
+    }
 }
 
 fn refused(what: String) -> CommandError {
