@@ -157,7 +157,7 @@ pub fn index(reports: &[Parts]) -> String {
          how to run each bench and what its goals mean: \
          [docs/benchmarks.md](../benchmarks.md).\n\n",
     );
-    let mut t = Table::new(&["report", "date", "build", "machine", "goals"]);
+    let mut t = Table::new(&["report", "date", "build", "machine", "command", "goals"]);
     for p in reports {
         let r = &p.run;
         t.row(&[
@@ -165,6 +165,7 @@ pub fn index(reports: &[Parts]) -> String {
             r.date_utc.get(..10).unwrap_or(&r.date_utc).to_string(),
             r.profile.clone(),
             format!("{}, {} cores", r.machine.cpu, r.machine.cores),
+            format!("`{}`", cell(&r.command)),
             goals_summary(p.goals.as_deref()),
         ]);
     }
@@ -242,7 +243,8 @@ mod tests {
         ])))
         .unwrap();
         let index = index(&[with, Parts::from_json(&json).unwrap()]);
-        assert!(index.contains("| [Scene queries](queries.md) | 2026-12-02 | debug | Test CPU @ 3.0GHz, 2 cores | 1 met, **1 not met** |"), "{index}");
+        assert!(index.contains("| [Scene queries](queries.md) | 2026-12-02 | debug | Test CPU @ 3.0GHz, 2 cores | \
+             `physics-bench queries --quick` | 1 met, **1 not met** |"), "{index}");
         assert!(index.contains("| none judged |"), "{index}");
         assert!(render(&serde_json::json!({"goals": []})).is_err());
     }
