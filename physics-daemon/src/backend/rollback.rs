@@ -86,7 +86,7 @@ impl<S: Duplicate + Send + 'static> Ring<S> {
 
     /// Keeps `state`, the state after `tick`, counted as `counted`, and drops the oldest
     /// beyond the `k + 1` newest (the state of the tick `k` back included).
-    pub fn keep(&mut self, k: usize, tick: u64, state: Box<S>, counted: CountedBytes) {
+    pub fn keep(&mut self, tick: u64, state: Box<S>, counted: CountedBytes, k: usize) {
         self.kept.push_back((tick, state, counted));
         while self.kept.len() > k + 1 {
             if let Some((_, state, _)) = self.kept.pop_front() {
@@ -198,7 +198,7 @@ mod tests {
             false => Ring::default(),
         };
         for t in ticks {
-            ring.keep(3, t, Box::new(Tick(t)), CountedBytes::new(counter, 10));
+            ring.keep(t, Box::new(Tick(t)), CountedBytes::new(counter, 10), 3);
         }
         ring
     }

@@ -29,7 +29,7 @@ impl Plane {
             &self.state_bytes,
             BYTES_PER_SLOT * self.bodies.slot_count() as u64,
         );
-        self.rollback.keep(k, self.clock.tick, copy, counted);
+        self.rollback.keep(self.clock.tick, copy, counted, k);
     }
 
     /// Goes back `n` ticks (1 ≤ n ≤ RollbackTicks and ticks kept so far). The state of the
