@@ -36,21 +36,11 @@ pub use host::{Host, Stop, WATCH_PERIOD};
 #[doc(hidden)]
 pub use members::property_rows;
 
-/// A write the daemon refuses after its call returned names the line that made it.
-pub(crate) fn set_origin(lua: &Lua, client: &Client) {
-    let weak = lua.weak();
-    client.set_origin(move || {
-        weak.try_upgrade()
-            .and_then(|lua| lua.inspect_stack(1, |d| d.current_line()).flatten())
-            .map_or(0, |line| line as u32)
-    });
-}
-
 /// Lets `PhysicsService.New{ Placement = "auto" | DAEMON }` place planes on the daemons of
 /// `cluster` (a `physics-lua --cluster` run); without it every plane is on the script's own
 /// daemon.
 pub fn set_cluster(lua: &Lua, cluster: client_sdk::remote::RemoteOptions) {
-    api::plane::context(lua).set_cluster(cluster);
+    api::plane::context::context(lua).set_cluster(cluster);
 }
 
 /// Installs the API into `lua`, talking to the daemon through `client`: the globals, the
@@ -63,7 +53,7 @@ pub fn install(lua: &Lua, client: Client) -> mlua::Result<Host> {
     lua.set_app_data(scheduler.clone());
     scheduler.watchdog.install(lua);
     host::errors::install(lua)?;
-    set_origin(lua, &client);
+    api::plane::context::set_origin(lua, &client);
     let modules = api::modules(lua, client.clone())?;
     let import = lua.create_function(move |_, name: Value| {
         let found = match &name {
@@ -88,7 +78,7 @@ pub fn install(lua: &Lua, client: Client) -> mlua::Result<Host> {
     let dyn_mesh: Table = globals.get::<mlua::Function>("import")?.call("DynMesh")?;
     globals.set("DynMesh", dyn_mesh)?;
     globals.set("wait", scheduler::wait_function(lua)?)?;
-    let daemon = api::plane::context(lua);
+    let daemon = api::plane::context::context(lua);
     Ok(Host::new(lua, scheduler, heart, client, daemon))
 }
 

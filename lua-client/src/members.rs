@@ -7,7 +7,7 @@ use crate::props;
 /// row order.
 pub fn property_rows() -> Vec<(&'static str, Vec<&'static str>)> {
     fn names<T: props::Target>(p: &props::Props<T>) -> (&'static str, Vec<&'static str>) {
-        let rows = p.rows.iter().chain(T::table_rows());
+        let rows = p.rows.iter().chain(p.table_rows());
         (p.owner, rows.map(|r| r.name).collect())
     }
     vec![

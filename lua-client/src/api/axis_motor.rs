@@ -7,7 +7,7 @@ use client_sdk::axis_motor::axis_index;
 use client_sdk::AxisMotor;
 use mlua::{UserDataMethods, Value};
 
-use super::joint::LuaJoint;
+use super::joint::state::LuaJoint;
 use crate::values::{describe, expected, finite_number, sdk_error};
 
 /// The option names of SetAxisMotor.

@@ -6,7 +6,7 @@
 
 use mlua::{Lua, MultiValue, Table, Value};
 
-use super::plane::context;
+use super::plane::context::context;
 use crate::values::{expected, sdk_error};
 
 /// The arguments without the module itself (`PhysicsService:F(...)` passes it first; a

@@ -7,7 +7,12 @@
 use client_sdk::{ContactPoint, Vec3};
 use mlua::{Lua, Table, Value};
 
-use super::object::PhysicsObject;
+use client_sdk::Handle;
+
+use super::map::map_value;
+use super::object::state::PhysicsObject;
+use super::part::part_ud;
+use super::plane::state::PlaneState;
 use crate::values::{expected, lua_number, new_vector, sdk_error};
 
 fn neg(v: Vec3) -> Vec3 {
@@ -50,10 +55,7 @@ pub fn get_contacts(lua: &Lua, this: Value) -> mlua::Result<Table> {
         let t = lua.create_table_with_capacity(0, 5)?;
         // The part the script holds (one value per part), or the Map it touches.
         let part = match &plane {
-            Some(plane) => match plane.part_of(c.other) {
-                Some(p) => Value::UserData(super::part::part_ud(lua, &p)?),
-                None => super::map::map_value(lua, plane, c.other)?.unwrap_or(Value::Nil),
-            },
+            Some(plane) => plane.body_value(lua, c.other)?,
             None => Value::Nil,
         };
         t.set("Part", part)?;
@@ -65,4 +67,13 @@ pub fn get_contacts(lua: &Lua, this: Value) -> mlua::Result<Table> {
         out.push(t)?;
     }
     Ok(out)
+}
+
+/// The script's value of body `handle` of `plane`: the BasePart it holds for it (one value
+/// per part), the Map it loaded, or nil.
+pub(crate) fn body_value(lua: &Lua, plane: &PlaneState, handle: Handle) -> mlua::Result<Value> {
+    Ok(match plane.part_of(handle) {
+        Some(p) => Value::UserData(part_ud(lua, &p)?),
+        None => map_value(lua, plane, handle)?.unwrap_or(Value::Nil),
+    })
 }

@@ -5,14 +5,14 @@
 //! of its joints has Broke handlers; `plane.EventsLost(n)` (or, with no handler, a line on stderr) says when a
 //! script fell so far behind that the daemon's queue dropped events.
 
-use std::cell::{Cell, RefCell};
-use std::collections::HashMap;
+use std::cell::Cell;
 use std::rc::{Rc, Weak};
 
 use client_sdk::{Contact, Handle, JointBroke};
 use mlua::{Lua, MultiValue, Value};
 
-use super::plane::PlaneState;
+use super::contact_points::body_value;
+use super::plane::state::{Broke, PlaneState};
 use crate::host::signal::Signal;
 use crate::host::Watched;
 use crate::values::{new_vector, sdk_error};
@@ -27,71 +27,6 @@ type TouchContact<'a> = (
     &'a [client_sdk::ContactPoint],
     bool,
 );
-
-thread_local! {
-    /// Counts every change that can change whether a plane's parts have touch or CFrame
-    /// handlers (a part's Touched / TouchEnded / CFrame-change handlers connected or gone, a
-    /// part added to or removed from a plane): a plane asks its parts again only after one.
-    static HANDLERS_EPOCH: Cell<u64> = const { Cell::new(0) };
-}
-
-/// A part's touch or CFrame handlers, or a plane's parts, changed (see `HANDLERS_EPOCH`).
-pub(crate) fn handlers_changed() {
-    HANDLERS_EPOCH.with(|e| e.set(e.get().wrapping_add(1)));
-}
-
-/// An answer about a plane's parts' handlers ("does any part have one?"), kept while
-/// [`handlers_changed`] was not called since it was found.
-#[derive(Default)]
-pub(crate) struct HandlersAnswer(Cell<Option<(u64, bool)>>);
-
-impl HandlersAnswer {
-    /// The kept answer, or `find`'s when handlers or parts changed since.
-    pub(crate) fn get(&self, find: impl FnOnce() -> bool) -> bool {
-        let epoch = HANDLERS_EPOCH.with(Cell::get);
-        match self.0.get() {
-            Some((seen, answer)) if seen == epoch => answer,
-            _ => {
-                let answer = find();
-                self.0.set(Some((epoch, answer)));
-                answer
-            }
-        }
-    }
-}
-
-/// Per plane: whether events are being read, and the `EventsLost` signal.
-pub struct ContactPump {
-    /// True while some part of the plane has touch handlers (events are drained each frame).
-    reading: Cell<bool>,
-    /// Whether a part had touch handlers, as of a `HANDLERS_EPOCH` (so a frame with nothing
-    /// changed does not ask every part again).
-    parts_listen: HandlersAnswer,
-    /// `plane.EventsLost`, created on first access.
-    lost: RefCell<Option<Signal>>,
-    /// `joint.Broke` of the joints whose signal was read, by joint handle.
-    broke: RefCell<HashMap<Handle, Broke>>,
-}
-
-/// A joint's `Broke` signal and what it needs to fire again.
-struct Broke {
-    signal: Signal,
-    /// The objects the joint joins (the world is none): the joint goes with either.
-    ends: Vec<Handle>,
-    /// It fired: a joint breaks once.
-    fired: Cell<bool>,
-}
-
-impl Default for ContactPump {
-    fn default() -> Self {
-        ContactPump {
-            reading: Cell::new(false),
-            parts_listen: HandlersAnswer::default(),
-            lost: RefCell::new(None),
-            broke: RefCell::default(),
-        }
-    }
-}
 
 /// `joint.Broke` of joint `joint` of `plane` joining the objects `ends`, created on first
 /// access; the plane starts reading its events when the signal gets its first handler.
@@ -123,40 +58,6 @@ pub fn joint_broke_signal(
         .clone()
 }
 
-/// A destroyed joint's Broke signal goes (its handlers with it).
-pub fn forget_joint(plane: &PlaneState, joint: Handle) {
-    let broke = plane.contacts.broke.borrow_mut().remove(&joint);
-    if let Some(b) = broke {
-        b.signal.disconnect_all();
-    }
-}
-
-/// The object `object` left the plane: its joints went with it, and so do their Broke
-/// signals and handlers (as on Roblox, where destroying an instance disconnects them).
-pub fn forget_joints_of(plane: &PlaneState, object: Handle) {
-    forget_broke(plane, |b| b.ends.contains(&object));
-}
-
-/// The plane went: every Broke signal and its handlers go with it.
-pub fn forget_all_joints(plane: &PlaneState) {
-    forget_broke(plane, |_| true);
-}
-
-/// Removes the Broke signals `which` picks and disconnects their handlers (after the map is
-/// released: a handler's finaliser may reach the plane).
-fn forget_broke(plane: &PlaneState, which: impl Fn(&Broke) -> bool) {
-    let gone: Vec<Broke> = plane
-        .contacts
-        .broke
-        .borrow_mut()
-        .extract_if(|_, b| which(b))
-        .map(|(_, b)| b)
-        .collect();
-    for b in gone {
-        b.signal.disconnect_all();
-    }
-}
-
 impl PlaneState {
     /// `plane.EventsLost`: fired with the number of events lost when the script fell behind.
     pub fn events_lost_signal(&self) -> Signal {
@@ -167,27 +68,6 @@ impl PlaneState {
                 Signal::new(format!("PhysicsPlane {}.EventsLost", self.plane.id()))
             })
             .clone()
-    }
-
-    /// Something of the plane got handlers: subscribe to the plane's events now, so the
-    /// first event after this point is delivered, and drop what queued while nobody
-    /// listened.
-    pub fn listen_for_contacts(&self) {
-        if !self.alive() || self.contacts.reading.get() {
-            return;
-        }
-        if let Err(e) = self.plane.subscribe_events() {
-            eprintln!(
-                "PhysicsPlane {}: cannot read contact events: {e}",
-                self.plane.id()
-            );
-            return;
-        }
-        // Reading starts here: what was queued before is not news, and what the next step
-        // publishes is (a joint that breaks on the first step after `Broke:Connect`).
-        if !self.contacts.reading.get() && self.plane.events().is_ok() {
-            self.contacts.reading.set(true);
-        }
     }
 
     /// Whether anyone listens to the plane's events: a part's touch handlers, a
@@ -281,10 +161,7 @@ impl PlaneState {
         if part.touch_listeners() == 0 {
             return Ok(());
         }
-        let other = match self.part_of(other) {
-            Some(p) => Value::UserData(super::part::part_ud(lua, &p)?),
-            None => super::map::map_value(lua, self, other)?.unwrap_or(Value::Nil),
-        };
+        let other = body_value(lua, self, other)?;
         let contact = match contact {
             Some((position, normal, impulse, points, flip)) => {
                 let t = lua.create_table()?;

@@ -11,7 +11,7 @@ use std::rc::{Rc, Weak};
 
 use mlua::{Lua, MetaMethod, Table, UserData, UserDataMethods, Value};
 
-use super::part::{BasePart, PartState};
+use super::part::state::{BasePart, PartState};
 use crate::host::scheduler::scheduler;
 use crate::host::Watched;
 use crate::values::{expected, CFrame};

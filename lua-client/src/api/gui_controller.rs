@@ -11,23 +11,10 @@ use std::cell::{Cell, RefCell};
 use client_sdk::{GuiController, GuiControllerProp, GuiEvent, Handle};
 use mlua::{Lua, MetaMethod, MultiValue, Table, UserData, UserDataMethods, Value};
 
-use super::gui_object::PhysicsGuiObject;
-use super::gui_plane::fire;
+use super::gui_plane::state::{ControllerState, PhysicsGuiObject};
 use crate::host::signal::Signal;
 use crate::values::{describe, expected, number, sdk_error};
 use crate::values::{dim_arg, new_dim};
-
-/// A controller as the host holds it.
-pub struct ControllerState {
-    ctrl: GuiController,
-    object: PhysicsGuiObject,
-    move_direction: Cell<[f32; 2]>,
-    waypoints: RefCell<Vec<[f32; 2]>>,
-    waypoint_reached: Signal,
-    path_finished: Signal,
-    moved: Signal,
-    ground_changed: Signal,
-}
 
 impl ControllerState {
     /// A controller of `object`.
@@ -276,5 +263,14 @@ impl UserData for GuiControllerUd {
                 }
             },
         );
+    }
+}
+
+/// Fires `signal` with `args` (used by controllers).
+pub fn fire(lua: &Lua, signal: &crate::host::signal::Signal, args: MultiValue) -> mlua::Result<()> {
+    if signal.listeners() > 0 {
+        signal.fire(lua, args)
+    } else {
+        Ok(())
     }
 }

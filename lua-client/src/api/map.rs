@@ -8,13 +8,12 @@
 //! `map.Vertices`, `map.Validation.OpenEdges`) next to `map.Stats`. A map is static: the
 //! properties of moving bodies (Velocity, Size, Weight, ...) are refused by name, with why.
 
-use std::cell::Cell;
-use std::rc::{Rc, Weak};
+use std::rc::Rc;
 
 use client_sdk::{Handle, Object, ObjectProp};
 use mlua::{AnyUserData, Lua, MetaMethod, Table, UserData, UserDataMethods, Value};
 
-use super::plane::{PhysicsPlane, PlaneState};
+use super::plane::state::{MapState, PhysicsPlane, PlaneState};
 use crate::props::{Get, Kind, Props, Row, Set, Target};
 use crate::values::{describe, lua_number, sdk_error, CFrame, DESCRIBE};
 
@@ -40,27 +39,7 @@ const REFUSED: [&str; 15] = [
     "LockRotZ",
 ];
 
-/// A map as the host holds it: the SDK's map, its plane, and whether the script destroyed it.
-pub struct MapState {
-    /// The SDK's map (its anchored object and the daemon's report).
-    pub map: client_sdk::Map,
-    plane: Weak<PlaneState>,
-    /// The file name it was loaded from (what `Name` and `tostring` show).
-    name: String,
-    destroyed: Cell<bool>,
-}
-
 impl MapState {
-    /// The map `map`, loaded from a file called `name` into `plane`.
-    pub fn new(map: client_sdk::Map, plane: &Rc<PlaneState>, name: String) -> MapState {
-        MapState {
-            map,
-            plane: Rc::downgrade(plane),
-            name,
-            destroyed: Cell::new(false),
-        }
-    }
-
     /// The map's handle (what hits and contacts name).
     pub fn handle(&self) -> Handle {
         self.map.handle()
@@ -184,6 +163,7 @@ macro_rules! own_row {
 /// The rows of `Map`.
 pub static MAP: Props<MapState> = Props {
     owner: "Map",
+    table: None,
     rows: &[
         // Moves the static map (it stays anchored): the newest tick, writes on top.
         Row {
@@ -259,7 +239,7 @@ pub static MAP: Props<MapState> = Props {
         own_row!("Name", |lua, m| Value::String(lua.create_string(&m.name)?)),
         // The plane's own value (`map.Plane == plane`); nil once the plane is collected.
         own_row!("Plane", |lua, m| match m.plane.upgrade() {
-            Some(p) => Value::UserData(super::plane::plane_ud(lua, &p)?),
+            Some(p) => Value::UserData(super::plane::context::plane_ud(lua, &p)?),
             None => Value::Nil,
         }),
         own_row!("Stats", |lua, m| Value::Table(m.stats(lua)?)),

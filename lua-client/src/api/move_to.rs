@@ -5,7 +5,7 @@
 
 use mlua::{UserDataMethods, Value};
 
-use super::plane::PhysicsPlane;
+use super::plane::state::PhysicsPlane;
 use crate::values::sdk_error;
 
 /// `MoveTo` on `PhysicsPlane`.

@@ -13,8 +13,9 @@ use std::rc::Rc;
 use client_sdk::{GuiPlane, PlaneId, PlaneKind};
 use mlua::{Lua, MultiValue, Table, UserDataMethods, Value};
 
-use super::gui_plane::{held_gui_plane, wrap_gui_plane, GuiPhysicsPlane, GuiPlaneState};
-use super::plane::{context, plane_ud, wrap_plane, PhysicsPlane, PlaneState};
+use super::gui_plane::state::{held_gui_plane, wrap_gui_plane, GuiPhysicsPlane, GuiPlaneState};
+use super::plane::context::{context, plane_ud, wrap_plane};
+use super::plane::state::{PhysicsPlane, PlaneState};
 use crate::host::scheduler::scheduler;
 use crate::host::signal::Signal;
 use crate::host::Watched;

@@ -10,9 +10,11 @@ use std::rc::Rc;
 use client_sdk::{Handle, Object, ShapeKind};
 use mlua::{UserDataMethods, Value};
 
-use super::object::{object_ud, PhysicsObject};
-use super::part::{part_ud, Body, PartShape, PartState};
-use super::plane::{PhysicsPlane, PlaneState};
+use super::object::object_ud;
+use super::object::state::PhysicsObject;
+use super::part::part_ud;
+use super::part::state::{Body, PartShape, PartState};
+use super::plane::state::{PhysicsPlane, PlaneState};
 use crate::values::sdk_error;
 
 const WHAT: &str = "PhysicsPlane:GetObjects";

@@ -8,9 +8,9 @@
 use client_sdk::{Falloff, ProbeHit, QueryParams, Shape};
 use mlua::{Lua, Table, UserDataMethods, Value};
 
-use super::object::PhysicsObject;
-use super::part::BasePart;
-use super::plane::{PhysicsPlane, PlaneState};
+use super::object::state::PhysicsObject;
+use super::part::state::BasePart;
+use super::plane::state::{PhysicsPlane, PlaneState};
 use super::query::{
     cframe_arg, live, object_handle, params, part_and_object, positive_arg, vector_arg, PARAM_KEYS,
 };

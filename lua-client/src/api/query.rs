@@ -11,9 +11,9 @@ use std::rc::Rc;
 use client_sdk::{FilterType, Found, Handle, Hit, QueryParams, Ray};
 use mlua::{Lua, Table, UserDataMethods, Value};
 
-use super::object::PhysicsObject;
-use super::part::BasePart;
-use super::plane::{PhysicsPlane, PlaneState};
+use super::object::state::PhysicsObject;
+use super::part::state::BasePart;
+use super::plane::state::{PhysicsPlane, PlaneState};
 use crate::values::{describe, expected, finite_number, new_vector, sdk_error, vector, CFrame};
 
 pub(super) const PARAM_KEYS: &str =

@@ -13,9 +13,10 @@ use client_sdk::ragdoll::BONE_PROPS;
 use client_sdk::{Bone, JointKind, Pose, RagdollDesc};
 use mlua::{AnyUserData, Lua, ObjectLike, Table, UserDataMethods, Value};
 
-use super::joint::LuaJoint;
-use super::part::{PartShape, PartState};
-use super::plane::{add, PhysicsPlane};
+use super::joint::state::LuaJoint;
+use super::part::state::{PartShape, PartState};
+use super::plane::add;
+use super::plane::state::PhysicsPlane;
 use crate::values::{describe, expected, finite_number, finite_vector, sdk_error, CFrame};
 
 const WHAT: &str = "PhysicsPlane:NewRagdoll";

@@ -11,8 +11,9 @@
 use client_sdk::{GuiPlane, PlaneKind, PlaneProp, PlaneSnapshot};
 use mlua::{Lua, MetaMethod, Table, UserData, UserDataFields, UserDataMethods, Value};
 
-use super::gui_plane::{wrap_gui_plane, GuiPhysicsPlane};
-use super::plane::{context, wrap_plane, PhysicsPlane};
+use super::gui_plane::state::{wrap_gui_plane, GuiPhysicsPlane};
+use super::plane::context::{context, wrap_plane};
+use super::plane::state::PhysicsPlane;
 use crate::api::plane::props::PLANE;
 use crate::values::{describe, expected, sdk_error};
 

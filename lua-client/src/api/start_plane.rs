@@ -9,8 +9,8 @@ use std::path::Path;
 use client_sdk::{GuiPlane, PlaneKind, PlaneSnapshot};
 use mlua::{AnyUserData, Lua, Table, Value};
 
-use super::gui_plane::wrap_gui_plane;
-use super::plane::{context, wrap_plane};
+use super::gui_plane::state::wrap_gui_plane;
+use super::plane::context::{context, wrap_plane};
 
 /// The start plane's script value, once made.
 struct StartPlane(AnyUserData);

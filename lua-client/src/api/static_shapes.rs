@@ -11,7 +11,7 @@
 
 use mlua::{Lua, Table, Value};
 
-use super::part::{PartShape, PartState};
+use super::part::state::{PartShape, PartState};
 use crate::values::rotation::{Quat, V3};
 use crate::values::{expected, finite_number, finite_vector, CFrame};
 

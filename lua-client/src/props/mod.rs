@@ -11,6 +11,8 @@
 //! - A documented property the SDK cannot do yet is a row marked `NotYet`, so wiring it later
 //!   is editing one row, and using it meanwhile is a clear error instead of a silent no-op.
 
+use std::sync::OnceLock;
+
 use client_sdk::settings::table::{AnyValue, PropKind, PropRow, Range};
 use mlua::{Error as LuaError, Lua, Value};
 
@@ -24,27 +26,39 @@ pub trait Target: 'static {
 
     /// Sends (queues) one property write; `name` is the property, for error messages.
     fn write(&self, name: &str, prop: Self::Prop) -> Result<(), LuaError>;
+}
 
-    /// The rows this type takes from its settings table (shm-layout's rows flagged `lua`),
-    /// looked up after its own rows. None by default.
-    fn table_rows() -> &'static [Row<Self>]
-    where
-        Self: Sized,
-    {
-        &[]
-    }
+/// Reads the stored value of a settings-table row (`name` the property, for the read's
+/// errors; `index` the row) from where `T` keeps its settings: `None` when the row has no
+/// plain value.
+pub type TableGet<T> = fn(&T, &str, usize) -> Result<Option<AnyValue>, LuaError>;
+/// The property write of a settings-table row (`index`) with value `v`, `None` when the row
+/// cannot take it.
+pub type TableProp<T> = fn(usize, AnyValue) -> Option<<T as Target>::Prop>;
 
-    /// The stored value of the settings-table row at `index` (`name` for messages).
-    fn table_get(&self, name: &str, _index: usize) -> Result<AnyValue, LuaError> {
-        Err(LuaError::runtime(format!("{name} has no settings table")))
-    }
+/// The rows a Lua type takes from its settings table (shm-layout's rows flagged `lua`),
+/// looked up after its own rows: each reads the stored value and writes one property of
+/// its row.
+pub struct Table<T: Target> {
+    /// The settings table's rows.
+    pub rows: &'static [PropRow],
+    /// Where the stored values are read.
+    pub get: TableGet<T>,
+    /// How a value becomes a write.
+    pub prop: TableProp<T>,
+    /// The Lua rows, made on first use.
+    lua_rows: OnceLock<Vec<Row<T>>>,
+}
 
-    /// The property write of the settings-table row at `index` with value `v`.
-    fn table_prop(name: &str, _index: usize, _v: AnyValue) -> Result<Self::Prop, LuaError>
-    where
-        Self: Sized,
-    {
-        Err(LuaError::runtime(format!("{name} has no settings table")))
+impl<T: Target> Table<T> {
+    /// The rows of the settings table `rows`, read through `get` and written through `prop`.
+    pub const fn new(rows: &'static [PropRow], get: TableGet<T>, prop: TableProp<T>) -> Table<T> {
+        Table {
+            rows,
+            get,
+            prop,
+            lua_rows: OnceLock::new(),
+        }
     }
 }
 
@@ -303,7 +317,7 @@ pub enum Get<T> {
     /// Documented, but the SDK cannot read it yet (no row needs it today).
     #[allow(dead_code)]
     NotYet,
-    /// The stored value of the settings-table row at this index ([`Target::table_get`]).
+    /// The stored value of the settings-table row at this index ([`Table::get`]).
     Table(usize),
 }
 
@@ -324,7 +338,7 @@ pub enum Set<T: Target> {
     /// Documented, but the SDK cannot write it yet (no row needs it today).
     #[allow(dead_code)]
     NotYet,
-    /// The settings-table row at `index` ([`Target::table_prop`]): writable, or an option
+    /// The settings-table row at `index` ([`Table::prop`]): writable, or an option
     /// of the creation call only when the row is `creation_only`.
     Table {
         /// The row's index in its table (its wire index).
@@ -365,6 +379,8 @@ pub struct Props<T: Target> {
     pub owner: &'static str,
     /// One row per property.
     pub rows: &'static [Row<T>],
+    /// The rows from its settings table, if it has one.
+    pub table: Option<Table<T>>,
 }
 
 fn key_text(key: &Value) -> String {
@@ -375,15 +391,41 @@ fn key_text(key: &Value) -> String {
 }
 
 impl<T: Target> Props<T> {
+    /// The rows from the type's settings table (none without one).
+    pub fn table_rows(&self) -> &[Row<T>] {
+        match &self.table {
+            Some(t) => t.lua_rows.get_or_init(|| table_rows(t.rows)),
+            None => &[],
+        }
+    }
+
+    /// The stored value of the settings-table row at `index` (`name` its property).
+    fn table_get(&self, target: &T, name: &str, index: usize) -> Result<AnyValue, LuaError> {
+        let what = format!("{}.{name}", self.owner);
+        let Some(t) = &self.table else {
+            return Err(LuaError::runtime(format!("{what} has no settings table")));
+        };
+        (t.get)(target, name, index)?
+            .ok_or_else(|| LuaError::runtime(format!("{what} has no plain value")))
+    }
+
+    /// The write of value `v` to the settings-table row at `index` (`what` names it).
+    fn table_prop(&self, what: &str, index: usize, v: AnyValue) -> Result<T::Prop, LuaError> {
+        let Some(t) = &self.table else {
+            return Err(LuaError::runtime(format!("{what} has no settings table")));
+        };
+        (t.prop)(index, v).ok_or_else(|| LuaError::runtime(format!("{what} cannot take {v:?}")))
+    }
+
     /// The row named by `key`, if `key` is one of its property names.
-    pub fn row(&self, key: &Value) -> Option<&'static Row<T>> {
+    pub fn row(&self, key: &Value) -> Option<&Row<T>> {
         let Value::String(s) = key else {
             return None;
         };
         let key = s.as_bytes();
         self.rows
             .iter()
-            .chain(T::table_rows())
+            .chain(self.table_rows())
             .find(|r| r.name.as_bytes() == &*key)
     }
 
@@ -412,10 +454,7 @@ impl<T: Target> Props<T> {
         match row.get {
             Get::Fn(f) => f(lua, target),
             Get::NotYet => Err(self.not_supported(row.name)),
-            Get::Table(index) => {
-                let what = format!("{}.{}", self.owner, row.name);
-                any_to_lua(lua, target.table_get(&what, index)?)
-            }
+            Get::Table(index) => any_to_lua(lua, self.table_get(target, row.name, index)?),
         }
     }
 
@@ -441,7 +480,10 @@ impl<T: Target> Props<T> {
                 creation_only: false,
             } => {
                 let what = format!("{}.{}", self.owner, row.name);
-                target.write(row.name, T::table_prop(&what, index, arg_to_any(arg()?)?)?)
+                target.write(
+                    row.name,
+                    self.table_prop(&what, index, arg_to_any(arg()?)?)?,
+                )
             }
             Set::ReadOnly | Set::CreationOnly(_) | Set::Table { .. } => {
                 Err(LuaError::runtime(format!(
@@ -482,7 +524,7 @@ impl<T: Target> Props<T> {
             Set::Table { index, .. } => {
                 let what = format!("{what} option {}", row.name);
                 let arg = row.kind.convert(&what, value)?;
-                return T::table_prop(&what, index, arg_to_any(arg)?);
+                return self.table_prop(&what, index, arg_to_any(arg)?);
             }
             Set::NotYet => return Err(self.not_supported(row.name)),
             Set::ReadOnly => return Err(not_an_option(row.name, "is read-only, not an option")),
@@ -539,7 +581,7 @@ impl Kind {
 
 /// The Lua rows of a settings table: one per row flagged `lua`, reading the stored value
 /// and writing one property of that row.
-pub fn table_rows<T: Target>(rows: &'static [PropRow]) -> Vec<Row<T>> {
+fn table_rows<T: Target>(rows: &'static [PropRow]) -> Vec<Row<T>> {
     rows.iter()
         .enumerate()
         .filter(|(_, r)| r.lua && r.stored)

@@ -4,178 +4,19 @@
 //! WaypointReached, PathFinished) come from the plane's per-tick event stream.
 
 pub(crate) mod props;
+pub(crate) mod state;
 
 use std::cell::{Cell, RefCell};
-use std::rc::{Rc, Weak};
+use std::rc::Rc;
 
-use client_sdk::{BodyState, Controller, ControllerProp, Pose, Vec3};
-use mlua::{AnyUserData, Lua, MetaMethod, MultiValue, UserData, UserDataMethods, Value};
+use client_sdk::{Pose, Vec3};
+use mlua::{MetaMethod, UserData, UserDataMethods, Value};
 
-use super::part::{BasePart, Body, Ended, PartState};
-use super::plane::PlaneState;
-use crate::host::signal::Signal;
-use crate::props::Target;
+use super::part::state::{BasePart, Body, Ended};
+use super::plane::state::{ControllerState, PlaneState};
 use crate::values::{describe, expected, finite_number, sdk_error, vector, CFrame};
 use props::CONTROLLER;
-
-/// A controller as the host holds it.
-pub struct ControllerState {
-    /// The SDK's controller.
-    pub controller: Controller,
-    /// The part it drives.
-    pub part: Rc<PartState>,
-    /// The part's own userdata (`controller:BasePart() == part`).
-    pub part_ud: AnyUserData,
-    /// Its body, shared with the part while the controller lives.
-    pub body: Rc<Body>,
-    /// The plane.
-    pub plane: Weak<PlaneState>,
-    /// The script's motion intent (MoveForward etc. change one axis of it).
-    move_vector: Cell<[f32; 2]>,
-    signals: RefCell<Vec<(&'static str, Signal)>>,
-}
-
-/// The Lua handle of a controller.
-#[derive(Clone)]
-pub struct LuaController(pub Rc<ControllerState>);
-
-impl ControllerState {
-    /// The signal `name`, created on first use (Moved asks the daemon for Moved events only
-    /// while it has handlers).
-    pub fn signal(self: &Rc<Self>, name: &'static str) -> Signal {
-        let mut signals = self.signals.borrow_mut();
-        if let Some((_, s)) = signals.iter().find(|(n, _)| *n == name) {
-            return s.clone();
-        }
-        let s = Signal::new(format!("Controller.{name}"));
-        let me = Rc::downgrade(self);
-        s.on_listeners(move |n| {
-            let Some(me) = me.upgrade() else {
-                return;
-            };
-            if me.body.ended().is_some() {
-                return;
-            }
-            if n > 0 {
-                if let Some(plane) = me.plane.upgrade() {
-                    plane.listen_for_contacts();
-                }
-            }
-            if name == "Moved" {
-                // A queued write: a refusal comes back with the frame's flush.
-                let _ = me.controller.set(ControllerProp::ReportMoved(n > 0));
-            }
-        });
-        signals.push((name, s.clone()));
-        s
-    }
-
-    /// Handlers connected to any of its signals.
-    pub fn listeners(&self) -> usize {
-        self.signals
-            .borrow()
-            .iter()
-            .map(|(_, s)| s.listeners())
-            .sum()
-    }
-
-    /// Fires `name` with `args` when someone listens.
-    pub fn fire(&self, lua: &Lua, name: &str, args: MultiValue) -> mlua::Result<()> {
-        let signal = self
-            .signals
-            .borrow()
-            .iter()
-            .find(|(n, _)| *n == name)
-            .map(|(_, s)| s.clone());
-        match signal {
-            Some(s) if s.listeners() > 0 => s.fire(lua, args),
-            _ => Ok(()),
-        }
-    }
-
-    fn disconnect_all(&self) {
-        for (_, s) in self.signals.borrow().iter() {
-            s.disconnect_all();
-        }
-    }
-}
-
-impl LuaController {
-    /// The SDK controller while it lives; else an error naming `what`.
-    pub fn live(&self, what: &str) -> mlua::Result<&Controller> {
-        match self.0.body.ended() {
-            None => Ok(&self.0.controller),
-            Some(why) => Err(mlua::Error::runtime(format!(
-                "Controller.{what}: the controller {}",
-                why.says()
-            ))),
-        }
-    }
-
-    /// Its published state (newest tick, with this process's writes on top).
-    pub fn state(&self, what: &str) -> mlua::Result<BodyState> {
-        self.live(what)?
-            .object()
-            .state()
-            .map_err(|e| sdk_error(&format!("Controller.{what}"), e))
-    }
-
-    /// Its facing (yaw, radians) from the published rotation.
-    pub fn yaw(&self, what: &str) -> mlua::Result<f32> {
-        let [x, y, z, w] = self.state(what)?.rotation;
-        // The body turns only about Y: forward (+Z) rotated by the quaternion.
-        let fx = 2.0 * (x * z + w * y);
-        let fz = 1.0 - 2.0 * (x * x + y * y);
-        Ok(fx.atan2(fz))
-    }
-
-    fn set_intent(&self, what: &str, x: Option<f32>, z: Option<f32>) -> mlua::Result<()> {
-        let [mut mx, mut mz] = self.0.move_vector.get();
-        if let Some(x) = x {
-            mx = x;
-        }
-        if let Some(z) = z {
-            mz = z;
-        }
-        self.live(what)?
-            .set_move_vector(mx, mz)
-            .map_err(|e| sdk_error(&format!("Controller:{what}"), e))?;
-        self.0.move_vector.set([mx, mz]);
-        Ok(())
-    }
-}
-
-impl Target for LuaController {
-    type Prop = ControllerProp;
-
-    fn write(&self, name: &str, prop: ControllerProp) -> mlua::Result<()> {
-        self.live(name)?
-            .set(prop)
-            .map_err(|e| sdk_error(&format!("Controller.{name}"), e))
-    }
-
-    fn table_rows() -> &'static [crate::props::Row<LuaController>] {
-        static ROWS: std::sync::OnceLock<Vec<crate::props::Row<LuaController>>> =
-            std::sync::OnceLock::new();
-        ROWS.get_or_init(|| crate::props::table_rows(ControllerProp::ROWS))
-    }
-
-    fn table_get(
-        &self,
-        name: &str,
-        index: usize,
-    ) -> mlua::Result<client_sdk::settings::table::AnyValue> {
-        props::table_get(self, name, index)
-    }
-
-    fn table_prop(
-        name: &str,
-        index: usize,
-        v: client_sdk::settings::table::AnyValue,
-    ) -> mlua::Result<ControllerProp> {
-        props::table_prop(name, index, v)
-    }
-}
+use state::LuaController;
 
 /// A point: a Vector, or a CFrame's position.
 fn point(what: &str, v: &Value) -> mlua::Result<Vec3> {

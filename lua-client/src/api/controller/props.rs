@@ -2,32 +2,16 @@
 //! shared memory (no request); settings and path state read back from the daemon
 //! (`controller.info()`, one round trip). The plain settings (WalkSpeed, JumpPower, ...) are
 //! not listed here: they are the controller settings table's rows flagged `lua`
-//! ([`table_get`], [`table_prop`]), their ranges taken from the table. Every write is one
+//! (the `table` of [`CONTROLLER`]), their ranges taken from the table. Every write is one
 //! `ControllerProp`; the writable rows are also the options of `plane:NewController(part,
 //! opts)`.
 
-use client_sdk::settings::table::AnyValue;
 use client_sdk::{ControllerInfo, ControllerProp};
 use mlua::{Error as LuaError, Value};
 
-use super::LuaController;
-use crate::props::{Get, Kind, Props, Row, Set};
+use super::state::LuaController;
+use crate::props::{Get, Kind, Props, Row, Set, Table, Target};
 use crate::values::{new_vector, sdk_error};
-
-/// The stored value of the controller settings row at `index` (read back from the daemon).
-pub fn table_get(c: &LuaController, what: &str, index: usize) -> Result<AnyValue, LuaError> {
-    let name = what.trim_start_matches("Controller.");
-    info(c, name)?
-        .settings
-        .get(index)
-        .ok_or_else(|| LuaError::runtime(format!("{what} has no plain value")))
-}
-
-/// The property write of the controller settings row at `index`.
-pub fn table_prop(what: &str, index: usize, v: AnyValue) -> Result<ControllerProp, LuaError> {
-    ControllerProp::from_any(index, v)
-        .ok_or_else(|| LuaError::runtime(format!("{what} cannot take {v:?}")))
-}
 
 /// The controller's settings and state as the daemon holds them (one round trip).
 fn info(c: &LuaController, what: &str) -> Result<ControllerInfo, LuaError> {
@@ -51,6 +35,11 @@ macro_rules! signal_row {
 /// The rows of `Controller`.
 pub static CONTROLLER: Props<LuaController> = Props {
     owner: "Controller",
+    table: Some(Table::new(
+        ControllerProp::ROWS,
+        |c, name, index| Ok(info(c, name)?.settings.get(index)),
+        ControllerProp::from_any,
+    )),
     rows: &[
         Row {
             name: "Position",
@@ -142,3 +131,13 @@ pub static CONTROLLER: Props<LuaController> = Props {
         },
     ],
 };
+
+impl Target for LuaController {
+    type Prop = ControllerProp;
+
+    fn write(&self, name: &str, prop: ControllerProp) -> mlua::Result<()> {
+        self.live(name)?
+            .set(prop)
+            .map_err(|e| sdk_error(&format!("Controller.{name}"), e))
+    }
+}

@@ -4,43 +4,15 @@
 
 pub(crate) mod props;
 
-use std::rc::{Rc, Weak};
+use std::rc::Rc;
 
-use client_sdk::{GuiObject, GuiObjectProp};
+use client_sdk::GuiObjectProp;
 use mlua::{MetaMethod, UserData, UserDataMethods, Value};
 
-use super::gui_basic::{GuiPrimitive, PrimState};
-use super::gui_plane::GuiPlaneState;
+use super::gui_basic::GuiPrimitive;
+use super::gui_plane::state::PhysicsGuiObject;
 use crate::values::dim_arg;
 use crate::values::sdk_error;
-
-/// The Lua handle of a GUI body.
-#[derive(Clone)]
-pub struct PhysicsGuiObject {
-    /// The SDK's object.
-    pub object: GuiObject,
-    /// The primitive it simulates.
-    pub prim: Rc<PrimState>,
-    /// Its plane.
-    pub plane: Weak<GuiPlaneState>,
-}
-
-impl PhysicsGuiObject {
-    /// Whether the body still exists (its plane alive, not destroyed).
-    pub fn alive(&self) -> bool {
-        self.plane.upgrade().is_some_and(|p| p.alive()) && self.object.is_alive().unwrap_or(false)
-    }
-
-    /// Errors naming `what` once the body ended.
-    pub fn check_alive(&self, what: &str) -> mlua::Result<()> {
-        match self.alive() {
-            true => Ok(()),
-            false => Err(mlua::Error::runtime(format!(
-                "{what}: the PhysicsGuiObject was destroyed (or its plane was)"
-            ))),
-        }
-    }
-}
 
 impl UserData for PhysicsGuiObject {
     fn add_methods<M: UserDataMethods<Self>>(methods: &mut M) {

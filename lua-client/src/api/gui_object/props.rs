@@ -3,17 +3,14 @@
 //! SDK's read-your-writes view of the newest tick (no request); ImpulseDirection reads the
 //! daemon's info; ZIndex, Size and Shape mirror the primitive (set them there). The plain
 //! stored settings (Mass, Friction, ...) are not listed here: they are the GUI object
-//! settings table's rows flagged `lua` (`Target::table_rows`). Every write is one
+//! settings table's rows flagged `lua` (the `table` of [`GUI_OBJECT`]). Every write is one
 //! `GuiObjectProp`.
 
-use std::sync::OnceLock;
-
-use client_sdk::settings::table::AnyValue;
 use client_sdk::{GuiObjectInfo, GuiObjectProp};
 use mlua::{Error as LuaError, Lua, Value};
 
-use super::PhysicsGuiObject;
-use crate::props::{table_rows, Get, Kind, Props, Row, Set, Target};
+use crate::api::gui_plane::state::PhysicsGuiObject;
+use crate::props::{Get, Kind, Props, Row, Set, Table, Target};
 use crate::values::{lua_number, new_dim, sdk_error};
 
 impl Target for PhysicsGuiObject {
@@ -23,26 +20,6 @@ impl Target for PhysicsGuiObject {
         let what = format!("PhysicsGuiObject.{name}");
         self.check_alive(&what)?;
         self.object.set(prop).map_err(|e| sdk_error(&what, e))
-    }
-
-    /// The GUI object settings table's rows flagged `lua` (Mass, Friction, ...): read from
-    /// the daemon's info, written as one `GuiObjectProp`.
-    fn table_rows() -> &'static [Row<PhysicsGuiObject>] {
-        static ROWS: OnceLock<Vec<Row<PhysicsGuiObject>>> = OnceLock::new();
-        ROWS.get_or_init(|| table_rows(GuiObjectProp::ROWS))
-    }
-
-    fn table_get(&self, what: &str, index: usize) -> mlua::Result<AnyValue> {
-        let name = what.trim_start_matches("PhysicsGuiObject.");
-        info(self, name)?
-            .settings
-            .get(index)
-            .ok_or_else(|| LuaError::runtime(format!("{what} has no plain value")))
-    }
-
-    fn table_prop(what: &str, index: usize, v: AnyValue) -> mlua::Result<GuiObjectProp> {
-        GuiObjectProp::from_any(index, v)
-            .ok_or_else(|| LuaError::runtime(format!("{what} cannot take {v:?}")))
     }
 }
 
@@ -91,6 +68,11 @@ fn boolean(_: &Lua, x: bool) -> Result<Value, LuaError> {
 /// The rows of `PhysicsGuiObject`.
 pub static GUI_OBJECT: Props<PhysicsGuiObject> = Props {
     owner: "PhysicsGuiObject",
+    table: Some(Table::new(
+        GuiObjectProp::ROWS,
+        |o, name, index| Ok(info(o, name)?.settings.get(index)),
+        GuiObjectProp::from_any,
+    )),
     rows: &[
         Row {
             name: "Position",

@@ -7,55 +7,25 @@
 //! signals in the order the daemon produced them.
 
 pub(crate) mod props;
+pub(crate) mod state;
 
-use std::cell::{Cell, RefCell};
-use std::collections::HashMap;
 use std::rc::Rc;
 
-use client_sdk::{GuiPlane, GuiPlaneOptions, GuiPlaneProp, Handle, PlaneProp};
-use mlua::{Lua, MetaMethod, MultiValue, UserData, UserDataMethods, Value};
+use client_sdk::{GuiPlaneOptions, GuiPlaneProp, PlaneProp};
+use mlua::{Lua, MetaMethod, UserData, UserDataMethods, Value};
 
 use super::gui_basic::{GuiPrimitive, PrimState};
-use super::gui_controller::{ControllerState, GuiControllerUd};
-use super::gui_object::PhysicsGuiObject;
-use super::plane::context;
-use crate::host::scheduler::scheduler;
+use super::gui_controller::GuiControllerUd;
+use super::plane::context::context;
 use crate::host::Watched;
 use crate::values::{describe, expected, finite_number, sdk_error};
 use crate::values::{dim_arg, new_dim};
-
-/// A GUI plane as the host holds it.
-pub struct GuiPlaneState {
-    /// The SDK's plane.
-    pub plane: GuiPlane,
-    alive: Cell<bool>,
-    prims: RefCell<Vec<Rc<PrimState>>>,
-    controllers: RefCell<HashMap<Handle, Rc<ControllerState>>>,
-}
+use state::{
+    wrap_gui_plane, ControllerState, GuiPhysicsPlane, GuiPlaneState, GuiPlanes, PhysicsGuiObject,
+};
 
 impl GuiPlaneState {
-    /// False after `:Destroy()`.
-    pub fn alive(&self) -> bool {
-        self.alive.get()
-    }
-
-    /// Errors with "the plane was destroyed" for `what` once destroyed.
-    pub fn check_alive(&self, what: &str) -> mlua::Result<()> {
-        match self.alive() {
-            true => Ok(()),
-            false => Err(mlua::Error::runtime(format!(
-                "GuiPhysicsPlane.{what}: the plane was destroyed"
-            ))),
-        }
-    }
-
-    /// Forgets a primitive whose body ended.
-    pub fn forget(&self, prim: &Rc<PrimState>, handle: Handle) {
-        self.prims.borrow_mut().retain(|p| !Rc::ptr_eq(p, prim));
-        self.controllers.borrow_mut().remove(&handle);
-    }
-
-    fn after_tick(&self, lua: &Lua) -> mlua::Result<()> {
+    pub(crate) fn after_tick(&self, lua: &Lua) -> mlua::Result<()> {
         self.deliver_signals(lua)?;
         let prims: Vec<Rc<PrimState>> = self.prims.borrow().clone();
         for p in prims {
@@ -89,7 +59,7 @@ impl GuiPlaneState {
         Ok(())
     }
 
-    fn destroy(&self) -> mlua::Result<()> {
+    pub(crate) fn destroy(&self) -> mlua::Result<()> {
         if !self.alive.replace(false) {
             return Ok(());
         }
@@ -167,14 +137,6 @@ impl GuiPlaneState {
         Ok(GuiControllerUd(state))
     }
 }
-
-/// The GUI planes of a Lua state, kept until `:Destroy()`.
-#[derive(Default)]
-struct GuiPlanes(RefCell<Vec<Rc<GuiPlaneState>>>);
-
-/// The Lua handle of a GUI plane.
-#[derive(Clone)]
-pub struct GuiPhysicsPlane(pub Rc<GuiPlaneState>);
 
 impl super::lifecycle::LuaPlane for GuiPhysicsPlane {
     const TYPE: &'static str = "GuiPhysicsPlane";
@@ -354,44 +316,4 @@ pub fn new_gui(lua: &Lua, opts: Value) -> mlua::Result<GuiPhysicsPlane> {
         .create_gui_plane(&o)
         .map_err(|e| sdk_error(WHAT, e))?;
     Ok(wrap_gui_plane(lua, plane))
-}
-
-/// The script's handle on a new GUI plane of this client (`NewGUI`, `FromSnapshot`).
-pub(crate) fn wrap_gui_plane(lua: &Lua, plane: GuiPlane) -> GuiPhysicsPlane {
-    let state = Rc::new(GuiPlaneState {
-        plane,
-        alive: Cell::new(true),
-        prims: RefCell::default(),
-        controllers: RefCell::default(),
-    });
-    scheduler(lua).watch(state.clone());
-    // GUI planes stay alive until `:Destroy()`, whether or not the script keeps a reference.
-    if lua.app_data_ref::<GuiPlanes>().is_none() {
-        lua.set_app_data(GuiPlanes::default());
-    }
-    if let Some(planes) = lua.app_data_ref::<GuiPlanes>() {
-        planes.0.borrow_mut().push(state.clone());
-    }
-    GuiPhysicsPlane(state)
-}
-
-/// The script's handle on GUI plane `id` when it holds one (`Open` of a plane it has).
-pub(crate) fn held_gui_plane(lua: &Lua, id: client_sdk::PlaneId) -> Option<GuiPhysicsPlane> {
-    let planes = lua.app_data_ref::<GuiPlanes>()?;
-    let found = planes
-        .0
-        .borrow()
-        .iter()
-        .find(|s| s.alive() && s.plane.plane().id() == id)
-        .cloned();
-    found.map(GuiPhysicsPlane)
-}
-
-/// Fires `signal` with `args` (used by controllers).
-pub fn fire(lua: &Lua, signal: &crate::host::signal::Signal, args: MultiValue) -> mlua::Result<()> {
-    if signal.listeners() > 0 {
-        signal.fire(lua, args)
-    } else {
-        Ok(())
-    }
 }

@@ -1,18 +1,17 @@
 //! GuiPhysicsPlane properties, which are also the options of `PhysicsService.NewGUI`: rows
 //! on the shared row system (`crate::props`), like `PhysicsPlane`'s. The 2D settings are not
-//! listed here: they are the GUI plane settings table's rows flagged `lua` ([`table_get`],
-//! [`table_prop`]), read from the daemon's info (one round trip) and written as one
+//! listed here: they are the GUI plane settings table's rows flagged `lua` (the
+//! `table` of [`GUI_PLANE`]), read from the daemon's info (one round trip) and written as one
 //! `PlaneProp::Gui`. `BoundsMin` / `BoundsMax` (the table's `Bounds` pair) are options of
 //! `NewGUI` only (given as a pair). What is left here are the rows that are not 2D settings.
 
 use client_sdk::settings::plane::MAX_ROLLBACK_TICKS;
-use client_sdk::settings::table::AnyValue;
 use client_sdk::validate::MAX_TICK_RATE;
 use client_sdk::{GuiPlaneInfo, GuiPlaneProp, PlaneProp};
 use mlua::{Error as LuaError, Lua, Value};
 
-use super::GuiPlaneState;
-use crate::props::{Get, Kind, Props, Row, Set, Target};
+use super::state::GuiPlaneState;
+use crate::props::{Get, Kind, Props, Row, Set, Table, Target};
 use crate::values::{lua_number, new_dim, sdk_error};
 
 impl Target for GuiPlaneState {
@@ -28,35 +27,6 @@ impl Target for GuiPlaneState {
         }
         .map_err(|e| sdk_error(&format!("GuiPhysicsPlane.{name}"), e))
     }
-
-    fn table_rows() -> &'static [Row<GuiPlaneState>] {
-        static ROWS: std::sync::OnceLock<Vec<Row<GuiPlaneState>>> = std::sync::OnceLock::new();
-        ROWS.get_or_init(|| crate::props::table_rows(GuiPlaneProp::ROWS))
-    }
-
-    fn table_get(&self, name: &str, index: usize) -> mlua::Result<AnyValue> {
-        table_get(self, name, index)
-    }
-
-    fn table_prop(name: &str, index: usize, v: AnyValue) -> mlua::Result<PlaneProp> {
-        table_prop(name, index, v)
-    }
-}
-
-/// The stored value of the GUI plane settings row at `index`, from the daemon's info.
-pub fn table_get(p: &GuiPlaneState, what: &str, index: usize) -> Result<AnyValue, LuaError> {
-    let name = what.trim_start_matches("GuiPhysicsPlane.");
-    info(p, name)?
-        .settings
-        .get(index)
-        .ok_or_else(|| LuaError::runtime(format!("{what} has no plain value")))
-}
-
-/// The option write of the GUI plane settings row at `index`.
-pub fn table_prop(what: &str, index: usize, v: AnyValue) -> Result<PlaneProp, LuaError> {
-    GuiPlaneProp::from_any(index, v)
-        .map(PlaneProp::Gui)
-        .ok_or_else(|| LuaError::runtime(format!("{what} cannot take {v:?}")))
 }
 
 /// The plane's settings as the daemon reports them (`what` names the property read).
@@ -81,6 +51,11 @@ fn bound(lua: &Lua, p: &GuiPlaneState, what: &str, max: bool) -> Result<Value, L
 /// The rows of `GuiPhysicsPlane` beyond its 2D settings (options of `NewGUI` as well).
 pub static GUI_PLANE: Props<GuiPlaneState> = Props {
     owner: "GuiPhysicsPlane",
+    table: Some(Table::new(
+        GuiPlaneProp::ROWS,
+        |p, name, index| Ok(info(p, name)?.settings.get(index)),
+        |index, v| GuiPlaneProp::from_any(index, v).map(PlaneProp::Gui),
+    )),
     rows: &[
         Row {
             name: "Enabled",

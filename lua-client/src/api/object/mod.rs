@@ -2,16 +2,19 @@
 //! tick in shared memory; writes join the client's per-frame batch.
 
 pub(crate) mod props;
+pub(crate) mod state;
 
 use std::rc::Rc;
 
-use client_sdk::{Object, ObjectProp, Pin, Restraint};
+use client_sdk::{Pin, Restraint};
 use mlua::{AnyUserData, Lua, MetaMethod, Table, UserData, UserDataMethods, Value};
 
-use super::part::{Body, Ended, PartState};
-use crate::props::{Kind, Target};
+use super::method_tables::index;
+use super::part::state::Ended;
+use crate::props::Kind;
 use crate::values::{describe, expected, new_vector, rotation, sdk_error, DESCRIBE};
 use props::OBJECT;
+use state::PhysicsObject;
 
 /// RotateTo's documented default strength.
 const DEFAULT_STRENGTH: f64 = 8.0;
@@ -52,92 +55,6 @@ fn restraint(opts: &Value) -> mlua::Result<Restraint> {
         lock_rot_y,
         lock_rot_z,
     })
-}
-
-/// A part's body in a plane, as scripts hold it.
-pub struct PhysicsObject {
-    /// The body `plane:Add` made; it ends (and this object goes stale) on Unlink, Destroy
-    /// or the plane's Destroy, and is never replaced.
-    pub body: Rc<Body>,
-    /// The wrapped part.
-    pub part: Rc<PartState>,
-    /// The wrapped part's own userdata, so `obj:BasePart() == part`.
-    pub part_ud: AnyUserData,
-}
-
-impl PhysicsObject {
-    /// The body, while it is still the part's; else an error for `what` (the property or
-    /// method, e.g. `PhysicsObject.Velocity`) naming the object and what happened to it.
-    pub fn live(&self, what: &str) -> mlua::Result<&Object> {
-        self.live_for(|| what.to_string())
-    }
-
-    /// [`live`](Self::live), naming `what` only when it fails.
-    pub fn live_for(&self, what: impl FnOnce() -> String) -> mlua::Result<&Object> {
-        match self.body.ended() {
-            None => Ok(&self.body.object),
-            Some(ended) => Err(mlua::Error::runtime(format!(
-                "{}: {} {}",
-                what(),
-                self.describe(),
-                ended.says()
-            ))),
-        }
-    }
-
-    /// Whether the body still exists and is still the part's.
-    pub fn alive(&self) -> bool {
-        self.body.ended().is_none() && self.body.object.is_alive().unwrap_or(false)
-    }
-
-    /// `PhysicsObject "Name"`: how `tostring` and error messages show the object.
-    pub fn describe(&self) -> String {
-        format!("PhysicsObject \"{}\"", self.part.name())
-    }
-
-    /// What `tostring` shows: [`describe`](Self::describe), then "(destroyed)" once the
-    /// object was destroyed (itself, its part or its plane) or "(unlinked)" once unlinked,
-    /// as a destroyed joint, plane or map shows.
-    pub fn tostring(&self) -> String {
-        match self.body.ended() {
-            None => self.describe(),
-            Some(Ended::Unlinked) => format!("{} (unlinked)", self.describe()),
-            Some(_) => format!("{} (destroyed)", self.describe()),
-        }
-    }
-}
-
-impl Target for PhysicsObject {
-    type Prop = ObjectProp;
-
-    fn write(&self, name: &str, prop: ObjectProp) -> mlua::Result<()> {
-        let what = || format!("PhysicsObject.{name}");
-        self.live_for(what)?
-            .set(prop)
-            .map_err(|e| sdk_error(&what(), e))
-    }
-
-    fn table_rows() -> &'static [crate::props::Row<PhysicsObject>] {
-        static ROWS: std::sync::OnceLock<Vec<crate::props::Row<PhysicsObject>>> =
-            std::sync::OnceLock::new();
-        ROWS.get_or_init(|| crate::props::table_rows(ObjectProp::ROWS))
-    }
-
-    fn table_get(
-        &self,
-        name: &str,
-        index: usize,
-    ) -> mlua::Result<client_sdk::settings::table::AnyValue> {
-        props::table_get(self, name, index)
-    }
-
-    fn table_prop(
-        name: &str,
-        index: usize,
-        v: client_sdk::settings::table::AnyValue,
-    ) -> mlua::Result<ObjectProp> {
-        props::table_prop(name, index, v)
-    }
 }
 
 /// `self` of a method called on a PhysicsObject.
@@ -283,10 +200,10 @@ pub fn methods(lua: &Lua) -> mlua::Result<Table> {
 }
 
 impl UserData for PhysicsObject {
-    // Methods come from `__index` after the properties (see `api::index`).
+    // Methods come from `__index` after the properties (see `method_tables::index`).
     fn add_methods<M: UserDataMethods<Self>>(methods: &mut M) {
         methods.add_meta_method(MetaMethod::Index, |lua, o, key: Value| {
-            super::index(lua, &OBJECT, |m| &m.object, o, key)
+            index(lua, &OBJECT, |m| &m.object, o, key)
         });
         methods.add_meta_method(
             MetaMethod::NewIndex,

@@ -4,15 +4,13 @@
 //! read, one round trip then); Size reads through to the wrapped part.
 //! Every SDK write is one `ObjectProp`. The stored properties with a plain value (Weight,
 //! Friction, ...) are not listed here: they are the object settings table's rows flagged
-//! `lua` ([`table_get`], [`table_prop`]).
+//! `lua` (the `table` of [`OBJECT`]: read from the same mirror, written as one `ObjectProp`).
 
-use client_sdk::settings::table::AnyValue;
 use client_sdk::{BodyState, ObjectInfo, ObjectProp};
 use mlua::{Error as LuaError, Value};
 
-use super::PhysicsObject;
-use crate::api::part::PartState;
-use crate::props::{Get, Kind, Props, Row, Set};
+use super::state::PhysicsObject;
+use crate::props::{Get, Kind, Props, Row, Set, Table, Target};
 use crate::values::{new_vector, sdk_error, CFrame};
 
 /// The object's properties (the SDK's mirror; one round trip the first time).
@@ -49,6 +47,11 @@ macro_rules! state_row {
 /// The rows of `PhysicsObject`.
 pub static OBJECT: Props<PhysicsObject> = Props {
     owner: "PhysicsObject",
+    table: Some(Table::new(
+        ObjectProp::ROWS,
+        |o, name, index| Ok(info(o, name)?.settings.get(index)),
+        ObjectProp::from_any,
+    )),
     rows: &[
         // The part's CFrame value is reused while the pose is the same (as `part.CFrame`).
         Row {
@@ -114,13 +117,8 @@ pub static OBJECT: Props<PhysicsObject> = Props {
             }),
             set: Set::Fn(|lua, o, a| {
                 o.live("PhysicsObject.CollisionGroup")?;
-                let ctx = crate::api::plane::context(lua);
-                PartState::set_collision_group(
-                    &o.part,
-                    &ctx,
-                    "PhysicsObject.CollisionGroup",
-                    a.string()?,
-                )
+                let ctx = crate::api::plane::context::context(lua);
+                ctx.set_collision_group(&o.part, "PhysicsObject.CollisionGroup", a.string()?)
             }),
         },
         // The density in effect (the explicit value, or Weight ÷ volume), not the stored
@@ -134,17 +132,13 @@ pub static OBJECT: Props<PhysicsObject> = Props {
     ],
 };
 
-/// The stored value of the object settings row at `index` (the SDK's mirror).
-pub fn table_get(o: &PhysicsObject, what: &str, index: usize) -> Result<AnyValue, LuaError> {
-    let name = what.trim_start_matches("PhysicsObject.");
-    info(o, name)?
-        .settings
-        .get(index)
-        .ok_or_else(|| LuaError::runtime(format!("{what} has no plain value")))
-}
+impl Target for PhysicsObject {
+    type Prop = ObjectProp;
 
-/// The property write of the object settings row at `index`.
-pub fn table_prop(what: &str, index: usize, v: AnyValue) -> Result<ObjectProp, LuaError> {
-    ObjectProp::from_any(index, v)
-        .ok_or_else(|| LuaError::runtime(format!("{what} cannot take {v:?}")))
+    fn write(&self, name: &str, prop: ObjectProp) -> mlua::Result<()> {
+        let what = || format!("PhysicsObject.{name}");
+        self.live_for(what)?
+            .set(prop)
+            .map_err(|e| sdk_error(&what(), e))
+    }
 }

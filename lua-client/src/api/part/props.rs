@@ -4,13 +4,14 @@
 
 use mlua::Value;
 
-use super::{BasePart, PartState};
+use super::state::BasePart;
 use crate::props::{Get, Kind, Props, Row, Set};
 use crate::values::{new_vector, sdk_error};
 
 /// The rows of `BasePart`.
 pub static PART: Props<BasePart> = Props {
     owner: "BasePart",
+    table: None,
     rows: &[
         Row {
             name: "CFrame",
@@ -73,8 +74,8 @@ pub static PART: Props<BasePart> = Props {
             kind: Kind::String,
             get: Get::Fn(|lua, p| Ok(Value::String(lua.create_string(p.0.collision_group())?))),
             set: Set::Fn(|lua, p, a| {
-                let ctx = crate::api::plane::context(lua);
-                PartState::set_collision_group(&p.0, &ctx, "BasePart.CollisionGroup", a.string()?)
+                let ctx = crate::api::plane::context::context(lua);
+                ctx.set_collision_group(&p.0, "BasePart.CollisionGroup", a.string()?)
             }),
         },
         Row {

@@ -1,23 +1,27 @@
 //! PhysicsPlane properties, which are also the options of `PhysicsService.New`. The options
 //! themselves are not listed here: they are the plane settings table's rows flagged `lua`
-//! ([`table_get`], [`table_prop`]), which read the SDK's property mirror
+//! (the `table` of [`PLANE`]), which read the SDK's property mirror
 //! (`plane.properties()`: a local lookup for a plane the script created and did not share,
 //! kept current by the script's own writes; otherwise one round trip that sends the queued
 //! writes first, so a script reads what it wrote) and write one `PlaneProp`; `Threads` and
 //! `Shared` (flagged `creation_only`) are options of the creation call only. What is left
 //! here are the rows that are not options.
 
-use client_sdk::settings::table::AnyValue;
 use client_sdk::PlaneProp;
 use mlua::{Error as LuaError, Value};
 
-use super::PlaneState;
-use crate::props::{Get, Kind, Props, Row, Set};
+use super::state::PlaneState;
+use crate::props::{Get, Kind, Props, Row, Set, Table, Target};
 use crate::values::sdk_error;
 
 /// The rows of `PhysicsPlane` beyond its options.
 pub static PLANE: Props<PlaneState> = Props {
     owner: "PhysicsPlane",
+    table: Some(Table::new(
+        PlaneProp::ROWS,
+        |p, name, index| Ok(p.info(name)?.settings.get(index)),
+        PlaneProp::from_any,
+    )),
     rows: &[
         // Fired with the number of contact events lost when the script fell behind.
         Row {
@@ -87,17 +91,20 @@ pub static PLANE: Props<PlaneState> = Props {
     ],
 };
 
-/// The option of the plane settings row at `index`, as set (the SDK's mirror).
-pub fn table_get(p: &PlaneState, what: &str, index: usize) -> Result<AnyValue, LuaError> {
-    let name = what.trim_start_matches("PhysicsPlane.");
-    p.info(name)?
-        .settings
-        .get(index)
-        .ok_or_else(|| LuaError::runtime(format!("{what} has no plain value")))
-}
+impl Target for PlaneState {
+    type Prop = PlaneProp;
 
-/// The option write of the plane settings row at `index`.
-pub fn table_prop(what: &str, index: usize, v: AnyValue) -> Result<PlaneProp, LuaError> {
-    PlaneProp::from_any(index, v)
-        .ok_or_else(|| LuaError::runtime(format!("{what} cannot take {v:?}")))
+    /// Applies an option change at once (with the writes queued before it): a plane
+    /// option can be refused for the plane's state (`DeferGpu = true` with a joint
+    /// present or no adapter), and the script learns it at the assignment, catchably.
+    fn write(&self, name: &str, prop: PlaneProp) -> mlua::Result<()> {
+        if !self.alive() {
+            return Err(mlua::Error::runtime(format!(
+                "PhysicsPlane.{name}: the plane was destroyed"
+            )));
+        }
+        self.plane
+            .set_now(prop)
+            .map_err(|e| sdk_error(&format!("PhysicsPlane.{name}"), e))
+    }
 }

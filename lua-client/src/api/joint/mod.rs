@@ -3,17 +3,22 @@
 //! Options are the SDK's `JointProp`s by name; reads (`Error`, `Broken`, `Force`, options)
 //! ask the daemon (one round trip).
 
+pub(crate) mod state;
+
 use std::rc::Rc;
 
-use client_sdk::{AxisMode, Joint, JointInfo, JointKind, JointProp, MapOptions, Object};
+use client_sdk::{AxisMode, JointInfo, JointKind, JointProp, MapOptions, Object};
 use mlua::{Lua, MetaMethod, Table, UserData, UserDataMethods, Value};
 
-use super::contacts::{forget_joint, joint_broke_signal};
-use super::object::PhysicsObject;
-use super::part::PartState;
-use super::plane::{add, PhysicsPlane, PlaneState};
+use super::axis_motor;
+use super::contacts::joint_broke_signal;
+use super::object::state::PhysicsObject;
+use super::part::state::PartState;
+use super::plane::add;
+use super::plane::state::PhysicsPlane;
 use crate::values::CFrame;
 use crate::values::{describe, expected, finite_number, finite_vector, new_vector, sdk_error};
+use state::LuaJoint;
 
 /// The option names `NewJoint` and the Joint's properties accept.
 const OPTIONS: [&str; 18] = [
@@ -163,46 +168,6 @@ fn info_value(lua: &Lua, info: &JointInfo, key: &str) -> mlua::Result<Value> {
     })
 }
 
-/// The Lua handle of a joint, with its plane (for its Broke signal), whether this script
-/// destroyed it, and the objects it joins (it goes with either).
-pub struct LuaJoint(
-    pub Joint,
-    pub Rc<PlaneState>,
-    std::cell::Cell<bool>,
-    Vec<client_sdk::Handle>,
-);
-
-impl LuaJoint {
-    /// The handle of `joint`, a joint of `plane` between `a` and `b` (`None`: the world).
-    pub fn new(joint: Joint, plane: Rc<PlaneState>, a: &Object, b: Option<&Object>) -> LuaJoint {
-        let ends = std::iter::once(a).chain(b).map(Object::handle).collect();
-        LuaJoint(joint, plane, std::cell::Cell::new(false), ends)
-    }
-
-    /// What `tostring` and messages call it: its kind, and "(destroyed)" once it is.
-    fn name(&self) -> String {
-        let gone = if self.2.get() { " (destroyed)" } else { "" };
-        format!("Joint {}{gone}", self.0.kind().name())
-    }
-
-    /// Whether the joint still exists: not destroyed by this script, nor removed by the
-    /// daemon with one of its objects.
-    fn alive(&self) -> bool {
-        !self.2.get() && self.0.info().is_ok()
-    }
-
-    /// The joint, unless this script destroyed it (then an error for `what`, the method).
-    pub(crate) fn live(&self, what: &str) -> mlua::Result<&Joint> {
-        if self.2.get() {
-            return Err(mlua::Error::runtime(format!(
-                "{what}: {} (read Alive to check)",
-                self.name()
-            )));
-        }
-        Ok(&self.0)
-    }
-}
-
 impl UserData for LuaJoint {
     fn add_methods<M: UserDataMethods<Self>>(methods: &mut M) {
         // Destroying a destroyed joint (or one removed with its object) does nothing, as
@@ -211,7 +176,7 @@ impl UserData for LuaJoint {
             if j.2.get() {
                 return Ok(());
             }
-            forget_joint(&j.1, j.0.handle());
+            j.1.contacts.forget_joint(j.0.handle());
             match j.0.destroy() {
                 Ok(()) => {
                     j.2.set(true);
@@ -252,7 +217,7 @@ impl UserData for LuaJoint {
             },
         );
         methods.add_meta_method(MetaMethod::ToString, |_, j, ()| Ok(j.name()));
-        super::axis_motor::add_methods(methods);
+        axis_motor::add_methods(methods);
     }
 }
 
