@@ -6,13 +6,15 @@
 
 use std::time::Instant;
 
+use crate::case::{judge, Case};
 use crate::families::chain::{Chain, Kind, Solver, StartPose};
 use crate::families::drop::{Drop, ALL_SHAPES};
 use crate::families::pile::Pile;
 use crate::families::projectile::{Projectile, Target};
 use crate::families::spring::{Spring, SpringKind};
 use crate::families::stack::{Order, Stack};
-use crate::{judge, Case, FuzzReport, Setting};
+use crate::fuzz::FuzzReport;
+use crate::setting::Setting;
 
 /// One parameter walked along a grid with the rest fixed.
 pub struct Probe {

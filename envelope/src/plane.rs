@@ -10,7 +10,7 @@ use shm_layout::{
     Shape,
 };
 
-use crate::Setting;
+use crate::setting::Setting;
 
 /// A case's plane and its per-tick records.
 pub struct Run {

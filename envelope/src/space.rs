@@ -1,91 +1,23 @@
-//! The parameter ranges of every family, as data: [`FULL`] is what `physics-bench
+//! The parameter ranges of every family, as data (each family's file declares its ranges
+//! struct; [`Space`] holds one of each): [`FULL`] is what `physics-bench
 //! envelope` explores; [`HOLDS`] is the documented envelope, where every oracle holds at
 //! the time of writing (tests/tests/envelope.rs asserts it). Widen a family's `HOLDS` entry
 //! as fixes land; narrow it (and say so in docs/stability.md) when a change breaks it.
 
+pub use crate::families::chain::ChainRanges;
+pub use crate::families::drop::DropRanges;
+pub use crate::families::pile::PileRanges;
+pub use crate::families::projectile::ProjectileRanges;
+pub use crate::families::spring::SpringRanges;
+pub use crate::families::stack::StackRanges;
+pub use crate::setting::SettingRanges;
+
 use crate::families::chain::{Kind, Solver, StartPose};
-use crate::families::drop::{DropShape, ALL_SHAPES};
+use crate::families::drop::ALL_SHAPES;
 use crate::families::projectile::Target;
 use crate::families::spring::SpringKind;
 use crate::families::stack::Order;
-use crate::Span;
-
-/// Ranges of the solver knobs.
-#[derive(Debug, Clone, Copy, serde::Serialize)]
-pub struct SettingRanges {
-    /// Ticks per second, log-uniform.
-    pub tick_rate: Span,
-    /// SolverIterations, inclusive.
-    pub iterations: (u32, u32),
-    /// HitBoxQuality, inclusive.
-    pub quality: (u32, u32),
-}
-
-#[derive(Debug, Clone, Copy, serde::Serialize)]
-pub struct StackRanges {
-    pub setting: SettingRanges,
-    pub count: (u32, u32),
-    pub ratio: Span,
-    pub size: Span,
-    pub orders: &'static [Order],
-}
-
-#[derive(Debug, Clone, Copy, serde::Serialize)]
-pub struct ChainRanges {
-    pub setting: SettingRanges,
-    pub links: (u32, u32),
-    pub ratio: Span,
-    pub link: Span,
-    pub poses: &'static [StartPose],
-    pub kinds: &'static [Kind],
-    pub solvers: &'static [Solver],
-}
-
-#[derive(Debug, Clone, Copy, serde::Serialize)]
-pub struct ProjectileRanges {
-    /// The ball's quality is `setting.quality`.
-    pub setting: SettingRanges,
-    pub targets: &'static [Target],
-    pub speed: Span,
-    pub radius: Span,
-    pub thickness: Span,
-    pub target_quality: (u32, u32),
-    /// Degrees off the target's normal, uniform.
-    pub angle: Span,
-    /// Target weight / ball weight (free bodies).
-    pub mass_ratio: Span,
-}
-
-#[derive(Debug, Clone, Copy, serde::Serialize)]
-pub struct DropRanges {
-    pub setting: SettingRanges,
-    pub shapes: &'static [DropShape],
-    pub size: Span,
-    pub aspect: Span,
-    pub height: Span,
-}
-
-#[derive(Debug, Clone, Copy, serde::Serialize)]
-pub struct SpringRanges {
-    pub setting: SettingRanges,
-    pub kinds: &'static [SpringKind],
-    pub stiffness: Span,
-    pub mass: Span,
-    pub amplitude: Span,
-}
-
-#[derive(Debug, Clone, Copy, serde::Serialize)]
-pub struct PileRanges {
-    pub setting: SettingRanges,
-    pub count: (u32, u32),
-    pub size: Span,
-    /// Distance of the floor from the origin along each axis, log-uniform ...
-    pub offset: Span,
-    /// ... except this share of cases, at the origin.
-    pub at_origin: f64,
-    /// Whether the pile has round parts (spheres, cylinders).
-    pub round: &'static [bool],
-}
+use crate::rng::Span;
 
 /// One range set per family.
 #[derive(Debug, Clone, Copy, serde::Serialize)]

@@ -13,11 +13,24 @@
 use shm_layout::{JointKind, JointProp, ObjectProp, Pose, Shape};
 
 use super::{draw_setting, plane_opts};
+use crate::luau::{luau_prelude, lv, LUAU_END};
+use crate::oracle::{at_most, finish, Outcome};
 use crate::plane::{BuildResult, Run};
-use crate::space::ChainRanges;
-use crate::{
-    at_most, finish, luau_prelude, lv, toward, toward_int, Outcome, Rng, Setting, LUAU_END,
-};
+use crate::rng::{Rng, Span};
+use crate::setting::{Setting, SettingRanges};
+use crate::steps::{toward, toward_int};
+
+/// The ranges a chain case is drawn from (their values: [`crate::space`]).
+#[derive(Debug, Clone, Copy, serde::Serialize)]
+pub struct ChainRanges {
+    pub setting: SettingRanges,
+    pub links: (u32, u32),
+    pub ratio: Span,
+    pub link: Span,
+    pub poses: &'static [StartPose],
+    pub kinds: &'static [Kind],
+    pub solvers: &'static [Solver],
+}
 
 /// Simulated seconds a chain runs.
 pub const RUN_S: f32 = 5.0;

@@ -10,9 +10,22 @@
 use shm_layout::{ObjectProp, Pose, Shape};
 
 use super::{draw_setting, plane_opts, tilt_deg};
+use crate::luau::{luau_prelude, lv, LUAU_END};
+use crate::oracle::{at_most, finish, Outcome};
 use crate::plane::{about_z, BuildResult, Run};
-use crate::space::DropRanges;
-use crate::{at_most, finish, luau_prelude, toward, Outcome, Rng, Setting, LUAU_END};
+use crate::rng::{Rng, Span};
+use crate::setting::{Setting, SettingRanges};
+use crate::steps::toward;
+
+/// The ranges a drop case is drawn from (their values: [`crate::space`]).
+#[derive(Debug, Clone, Copy, serde::Serialize)]
+pub struct DropRanges {
+    pub setting: SettingRanges,
+    pub shapes: &'static [DropShape],
+    pub size: Span,
+    pub aspect: Span,
+    pub height: Span,
+}
 
 /// Simulated seconds after landing before the body is judged.
 pub const REST_S: f32 = 3.0;
@@ -254,7 +267,7 @@ impl Drop {
         let part = match self.shape {
             DropShape::Pyramid => {
                 let (v, t) = Self::pyramid(d);
-                let vs: Vec<String> = v.iter().map(|p| crate::lv(*p)).collect();
+                let vs: Vec<String> = v.iter().map(|p| lv(*p)).collect();
                 let ts: Vec<String> = t
                     .iter()
                     .map(|t| format!("{{ {}, {}, {} }}", t[0] + 1, t[1] + 1, t[2] + 1))

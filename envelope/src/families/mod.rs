@@ -9,8 +9,8 @@ pub mod projectile;
 pub mod spring;
 pub mod stack;
 
-use crate::space::SettingRanges;
-use crate::{Rng, Setting};
+use crate::rng::Rng;
+use crate::setting::{Setting, SettingRanges};
 
 /// A setting drawn from `r`: tick rate log-uniform, iterations and quality log-uniform
 /// integers.

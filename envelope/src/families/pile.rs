@@ -13,11 +13,26 @@
 use shm_layout::{ObjectProp, Pose, Shape};
 
 use super::{draw_setting, plane_opts};
+use crate::luau::{luau_prelude, lv, LUAU_END};
+use crate::oracle::{at_most, finish, Outcome};
 use crate::plane::{BuildResult, Run};
-use crate::space::PileRanges;
-use crate::{
-    at_most, finish, luau_prelude, lv, toward, toward_int, Outcome, Rng, Setting, LUAU_END,
-};
+use crate::rng::{round3, Rng, Span};
+use crate::setting::{Setting, SettingRanges};
+use crate::steps::{toward, toward_int};
+
+/// The ranges a pile case is drawn from (their values: [`crate::space`]).
+#[derive(Debug, Clone, Copy, serde::Serialize)]
+pub struct PileRanges {
+    pub setting: SettingRanges,
+    pub count: (u32, u32),
+    pub size: Span,
+    /// Distance of the floor from the origin along each axis, log-uniform ...
+    pub offset: Span,
+    /// ... except this share of cases, at the origin.
+    pub at_origin: f64,
+    /// Whether the pile has round parts (spheres, cylinders).
+    pub round: &'static [bool],
+}
 
 /// Simulated seconds a pile has to settle and sleep.
 pub const SETTLE_S: f32 = 8.0;
@@ -165,7 +180,7 @@ impl Pile {
                 offset: 0.0,
                 ..self.clone()
             });
-            let half = crate::round3(self.offset / 10.0);
+            let half = round3(self.offset / 10.0);
             if half >= 1.0 {
                 out.push(Pile {
                     offset: half,

@@ -14,9 +14,28 @@
 use shm_layout::{ObjectProp, PlaneProp, Pose, Shape};
 
 use super::{draw_setting, plane_opts};
+use crate::luau::{luau_prelude, lv, LUAU_END};
+use crate::oracle::{at_most, finish, Outcome};
 use crate::plane::{norm, sub, unrotate, BuildResult, Run};
-use crate::space::ProjectileRanges;
-use crate::{at_most, finish, luau_prelude, lv, toward, Outcome, Rng, Setting, LUAU_END};
+use crate::rng::{Rng, Span};
+use crate::setting::{Setting, SettingRanges};
+use crate::steps::toward;
+
+/// The ranges a projectile case is drawn from (their values: [`crate::space`]).
+#[derive(Debug, Clone, Copy, serde::Serialize)]
+pub struct ProjectileRanges {
+    /// The ball's quality is `setting.quality`.
+    pub setting: SettingRanges,
+    pub targets: &'static [Target],
+    pub speed: Span,
+    pub radius: Span,
+    pub thickness: Span,
+    pub target_quality: (u32, u32),
+    /// Degrees off the target's normal, uniform.
+    pub angle: Span,
+    /// Target weight / ball weight (free bodies).
+    pub mass_ratio: Span,
+}
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
 pub enum Target {

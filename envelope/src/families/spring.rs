@@ -12,9 +12,22 @@
 use shm_layout::{AxisMode, AxisMotor, JointKind, JointProp, ObjectProp, PlaneProp, Pose, Shape};
 
 use super::plane_opts;
+use crate::luau::{luau_prelude, LUAU_END};
+use crate::oracle::{at_least, at_most, finish, Outcome};
 use crate::plane::{BuildResult, Run};
-use crate::space::SpringRanges;
-use crate::{at_least, at_most, finish, luau_prelude, toward, Outcome, Rng, Setting, LUAU_END};
+use crate::rng::{Rng, Span};
+use crate::setting::{Setting, SettingRanges};
+use crate::steps::toward;
+
+/// The ranges a spring case is drawn from (their values: [`crate::space`]).
+#[derive(Debug, Clone, Copy, serde::Serialize)]
+pub struct SpringRanges {
+    pub setting: SettingRanges,
+    pub kinds: &'static [SpringKind],
+    pub stiffness: Span,
+    pub mass: Span,
+    pub amplitude: Span,
+}
 
 /// Rest length of a `Spring` joint.
 const REST: f64 = 2.0;

@@ -12,9 +12,22 @@
 use shm_layout::{ObjectProp, Pose, Shape};
 
 use super::{draw_setting, plane_opts, tilt_deg};
+use crate::luau::{luau_prelude, LUAU_END};
+use crate::oracle::{at_most, finish, Outcome};
 use crate::plane::{BuildResult, Run};
-use crate::space::StackRanges;
-use crate::{at_most, finish, luau_prelude, toward, toward_int, Outcome, Rng, Setting, LUAU_END};
+use crate::rng::{Rng, Span};
+use crate::setting::{Setting, SettingRanges};
+use crate::steps::{toward, toward_int};
+
+/// The ranges a stack case is drawn from (their values: [`crate::space`]).
+#[derive(Debug, Clone, Copy, serde::Serialize)]
+pub struct StackRanges {
+    pub setting: SettingRanges,
+    pub count: (u32, u32),
+    pub ratio: Span,
+    pub size: Span,
+    pub orders: &'static [Order],
+}
 
 /// Simulated seconds before the stack is judged.
 pub const SETTLE_S: f32 = 5.0;
