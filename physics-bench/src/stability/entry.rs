@@ -1,4 +1,4 @@
-//! The lines of stability.json: what `stability` measured per scene and sweep, which
+//! The entries of stability.json: what `stability` measured per scene and sweep, which
 //! the markdown renders.
 
 use super::sweeps::SweepPoint;
@@ -13,7 +13,7 @@ pub struct Remedy {
     pub cost: f64,
 }
 
-/// One line of stability.json: a scene, or a sweep judged by its critical value.
+/// One entry of stability.json: a scene, or a sweep judged by its critical value.
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct Entry {
     pub scene: &'static str,
