@@ -234,8 +234,7 @@ impl Plane {
     ) {
         self.clock.max_penetration = max_penetration;
         self.clock.contact_pairs = contact_pairs;
-        self.events.clear();
-        self.removed.clear();
+        self.events.clear_step();
         self.bodies.stepped();
         self.clock.advance(dt);
         self.state_hash = state_hash;

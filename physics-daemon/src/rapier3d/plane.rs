@@ -3,8 +3,6 @@
 //! one visible order. The ops that reach the parts are `impl Plane` blocks in the parts'
 //! folders (`objects/ops.rs`, `joints/ops.rs`, ...), which nothing here imports.
 
-use std::sync::mpsc;
-
 use std::time::Instant;
 
 use rapier3d::prelude::*;
@@ -17,6 +15,7 @@ use shm_layout::{
 use crate::backend::{HeaderFigures, SlotTable};
 use crate::rapier3d::contacts::figures::contact_figures;
 use crate::rapier3d::contacts::hooks::RestThreshold;
+use crate::rapier3d::contacts::log::{Events, Kept};
 use crate::rapier3d::controllers::Controllers;
 use crate::rapier3d::history::pose_mirror::PoseMirror;
 use crate::rapier3d::history::publish;
@@ -54,22 +53,10 @@ pub struct Plane {
     pub(super) boosted: u32,
     /// Whether the last adaptive pass found a pair of a high mass ratio (see `adaptive`).
     pub(super) stiffened: bool,
-    /// Objects asking for contact events; the event collector runs only when > 0.
-    pub(super) reporting: u32,
-    pub(super) collision_tx: mpsc::Sender<CollisionEvent>,
-    pub(super) collision_rx: mpsc::Receiver<CollisionEvent>,
-    pub(super) force_tx: mpsc::Sender<ContactForceEvent>,
-    pub(super) tear_tx: mpsc::Sender<SoftBodyTearEvent>,
-    pub(super) events: Vec<EventRecord>,
-    /// Running number of the next event (EventRecord::seq).
-    pub(super) event_seq: u64,
-    /// Colliders removed since the last step with the object they belonged to, so their
-    /// contact-stopped events still name it.
-    pub(super) removed: Vec<(ColliderHandle, shm_layout::Handle)>,
+    /// The events of the last step and what contact events need across steps.
+    pub(super) events: Events,
     /// Character controllers by slot; ticked before each step (none: nothing to do).
     pub(super) controllers: Controllers,
-    /// Events produced before the step (controllers), published with the step's events.
-    pub(super) pending_events: Vec<EventRecord>,
     /// The collision-group table objects' CollisionGroup indexes into.
     pub(super) groups: CollisionGroups,
     /// Bodies an op added, moved or reshaped since the last step: a query first brings their
@@ -95,9 +82,6 @@ impl Plane {
         let settings = PlaneSettings::default();
         let mut world = PhysicsWorld::new();
         world.gravity = Vector::from(settings.gravity);
-        let (collision_tx, collision_rx) = mpsc::channel();
-        let (force_tx, _) = mpsc::channel();
-        let (tear_tx, _) = mpsc::channel();
         Plane {
             id,
             settings,
@@ -111,17 +95,9 @@ impl Plane {
             clock: Default::default(),
             boosted: 0,
             stiffened: false,
-            reporting: 0,
-            collision_tx,
-            collision_rx,
-            force_tx,
-            tear_tx,
-            events: Vec::new(),
-            event_seq: 0,
-            removed: Vec::new(),
+            events: Events::default(),
             groups: CollisionGroups::default(),
             controllers: Default::default(),
-            pending_events: Vec::new(),
             query_stale: Default::default(),
             joints: Joints::default(),
             map_pending: PendingMap::default(),
@@ -194,12 +170,8 @@ impl Plane {
                 .unwrap_or_else(std::sync::PoisonError::into_inner)
         });
         // Contacts of objects removed since the last step still end with an event.
-        if self.reporting > 0 || !self.removed.is_empty() {
-            let collector = ChannelEventCollector::new(
-                self.collision_tx.clone(),
-                self.force_tx.clone(),
-                self.tear_tx.clone(),
-            );
+        if self.events.listening() {
+            let collector = self.events.collector();
             self.world.step_with_events(&hooks, &collector);
         } else {
             self.world.step_with_events(&hooks, &());
@@ -212,7 +184,7 @@ impl Plane {
         self.clock.advance(asked);
         self.collect_events();
         self.joints_after_step(dt);
-        self.removed.clear();
+        self.events.step_done();
         let rehash = moving || self.awake_count() > 0;
         let mut mirror = std::mem::take(&mut self.mirror);
         if rehash {
@@ -233,7 +205,7 @@ impl Plane {
 
     /// Events of the last step (contact started / stopped).
     pub fn events(&self) -> &[EventRecord] {
-        &self.events
+        self.events.records()
     }
 
     /// The header of the newest tick.
@@ -244,7 +216,7 @@ impl Plane {
                 slot_count: self.bodies.slot_count() as u32,
                 body_count: self.bodies.live(),
                 max_joint_error: self.joints.max_error,
-                event_count: self.event_seq,
+                event_count: self.events.count(),
                 state_hash: self.state_hash,
             },
         )
@@ -340,9 +312,10 @@ impl Plane {
 
 /// The plane's state, field list written once: `StateRef` borrows it to encode, `State`
 /// owns it decoded, `clone_state` copies it (Rewind). The engine's world comes first; the
-/// other fields are the plane's own and `Clone`.
+/// other fields are the plane's own and `Clone`, each `field: type = where the plane
+/// holds it`.
 macro_rules! plane_state {
-    (world, $($vis:vis $field:ident: $ty:ty,)*) => {
+    (world, $($vis:vis $field:ident: $ty:ty = $($place:ident).+,)*) => {
         #[derive(serde::Serialize)]
         pub(super) struct StateRef<'a> {
             world: &'a PhysicsWorld,
@@ -359,16 +332,16 @@ macro_rules! plane_state {
             /// The state as an owned copy (what Rewind keeps): the engine's sets cloned, its
             /// per-step workspaces fresh.
             pub(super) fn clone_state(&self) -> State {
-                State { world: copy_world(&self.world), $($field: self.$field.clone(),)* }
+                State { world: copy_world(&self.world), $($field: self.$($place).+.clone(),)* }
             }
 
             pub(super) fn state_ref(&self) -> StateRef<'_> {
-                StateRef { world: &self.world, $($field: &self.$field,)* }
+                StateRef { world: &self.world, $($field: &self.$($place).+,)* }
             }
 
             pub(super) fn take_state(&mut self, state: State) {
                 self.world = state.world;
-                $(self.$field = state.$field;)*
+                $(self.$($place).+ = state.$field;)*
             }
         }
 
@@ -407,20 +380,18 @@ fn copy_world(w: &PhysicsWorld) -> PhysicsWorld {
 
 plane_state! {
     world,
-    pub(super) settings: PlaneSettings,
-    pub(super) bodies: SlotTable<Body>,
-    pub(super) driven: u32,
-    pub(super) mesh_vertices: u64,
-    held: Vec<held::HeldBody>,
-    pub(super) clock: crate::backend::Clock,
-    pub(super) boosted: u32,
-    pub(super) stiffened: bool,
-    pub(super) reporting: u32,
-    pub(super) event_seq: u64,
-    pub(super) removed: Vec<(ColliderHandle, shm_layout::Handle)>,
-    pub(super) controllers: Controllers,
-    pub(super) groups: CollisionGroups,
-    pub(super) query_stale: crate::backend::Marks<RigidBodyHandle>,
-    pub(super) joints: Joints,
-    pub(super) state_hash: u64,
+    pub(super) settings: PlaneSettings = settings,
+    pub(super) bodies: SlotTable<Body> = bodies,
+    pub(super) driven: u32 = driven,
+    pub(super) mesh_vertices: u64 = mesh_vertices,
+    held: Vec<held::HeldBody> = held,
+    pub(super) clock: crate::backend::Clock = clock,
+    pub(super) boosted: u32 = boosted,
+    pub(super) stiffened: bool = stiffened,
+    events: Kept = events.kept,
+    pub(super) controllers: Controllers = controllers,
+    pub(super) groups: CollisionGroups = groups,
+    pub(super) query_stale: crate::backend::Marks<RigidBodyHandle> = query_stale,
+    pub(super) joints: Joints = joints,
+    pub(super) state_hash: u64 = state_hash,
 }

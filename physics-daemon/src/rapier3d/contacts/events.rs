@@ -10,15 +10,9 @@ impl Plane {
     /// contact point, the normal (from `a` toward `b`), the normal impulse of the step and
     /// the pair's manifold points (`contact_points.rs`).
     pub(in crate::rapier3d) fn collect_events(&mut self) {
-        self.events.clear();
         // Events the controllers produced before the step come first, in their order.
-        for mut record in std::mem::take(&mut self.pending_events) {
-            record.tick = self.clock.tick;
-            record.seq = self.event_seq;
-            self.event_seq += 1;
-            self.events.push(record);
-        }
-        while let Ok(event) = self.collision_rx.try_recv() {
+        self.events.begin_tick(self.clock.tick);
+        while let Some(event) = self.events.next_collision() {
             let (c1, c2) = (event.collider1(), event.collider2());
             let (Some(a), Some(b)) = (self.handle_of_collider(c1), self.handle_of_collider(c2))
             else {
@@ -31,7 +25,6 @@ impl Plane {
                 b_slot: b.slot,
                 b_generation: b.generation,
                 tick: self.clock.tick,
-                seq: self.event_seq,
                 ..EventRecord::default()
             };
             if event.started() {
@@ -45,8 +38,7 @@ impl Plane {
                 record.point_count = points.len() as u32;
                 record.points[..points.len()].copy_from_slice(&points);
             }
-            self.event_seq += 1;
-            self.events.push(record);
+            self.events.record(record);
         }
     }
 

@@ -262,7 +262,7 @@ impl Plane {
                 };
         }
         for (kind, index, velocity) in events {
-            self.pending_events.push(EventRecord {
+            self.events.queue(EventRecord {
                 kind,
                 a_slot: handle.slot,
                 a_generation: handle.generation,

@@ -210,10 +210,8 @@ impl Plane {
         let threads = state.settings.threads;
         state.bodies.take_marks_of(&mut self.bodies);
         self.take_state(state);
-        self.events.clear();
-        self.pending_events.clear();
+        self.events.reset();
         self.map_pending = Default::default();
-        while self.collision_rx.try_recv().is_ok() {}
         // Derived from the parts (rebuilt, not stored).
         self.quality_counts = [0; shm_layout::validate::MAX_HIT_BOX_QUALITY as usize + 1];
         for (_, body) in self.bodies.iter() {

@@ -250,7 +250,7 @@ impl Plane {
                 if let Some(r) = rapier {
                     self.world.impulse_joints.remove(r, true);
                 }
-                self.events.push(EventRecord {
+                self.events.record(EventRecord {
                     kind: EVENT_JOINT_BROKE,
                     a_slot: h.slot,
                     a_generation: h.generation,
@@ -259,10 +259,8 @@ impl Plane {
                     impulse: force,
                     position: anchor.into(),
                     tick: self.clock.tick,
-                    seq: self.event_seq,
                     ..EventRecord::default()
                 });
-                self.event_seq += 1;
             }
             let j = self.joints.table.get(h).expect("live handle");
             if !j.broken {

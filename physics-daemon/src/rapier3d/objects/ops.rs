@@ -92,11 +92,7 @@ impl Plane {
         collider: ColliderHandle,
     ) -> Option<Handle> {
         let Some(c) = self.world.colliders.get(collider) else {
-            return self
-                .removed
-                .iter()
-                .find(|(c, _)| *c == collider)
-                .map(|(_, h)| *h);
+            return self.events.removed_owner(collider);
         };
         let slot = self.world.bodies.get(c.parent()?)?.user_data as usize;
         self.bodies.handle_at(slot)
@@ -128,7 +124,7 @@ impl Plane {
         } = self.bodies.remove(handle).map_err(|e| self.in_plane(e))?;
         self.controllers.remove(&handle.slot);
         if part.report_contacts {
-            self.reporting -= 1;
+            self.events.count_reporting(false);
         }
         self.quality_counts[part.hit_box_quality as usize] -= 1;
         self.mesh_vertices -= part.mesh_vertex_count() as u64;
@@ -137,7 +133,7 @@ impl Plane {
         }
         // Its contact-stopped events come at the next step, after the slot is gone.
         for c in self.world.bodies[h].colliders() {
-            self.removed.push((*c, handle));
+            self.events.collider_removed(*c, handle);
         }
         self.remove_joints_of(h);
         self.world.remove_body(h);

@@ -127,7 +127,7 @@ impl Plane {
             // shape changed: a fresh collider gets fresh contacts.
             for c in self.world.bodies[h].colliders().to_vec() {
                 self.world.remove_collider(c);
-                self.removed.push((c, handle));
+                self.events.collider_removed(c, handle);
             }
             let mut collider = ColliderBuilder::new(part.collider_shape()?).build();
             part.configure_collider(&mut collider, &self.groups)?;
@@ -158,8 +158,8 @@ impl Plane {
             _ => {}
         }
         match (before.reporting, after.reporting) {
-            (false, true) => self.reporting += 1,
-            (true, false) => self.reporting -= 1,
+            (false, true) => self.events.count_reporting(true),
+            (true, false) => self.events.count_reporting(false),
             _ => {}
         }
     }
