@@ -16,8 +16,8 @@ use shm_layout::cluster::{self as keys, LoadReport};
 use zenoh::Wait;
 
 use super::error::ClusterError;
-use crate::server::gauge::stepped_nanos;
-pub use crate::server::gauge::Gauge;
+use crate::server::quotas::gauge::stepped_nanos;
+pub use crate::server::quotas::gauge::Gauge;
 
 /// CPU time this process used so far (user + system).
 fn process_cpu() -> Duration {

@@ -2,7 +2,7 @@
 //! hands a moving plane to (a query on the target's `physics/<c>/migrate/<daemon>`, whose
 //! payload is the [`MovingPlane`] and whose reply the target's [`MoveAnswer`]), and the
 //! queryable that takes planes arriving here to this daemon's loop
-//! ([`crate::server::moves::Migration::arrive`]) and answers once the loop restored them.
+//! ([`crate::server::moves::migration::Migration::arrive`]) and answers once the loop restored them.
 
 use std::sync::Arc;
 use std::time::Duration;
@@ -12,7 +12,7 @@ use zenoh::query::Query;
 use zenoh::{Session, Wait};
 
 use super::error::ClusterError;
-use crate::server::moves::{Courier, Migration, RESTORE_WAIT};
+use crate::server::moves::migration::{Courier, Migration, RESTORE_WAIT};
 
 /// How long a liveliness question about the target waits.
 const ASK_TIMEOUT: Duration = Duration::from_secs(1);

@@ -139,7 +139,7 @@ impl Cluster {
     pub fn start_migration(
         &mut self,
         domain: &str,
-    ) -> Result<Arc<crate::server::moves::Migration>, ClusterError> {
+    ) -> Result<Arc<crate::server::moves::migration::Migration>, ClusterError> {
         let (migration, arrivals) = migrate::start(
             &self.session,
             &self.cluster,
@@ -155,7 +155,7 @@ impl Cluster {
     pub fn start_rebalance(
         &mut self,
         share: f32,
-        migration: Arc<crate::server::moves::Migration>,
+        migration: Arc<crate::server::moves::migration::Migration>,
         domain: &str,
     ) -> Result<(), ClusterError> {
         let r = rebalance::start(

@@ -2,7 +2,7 @@
 //! load report, docs/cluster.md "Load") moves planes to the least loaded member with room,
 //! through the path of `MoveTo` (`crate::server::moves`): the largest 3D plane first, never
 //! one pinned to it (placed by name), never one that arrived within
-//! [`crate::server::moves::SETTLE`].
+//! [`crate::server::moves::migration::SETTLE`].
 //!
 //! Hysteresis, so planes do not ping-pong: a member has room only while it uses less than
 //! half of `SHARE`; after a move the daemon waits [`COOLDOWN`] (its load report then shows
@@ -16,7 +16,7 @@ use shm_layout::cluster::{self as keys, LoadReport};
 use zenoh::{Session, Wait};
 
 use super::error::ClusterError;
-use crate::server::moves::{Migration, RebalanceRequest};
+use crate::server::moves::migration::{Migration, RebalanceRequest};
 
 /// How often the loads are looked at (the load report's period).
 pub const PERIOD: Duration = Duration::from_secs(1);

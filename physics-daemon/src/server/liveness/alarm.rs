@@ -1,6 +1,6 @@
 //! What wakes the request loop to look for gone clients: one epoll descriptor, watched by
 //! the loop's WaitSet, that becomes readable when a watched client process exits (its pidfd,
-//! [`super::pidwatch`]). With it the loop of a daemon whose clients sit idle sleeps until
+//! [`crate::server::liveness::pidwatch`]). With it the loop of a daemon whose clients sit idle sleeps until
 //! one dies (or something else wakes it) instead of looking twice a second; where it cannot
 //! be had, the loop keeps looking at its period. The domain's node folder is deliberately
 //! not on it: any process of the user can make and remove nodes there as fast as it likes,

@@ -10,8 +10,8 @@
 
 use std::time::{Duration, Instant, SystemTime};
 
-use super::alarm::Registry;
-use super::pidwatch::{folder_stamp, PidWatch};
+use crate::server::liveness::alarm::Registry;
+use crate::server::liveness::pidwatch::{folder_stamp, PidWatch};
 
 /// The longest the loop goes without listing nodes while clients are connected.
 pub const FULL_CHECK: Duration = Duration::from_secs(5);

@@ -7,7 +7,7 @@
 use std::collections::{BTreeMap, HashMap};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{mpsc, Arc};
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 use iceoryx2::config::Config;
 use iceoryx2::port::listener::Listener;
@@ -15,12 +15,29 @@ use iceoryx2::prelude::*;
 use iceoryx2_bb_posix::socket_pair::StreamingSocket;
 use shm_layout::names;
 
-use super::worker::Waker;
-use super::{
-    alarm, control_nodes, liveness, moves, origin, persist, pidwatch, quota, resources, trim,
-    Clients, ControlServer, Daemon, Options, HOUSEKEEPING,
-};
+use crate::publish::MAX_NODES;
+use crate::server::daemon::{ControlServer, Daemon, Options};
+use crate::server::liveness::{alarm, pidwatch, schedule};
+use crate::server::moves::migration::Tombstones;
+use crate::server::persistence::persist;
+use crate::server::quotas::limits::Limits;
+use crate::server::quotas::{quota, resources};
+use crate::server::requests::clients::Clients;
+use crate::server::requests::origin;
+use crate::server::trim;
+use crate::server::worker::Waker;
 use crate::DaemonError;
+
+/// How often dead clients are looked for while clients are connected (and, for a daemon
+/// started on demand, whether its starter is gone). Otherwise the daemon has nothing to look
+/// for and sleeps until a request (or a shutdown wake-up).
+const HOUSEKEEPING: Duration = Duration::from_millis(500);
+
+/// Nodes that may open the control services: every client's, one spare each for nodes
+/// that have not said Hello yet, and never fewer than a plane's services allow.
+fn control_nodes(limits: &Limits) -> usize {
+    (limits.max_clients * 2).max(MAX_NODES)
+}
 
 /// The transport ports the daemon keeps: the node, the control service and its (single)
 /// server. The request wake-up listener stays with the loop, which waits on it.
@@ -32,7 +49,7 @@ struct Ports {
 
 /// Runs the daemon of `domain` until `shutdown` (or, for an on-demand daemon, until its
 /// starter is gone and no client is left).
-pub(super) fn serve(
+pub(crate) fn serve(
     domain: &str,
     config: &Config,
     shutdown: &AtomicBool,
@@ -235,13 +252,13 @@ fn start(
         writer,
         transfers: HashMap::new(),
         stage_to: None,
-        liveness: liveness::Schedule::default(),
-        moved: moves::Tombstones::default(),
+        liveness: schedule::Schedule::default(),
+        moved: Tombstones::default(),
     };
     // Persistent planes of the last daemon come back before the first request.
     daemon.restore_saved();
     // iceoryx2 creates its node-counter segment world-writable: narrow it to this user.
-    super::files::restrict(domain);
+    crate::server::files::restrict(domain);
     tracing::info!(domain, pid = std::process::id(), "physics daemon ready");
     Ok(daemon)
 }

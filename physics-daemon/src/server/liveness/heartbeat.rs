@@ -2,12 +2,12 @@
 //! connected, so a waiting client can tell "slow" from "stalled" (SIGSTOP, swapped out,
 //! frozen) within about a second instead of its request timeout.
 //!
-//! The resource guard's thread beats, at the start of each of its looks ([`super::resources`]):
+//! The resource guard's thread beats, at the start of each of its looks ([`crate::server::quotas::resources`]):
 //! it has a node of its own, never waits for the request loop, and looks every period while
 //! any other process has a node in the domain, which every connected local client has. One
 //! thread waking twice a second for both instead of a thread of its own waking five times:
 //! an idle daemon's CPU is the count of its wake-ups. Without clients nobody listens: no
-//! beats (the loop says when through [`super::resources::Watch::beat`]).
+//! beats (the loop says when through [`crate::server::quotas::resources::Watch::beat`]).
 
 use std::time::Duration;
 
@@ -18,10 +18,11 @@ use shm_layout::names;
 use crate::publish::MAX_NODES;
 use crate::DaemonError;
 
-/// Time between beats (the guard's period). Clients call a stopped daemon stalled after
-/// `client_sdk`'s thresholds (600 ms for a reader's watch, 1 s for a waiting request)
-/// without one, and a daemon that runs but does not beat after 3 s.
-pub const PERIOD: Duration = super::resources::PERIOD;
+/// Time between beats (the resource guard, which beats, looks at this period). Clients call
+/// a stopped daemon stalled after `client_sdk`'s thresholds (600 ms for a reader's watch,
+/// 1 s for a waiting request) without one, and a daemon that runs but does not beat after
+/// 3 s.
+pub const PERIOD: Duration = Duration::from_millis(500);
 
 /// The heartbeat's publisher.
 pub struct Heart {

@@ -10,153 +10,19 @@
 //! one host): nothing of the plane can change in between, and a refused move leaves the
 //! plane where it was, untouched.
 
-use std::collections::{HashMap, VecDeque};
-use std::sync::{mpsc, Arc, Mutex};
+use std::sync::{mpsc, Arc};
 use std::time::{Duration, Instant};
 
 use shm_layout::migrate::{MoveAnswer, Moved, MovingPlane};
 use shm_layout::{CommandError, CommandResult, ErrorKind, PlaneId, PlaneKind, PlaneProp, Reply};
 
-use super::worker::{self, PlaneCell, SharedUsage};
-use super::{Daemon, PlaneEntry, MAX_PLANES};
+use crate::server::daemon::{Daemon, PlaneEntry, MAX_PLANES};
+use crate::server::moves::migration::{RESTORE_WAIT, SETTLE};
+use crate::server::requests::refusals::unknown_plane;
+use crate::server::worker::{self, PlaneCell, SharedUsage};
 
 /// How long a move waits for the plane's queued runs to be applied.
 const IDLE_WAIT: Duration = Duration::from_secs(5);
-/// How long the target takes at most to restore an arriving plane. An arrival its loop
-/// reaches later than half of this is refused unrestored; the one that brought it waits
-/// twice this for the answer, and the old daemon a little longer: a plane the old daemon
-/// gave up on is never restored after all (two daemons moving planes to each other at
-/// once both wait, then both refuse, and both planes stay).
-pub const RESTORE_WAIT: Duration = Duration::from_secs(10);
-/// Tombstones kept (the oldest go first): a client that has not touched a moved plane for
-/// this many later moves gets `UnknownPlane` instead of the way to it.
-const MAX_TOMBSTONES: usize = 4096;
-
-/// How a daemon reaches the others of its cluster for migrations (the cluster side).
-pub trait Courier: Send + Sync {
-    /// Whether `daemon` is a live member; the error says why not (naming the live ones).
-    fn check_target(&self, daemon: &str) -> Result<(), String>;
-    /// Hands `plane` to `daemon` and waits (bounded) for its answer.
-    fn deliver(&self, daemon: &str, plane: &MovingPlane) -> MoveAnswer;
-}
-
-/// A plane `--rebalance` wants moved: the largest movable plane goes to `target`.
-#[derive(Debug, Clone)]
-pub struct RebalanceRequest {
-    /// The member with room.
-    pub target: String,
-}
-
-/// Planes that arrived this recently are not moved on by `--rebalance` (no ping-pong).
-pub const SETTLE: Duration = Duration::from_secs(30);
-
-/// A plane arriving from another daemon, and where its answer goes.
-pub struct Arrival {
-    plane: MovingPlane,
-    answer: mpsc::Sender<MoveAnswer>,
-    queued: Instant,
-}
-
-/// The migration hook of a daemon in a cluster ([`super::Options::migrate`]).
-pub struct Migration {
-    /// This daemon's `--name`.
-    pub me: String,
-    /// Its cluster.
-    pub cluster: String,
-    /// An endpoint of the cluster that clients of a moved plane connect through.
-    pub endpoint: String,
-    courier: Box<dyn Courier>,
-    arrivals: Mutex<Vec<Arrival>>,
-    rebalance: Mutex<Vec<RebalanceRequest>>,
-}
-
-impl Migration {
-    /// The hook for daemon `me` of `cluster`, reaching the others through `courier`.
-    pub fn new(me: &str, cluster: &str, endpoint: &str, courier: Box<dyn Courier>) -> Migration {
-        Migration {
-            me: me.to_string(),
-            cluster: cluster.to_string(),
-            endpoint: endpoint.to_string(),
-            courier,
-            arrivals: Mutex::default(),
-            rebalance: Mutex::default(),
-        }
-    }
-
-    /// Asks the loop to move its largest movable plane to `request.target` (`--rebalance`;
-    /// wake the loop after: `crate::wake`).
-    pub fn rebalance(&self, request: RebalanceRequest) {
-        self.rebalance
-            .lock()
-            .unwrap_or_else(|p| p.into_inner())
-            .push(request);
-    }
-
-    /// Queues a plane that arrives (wake the loop after: `crate::wake`); its answer comes
-    /// on the receiver once the loop restored or refused it.
-    pub fn arrive(&self, plane: MovingPlane) -> mpsc::Receiver<MoveAnswer> {
-        let (answer, receiver) = mpsc::channel();
-        self.arrivals
-            .lock()
-            .unwrap_or_else(|p| p.into_inner())
-            .push(Arrival {
-                plane,
-                answer,
-                queued: Instant::now(),
-            });
-        receiver
-    }
-
-    fn take(&self) -> Vec<Arrival> {
-        std::mem::take(&mut *self.arrivals.lock().unwrap_or_else(|p| p.into_inner()))
-    }
-}
-
-impl std::fmt::Debug for Migration {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("Migration")
-            .field("me", &self.me)
-            .field("cluster", &self.cluster)
-            .finish()
-    }
-}
-
-/// What the loop keeps about moves: the planes that left (old id → where they went, and
-/// the owner the claim key is for), the planes pinned to this daemon, and when planes
-/// arrived.
-#[derive(Default)]
-pub(super) struct Tombstones {
-    map: HashMap<PlaneId, (Moved, u128)>,
-    order: VecDeque<PlaneId>,
-    pinned: std::collections::HashSet<PlaneId>,
-    arrived: HashMap<PlaneId, Instant>,
-}
-
-impl Tombstones {
-    fn insert(&mut self, moved: Moved, owner: u128) {
-        if self.order.len() >= MAX_TOMBSTONES {
-            if let Some(old) = self.order.pop_front() {
-                self.map.remove(&old);
-            }
-        }
-        self.order.push_back(moved.from_id);
-        self.pinned.remove(&moved.from_id);
-        self.arrived.remove(&moved.from_id);
-        self.map.insert(moved.from_id, (moved, owner));
-    }
-
-    /// The refusal `client` gets for plane `id` that left (the claim key only for its
-    /// owner).
-    fn refusal(&self, id: PlaneId, client: u128) -> Option<CommandError> {
-        let (moved, owner) = self.map.get(&id)?;
-        let mut moved = moved.clone();
-        if *owner != client {
-            moved.key = 0;
-        }
-        Some(moved.to_error())
-    }
-}
-
 /// 128 random bits (a claim key).
 fn random_key() -> u128 {
     use std::io::Read;
@@ -179,7 +45,7 @@ fn move_error(message: String) -> CommandError {
 
 impl Daemon {
     /// The refusal of `client`'s command for plane `id` when it moved away.
-    pub(super) fn moved_refusal(&self, client: u128, id: PlaneId) -> Option<CommandError> {
+    pub(crate) fn moved_refusal(&self, client: u128, id: PlaneId) -> Option<CommandError> {
         if self.planes.contains_key(&id) {
             return None;
         }
@@ -187,7 +53,7 @@ impl Daemon {
     }
 
     /// `Pin` of plane `id` (its owner asked): `--rebalance` leaves it here.
-    pub(super) fn pin_plane(&mut self, id: PlaneId) -> CommandResult {
+    pub(crate) fn pin_plane(&mut self, id: PlaneId) -> CommandResult {
         self.plane(id)?;
         self.moved.pinned.insert(id);
         Ok(Reply::Done)
@@ -195,7 +61,7 @@ impl Daemon {
 
     /// Serves `--rebalance`'s requests: the largest 3D plane that is not pinned and did not
     /// arrive within [`SETTLE`] moves to the target, through the path of `MoveTo`.
-    pub(super) fn take_rebalance(&mut self) {
+    pub(crate) fn take_rebalance(&mut self) {
         let Some(migration) = self.options.migrate.clone() else {
             return;
         };
@@ -233,7 +99,7 @@ impl Daemon {
     }
 
     /// `MoveTo(daemon)` of plane `id` (its owner asked: `check_access`).
-    pub(super) fn move_plane(&mut self, id: PlaneId, daemon: &str) -> CommandResult {
+    pub(crate) fn move_plane(&mut self, id: PlaneId, daemon: &str) -> CommandResult {
         let Some(migration) = self.options.migrate.clone() else {
             return Err(move_error(format!(
                 "MoveTo({daemon:?}) needs a daemon in a cluster: this daemon runs without \
@@ -281,7 +147,7 @@ impl Daemon {
             ));
         };
         let Some(plane) = guard.as_mut() else {
-            return Err(super::dispatch::unknown_plane(id));
+            return Err(unknown_plane(id));
         };
         let tick = plane.tick();
         let bytes = match plane.apply(shm_layout::PlaneOp::Snapshot)? {
@@ -346,12 +212,12 @@ impl Daemon {
     }
 
     /// `ClaimMoved(key)`: the plane that arrived with this key becomes `client`'s.
-    pub(super) fn claim_moved(&mut self, client: u128, id: PlaneId, key: u128) -> CommandResult {
+    pub(crate) fn claim_moved(&mut self, client: u128, id: PlaneId, key: u128) -> CommandResult {
         let refusal = self.moved.refusal(id, client);
         let entry = self
             .planes
             .get_mut(&id)
-            .ok_or_else(|| refusal.unwrap_or_else(|| super::dispatch::unknown_plane(id)))?;
+            .ok_or_else(|| refusal.unwrap_or_else(|| unknown_plane(id)))?;
         if entry.owner == client {
             return Ok(Reply::Done);
         }
@@ -374,7 +240,7 @@ impl Daemon {
     }
 
     /// Restores the planes that arrived from other daemons and answers each.
-    pub(super) fn take_arrivals(&mut self) {
+    pub(crate) fn take_arrivals(&mut self) {
         let Some(migration) = self.options.migrate.clone() else {
             return;
         };
@@ -391,7 +257,7 @@ impl Daemon {
         }
     }
 
-    fn arrive_plane(&mut self, moving: MovingPlane) -> MoveAnswer {
+    pub(crate) fn arrive_plane(&mut self, moving: MovingPlane) -> MoveAnswer {
         if moving.kind != PlaneKind::Rapier3d {
             return Err(format!("a {} plane cannot move", moving.kind.words()));
         }

@@ -17,16 +17,17 @@ use shm_layout::{
     Reply,
 };
 
-use super::limits::exceeded;
-use super::persist::Loaded;
-use super::worker::{self, Job, PlaneCell, SharedUsage};
-use super::{Daemon, PlaneEntry, Routed};
+use crate::server::daemon::{Daemon, PlaneEntry, Routed};
+use crate::server::persistence::persist::Loaded;
+use crate::server::quotas::limits::exceeded;
+use crate::server::requests::refusals::unknown_plane;
+use crate::server::worker::{self, Job, PlaneCell, SharedUsage};
 
 /// The owner of an orphaned plane: no client (iceoryx2 node ids are random 128-bit values).
-pub(super) const ORPHAN: u128 = 0;
+pub(crate) const ORPHAN: u128 = 0;
 
 /// The name and persistence a creation asks for.
-pub(super) struct Naming {
+pub(crate) struct Naming {
     pub name: Option<PlaneName>,
     pub persistent: bool,
 }
@@ -34,7 +35,7 @@ pub(super) struct Naming {
 impl Daemon {
     /// Checks a creation's `Name` and `Persistent`: a valid name not taken in the domain; a
     /// persistent plane needs a name and a daemon with a state directory.
-    pub(super) fn naming(&self, props: &[PlaneProp]) -> Result<Naming, CommandError> {
+    pub(crate) fn naming(&self, props: &[PlaneProp]) -> Result<Naming, CommandError> {
         let mut naming = Naming {
             name: None,
             persistent: false,
@@ -83,7 +84,7 @@ impl Daemon {
     }
 
     /// The plane named `name`, if any.
-    fn named(&self, name: &str) -> Option<(PlaneId, &PlaneEntry)> {
+    pub(crate) fn named(&self, name: &str) -> Option<(PlaneId, &PlaneEntry)> {
         self.planes
             .iter()
             .find(|(_, e)| e.name.as_ref().is_some_and(|n| n.as_str() == name))
@@ -91,7 +92,7 @@ impl Daemon {
     }
 
     /// `ListPlanes`: every named plane, by name.
-    pub(super) fn named_planes(&self) -> Vec<NamedPlane> {
+    pub(crate) fn named_planes(&self) -> Vec<NamedPlane> {
         let mut list: Vec<NamedPlane> = self
             .planes
             .iter()
@@ -112,7 +113,7 @@ impl Daemon {
 
     /// `Open(name)`: the plane's id; an orphaned plane becomes `client`'s (and a restored
     /// one starts ticking again, telling its new owner what it lost).
-    pub(super) fn open_plane(&mut self, client: u128, name: &str) -> CommandResult {
+    pub(crate) fn open_plane(&mut self, client: u128, name: &str) -> CommandResult {
         // A forged name (any length, any bytes) is refused naming at most 64 characters.
         shm_layout::plane_name::check_text(name)?;
         let Some((id, entry)) = self.named(name) else {
@@ -156,7 +157,7 @@ impl Daemon {
             ));
         }
         let Some(entry) = self.planes.get_mut(&id) else {
-            return Err(super::dispatch::unknown_plane(id));
+            return Err(unknown_plane(id));
         };
         entry.owner = client;
         let recovered = entry.recovered.take();
@@ -183,7 +184,7 @@ impl Daemon {
 
     /// The client `client` leaves: its persistent planes stay, orphaned (they keep ticking
     /// at their TickRate); returns the planes to remove.
-    pub(super) fn orphan_persistent(&mut self, owned: Vec<PlaneId>) -> Vec<PlaneId> {
+    pub(crate) fn orphan_persistent(&mut self, owned: Vec<PlaneId>) -> Vec<PlaneId> {
         owned
             .into_iter()
             .filter(|id| match self.planes.get_mut(id) {
@@ -198,34 +199,34 @@ impl Daemon {
     }
 
     /// `Save` on plane `id`: handed to its worker (after the runs queued before it).
-    pub(super) fn save_plane(&mut self, id: PlaneId) -> Routed {
+    pub(crate) fn save_plane(&mut self, id: PlaneId) -> Routed {
         let Some(entry) = self.planes.get(&id) else {
-            return Routed::Now(vec![Err(super::dispatch::unknown_plane(id))]);
+            return Routed::Now(vec![Err(unknown_plane(id))]);
         };
         let ticket = self.next_ticket;
         self.next_ticket += 1;
         entry.cell.handed_over();
         match entry.jobs.send(Job::Save { ticket }) {
             Ok(()) => Routed::Wait(ticket),
-            Err(_) => Routed::Now(vec![Err(super::dispatch::unknown_plane(id))]),
+            Err(_) => Routed::Now(vec![Err(unknown_plane(id))]),
         }
     }
 
     /// Restores the persistent planes of the state directory, orphaned and held until
     /// opened; waits until each is restored or failed (a client that opens one at once
     /// finds it ready).
-    pub(super) fn restore_saved(&mut self) {
+    pub(crate) fn restore_saved(&mut self) {
         let Some(dir) = self.writer.as_ref().map(|w| w.dir().to_path_buf()) else {
             return;
         };
-        self.restore_loaded(super::persist::load(&dir));
+        self.restore_loaded(crate::server::persistence::persist::load(&dir));
     }
 
     /// Takes the planes a cluster peer handed over (`Options::adopt`, failover): each is
     /// restored like a file of the state directory, orphaned until opened. One whose name
     /// is in use here, or that arrives on a daemon without `--state-dir`, is refused with
     /// an error in the log.
-    pub(super) fn adopt_planes(&mut self) {
+    pub(crate) fn adopt_planes(&mut self) {
         let Some(adopt) = self.options.adopt.clone() else {
             return;
         };
@@ -246,7 +247,7 @@ impl Daemon {
         self.restore_loaded(kept);
     }
 
-    fn restore_loaded(&mut self, planes: Vec<Loaded>) {
+    pub(crate) fn restore_loaded(&mut self, planes: Vec<Loaded>) {
         let mut waiting = Vec::new();
         for loaded in planes {
             let name = loaded.name;
@@ -296,7 +297,7 @@ impl Daemon {
         }
     }
 
-    fn spawn_restored(&mut self, loaded: Loaded) -> Result<u64, CommandError> {
+    pub(crate) fn spawn_restored(&mut self, loaded: Loaded) -> Result<u64, CommandError> {
         let id = self.next_plane_id;
         let ticket = self.next_ticket;
         let usage = Arc::new(SharedUsage::admit(self.owners.of(0))?);

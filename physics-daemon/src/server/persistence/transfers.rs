@@ -15,8 +15,8 @@ use shm_layout::snapshot::checksum;
 use shm_layout::snapshot_transfer::{MAX_OPEN_TRANSFERS, PIECE_BYTES};
 use shm_layout::{CommandError, CommandResult, ErrorKind, Reply, TransferOp, TransferReply};
 
-use super::limits::Limits;
-use super::quota::{HeldBytes, OwnerUsage};
+use crate::server::quotas::limits::Limits;
+use crate::server::quotas::quota::{HeldBytes, OwnerUsage};
 
 /// Room a reply or request needs besides a piece's bytes (framing, the result's variant).
 const OVERHEAD: usize = 256;

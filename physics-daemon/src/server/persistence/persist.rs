@@ -211,7 +211,7 @@ impl Writer {
     /// The saver a persistent plane's worker uses. `restored`: the tick of the snapshot a
     /// restored plane starts from (its tick record is left alone until it moves past it, so
     /// the old daemon's record survives a second crash before anyone opens the plane).
-    pub(super) fn plane_file(
+    pub(crate) fn plane_file(
         &self,
         id: PlaneId,
         name: &str,
@@ -265,7 +265,7 @@ impl Drop for Writer {
 }
 
 /// A persistent plane's side of the writer: held by its worker.
-pub(super) struct PlaneFile {
+pub(crate) struct PlaneFile {
     id: PlaneId,
     name: String,
     jobs: Sender<Write>,

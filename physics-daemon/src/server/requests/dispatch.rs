@@ -12,16 +12,17 @@ use shm_layout::{
     Response, CRATE_VERSION, LAYOUT_VERSION,
 };
 
-use super::limits::exceeded;
-use super::worker::{self, Budget, PlaneCell, SharedUsage};
-use super::{Daemon, Origin, PlaneEntry, Routed, MAX_PLANES};
-use crate::DaemonError;
+use crate::server::daemon::{Daemon, PlaneEntry, Request, Routed, MAX_PLANES};
+use crate::server::quotas::limits::exceeded;
+use crate::server::requests::origin::Origin;
+use crate::server::requests::refusals::unknown_plane;
+use crate::server::worker::{self, Budget, PlaneCell, SharedUsage};
 
 impl Daemon {
     /// Copies a request's bytes out of the sender's memory (see `request_bytes`), or the
     /// reply that rejects it: over `--max-request-bytes` (checked before anything is read),
     /// or a length past the sender's readable memory.
-    pub(super) fn take_bytes(&self, request: &super::Request) -> Result<Vec<u8>, Vec<u8>> {
+    pub(crate) fn take_bytes(&self, request: &Request) -> Result<Vec<u8>, Vec<u8>> {
         let payload = request.payload();
         let limit = self.options.limits.request_bytes;
         if payload.len() > limit {
@@ -32,7 +33,7 @@ impl Daemon {
                 payload.len(),
             ))));
         }
-        super::request_bytes::copy(payload.as_ptr(), payload.len()).map_err(|e| {
+        crate::server::requests::request_bytes::copy(payload.as_ptr(), payload.len()).map_err(|e| {
             codec::encode_response(&Response::Rejected(CommandError::new(
                 ErrorKind::Malformed,
                 e.to_string(),
@@ -42,7 +43,7 @@ impl Daemon {
 
     /// Decodes one request into its commands, or the reply that rejects it. Never panics on
     /// any input.
-    pub(super) fn decode(&self, bytes: &[u8]) -> Result<Vec<Command>, Vec<u8>> {
+    pub(crate) fn decode(&self, bytes: &[u8]) -> Result<Vec<Command>, Vec<u8>> {
         let limits = &self.options.limits;
         if bytes.len() > limits.request_bytes {
             return Err(codec::encode_response(&Response::Rejected(exceeded(
@@ -81,7 +82,7 @@ impl Daemon {
 
     /// Serves `command` at once, or hands it (with the commands after it in `rest` that go
     /// to the same plane) to the plane's worker.
-    pub(super) fn route(
+    pub(crate) fn route(
         &mut self,
         origin: Origin,
         command: Command,
@@ -179,20 +180,32 @@ impl Daemon {
 
     /// The snapshot transfers of the connection `origin` (made on first use; its process
     /// pays for what they hold).
-    fn transfers_of(&mut self, origin: Origin) -> Arc<super::transfers::ClientTransfers> {
+    pub(crate) fn transfers_of(
+        &mut self,
+        origin: Origin,
+    ) -> Arc<crate::server::persistence::transfers::ClientTransfers> {
         let limits = self.options.limits;
-        let owner = self
-            .owners
-            .of(super::clients::owner_key(origin.pid, origin.id));
+        let owner = self.owners.of(crate::server::requests::clients::owner_key(
+            origin.pid, origin.id,
+        ));
         self.transfers
             .entry(origin.id)
-            .or_insert_with(|| Arc::new(super::transfers::ClientTransfers::new(owner, limits)))
+            .or_insert_with(|| {
+                Arc::new(crate::server::persistence::transfers::ClientTransfers::new(
+                    owner, limits,
+                ))
+            })
             .clone()
     }
 
     /// Any client may read any plane; only the owner changes it unless the owner shared
     /// it; only the owner destroys it.
-    fn check_access(&self, client: u128, id: PlaneId, op: &PlaneOp) -> Result<(), CommandError> {
+    pub(crate) fn check_access(
+        &self,
+        client: u128,
+        id: PlaneId,
+        op: &PlaneOp,
+    ) -> Result<(), CommandError> {
         let entry = self.plane(id)?;
         if entry.owner == client || op.is_read_only() {
             return Ok(());
@@ -222,16 +235,21 @@ impl Daemon {
 
     /// The total of the requesting process when it does not own plane `id` (it adds to a
     /// shared plane: what it adds counts against it).
-    fn guest_of(&mut self, origin: Origin, id: PlaneId) -> Option<Arc<super::quota::OwnerUsage>> {
+    pub(crate) fn guest_of(
+        &mut self,
+        origin: Origin,
+        id: PlaneId,
+    ) -> Option<Arc<crate::server::quotas::quota::OwnerUsage>> {
         let owner = self.planes.get(&id)?.owner;
         let owner_pid = self.clients.get(owner).map(|c| c.pid)?;
-        let key = super::clients::owner_key(origin.pid, origin.id);
-        (super::clients::owner_key(owner_pid, owner) != key).then(|| self.owners.of(key))
+        let key = crate::server::requests::clients::owner_key(origin.pid, origin.id);
+        (crate::server::requests::clients::owner_key(owner_pid, owner) != key)
+            .then(|| self.owners.of(key))
     }
 
     /// The quotas a run is checked against: the limits (the owner's totals are reserved
     /// atomically as ops run, see `quota`), and the reply bytes the request has left.
-    pub(super) fn budget(&self) -> Budget {
+    pub(crate) fn budget(&self) -> Budget {
         Budget {
             limits: self.options.limits,
             reply_left: self.reply_left,
@@ -240,7 +258,7 @@ impl Daemon {
         }
     }
 
-    fn hello(&mut self, origin: Origin, crate_version: &str) -> CommandResult {
+    pub(crate) fn hello(&mut self, origin: Origin, crate_version: &str) -> CommandResult {
         let (client, pid) = (origin.id, origin.pid);
         if crate_version != CRATE_VERSION {
             return Err(CommandError::new(
@@ -268,7 +286,7 @@ impl Daemon {
     }
 
     /// Plane `id` is being destroyed by its owner: a persistent plane's files go with it.
-    pub(super) fn forget_file(&mut self, id: PlaneId) {
+    pub(crate) fn forget_file(&mut self, id: PlaneId) {
         let Some(entry) = self.planes.get(&id) else {
             return;
         };
@@ -282,13 +300,18 @@ impl Daemon {
         }
     }
 
-    pub(super) fn plane(&self, id: PlaneId) -> Result<&PlaneEntry, CommandError> {
+    pub(crate) fn plane(&self, id: PlaneId) -> Result<&PlaneEntry, CommandError> {
         self.planes.get(&id).ok_or_else(|| unknown_plane(id))
     }
 
     /// Starts the worker of a new plane; it answers the command once the plane exists
     /// (tick 0 published) or failed to.
-    fn create_plane(&mut self, owner: u128, kind: PlaneKind, props: Vec<PlaneProp>) -> Routed {
+    pub(crate) fn create_plane(
+        &mut self,
+        owner: u128,
+        kind: PlaneKind,
+        props: Vec<PlaneProp>,
+    ) -> Routed {
         let refuse = |e: CommandError| Routed::Now(vec![Err(e)]);
         if self.planes.len() >= MAX_PLANES {
             return refuse(CommandError::new(
@@ -313,11 +336,12 @@ impl Daemon {
         let id = self.next_plane_id;
         let ticket = self.next_ticket;
         let owner_pid = self.clients.get(owner).map_or(0, |c| c.pid);
-        let usage =
-            match SharedUsage::admit(self.owners.of(super::clients::owner_key(owner_pid, owner))) {
-                Ok(usage) => Arc::new(usage),
-                Err(e) => return refuse(e),
-            };
+        let usage = match SharedUsage::admit(self.owners.of(
+            crate::server::requests::clients::owner_key(owner_pid, owner),
+        )) {
+            Ok(usage) => Arc::new(usage),
+            Err(e) => return refuse(e),
+        };
         let cell = Arc::new(PlaneCell::default());
         let (jobs, receiver) = mpsc::channel();
         let shared = PlaneProp::shared_in(&props);
@@ -353,32 +377,10 @@ impl Daemon {
     }
 }
 
-/// The error for a plane that is not (or no longer) there.
-pub(super) fn unknown_plane(id: PlaneId) -> CommandError {
-    CommandError::new(
-        ErrorKind::UnknownPlane,
-        format!("plane {id} does not exist"),
-    )
-}
-
-/// A daemon failure as the error of the command that met it.
-pub(super) fn internal(e: DaemonError) -> CommandError {
-    CommandError::new(ErrorKind::Internal, e.to_string())
-}
-
-/// The text of a caught panic.
-pub(super) fn panic_message(panic: &(dyn std::any::Any + Send)) -> String {
-    panic
-        .downcast_ref::<&str>()
-        .map(|s| s.to_string())
-        .or_else(|| panic.downcast_ref::<String>().cloned())
-        .unwrap_or_else(|| "a panic without a message".to_string())
-}
-
 impl Daemon {
     /// The start of plane `id`'s worker with what every worker gets from the daemon, under
     /// the next ticket (no file, no snapshot to restore: set those on the result).
-    pub(super) fn worker_setup(
+    pub(crate) fn worker_setup(
         &self,
         id: PlaneId,
         kind: PlaneKind,
@@ -404,7 +406,7 @@ impl Daemon {
 
     /// Starts the worker of `setup` (made by [`Daemon::worker_setup`]) on `jobs`; the plane
     /// id and the ticket it used are taken.
-    pub(super) fn start_worker(
+    pub(crate) fn start_worker(
         &mut self,
         setup: worker::Setup,
         jobs: mpsc::Receiver<worker::Job>,

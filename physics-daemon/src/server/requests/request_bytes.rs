@@ -13,7 +13,7 @@
 
 /// Why a request's bytes could not be taken.
 #[derive(Debug, Clone, PartialEq, Eq)]
-pub(super) enum Unreadable {
+pub(crate) enum Unreadable {
     /// The header claims `len` bytes but fewer are readable from the payload's start.
     Fault {
         /// Bytes the header claims.
@@ -38,7 +38,7 @@ impl std::fmt::Display for Unreadable {
 /// Copies `len` bytes from `ptr` (a request payload in another process's shared memory,
 /// mapped into ours) without faulting on unmapped pages. The caller has already bounded
 /// `len` by the request-size limit.
-pub(super) fn copy(ptr: *const u8, len: usize) -> Result<Vec<u8>, Unreadable> {
+pub(crate) fn copy(ptr: *const u8, len: usize) -> Result<Vec<u8>, Unreadable> {
     let mut out = vec![0u8; len];
     let mut done = 0usize;
     while done < len {

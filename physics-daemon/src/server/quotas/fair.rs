@@ -72,7 +72,7 @@ impl CpuAccount {
     /// Charges `used` of CPU at `now`. Returns when the process's next automatic tick may
     /// run, when it is past its share (`None`: at once).
     pub fn charge(&self, used: Duration, now: Instant) -> Option<Instant> {
-        super::gauge::note_step(used);
+        note_step(used);
         let start = self.shares.start;
         let now_ns = now.saturating_duration_since(start).as_nanos() as u64;
         let floor = now_ns.saturating_sub(BURST.as_nanos() as u64);
@@ -94,6 +94,19 @@ impl CpuAccount {
         let clock = self.clock_ns.load(Ordering::SeqCst);
         (clock > now_ns).then(|| start + Duration::from_nanos(clock))
     }
+}
+
+/// Nanoseconds spent stepping planes since the daemon started.
+static STEP_NANOS: AtomicU64 = AtomicU64::new(0);
+
+/// Counts `used` as time spent stepping a plane.
+pub fn note_step(used: Duration) {
+    STEP_NANOS.fetch_add(used.as_nanos() as u64, Ordering::Relaxed);
+}
+
+/// Nanoseconds spent stepping planes since the daemon started ([`note_step`]).
+pub fn stepped_nanos() -> u64 {
+    STEP_NANOS.load(Ordering::Relaxed)
 }
 
 #[cfg(test)]

@@ -4,17 +4,9 @@
 
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
-use std::time::Duration;
 
-use super::quota::PlaneUsage;
-
-/// Nanoseconds spent stepping planes since the daemon started.
-static STEP_NANOS: AtomicU64 = AtomicU64::new(0);
-
-/// Counts `used` as time spent stepping a plane.
-pub fn note_step(used: Duration) {
-    STEP_NANOS.fetch_add(used.as_nanos() as u64, Ordering::Relaxed);
-}
+pub use crate::server::quotas::fair::stepped_nanos;
+use crate::server::quotas::quota::PlaneUsage;
 
 /// What the server loop tells the reporter: the usage records of its planes.
 #[derive(Debug, Default)]
@@ -45,9 +37,4 @@ impl Gauge {
             planes.iter().map(|p| p.objects()).sum(),
         )
     }
-}
-
-/// Nanoseconds spent stepping planes since the daemon started ([`note_step`]).
-pub fn stepped_nanos() -> u64 {
-    STEP_NANOS.load(Ordering::Relaxed)
 }

@@ -5,6 +5,11 @@
 
 use shm_layout::{CommandError, ErrorKind};
 
+/// Clients one daemon serves at once by default (`--max-clients`): with the default
+/// `--max-clients-per-process` of 16, sixteen processes at their cap before the table is
+/// full, so a few processes cannot lock everyone else out.
+pub const MAX_CLIENTS: usize = 256;
+
 /// The daemon's per-client and per-request limits.
 #[derive(Debug, Clone, Copy, PartialEq, clap::Args)]
 pub struct Limits {
@@ -94,7 +99,7 @@ impl Limits {
         hello_timeout_ms: 5_000,
         nodes_per_process: 32,
         ports_per_process: 16,
-        max_clients: super::clients::MAX_CLIENTS,
+        max_clients: MAX_CLIENTS,
     };
 }
 

@@ -10,11 +10,18 @@ use std::collections::HashMap;
 
 use iceoryx2::prelude::*;
 
-use super::Origin;
+/// The sender of a request, as the transport reports it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Origin {
+    /// The sender's iceoryx2 node id.
+    pub id: u128,
+    /// The sender's process id.
+    pub pid: u32,
+}
 
 /// The control service as the daemon opened it (its port list names each client port's
 /// node).
-pub(super) type ControlService = iceoryx2::service::port_factory::request_response::PortFactory<
+pub(crate) type ControlService = iceoryx2::service::port_factory::request_response::PortFactory<
     ipc::Service,
     [u8],
     u128,
@@ -26,14 +33,14 @@ pub(super) type ControlService = iceoryx2::service::port_factory::request_respon
 /// service's port list when a port is not known yet. Port ids are never reused, so a
 /// remembered port cannot come to mean another client.
 #[derive(Default)]
-pub(super) struct Origins {
+pub(crate) struct Origins {
     ports: HashMap<u128, Origin>,
 }
 
 impl Origins {
     /// The node and process of client port `port`; `None` when the service lists no such
     /// port (it closed, or its process died, before the request was served).
-    pub(super) fn of(&mut self, service: &ControlService, port: u128) -> Option<Origin> {
+    pub(crate) fn of(&mut self, service: &ControlService, port: u128) -> Option<Origin> {
         if let Some(origin) = self.ports.get(&port) {
             return Some(*origin);
         }

@@ -9,10 +9,7 @@ use iceoryx2::port::notifier::Notifier;
 use iceoryx2::prelude::*;
 use shm_layout::names;
 
-/// Clients one daemon serves at once by default (`--max-clients`): with the default
-/// `--max-clients-per-process` of 16, sixteen processes at their cap before the table is
-/// full, so a few processes cannot lock everyone else out.
-pub const MAX_CLIENTS: usize = 256;
+use crate::server::quotas::limits::MAX_CLIENTS;
 
 /// One connected client.
 pub struct Client {
@@ -74,7 +71,7 @@ impl Clients {
             return Ok(());
         }
         if self.connected.len() >= self.max {
-            return Err(super::limits::exceeded(
+            return Err(crate::server::quotas::limits::exceeded(
                 "clients of the daemon",
                 self.max,
                 "max-clients",
@@ -86,7 +83,7 @@ impl Clients {
         // many sessions it serves).
         let same_process = self.connected.values().filter(|c| c.pid == pid).count();
         if same_process >= per_process && pid != std::process::id() {
-            return Err(super::limits::exceeded(
+            return Err(crate::server::quotas::limits::exceeded(
                 "clients per process",
                 per_process,
                 "max-clients-per-process",

@@ -40,11 +40,11 @@ impl PidWatch {
     }
 
     /// [`PidWatch::watch`], registering each new descriptor with `alarm` too (the loop's
-    /// [`super::alarm`], which then rings when that process exits).
+    /// [`crate::server::liveness::alarm`], which then rings when that process exits).
     pub fn watch_with(
         &mut self,
         pids: impl IntoIterator<Item = u32>,
-        alarm: Option<&super::alarm::Registry>,
+        alarm: Option<&crate::server::liveness::alarm::Registry>,
     ) {
         let mut wanted: Vec<u32> = pids.into_iter().filter(|&p| p != 0).collect();
         wanted.sort_unstable();

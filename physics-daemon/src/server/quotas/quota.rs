@@ -12,8 +12,8 @@ use std::sync::{Arc, Mutex};
 use shm_layout::settings::plane::NO_SHARED_OBJECT_LIMIT;
 use shm_layout::{CommandError, ErrorKind, Handle, OpCost, PlaneId};
 
-use super::limits::{exceeded, Limits};
 use crate::backend::{Backend, Usage};
+use crate::server::quotas::limits::{exceeded, Limits};
 
 /// Memory one empty plane costs the daemon, measured: 1.8 MiB in a debug build (its worker
 /// thread, engine, node and output ports). It was 10.2 MiB while iceoryx2 kept a reference
@@ -83,7 +83,7 @@ pub struct OwnerUsage {
     /// The daemon's total, which every change of this one also moves.
     memory: Arc<DaemonMemory>,
     /// The process's CPU account (fair shares between processes).
-    pub cpu: super::fair::CpuAccount,
+    pub cpu: crate::server::quotas::fair::CpuAccount,
 }
 
 /// A reservation: released when dropped (by then the plane's own count holds what the op
@@ -372,7 +372,7 @@ impl Drop for PlaneUsage {
 pub struct Owners {
     by_pid: HashMap<u128, Arc<OwnerUsage>>,
     memory: Arc<DaemonMemory>,
-    shares: Arc<super::fair::CpuShares>,
+    shares: Arc<crate::server::quotas::fair::CpuShares>,
 }
 
 impl Owners {
@@ -394,7 +394,7 @@ impl Owners {
             .or_insert_with(|| {
                 Arc::new(OwnerUsage {
                     memory: memory.clone(),
-                    cpu: super::fair::CpuAccount::new(shares.clone()),
+                    cpu: crate::server::quotas::fair::CpuAccount::new(shares.clone()),
                     ..OwnerUsage::default()
                 })
             })

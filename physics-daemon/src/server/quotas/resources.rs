@@ -7,7 +7,7 @@
 //! A thread of its own (with its own node, so the request loop never waits for it) looks at
 //! who holds what every [`PERIOD`] while any other process has a node in the domain (with
 //! none there is nothing to cap, and it sleeps until the domain's node folder changes:
-//! [`super::folder_watch`]) and evicts the excess: it removes
+//! [`crate::server::liveness::folder_watch`]) and evicts the excess: it removes
 //! the offending node from the service, exactly as it removes a dead process's node (its
 //! ports there, their connections and data segments; iceoryx2's slots are owner-tagged, so
 //! the evicted process cannot later release a slot someone else got). The evicted process
@@ -21,7 +21,7 @@
 //!   ports there (the node with the most ports first).
 //!
 //! The same thread beats the daemon's heartbeat at each look while clients are connected
-//! ([`super::heartbeat`]).
+//! ([`crate::server::liveness::heartbeat`]).
 //!
 //! Identities here come from iceoryx2's node and port lists (see `docs/security.md` for
 //! what a process of the same user can still forge).
@@ -39,16 +39,16 @@ use iceoryx2::service::internal::ServiceInternal;
 use iceoryx2::service::service_hash::ServiceHash;
 use shm_layout::{names, BodyState, EventRecord, PlaneId, TickHeader};
 
-use super::folder_watch::{FolderWatch, Wake};
-use super::origin::ControlService;
-use super::Limits;
+use crate::server::liveness::folder_watch::{FolderWatch, Wake};
+use crate::server::quotas::limits::Limits;
+use crate::server::requests::origin::ControlService;
 use crate::DaemonError;
 
 /// Most departures a watch keeps for the guard's next look (see `WatchState::left`).
 const MAX_LEFT: usize = 4096;
 
-/// Time between two looks.
-pub const PERIOD: Duration = Duration::from_millis(500);
+/// Time between two looks: the heartbeat's period (the guard beats at each look).
+pub const PERIOD: Duration = crate::server::liveness::heartbeat::PERIOD;
 
 /// How long an evicted node is left alone before it is looked at again (it may have joined
 /// services again).
@@ -182,10 +182,10 @@ impl Watch {
         }
         let changed = match (&self.wake, folder) {
             (Some(wake), Some(folder)) if quiet => {
-                super::folder_watch::wait(wake, Some(folder), QUIET_LOOK)
+                crate::server::liveness::folder_watch::wait(wake, Some(folder), QUIET_LOOK)
             }
             (Some(wake), folder) => {
-                super::folder_watch::wait(wake, None, PERIOD);
+                crate::server::liveness::folder_watch::wait(wake, None, PERIOD);
                 folder.is_some_and(FolderWatch::drain)
             }
             (None, folder) => {
@@ -206,8 +206,8 @@ impl Watch {
 }
 
 /// The longest a quiet guard sleeps without a change in the node folder: a safety net, as
-/// the loop's own listing ([`super::liveness::SAFETY_NET`]).
-const QUIET_LOOK: Duration = super::liveness::SAFETY_NET;
+/// the loop's own listing ([`crate::server::liveness::schedule::SAFETY_NET`]).
+const QUIET_LOOK: Duration = crate::server::liveness::schedule::SAFETY_NET;
 
 /// Runs the guard until `watch` says stop. Errors are logged: without the guard the daemon
 /// still serves (only without the caps).
@@ -228,14 +228,15 @@ fn guard(config: &Config, limits: &Limits, watch: &Watch) -> Result<(), DaemonEr
         .map_err(|e| ipc("node", &e))?;
     let mut control: Option<ControlService> = None;
     let mut guard = Guard::default();
-    let mut heart = match super::heartbeat::Heart::open(&node, limits.max_clients) {
+    let mut heart = match crate::server::liveness::heartbeat::Heart::open(&node, limits.max_clients)
+    {
         Ok(heart) => Some(heart),
         Err(e) => {
             tracing::warn!("no heartbeat: {e}");
             None
         }
     };
-    let beat = |heart: &mut Option<super::heartbeat::Heart>| {
+    let beat = |heart: &mut Option<crate::server::liveness::heartbeat::Heart>| {
         if let Some(heart) = heart.as_mut().filter(|_| watch.beating()) {
             heart.beat();
         }
@@ -335,7 +336,7 @@ struct Guard {
     /// verdict is due at a later look.
     pending_hello: usize,
     /// The processes of the live nodes last listed (a killed one leaves its node behind).
-    pids: super::pidwatch::PidWatch,
+    pids: crate::server::liveness::pidwatch::PidWatch,
     /// The node folder changed since the last listing (its watch woke the guard).
     folder_changed: bool,
 }
@@ -377,15 +378,15 @@ impl Guard {
     /// listed when that folder changed, while a node's Hello verdict is pending, when the
     /// process of a listed node exited (a killed process leaves its node behind without
     /// touching the folder: its resources are removed then; seen through pidfds,
-    /// `super::pidwatch`), and at least every [`super::liveness::SAFETY_NET`]
-    /// ([`super::liveness::FULL_CHECK`] where pidfds cannot watch every such process).
+    /// `crate::server::liveness::pidwatch`), and at least every [`crate::server::liveness::schedule::SAFETY_NET`]
+    /// ([`crate::server::liveness::schedule::FULL_CHECK`] where pidfds cannot watch every such process).
     fn list_nodes_now(&mut self, config: &Config, now: Instant) -> bool {
         let folder = config.global.node_dir().to_string();
-        let stamp = super::pidwatch::folder_stamp(&folder);
+        let stamp = crate::server::liveness::pidwatch::folder_stamp(&folder);
         let exited = self.pids.any_exited();
         let period = match exited {
-            Some(_) => super::liveness::SAFETY_NET,
-            None => super::liveness::FULL_CHECK,
+            Some(_) => crate::server::liveness::schedule::SAFETY_NET,
+            None => crate::server::liveness::schedule::FULL_CHECK,
         };
         let due = match self.listed {
             None => true,
