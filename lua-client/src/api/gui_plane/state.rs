@@ -17,9 +17,9 @@ use crate::host::signal::Signal;
 pub struct GuiPlaneState {
     /// The SDK's plane.
     pub plane: GuiPlane,
-    pub(crate) alive: Cell<bool>,
-    pub(crate) prims: RefCell<Vec<Rc<PrimState>>>,
-    pub(crate) controllers: RefCell<HashMap<Handle, Rc<ControllerState>>>,
+    pub(super) alive: Cell<bool>,
+    pub(super) prims: RefCell<Vec<Rc<PrimState>>>,
+    pub(super) controllers: RefCell<HashMap<Handle, Rc<ControllerState>>>,
 }
 
 impl GuiPlaneState {

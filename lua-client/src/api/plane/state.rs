@@ -19,14 +19,14 @@ use crate::values::sdk_error;
 pub struct PlaneState {
     /// The SDK's plane.
     pub plane: Plane,
-    pub(crate) alive: Cell<bool>,
+    alive: Cell<bool>,
     pub(crate) parts: RefCell<Vec<Rc<PartState>>>,
     /// The same parts by their body's handle (contacts and query hits name handles).
-    pub(crate) by_handle: RefCell<HashMap<Handle, Rc<PartState>>>,
+    by_handle: RefCell<HashMap<Handle, Rc<PartState>>>,
     /// Contact delivery of this plane (`contacts.rs`).
     pub(crate) contacts: ContactPump,
     /// Its character controllers by body handle (`controller/`).
-    pub(crate) controllers: RefCell<HashMap<Handle, Rc<ControllerState>>>,
+    controllers: RefCell<HashMap<Handle, Rc<ControllerState>>>,
     /// Its maps by body handle (`map.rs`): hits and contacts on a map hand back its Map.
     pub(crate) maps: RefCell<HashMap<Handle, Rc<MapState>>>,
     /// Whether a part has CFrame handlers (so a step with none connected does not copy and
