@@ -18,7 +18,7 @@
 //!   Luau repro.
 //! - [`space`]: the parameter ranges as data: [`space::FULL`] (what the fuzzer explores)
 //!   and [`space::HOLDS`] (where every oracle holds today; widened as fixes land).
-//! - [`case`]: a case of any family, judged and shrunk; [`fuzz`]: the fuzz run and its
+//! - [`case`]: a case of any family, judged and shrunk; [`fuzz`](mod@fuzz): the fuzz run and its
 //!   report; [`critical`]: the critical-value searches and the goals.
 //!
 //! Oracles shared by every family: every body finite after every tick (`finite`), and the
