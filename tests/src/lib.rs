@@ -294,6 +294,8 @@ pub fn physics_lua(domain: &str, script: &str, extra: &[&str]) -> Command {
     command
 }
 
+pub mod structure;
+
 /// The .glb files the examples and Luau tests load (`examples/assets/`), generated here with
 /// the SDK's glTF writer; `tests/tests/maps.rs` checks the shipped files are exactly these
 /// (`PHYSICS_WRITE_ASSETS=1` rewrites them).

@@ -10,6 +10,8 @@
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
+use integration_tests::structure::{circles, rust_files};
+
 fn repo() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
         .parent()
@@ -66,17 +68,6 @@ fn words(s: &str) -> impl Iterator<Item = &str> {
         .filter(|w| !w.is_empty())
 }
 
-fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
-    for entry in std::fs::read_dir(dir).unwrap() {
-        let path = entry.unwrap().path();
-        if path.is_dir() {
-            rust_files(&path, out);
-        } else if path.extension().is_some_and(|e| e == "rs") {
-            out.push(path);
-        }
-    }
-}
-
 /// module → the modules it imports.
 fn edges(krate: &str) -> BTreeMap<String, BTreeSet<String>> {
     let src = repo().join(krate).join("src");
@@ -129,66 +120,6 @@ fn edges(krate: &str) -> BTreeMap<String, BTreeSet<String>> {
         }
     }
     graph
-}
-
-/// The strongly connected components with more than one module (Tarjan).
-fn circles(graph: &BTreeMap<String, BTreeSet<String>>) -> Vec<Vec<String>> {
-    struct State<'a> {
-        graph: &'a BTreeMap<String, BTreeSet<String>>,
-        index: BTreeMap<&'a str, usize>,
-        low: BTreeMap<&'a str, usize>,
-        stack: Vec<&'a str>,
-        on: BTreeSet<&'a str>,
-        out: Vec<Vec<String>>,
-    }
-    fn visit<'a>(s: &mut State<'a>, n: &'a str) {
-        let i = s.index.len();
-        s.index.insert(n, i);
-        s.low.insert(n, i);
-        s.stack.push(n);
-        s.on.insert(n);
-        for w in &s.graph[n] {
-            let w = w.as_str();
-            if !s.index.contains_key(w) {
-                visit(s, w);
-                let lw = s.low[w];
-                let ln = s.low.get_mut(n).unwrap();
-                *ln = (*ln).min(lw);
-            } else if s.on.contains(w) {
-                let iw = s.index[w];
-                let ln = s.low.get_mut(n).unwrap();
-                *ln = (*ln).min(iw);
-            }
-        }
-        if s.low[n] == s.index[n] {
-            let mut comp = Vec::new();
-            while let Some(w) = s.stack.pop() {
-                s.on.remove(w);
-                comp.push(w.to_string());
-                if w == n {
-                    break;
-                }
-            }
-            if comp.len() > 1 {
-                comp.sort();
-                s.out.push(comp);
-            }
-        }
-    }
-    let mut s = State {
-        graph,
-        index: BTreeMap::new(),
-        low: BTreeMap::new(),
-        stack: Vec::new(),
-        on: BTreeSet::new(),
-        out: Vec::new(),
-    };
-    for n in graph.keys() {
-        if !s.index.contains_key(n.as_str()) {
-            visit(&mut s, n);
-        }
-    }
-    s.out
 }
 
 #[test]
