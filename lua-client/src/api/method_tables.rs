@@ -15,7 +15,7 @@ pub struct MethodTables {
     pub object: Table,
 }
 
-/// The method tables [`modules`] registered in `lua`.
+/// The method tables [`super::modules`] registered in `lua`.
 pub fn method_tables(lua: &Lua) -> Rc<MethodTables> {
     lua.app_data_ref::<Rc<MethodTables>>()
         .expect("lua_client::install registers the method tables")

@@ -1,5 +1,5 @@
 //! `PhysicsService.New` and the `PhysicsPlane` it returns: the plane's state
-//! ([`state`]), the script's planes ([`context`]), its property rows ([`props`]), and here
+//! ([`state`]), the script's planes ([`mod@context`]), its property rows ([`props`]), and here
 //! what a plane does per step, `plane:Add` and `New` itself.
 
 pub(crate) mod context;
