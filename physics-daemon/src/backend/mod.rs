@@ -5,6 +5,13 @@
 //!
 //! Adding a plane kind: a folder of its own (like `rapier3d/`) with a type implementing
 //! [`Backend`], a [`PlaneKind`] variant in shm-layout, and one line in `kinds::create`.
+//!
+//! Beside the seam, what the plane kinds share, none of which knows a plane type: the tick
+//! [`clock`], [`SlotTable`] with its [`Dirty`] marks, [`Marks`], [`counted`] state bytes,
+//! [`object_op`](mod@object_op) routing, thread [`pools`]; and for both rapier planes, generic over the
+//! engine: [`rapier_world`] (the world copy, the query refresh, body motion), [`held`]
+//! bodies, `plane_state` (the state-as-a-value macro), the [`rollback`] ring and
+//! `snapshot_decode`.
 
 pub mod clock;
 pub mod counted;
