@@ -1,5 +1,5 @@
 //! Rollback on GUI planes (`RollbackTicks = K`, `PlaneOp::Rewind(n)`), as on 3D planes
-//! (`rapier3d/rollback.rs`): with K > 0 the plane keeps its state after each of its last K
+//! (`rapier3d/history/`): with K > 0 the plane keeps its state after each of its last K
 //! ticks (an in-memory copy each, counted in the owner's state bytes) and can go back n ≤ K
 //! ticks; the script then re-applies corrected inputs and steps again. With K = 0 (the
 //! default) nothing is kept and a step pays nothing. The ticks are kept in a

@@ -1,4 +1,4 @@
-//! A GUI plane's whole state as bytes, and back (see `rapier3d/snapshot.rs`, which this
+//! A GUI plane's whole state as bytes, and back (see `rapier3d/history/snapshot.rs`, which this
 //! follows): its `State` (rapier2d's world and the plane's own tables), so that a restored
 //! plane continues bit for bit. The id, the quota counter and the scratch stay with the
 //! plane.
