@@ -388,7 +388,7 @@ impl Backend for GpuPlane {
 
     fn apply(&mut self, op: PlaneOp) -> CommandResult {
         // The last tick is kept for Rewind before an op changes anything (see
-        // `rapier3d::rollback`).
+        // `rapier3d::history`).
         self.plane.idle_work()?;
         match op {
             PlaneOp::Set(prop) => self.set(prop).map(|_| Reply::Done),
