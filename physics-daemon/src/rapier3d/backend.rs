@@ -146,7 +146,7 @@ impl Backend for Plane {
     fn usage(&self) -> Usage {
         Usage {
             objects: self.bodies.live() as u64 + self.joints.live() as u64,
-            mesh_vertices: self.mesh_vertices + self.map_pending.cost(),
+            mesh_vertices: self.tally.mesh_vertices() + self.map_pending.cost(),
             state_bytes: self.state_bytes.get(),
         }
     }

@@ -6,7 +6,6 @@
 use std::time::Instant;
 
 use rapier3d::prelude::*;
-use shm_layout::validate::MAX_HIT_BOX_QUALITY;
 use shm_layout::{
     BodyState, CollisionGroups, CommandError, EventRecord, PlaneId, PlaneInfo, PlaneKind,
     PlaneSettings, StateHasher, TickHeader,
@@ -15,7 +14,7 @@ use shm_layout::{
 use crate::backend::{HeaderFigures, SlotTable};
 use crate::rapier3d::contacts::figures::contact_figures;
 use crate::rapier3d::contacts::hooks::RestThreshold;
-use crate::rapier3d::contacts::log::{Events, Kept};
+use crate::rapier3d::contacts::log::{Events, Kept as EventsKept};
 use crate::rapier3d::controllers::Controllers;
 use crate::rapier3d::history::pose_mirror::PoseMirror;
 use crate::rapier3d::history::publish;
@@ -24,6 +23,7 @@ use crate::rapier3d::joints::table::Joints;
 use crate::rapier3d::objects::body::{body_state, Body, MAX_SLOTS};
 use crate::rapier3d::objects::body_pass::{self, Scratch};
 use crate::rapier3d::objects::maps::PendingMap;
+use crate::rapier3d::objects::tally::{Kept as TallyKept, Tally};
 
 mod held {
     //! Held objects: see `crate::backend::held`.
@@ -37,12 +37,8 @@ pub struct Plane {
     pub(super) settings: PlaneSettings,
     pub(super) world: PhysicsWorld,
     pub(super) bodies: SlotTable<Body>,
-    /// Objects per HitBoxQuality value: the plane-wide solver scales with the maximum.
-    pub(super) quality_counts: [u32; MAX_HIT_BOX_QUALITY as usize + 1],
-    /// Objects with a drive of their own (ImpulseDirection, ConstantForce, RotateTo, SetPin).
-    pub(super) driven: u32,
-    /// Mesh vertices of all parts (for quotas).
-    pub(super) mesh_vertices: u64,
+    /// Tallies over the objects' parts: per quality, driven, mesh vertices.
+    pub(super) tally: Tally,
     /// Buffers of the per-body passes.
     pub(super) pass: Scratch,
     /// Objects a step must leave where it found them (see `held`).
@@ -87,9 +83,7 @@ impl Plane {
             settings,
             world,
             bodies: SlotTable::tracked("object", MAX_SLOTS),
-            quality_counts: [0; MAX_HIT_BOX_QUALITY as usize + 1],
-            driven: 0,
-            mesh_vertices: 0,
+            tally: Tally::default(),
             pass: Scratch::default(),
             held: Vec::new(),
             clock: Default::default(),
@@ -382,13 +376,12 @@ plane_state! {
     world,
     pub(super) settings: PlaneSettings = settings,
     pub(super) bodies: SlotTable<Body> = bodies,
-    pub(super) driven: u32 = driven,
-    pub(super) mesh_vertices: u64 = mesh_vertices,
+    pub(super) tally: TallyKept = tally.kept,
     held: Vec<held::HeldBody> = held,
     pub(super) clock: crate::backend::Clock = clock,
     pub(super) boosted: u32 = boosted,
     pub(super) stiffened: bool = stiffened,
-    events: Kept = events.kept,
+    events: EventsKept = events.kept,
     pub(super) controllers: Controllers = controllers,
     pub(super) groups: CollisionGroups = groups,
     pub(super) query_stale: crate::backend::Marks<RigidBodyHandle> = query_stale,

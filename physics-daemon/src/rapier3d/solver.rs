@@ -57,10 +57,7 @@ pub(super) struct SolverSettings {
 
 impl Plane {
     pub(super) fn max_quality(&self) -> u32 {
-        (1..=MAX_HIT_BOX_QUALITY)
-            .rev()
-            .find(|q| self.quality_counts[*q as usize] > 0)
-            .unwrap_or(1)
+        self.tally.max_quality()
     }
 
     /// The step length the solver settings are computed for when no step gives one (plane

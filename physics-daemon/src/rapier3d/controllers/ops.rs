@@ -132,7 +132,7 @@ impl Plane {
             .build();
         let h = self.world.insert_body(body);
         self.world.insert_collider(collider, Some(h));
-        self.quality_counts[part.hit_box_quality as usize] += 1;
+        self.tally.add(part.hit_box_quality, 0);
         let handle = self.bodies.insert(Body {
             handle: h,
             part: Box::new(part),

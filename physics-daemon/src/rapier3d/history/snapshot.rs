@@ -180,7 +180,7 @@ impl Plane {
         controllers::count_paths_in(&mut state.controllers, &paths);
         let held = [
             state.bodies.live() as u64 + state.joints.live() as u64,
-            state.mesh_vertices,
+            state.tally.mesh_vertices(),
             paths.get(),
         ];
         let claimed = [header.objects, header.mesh_vertices, header.state_bytes];
@@ -213,10 +213,8 @@ impl Plane {
         self.events.reset();
         self.map_pending = Default::default();
         // Derived from the parts (rebuilt, not stored).
-        self.quality_counts = [0; shm_layout::validate::MAX_HIT_BOX_QUALITY as usize + 1];
-        for (_, body) in self.bodies.iter() {
-            self.quality_counts[body.part.hit_box_quality as usize] += 1;
-        }
+        self.tally
+            .recount_qualities(self.bodies.iter().map(|(_, b)| b.part.hit_box_quality));
         self.set_threads(threads)?;
         // Their mapping onto the engine (Gravity, NeverSleep; Threads is set above; DeferGpu
         // was refused as an override).

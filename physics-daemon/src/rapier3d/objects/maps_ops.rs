@@ -128,8 +128,8 @@ impl Plane {
             .build();
         let h = self.world.insert_body(body);
         self.world.insert_collider(collider, Some(h));
-        self.quality_counts[part.hit_box_quality as usize] += 1;
-        self.mesh_vertices += part.mesh_vertex_count() as u64;
+        self.tally
+            .add(part.hit_box_quality, part.mesh_vertex_count() as u64);
         let handle = self.bodies.insert(Body {
             handle: h,
             part: Box::new(part),

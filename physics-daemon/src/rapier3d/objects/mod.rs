@@ -15,3 +15,4 @@ mod ops;
 pub(super) mod part;
 mod properties;
 mod stepping;
+pub(super) mod tally;

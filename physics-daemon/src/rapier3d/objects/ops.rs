@@ -42,8 +42,8 @@ impl Plane {
         let h = self.world.insert_body(body);
         self.world.insert_collider(collider, Some(h));
         part.configure_body(&mut self.world.bodies[h], &self.world.colliders);
-        self.quality_counts[part.hit_box_quality as usize] += 1;
-        self.mesh_vertices += shape.mesh_vertices() as u64;
+        self.tally
+            .add(part.hit_box_quality, shape.mesh_vertices() as u64);
         let handle = self.bodies.insert(Body {
             handle: h,
             part: Box::new(part),
@@ -126,11 +126,11 @@ impl Plane {
         if part.report_contacts {
             self.events.count_reporting(false);
         }
-        self.quality_counts[part.hit_box_quality as usize] -= 1;
-        self.mesh_vertices -= part.mesh_vertex_count() as u64;
-        if part.is_driven() {
-            self.driven -= 1;
-        }
+        self.tally.remove(
+            part.hit_box_quality,
+            part.mesh_vertex_count() as u64,
+            part.is_driven(),
+        );
         // Its contact-stopped events come at the next step, after the slot is gone.
         for c in self.world.bodies[h].colliders() {
             self.events.collider_removed(*c, handle);

@@ -148,13 +148,10 @@ impl Plane {
     /// Keeps the plane's per-part counts (objects per quality, driven, reporting) in step
     /// with one part's change.
     fn recount(&mut self, before: Counted, after: Counted) {
-        if before.quality != after.quality {
-            self.quality_counts[before.quality as usize] -= 1;
-            self.quality_counts[after.quality as usize] += 1;
-        }
+        self.tally.requalify(before.quality, after.quality);
         match (before.driven, after.driven) {
-            (false, true) => self.driven += 1,
-            (true, false) => self.driven -= 1,
+            (false, true) => self.tally.count_driven(true),
+            (true, false) => self.tally.count_driven(false),
             _ => {}
         }
         match (before.reporting, after.reporting) {

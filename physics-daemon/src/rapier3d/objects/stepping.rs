@@ -19,7 +19,7 @@ impl Plane {
         let p = &mut self.world.integration_parameters;
         p.normalized_max_linear_velocity = self.settings.max_linear_speed / p.length_unit;
         let inputs = Inputs {
-            forces: Env::new(&self.settings, self.world.gravity, self.driven, dt),
+            forces: Env::new(&self.settings, self.world.gravity, self.tally.driven(), dt),
             max_angular_speed: self.settings.max_angular_speed,
             prediction: Prediction::new(&self.world, dt),
         };
