@@ -11,7 +11,7 @@
 //!   a stiffer contact leaks less. At the defaults (240 substeps/s) nothing changes; at 1,920
 //!   substeps/s and above (e.g. 240 Hz × 8, 60 Hz × 32) a 1,000:1 box holds.
 //! - Contact prediction: a body that moves more than half the prediction distance in a tick
-//!   gets rapier's soft CCD (`soft_ccd_prediction`, up to [`SOFT_CCD_REACH`] ahead): the
+//!   gets rapier's soft CCD (`soft_ccd_prediction`, up to `SOFT_CCD_REACH` ahead): the
 //!   contacts it will make during the tick are predicted along its velocity, so it is
 //!   stopped in that tick. The published velocity of the tick of impact is the solved one,
 //!   and a bounce starts at the surface instead of from wherever the body had sunk to (that

@@ -16,7 +16,7 @@
 //!
 //! [`ClippedQueries`], the dispatcher every query of a 3D plane uses, answers:
 //! - a contact of a capsule with a box whose segment stays outside the box in closed form
-//!   (`capsule_contact`);
+//!   (`capsule`);
 //! - a contact of a convex shape with a box from the box's face when the shape's deepest
 //!   point lies over it (exact at any size, see [`face_contact`]);
 //! - otherwise any query against a much larger box on that box clipped to the region near

@@ -8,7 +8,7 @@ use crate::rapier3d::plane::Plane;
 impl Plane {
     /// Turns the step's collision events into records: both objects, and for a start the
     /// contact point, the normal (from `a` toward `b`), the normal impulse of the step and
-    /// the pair's manifold points (`contact_points.rs`).
+    /// the pair's manifold points (`points.rs`).
     pub(in crate::rapier3d) fn collect_events(&mut self) {
         // Events the controllers produced before the step come first, in their order.
         self.events.begin_tick(self.clock.tick);

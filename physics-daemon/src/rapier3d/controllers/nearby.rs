@@ -13,7 +13,7 @@
 //! A tick allocates nothing here: the candidate list is a buffer of the thread it runs on,
 //! handed back when the tick ends. A box candidate keeps its half extents, so the
 //! capsule's contacts with it (most of a tick's work) go straight to the closed form of
-//! `capsule_contact` without asking the shapes what they are.
+//! `contacts::capsule` without asking the shapes what they are.
 
 use std::cell::{Cell, RefCell};
 

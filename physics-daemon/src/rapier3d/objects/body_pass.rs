@@ -11,8 +11,9 @@
 //! numbers are written in the same order: Threads only changes which thread does the
 //! arithmetic, never the result (`tests` checks it bit for bit).
 //!
-//! The after-step passes on the pool are in `limits` (finding bodies over MaxAngularSpeed)
-//! and `contacts` (the contact figures, run beside the state hash).
+//! The after-step passes on the pool are [`Scratch::cap_angular_speeds`] (finding bodies over
+//! MaxAngularSpeed, capped with `limits`) and the contact figures (`contacts::figures`, run
+//! beside the state hash).
 
 use std::sync::Arc;
 

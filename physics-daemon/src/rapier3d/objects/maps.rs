@@ -5,6 +5,8 @@
 //! at the welded edges take the neighbouring triangles' normals, so a body sliding across a
 //! seam meets no ghost bump. Every check runs before the world changes: a failed build
 //! leaves nothing behind.
+//!
+//! [`MapOp::Upload`]: shm_layout::map_op::MapOp::Upload
 
 use std::collections::HashMap;
 
