@@ -1,6 +1,7 @@
-//! `PhysicsGuiObject`: the body `GuiPhysicsPlane:Add(primitive)` returns. Its properties are
-//! the rows in `props/gui.rs`; its methods are `ApplyImpulse`, `ApplyForce`, `Wake` and
-//! `Destroy` (the primitive stays at its last simulated position).
+//! `PhysicsGuiObject`: the body `GuiPhysicsPlane:Add(primitive)` returns (its handle lives
+//! with the GUI plane's state, `gui_plane/state.rs`). Its properties are the rows in
+//! `props.rs`; its methods are `ApplyImpulse`, `ApplyForce`, `Wake` and `Destroy` (the
+//! primitive stays at its last simulated position).
 
 pub(crate) mod props;
 
