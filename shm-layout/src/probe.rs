@@ -10,9 +10,8 @@ use serde::{Deserialize, Serialize};
 use crate::error::CommandError;
 use crate::geometry::Vec3;
 use crate::ids::Handle;
-use crate::query::{QueryFilter, QueryOp, MAX_QUERY_DISTANCE};
-use crate::settings::controller::MAX_SLOPE_LIMIT;
-use crate::validate::{bounded3, extent, in_range, non_negative, pose, MAX_COORDINATE};
+use crate::query::{QueryFilter, MAX_QUERY_DISTANCE};
+use crate::validate::{bounded3, in_range, MAX_COORDINATE};
 
 /// The walkable-slope limit (degrees) probes use when none is given: the controllers'
 /// `MaxSlope` default.
@@ -70,82 +69,8 @@ pub struct Explosion {
     pub filter: QueryFilter,
 }
 
-/// A slope limit in degrees, `[0, MAX_SLOPE_LIMIT]`.
-fn slope(field: &str, v: f32) -> Result<f32, CommandError> {
-    in_range(field, v, 0.0, MAX_SLOPE_LIMIT)
-}
-
-/// A reach: finite, ≥ 0 and at most [`MAX_QUERY_DISTANCE`].
-fn reach(field: &str, v: f32) -> Result<f32, CommandError> {
-    in_range(field, non_negative(field, v)?, 0.0, MAX_QUERY_DISTANCE)
-}
-
 fn point(field: &str, p: Vec3) -> Result<Vec3, CommandError> {
     bounded3(field, p, MAX_COORDINATE)
-}
-
-/// The checks of the proximity variants of [`QueryOp`] (called by `QueryOp::checked`).
-pub(crate) fn checked(op: QueryOp) -> Result<QueryOp, CommandError> {
-    Ok(match op {
-        QueryOp::ProbeGround {
-            position,
-            radius,
-            max_distance,
-            max_slope,
-            filter,
-        } => QueryOp::ProbeGround {
-            position: point("position", position)?,
-            radius: extent("radius", radius)?,
-            max_distance: reach("maxDistance", max_distance)?,
-            max_slope: slope("MaxSlopeAngle", max_slope)?,
-            filter: filter.checked()?,
-        },
-        QueryOp::ClosestPoint {
-            position,
-            max_distance,
-            filter,
-        } => QueryOp::ClosestPoint {
-            position: point("position", position)?,
-            max_distance: reach("MaxDistance", max_distance)?,
-            filter: filter.checked()?,
-        },
-        QueryOp::Clearance {
-            shape,
-            pose: p,
-            max_distance,
-            own,
-            filter,
-        } => {
-            shape.check()?;
-            QueryOp::Clearance {
-                shape,
-                pose: pose("cframe", p)?,
-                max_distance: reach("MaxDistance", max_distance)?,
-                own,
-                filter: filter.checked()?,
-            }
-        }
-        QueryOp::ProbeWall {
-            pose: p,
-            radius,
-            height,
-            max_distance,
-            max_slope,
-            filter,
-        } => {
-            let radius = extent("radius", radius)?;
-            let height = extent("height", height)?;
-            QueryOp::ProbeWall {
-                pose: pose("cframe", p)?,
-                radius,
-                height,
-                max_distance: reach("maxDistance", max_distance)?,
-                max_slope: slope("MaxSlopeAngle", max_slope)?,
-                filter: filter.checked()?,
-            }
-        }
-        other => other,
-    })
 }
 
 impl Explosion {
@@ -171,6 +96,7 @@ impl Explosion {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::query::QueryOp;
 
     #[test]
     fn the_default_slope_limit_is_the_controllers() {

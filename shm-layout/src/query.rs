@@ -7,7 +7,8 @@ use serde::{Deserialize, Serialize};
 use crate::error::CommandError;
 use crate::geometry::{Pose, Vec3};
 use crate::ids::Handle;
-use crate::validate::{bounded3, extent, pose, size, MAX_COORDINATE};
+use crate::settings::controller::MAX_SLOPE_LIMIT;
+use crate::validate::{bounded3, extent, in_range, non_negative, pose, size, MAX_COORDINATE};
 
 /// Most rays one [`QueryOp::Raycast`] may carry (bounds the work of one request).
 pub const MAX_RAYS: usize = 65_536;
@@ -312,7 +313,7 @@ impl QueryOp {
                     after_slot,
                 }
             }
-            op => crate::probe::checked(op)?,
+            op => checked_probe(op)?,
         })
     }
 
@@ -369,6 +370,85 @@ impl QueryFilter {
         }
         Ok(self)
     }
+}
+
+fn point(field: &str, p: Vec3) -> Result<Vec3, CommandError> {
+    bounded3(field, p, MAX_COORDINATE)
+}
+
+/// A slope limit in degrees, `[0, MAX_SLOPE_LIMIT]`.
+fn slope(field: &str, v: f32) -> Result<f32, CommandError> {
+    in_range(field, v, 0.0, MAX_SLOPE_LIMIT)
+}
+
+/// A reach: finite, ≥ 0 and at most [`MAX_QUERY_DISTANCE`].
+fn reach(field: &str, v: f32) -> Result<f32, CommandError> {
+    in_range(field, non_negative(field, v)?, 0.0, MAX_QUERY_DISTANCE)
+}
+
+/// The checks of the proximity variants of [`QueryOp`] (`ProbeGround`, `ClosestPoint`,
+/// `Clearance`, `ProbeWall`: see [`crate::probe`]), called by `QueryOp::checked`.
+fn checked_probe(op: QueryOp) -> Result<QueryOp, CommandError> {
+    Ok(match op {
+        QueryOp::ProbeGround {
+            position,
+            radius,
+            max_distance,
+            max_slope,
+            filter,
+        } => QueryOp::ProbeGround {
+            position: point("position", position)?,
+            radius: extent("radius", radius)?,
+            max_distance: reach("maxDistance", max_distance)?,
+            max_slope: slope("MaxSlopeAngle", max_slope)?,
+            filter: filter.checked()?,
+        },
+        QueryOp::ClosestPoint {
+            position,
+            max_distance,
+            filter,
+        } => QueryOp::ClosestPoint {
+            position: point("position", position)?,
+            max_distance: reach("MaxDistance", max_distance)?,
+            filter: filter.checked()?,
+        },
+        QueryOp::Clearance {
+            shape,
+            pose: p,
+            max_distance,
+            own,
+            filter,
+        } => {
+            shape.check()?;
+            QueryOp::Clearance {
+                shape,
+                pose: pose("cframe", p)?,
+                max_distance: reach("MaxDistance", max_distance)?,
+                own,
+                filter: filter.checked()?,
+            }
+        }
+        QueryOp::ProbeWall {
+            pose: p,
+            radius,
+            height,
+            max_distance,
+            max_slope,
+            filter,
+        } => {
+            let radius = extent("radius", radius)?;
+            let height = extent("height", height)?;
+            QueryOp::ProbeWall {
+                pose: pose("cframe", p)?,
+                radius,
+                height,
+                max_distance: reach("maxDistance", max_distance)?,
+                max_slope: slope("MaxSlopeAngle", max_slope)?,
+                filter: filter.checked()?,
+            }
+        }
+        other => other,
+    })
 }
 
 #[cfg(test)]
