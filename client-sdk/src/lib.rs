@@ -8,8 +8,9 @@
 //! Writes are queued and sent as one request per [`Client::flush`] (or when a call needs an
 //! answer); reads see your own writes until the daemon's samples reflect them.
 //!
-//! Every iceoryx2 port is built in one module (`transport`); the other modules hold what it
-//! returns.
+//! Every port is reached through one module (`transport`): this host's iceoryx2 ports, built
+//! by the `local-transport` crate, or a cluster member's relay; the other modules hold what
+//! it returns.
 
 #![deny(missing_docs)]
 
