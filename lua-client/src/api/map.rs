@@ -17,27 +17,34 @@ use super::plane::state::{MapState, PhysicsPlane, PlaneState};
 use crate::props::{Get, Kind, Props, Row, Set, Target};
 use crate::values::{describe, lua_number, sdk_error, CFrame, DESCRIBE};
 
-/// What a map lets change, as refusals of the other object properties say.
-const CHANGEABLE: &str = "only CFrame, Friction, Bounciness, CanCollide and CollisionGroup can";
+/// What a map lets change, as refusals of the other object properties say: its writable
+/// rows ("only CFrame, Friction, Bounciness, CanCollide and CollisionGroup can").
+fn changeable() -> String {
+    let names: Vec<&str> = MAP
+        .rows
+        .iter()
+        .filter(|r| !matches!(r.set, Set::ReadOnly) && r.name != "Anchored")
+        .map(|r| r.name)
+        .collect();
+    match names.split_last() {
+        Some((last, rest)) if !rest.is_empty() => {
+            format!("only {} and {last} can", rest.join(", "))
+        }
+        _ => format!("only {} can", names.concat()),
+    }
+}
 
-/// Properties of moving bodies a map refuses (it is static), by their PhysicsObject names.
-const REFUSED: [&str; 15] = [
-    "Velocity",
-    "AngularVelocity",
-    "Size",
-    "Weight",
-    "Density",
-    "CenterOfMass",
-    "HitBoxQuality",
-    "ImpulseDirection",
-    "ConstantForce",
-    "LockX",
-    "LockY",
-    "LockZ",
-    "LockRotX",
-    "LockRotY",
-    "LockRotZ",
-];
+/// Whether `name` is a writable PhysicsObject property that a map has no row for: a property
+/// of moving bodies a map refuses (it is static).
+fn refused_on_maps(name: &str) -> bool {
+    let object = &super::object::props::OBJECT;
+    let writable = object
+        .rows
+        .iter()
+        .chain(object.table_rows())
+        .any(|r| r.name == name && !matches!(r.set, Set::ReadOnly));
+    writable && !MAP.rows.iter().any(|r| r.name == name)
+}
 
 impl MapState {
     /// The map's handle (what hits and contacts name).
@@ -225,7 +232,8 @@ pub static MAP: Props<MapState> = Props {
                 match a.bool()? {
                     true => Ok(()),
                     false => Err(mlua::Error::runtime(format!(
-                        "Map.Anchored cannot be false: a map is a static triangle mesh ({CHANGEABLE})"
+                        "Map.Anchored cannot be false: a map is a static triangle mesh ({})",
+                        changeable()
                     ))),
                 }
             }),
@@ -271,10 +279,11 @@ impl UserData for Map {
             |lua, m, (key, value): (Value, Value)| {
                 if let Value::String(s) = &key {
                     let name = s.to_string_lossy();
-                    if REFUSED.contains(&name.as_str()) {
+                    if refused_on_maps(&name) {
                         return Err(mlua::Error::runtime(format!(
                             "Map.{name} cannot change: a map is a static triangle mesh \
-                             ({CHANGEABLE}; assigned {})",
+                             ({}; assigned {})",
+                            changeable(),
                             describe(&value)
                         )));
                     }
@@ -351,5 +360,54 @@ impl PlaneState {
     /// The map whose body is `handle`, if this host loaded it.
     pub(crate) fn map_of(&self, handle: Handle) -> Option<Rc<MapState>> {
         self.maps.borrow().get(&handle).cloned()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn maps_refuse_what_moves_and_take_what_the_daemon_takes() {
+        for name in [
+            "Velocity",
+            "AngularVelocity",
+            "Size",
+            "Weight",
+            "Density",
+            "CenterOfMass",
+            "HitBoxQuality",
+            "ImpulseDirection",
+            "ConstantForce",
+            "GravityScale",
+        ] {
+            assert!(refused_on_maps(name), "{name} should be refused on maps");
+        }
+        for name in [
+            "CFrame",
+            "Friction",
+            "Bounciness",
+            "CanCollide",
+            "CollisionGroup",
+        ] {
+            assert!(!refused_on_maps(name), "{name} changes on maps");
+        }
+        // What the Lua Map lets change is what the daemon lets a map change (one flag,
+        // `on_maps`, in the object settings table).
+        for row in MAP.rows.iter().filter(|r| !matches!(r.set, Set::ReadOnly)) {
+            if row.name == "Anchored" {
+                continue;
+            }
+            let wire = ObjectProp::row_named(row.name);
+            assert!(
+                wire.on_maps,
+                "Map.{} is writable but maps refuse it",
+                row.name
+            );
+        }
+        assert_eq!(
+            changeable(),
+            "only CFrame, Friction, Bounciness, CanCollide and CollisionGroup can"
+        );
     }
 }

@@ -88,7 +88,7 @@ super::table::settings_table! {
     pub struct ObjectSettings;
     rows {
         /// Teleports the object.
-        Pose(Pose) "CFrame" = Pose::IDENTITY, flags: [published];
+        Pose(Pose) "CFrame" = Pose::IDENTITY, flags: [published, on_maps];
         /// Linear velocity.
         Velocity(Vec3) "Velocity" = [0.0; 3], flags: [published];
         /// Angular velocity (rad/s).
@@ -96,7 +96,7 @@ super::table::settings_table! {
         /// Anchored objects do not move; setting it zeroes both velocities.
         Anchored(bool) "Anchored" = false, flags: [published, derived];
         /// Report contact started / stopped events for this object.
-        ReportContacts(bool) "ReportContacts" = false, field: report_contacts;
+        ReportContacts(bool) "ReportContacts" = false, field: report_contacts, flags: [on_maps];
         /// Mass used when `Density` is 0 (impulses divide by it; free fall ignores it). Default 1;
         /// at least `validate::MIN_MASS`.
         Weight(f32) "Weight" = 1.0, range: Range::AtLeast(MIN_MASS as f64), field: weight,
@@ -107,12 +107,12 @@ super::table::settings_table! {
             flags: [derived];
         /// Restitution, clamped to [0, 1]; a pair uses the higher value. Default 0.
         Bounciness(f32) "Bounciness" = 0.0, range: Range::Clamped(0.0, 1.0), field: bounciness,
-            flags: [lua];
+            flags: [lua, on_maps];
         /// Coulomb friction in [0, 1]; a pair uses `sqrt(a·b)`. Default 0.5.
         Friction(f32) "Friction" = 0.5, range: Range::Within(0.0, 1.0), field: friction,
-            flags: [lua];
+            flags: [lua, on_maps];
         /// When false the object passes through everything.
-        CanCollide(bool) "CanCollide" = true, field: can_collide, flags: [lua];
+        CanCollide(bool) "CanCollide" = true, field: can_collide, flags: [lua, on_maps];
         /// Fidelity dial, clamped to [1, 32]. Default 1.
         HitBoxQuality(u32) "HitBoxQuality" = 1,
             range: Range::Clamped(1.0, MAX_HIT_BOX_QUALITY as f64), field: hit_box_quality,
@@ -138,14 +138,36 @@ super::table::settings_table! {
         Pin(Option<Pin>) "SetPin" = None, check: check_pin, field: pin, flags: [cpu_only];
         /// The object's collision group: an index into the plane's collision-group table.
         CollisionGroup(u8) "CollisionGroup" = 0, check: check_collision_group,
-            field: collision_group;
+            field: collision_group, flags: [on_maps];
         /// Held: steps leave the object where it is (pose and velocities as before the step)
         /// until `Held(false)`, or for at most [`MAX_HELD_TICKS`] ticks. The SDK adds objects
         /// held on planes that tick by themselves and releases them with its next flush, so
         /// properties written right after an add apply before the object's first step.
-        Held(bool) "Held" = false;
+        Held(bool) "Held" = false, flags: [on_maps];
         /// Multiplies the plane's Gravity for this object: 0 floats, -1 falls up. Default 1.
         GravityScale(f32) "GravityScale" = 1.0, field: gravity_scale, flags: [lua, cpu_only];
+    }
+}
+
+impl ObjectProp {
+    /// Whether a map (a static triangle mesh) takes this value: a row flagged `on_maps`, or
+    /// `Anchored(true)` (a map is anchored and stays so).
+    pub fn changes_on_map(&self) -> bool {
+        self.row().on_maps || matches!(self, ObjectProp::Anchored(true))
+    }
+
+    /// The properties a map lets change, in the API's words ("CFrame, ... and Held"), for the
+    /// errors that refuse the others.
+    pub fn map_changeable() -> String {
+        let names: Vec<&str> = ObjectProp::ROWS
+            .iter()
+            .filter(|r| r.on_maps)
+            .map(|r| r.name)
+            .collect();
+        match names.split_last() {
+            Some((last, rest)) if !rest.is_empty() => format!("{} and {last}", rest.join(", ")),
+            _ => names.concat(),
+        }
     }
 }
 

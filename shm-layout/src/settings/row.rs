@@ -80,6 +80,8 @@ pub struct PropRow {
     pub changes_forces: bool,
     /// The GPU path cannot honour a value other than the default.
     pub cpu_only: bool,
+    /// A map (a static triangle mesh) may change it; maps refuse every other property.
+    pub on_maps: bool,
 }
 
 impl PropRow {
@@ -96,6 +98,7 @@ impl PropRow {
         creation_only: false,
         changes_forces: false,
         cpu_only: false,
+        on_maps: false,
     };
 }
 
