@@ -30,8 +30,6 @@
 
 use rapier3d::prelude::*;
 
-use super::Plane;
-
 /// Depth (units at HitBoxQuality 1, scaled with the plane's allowed error) past which a
 /// contact asks for more substeps: six times rapier's allowed error.
 const TRIGGER_DEPTH: f32 = 0.03;
@@ -60,46 +58,60 @@ const MAX_LEVEL: i32 = 100;
 /// high-ratio pair), bodies as raw handle parts.
 type Support = ((u32, u32), (u32, u32), bool);
 
-impl Plane {
+/// The adaptive pass's state (see the module doc).
+#[derive(Debug, Clone, Default, serde::Serialize, serde::Deserialize)]
+pub(super) struct Adaptive {
+    /// Bodies the last pass gave extra substeps.
+    boosted: u32,
+    /// Whether the last pass found a pair of a high mass ratio.
+    stiffened: bool,
+}
+
+impl Adaptive {
     /// After a step: boosts the bodies of the pairs that need more substeps and lets the
     /// others' boosts go (see the module doc).
-    pub(super) fn adapt_solving(&mut self) {
-        let articulated = self.world.multibody_joints.iter().next().is_some();
-        if !self.settings.adaptive_solving || articulated {
+    /// `on`: the plane's AdaptiveSolving; `awake`: bodies awake after the step; the step's
+    /// deepest penetration and tick.
+    pub(super) fn adapt(
+        &mut self,
+        world: &mut PhysicsWorld,
+        on: bool,
+        awake: usize,
+        (max_penetration, tick): (f32, u64),
+    ) {
+        let articulated = world.multibody_joints.iter().next().is_some();
+        if !on || articulated {
             if self.boosted > 0 || self.stiffened {
-                self.unboost_all();
+                self.unboost_all(&mut world.bodies);
             }
             return;
         }
         // Nothing awake, nothing to decide: a sleeping pair keeps what it had (it costs
         // nothing asleep) and is looked at again once something wakes. A settled pile pays
         // no pass at all (the periodic pass over every pair cost it 12 % of its step).
-        if self.awake_count() == 0 {
+        if awake == 0 {
             return;
         }
-        let scale = self
-            .world
-            .integration_parameters
-            .normalized_allowed_linear_error
-            / BASE_ALLOWED_ERROR;
+        let scale =
+            world.integration_parameters.normalized_allowed_linear_error / BASE_ALLOWED_ERROR;
         let (trigger, release) = (TRIGGER_DEPTH * scale, RELEASE_DEPTH * scale);
-        if self.clock.max_penetration <= release && !self.clock.tick.is_multiple_of(PASS_EVERY) {
+        if max_penetration <= release && !tick.is_multiple_of(PASS_EVERY) {
             return;
         }
-        let bodies = &self.world.bodies;
+        let bodies = &world.bodies;
         // (body, extra substeps) for the bodies some pair asks for; bodies to let go.
         let (mut wanted, mut unwanted) = (Vec::new(), Vec::new());
         let mut stiffened = false;
         // Support edges (lower body, upper body, whether the upper is the heavy one of a
         // high-ratio pair) for the dominance pass below.
-        let down = self.world.gravity.normalize_or_zero();
+        let down = world.gravity.normalize_or_zero();
         let mut supports = Vec::new();
         // Dynamic bodies resting on anchored geometry: only such a light body carries a heavy
         // one as a floor would. Higher in a column the extra substeps hold the pair (a light
         // box given the heavy one's weight to nobody above the floor let a 1,000:1 box on a
         // column of four sink through it).
         let mut grounded = std::collections::BTreeSet::new();
-        for pair in self.world.narrow_phase.contact_pairs() {
+        for pair in world.narrow_phase.contact_pairs() {
             let Some((manifold, contact)) = pair.find_deepest_contact() else {
                 continue;
             };
@@ -170,13 +182,13 @@ impl Plane {
             for s in supports.iter_mut() {
                 s.2 &= grounded.contains(&s.0);
             }
-            set_dominance(&mut self.world.bodies, &supports);
+            set_dominance(&mut world.bodies, &supports);
         }
         // Each body takes the largest request of its pairs.
         wanted.sort_unstable_by(|a, b| a.0.cmp(&b.0).then(b.1.cmp(&a.1)));
         wanted.dedup_by_key(|w| w.0);
         self.boosted = wanted.len() as u32;
-        let bodies = &mut self.world.bodies;
+        let bodies = &mut world.bodies;
         for raw in unwanted {
             if wanted.binary_search_by(|w| w.0.cmp(&raw)).is_err() {
                 set_extra(bodies, raw, 0);
@@ -189,26 +201,24 @@ impl Plane {
 
     /// Every body back to the plane's own substeps (AdaptiveSolving turned off, or an
     /// articulation made).
-    fn unboost_all(&mut self) {
-        let boosted: Vec<RigidBodyHandle> = self
-            .world
-            .bodies
+    fn unboost_all(&mut self, bodies: &mut RigidBodySet) {
+        let boosted: Vec<RigidBodyHandle> = bodies
             .iter()
             .filter(|(_, b)| b.additional_solver_iterations() > 0)
             .map(|(h, _)| h)
             .collect();
         for h in boosted {
-            set_extra(&mut self.world.bodies, h.into_raw_parts(), 0);
+            set_extra(bodies, h.into_raw_parts(), 0);
         }
         if self.stiffened {
-            set_dominance(&mut self.world.bodies, &[]);
+            set_dominance(bodies, &[]);
         }
         (self.boosted, self.stiffened) = (0, false);
     }
 
-    /// Whether the plane's contacts follow the boosted substep rate in stiffness this step.
-    pub(super) fn contacts_stiffened(&self) -> bool {
-        self.stiffened && self.settings.adaptive_solving
+    /// Whether the last pass found a pair of a high mass ratio.
+    pub(super) fn stiffened(&self) -> bool {
+        self.stiffened
     }
 }
 

@@ -12,6 +12,7 @@ use shm_layout::{
 };
 
 use crate::backend::{HeaderFigures, SlotTable};
+use crate::rapier3d::adaptive::Adaptive;
 use crate::rapier3d::contacts::figures::contact_figures;
 use crate::rapier3d::contacts::hooks::RestThreshold;
 use crate::rapier3d::contacts::log::{Events, Kept as EventsKept};
@@ -45,10 +46,8 @@ pub struct Plane {
     held: Vec<held::HeldBody>,
     /// The tick clock and the last step's figures (see `backend::clock`).
     pub(super) clock: crate::backend::Clock,
-    /// Bodies the last adaptive pass gave extra substeps (see `adaptive`).
-    pub(super) boosted: u32,
-    /// Whether the last adaptive pass found a pair of a high mass ratio (see `adaptive`).
-    pub(super) stiffened: bool,
+    /// The adaptive pass's boosted bodies and stiffened contacts (see `adaptive`).
+    pub(super) adaptive: Adaptive,
     /// The events of the last step and what contact events need across steps.
     pub(super) events: Events,
     /// Character controllers by slot; ticked before each step (none: nothing to do).
@@ -87,8 +86,7 @@ impl Plane {
             pass: Scratch::default(),
             held: Vec::new(),
             clock: Default::default(),
-            boosted: 0,
-            stiffened: false,
+            adaptive: Adaptive::default(),
             events: Events::default(),
             groups: CollisionGroups::default(),
             controllers: Default::default(),
@@ -379,8 +377,7 @@ plane_state! {
     pub(super) tally: TallyKept = tally.kept,
     held: Vec<held::HeldBody> = held,
     pub(super) clock: crate::backend::Clock = clock,
-    pub(super) boosted: u32 = boosted,
-    pub(super) stiffened: bool = stiffened,
+    adaptive: Adaptive = adaptive,
     events: EventsKept = events.kept,
     pub(super) controllers: Controllers = controllers,
     pub(super) groups: CollisionGroups = groups,

@@ -56,6 +56,20 @@ pub(super) struct SolverSettings {
 }
 
 impl Plane {
+    /// After a step: boosts the bodies of the pairs that need more substeps and lets the
+    /// others' boosts go (see `adaptive`).
+    pub(super) fn adapt_solving(&mut self) {
+        let awake = self.awake_count();
+        let step = (self.clock.max_penetration, self.clock.tick);
+        let on = self.settings.adaptive_solving;
+        self.adaptive.adapt(&mut self.world, on, awake, step);
+    }
+
+    /// Whether the plane's contacts follow the boosted substep rate in stiffness this step.
+    pub(super) fn contacts_stiffened(&self) -> bool {
+        self.adaptive.stiffened() && self.settings.adaptive_solving
+    }
+
     pub(super) fn max_quality(&self) -> u32 {
         self.tally.max_quality()
     }
