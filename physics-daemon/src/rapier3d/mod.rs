@@ -4,14 +4,15 @@
 //!
 //! Layers, lowest first (a file imports only files of its own layer's parts or below):
 //! - the parts' state and the free functions over it: `objects/` (the slot table's bodies,
-//!   parts, the body pass, forces, speed limits, maps), `joints/` (joint table, motors,
-//!   articulations), `contacts/` (contact hooks, figures, thin colliders, clipped and capsule
-//!   contacts), `history/` (pose mirror, publishing, the rollback ring), `controllers`
-//!   (character controllers);
+//!   parts, tallies, the body pass, forces, speed limits, maps), `joints/` (joint table,
+//!   motors, articulations), `contacts/` (the event log, contact hooks and figures, thin
+//!   colliders, clipped and capsule contacts), `history/` (pose mirror, publishing, the
+//!   rollback ring), `controllers` (character controllers), `adaptive` (extra substeps);
 //! - `plane`: the [`Plane`] over them, its state for snapshots and its step;
 //! - the `impl Plane` files that nothing imports: `options` (creation, plane options),
-//!   `backend` (op routing), `objects/ops.rs`, `objects/properties.rs`, `joints/ops.rs`,
-//!   `queries/`, `history/snapshot.rs`, `solver`, `adaptive`, `offload`, ...
+//!   `backend` (op routing), `solver`, `offload`, and in the parts' folders `objects/ops.rs`,
+//!   `objects/properties.rs`, `joints/ops.rs`, `contacts/events.rs`, `queries/`,
+//!   `history/snapshot.rs`, `history/rewind.rs`, `controllers/ops.rs`, ...
 
 mod adaptive;
 mod backend;

@@ -1,8 +1,8 @@
 //! The plane's objects: the slot table's entries (`body`), their parts and how a part maps
-//! onto rapier (`part`), the property setters (`properties`), the per-body pass before each
-//! step (`body_pass`: forces, speed limits, contact prediction) and triangle-mesh maps.
-//! `ops.rs`, `properties.rs`, `maps_ops.rs` and `stepping.rs` are the plane's `impl Plane`
-//! side; the others know no plane.
+//! onto rapier (`part`), the tallies over the parts (`tally`), the per-body pass before each
+//! step (`body_pass`: forces, speed limits, contact prediction) and triangle-mesh maps
+//! (`maps`, `map_store`). `ops.rs`, `properties.rs`, `maps_ops.rs` and `stepping.rs` are
+//! the plane's `impl Plane` side; the others know no plane.
 
 pub(super) mod body;
 pub(super) mod body_pass;
