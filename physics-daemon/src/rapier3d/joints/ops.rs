@@ -1,13 +1,4 @@
-//! Joints: every [`JointKind`] is one rapier `GenericJoint` built from the joint's
-//! [`JointSettings`] (locked, limited, coupled and motorised axes of the joint frame, whose
-//! X axis is `Axis`). After each step the plane measures every joint's positional and
-//! angular error (the tick header's `max_joint_error`), its constraint force, and breaks
-//! the joints whose force exceeded `BreakForce` (an `EVENT_JOINT_BROKE` event).
-//!
-//! Joint frames: frame A is `AnchorA` on A with X along `Axis`; frame B is `AnchorB` on B
-//! with the rotation that makes the two frames coincide in the pose the bodies had when
-//! the joint was made, so every angle (hinge angle, limits, motor targets) is measured from
-//! the creation pose.
+//! Joint ops of the plane: create, set, info, destroy, and the joints of a removed body.
 
 use rapier3d::prelude::*;
 use shm_layout::joint_op::{JointInfo, JointKind, JointOp, JointProp, JointSettings};
