@@ -3,7 +3,7 @@
 //! budget used, CPU) and answers queries on that key with the latest one, so a newcomer (a
 //! client choosing where to place a plane) reads every member's load at once.
 //!
-//! Its inputs come through two hooks of the server (`server::gauge`) and cost nothing
+//! Its inputs come through two hooks of the server (`server::quotas::gauge`) and cost nothing
 //! without a cluster: the server loop hands the [`Gauge`] its planes' usage records when the
 //! set of planes changes, and every step's duration is added to one counter.
 

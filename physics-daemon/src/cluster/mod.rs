@@ -28,6 +28,8 @@ pub mod session;
 
 use std::sync::Arc;
 
+use crate::server::moves::migration::Migration;
+use crate::server::persistence::persist::Adoptions;
 pub use error::ClusterError;
 pub use session::ClusterArgs;
 
@@ -103,7 +105,7 @@ impl Cluster {
     pub fn start_failover(
         &mut self,
         dir: std::path::PathBuf,
-        adopt: Arc<crate::server::persist::Adoptions>,
+        adopt: Arc<Adoptions>,
         domain: &str,
     ) -> Result<(), ClusterError> {
         let f = failover::Failover::start(
@@ -136,10 +138,7 @@ impl Cluster {
 
     /// Starts taking planes that move here from other members, and returns the hook the
     /// server loop moves planes away and takes arrivals through ([`migrate`]).
-    pub fn start_migration(
-        &mut self,
-        domain: &str,
-    ) -> Result<Arc<crate::server::moves::migration::Migration>, ClusterError> {
+    pub fn start_migration(&mut self, domain: &str) -> Result<Arc<Migration>, ClusterError> {
         let (migration, arrivals) = migrate::start(
             &self.session,
             &self.cluster,
@@ -155,7 +154,7 @@ impl Cluster {
     pub fn start_rebalance(
         &mut self,
         share: f32,
-        migration: Arc<crate::server::moves::migration::Migration>,
+        migration: Arc<Migration>,
         domain: &str,
     ) -> Result<(), ClusterError> {
         let r = rebalance::start(

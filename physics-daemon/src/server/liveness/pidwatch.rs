@@ -11,6 +11,7 @@
 //! Where pidfds cannot be had (an old kernel, `EMFILE`, more than [`MAX_WATCHED`] processes),
 //! [`PidWatch::any_exited`] answers `None` and the caller keeps its short listing period.
 
+use super::alarm;
 use std::collections::HashMap;
 use std::os::fd::{AsRawFd, FromRawFd, OwnedFd};
 
@@ -44,7 +45,7 @@ impl PidWatch {
     pub fn watch_with(
         &mut self,
         pids: impl IntoIterator<Item = u32>,
-        alarm: Option<&crate::server::liveness::alarm::Registry>,
+        alarm: Option<&alarm::Registry>,
     ) {
         let mut wanted: Vec<u32> = pids.into_iter().filter(|&p| p != 0).collect();
         wanted.sort_unstable();

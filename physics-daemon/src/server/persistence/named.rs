@@ -17,6 +17,7 @@ use shm_layout::{
     Reply,
 };
 
+use super::persist;
 use crate::server::daemon::{Daemon, PlaneEntry, Routed};
 use crate::server::persistence::persist::Loaded;
 use crate::server::quotas::limits::exceeded;
@@ -219,7 +220,7 @@ impl Daemon {
         let Some(dir) = self.writer.as_ref().map(|w| w.dir().to_path_buf()) else {
             return;
         };
-        self.restore_loaded(crate::server::persistence::persist::load(&dir));
+        self.restore_loaded(persist::load(&dir));
     }
 
     /// Takes the planes a cluster peer handed over (`Options::adopt`, failover): each is

@@ -12,6 +12,7 @@ use std::sync::{Arc, Mutex};
 use shm_layout::settings::plane::NO_SHARED_OBJECT_LIMIT;
 use shm_layout::{CommandError, ErrorKind, Handle, OpCost, PlaneId};
 
+use super::fair;
 use crate::backend::{Backend, Usage};
 use crate::server::quotas::limits::{exceeded, Limits};
 
@@ -83,7 +84,7 @@ pub struct OwnerUsage {
     /// The daemon's total, which every change of this one also moves.
     memory: Arc<DaemonMemory>,
     /// The process's CPU account (fair shares between processes).
-    pub cpu: crate::server::quotas::fair::CpuAccount,
+    pub cpu: fair::CpuAccount,
 }
 
 /// A reservation: released when dropped (by then the plane's own count holds what the op
@@ -372,7 +373,7 @@ impl Drop for PlaneUsage {
 pub struct Owners {
     by_pid: HashMap<u128, Arc<OwnerUsage>>,
     memory: Arc<DaemonMemory>,
-    shares: Arc<crate::server::quotas::fair::CpuShares>,
+    shares: Arc<fair::CpuShares>,
 }
 
 impl Owners {
@@ -394,7 +395,7 @@ impl Owners {
             .or_insert_with(|| {
                 Arc::new(OwnerUsage {
                     memory: memory.clone(),
-                    cpu: crate::server::quotas::fair::CpuAccount::new(shares.clone()),
+                    cpu: fair::CpuAccount::new(shares.clone()),
                     ..OwnerUsage::default()
                 })
             })

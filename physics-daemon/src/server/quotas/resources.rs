@@ -39,7 +39,11 @@ use iceoryx2::service::internal::ServiceInternal;
 use iceoryx2::service::service_hash::ServiceHash;
 use shm_layout::{names, BodyState, EventRecord, PlaneId, TickHeader};
 
+use crate::server::liveness::folder_watch;
 use crate::server::liveness::folder_watch::{FolderWatch, Wake};
+use crate::server::liveness::heartbeat;
+use crate::server::liveness::pidwatch;
+use crate::server::liveness::schedule;
 use crate::server::quotas::limits::Limits;
 use crate::server::requests::origin::ControlService;
 use crate::DaemonError;
@@ -48,7 +52,7 @@ use crate::DaemonError;
 const MAX_LEFT: usize = 4096;
 
 /// Time between two looks: the heartbeat's period (the guard beats at each look).
-pub const PERIOD: Duration = crate::server::liveness::heartbeat::PERIOD;
+pub const PERIOD: Duration = heartbeat::PERIOD;
 
 /// How long an evicted node is left alone before it is looked at again (it may have joined
 /// services again).
@@ -182,10 +186,10 @@ impl Watch {
         }
         let changed = match (&self.wake, folder) {
             (Some(wake), Some(folder)) if quiet => {
-                crate::server::liveness::folder_watch::wait(wake, Some(folder), QUIET_LOOK)
+                folder_watch::wait(wake, Some(folder), QUIET_LOOK)
             }
             (Some(wake), folder) => {
-                crate::server::liveness::folder_watch::wait(wake, None, PERIOD);
+                folder_watch::wait(wake, None, PERIOD);
                 folder.is_some_and(FolderWatch::drain)
             }
             (None, folder) => {
@@ -207,7 +211,7 @@ impl Watch {
 
 /// The longest a quiet guard sleeps without a change in the node folder: a safety net, as
 /// the loop's own listing ([`crate::server::liveness::schedule::SAFETY_NET`]).
-const QUIET_LOOK: Duration = crate::server::liveness::schedule::SAFETY_NET;
+const QUIET_LOOK: Duration = schedule::SAFETY_NET;
 
 /// Runs the guard until `watch` says stop. Errors are logged: without the guard the daemon
 /// still serves (only without the caps).
@@ -228,15 +232,14 @@ fn guard(config: &Config, limits: &Limits, watch: &Watch) -> Result<(), DaemonEr
         .map_err(|e| ipc("node", &e))?;
     let mut control: Option<ControlService> = None;
     let mut guard = Guard::default();
-    let mut heart = match crate::server::liveness::heartbeat::Heart::open(&node, limits.max_clients)
-    {
+    let mut heart = match heartbeat::Heart::open(&node, limits.max_clients) {
         Ok(heart) => Some(heart),
         Err(e) => {
             tracing::warn!("no heartbeat: {e}");
             None
         }
     };
-    let beat = |heart: &mut Option<crate::server::liveness::heartbeat::Heart>| {
+    let beat = |heart: &mut Option<heartbeat::Heart>| {
         if let Some(heart) = heart.as_mut().filter(|_| watch.beating()) {
             heart.beat();
         }
@@ -336,7 +339,7 @@ struct Guard {
     /// verdict is due at a later look.
     pending_hello: usize,
     /// The processes of the live nodes last listed (a killed one leaves its node behind).
-    pids: crate::server::liveness::pidwatch::PidWatch,
+    pids: pidwatch::PidWatch,
     /// The node folder changed since the last listing (its watch woke the guard).
     folder_changed: bool,
 }
@@ -382,11 +385,11 @@ impl Guard {
     /// ([`crate::server::liveness::schedule::FULL_CHECK`] where pidfds cannot watch every such process).
     fn list_nodes_now(&mut self, config: &Config, now: Instant) -> bool {
         let folder = config.global.node_dir().to_string();
-        let stamp = crate::server::liveness::pidwatch::folder_stamp(&folder);
+        let stamp = pidwatch::folder_stamp(&folder);
         let exited = self.pids.any_exited();
         let period = match exited {
-            Some(_) => crate::server::liveness::schedule::SAFETY_NET,
-            None => crate::server::liveness::schedule::FULL_CHECK,
+            Some(_) => schedule::SAFETY_NET,
+            None => schedule::FULL_CHECK,
         };
         let due = match self.listed {
             None => true,

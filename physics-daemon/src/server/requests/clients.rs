@@ -9,6 +9,7 @@ use iceoryx2::port::notifier::Notifier;
 use iceoryx2::prelude::*;
 use shm_layout::names;
 
+use crate::server::quotas::limits;
 use crate::server::quotas::limits::MAX_CLIENTS;
 
 /// One connected client.
@@ -71,7 +72,7 @@ impl Clients {
             return Ok(());
         }
         if self.connected.len() >= self.max {
-            return Err(crate::server::quotas::limits::exceeded(
+            return Err(limits::exceeded(
                 "clients of the daemon",
                 self.max,
                 "max-clients",
@@ -83,7 +84,7 @@ impl Clients {
         // many sessions it serves).
         let same_process = self.connected.values().filter(|c| c.pid == pid).count();
         if same_process >= per_process && pid != std::process::id() {
-            return Err(crate::server::quotas::limits::exceeded(
+            return Err(limits::exceeded(
                 "clients per process",
                 per_process,
                 "max-clients-per-process",

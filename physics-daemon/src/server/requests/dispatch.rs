@@ -12,8 +12,12 @@ use shm_layout::{
     Response, CRATE_VERSION, LAYOUT_VERSION,
 };
 
+use super::clients;
+use super::request_bytes;
 use crate::server::daemon::{Daemon, PlaneEntry, Request, Routed, MAX_PLANES};
+use crate::server::persistence::transfers;
 use crate::server::quotas::limits::exceeded;
+use crate::server::quotas::quota;
 use crate::server::requests::origin::Origin;
 use crate::server::requests::refusals::unknown_plane;
 use crate::server::worker::{self, Budget, PlaneCell, SharedUsage};
@@ -33,7 +37,7 @@ impl Daemon {
                 payload.len(),
             ))));
         }
-        crate::server::requests::request_bytes::copy(payload.as_ptr(), payload.len()).map_err(|e| {
+        request_bytes::copy(payload.as_ptr(), payload.len()).map_err(|e| {
             codec::encode_response(&Response::Rejected(CommandError::new(
                 ErrorKind::Malformed,
                 e.to_string(),
@@ -180,21 +184,12 @@ impl Daemon {
 
     /// The snapshot transfers of the connection `origin` (made on first use; its process
     /// pays for what they hold).
-    pub(crate) fn transfers_of(
-        &mut self,
-        origin: Origin,
-    ) -> Arc<crate::server::persistence::transfers::ClientTransfers> {
+    pub(crate) fn transfers_of(&mut self, origin: Origin) -> Arc<transfers::ClientTransfers> {
         let limits = self.options.limits;
-        let owner = self.owners.of(crate::server::requests::clients::owner_key(
-            origin.pid, origin.id,
-        ));
+        let owner = self.owners.of(clients::owner_key(origin.pid, origin.id));
         self.transfers
             .entry(origin.id)
-            .or_insert_with(|| {
-                Arc::new(crate::server::persistence::transfers::ClientTransfers::new(
-                    owner, limits,
-                ))
-            })
+            .or_insert_with(|| Arc::new(transfers::ClientTransfers::new(owner, limits)))
             .clone()
     }
 
@@ -239,12 +234,11 @@ impl Daemon {
         &mut self,
         origin: Origin,
         id: PlaneId,
-    ) -> Option<Arc<crate::server::quotas::quota::OwnerUsage>> {
+    ) -> Option<Arc<quota::OwnerUsage>> {
         let owner = self.planes.get(&id)?.owner;
         let owner_pid = self.clients.get(owner).map(|c| c.pid)?;
-        let key = crate::server::requests::clients::owner_key(origin.pid, origin.id);
-        (crate::server::requests::clients::owner_key(owner_pid, owner) != key)
-            .then(|| self.owners.of(key))
+        let key = clients::owner_key(origin.pid, origin.id);
+        (clients::owner_key(owner_pid, owner) != key).then(|| self.owners.of(key))
     }
 
     /// The quotas a run is checked against: the limits (the owner's totals are reserved
@@ -336,9 +330,7 @@ impl Daemon {
         let id = self.next_plane_id;
         let ticket = self.next_ticket;
         let owner_pid = self.clients.get(owner).map_or(0, |c| c.pid);
-        let usage = match SharedUsage::admit(self.owners.of(
-            crate::server::requests::clients::owner_key(owner_pid, owner),
-        )) {
+        let usage = match SharedUsage::admit(self.owners.of(clients::owner_key(owner_pid, owner))) {
             Ok(usage) => Arc::new(usage),
             Err(e) => return refuse(e),
         };

@@ -260,7 +260,7 @@ impl Daemon {
 
     pub(crate) fn release_gone_clients(&mut self) {
         // Listing nodes reads every node of the domain: only when a client's process exited,
-        // a node came or went, or rarely (`liveness::Schedule`).
+        // a node came or went, or rarely (`schedule::Schedule`).
         let clients = &self.clients;
         let all_alive = || {
             clients.ids().all(|id| {

@@ -17,6 +17,7 @@ use shm_layout::names;
 
 use crate::publish::MAX_NODES;
 use crate::server::daemon::{ControlServer, Daemon, Options};
+use crate::server::files;
 use crate::server::liveness::{alarm, pidwatch, schedule};
 use crate::server::moves::migration::Tombstones;
 use crate::server::persistence::persist;
@@ -258,7 +259,7 @@ fn start(
     // Persistent planes of the last daemon come back before the first request.
     daemon.restore_saved();
     // iceoryx2 creates its node-counter segment world-writable: narrow it to this user.
-    crate::server::files::restrict(domain);
+    files::restrict(domain);
     tracing::info!(domain, pid = std::process::id(), "physics daemon ready");
     Ok(daemon)
 }

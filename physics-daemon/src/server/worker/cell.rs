@@ -12,6 +12,7 @@ use crate::backend::Backend;
 
 use super::messages::{Budget, SharedUsage};
 use super::ops::run_ops;
+use crate::server::persistence::persist;
 
 /// The plane, shared by its worker and the request loop.
 #[derive(Default)]
@@ -22,7 +23,7 @@ pub(crate) struct PlaneCell {
     /// never applies a run inline (it would overtake them).
     pub(crate) queued: AtomicUsize,
     /// Its tick, whether it changed since its last write, held or destroyed (`persist`).
-    pub marks: crate::server::persistence::persist::Marks,
+    pub marks: persist::Marks,
 }
 
 /// What [`PlaneCell::try_apply`] did.

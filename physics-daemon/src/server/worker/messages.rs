@@ -8,7 +8,9 @@ use std::sync::{Arc, Mutex};
 use iceoryx2_bb_posix::socket_pair::StreamingSocket;
 use shm_layout::{CommandResult, PlaneId, PlaneOp};
 
+use crate::server::persistence::transfers;
 use crate::server::quotas::limits::Limits;
+use crate::server::quotas::quota;
 
 /// What the request loop asks of a worker.
 pub(crate) enum Job {
@@ -49,14 +51,14 @@ pub(crate) struct Budget {
     pub reply_left: usize,
     /// The requesting process's total when it is not the plane owner's (a `Shared` plane):
     /// the objects it adds count against it.
-    pub guest: Option<Arc<crate::server::quotas::quota::OwnerUsage>>,
+    pub guest: Option<Arc<quota::OwnerUsage>>,
     /// The requesting connection's snapshot transfers: a snapshot too large for the reply
     /// waits there as a download.
-    pub transfers: Option<Arc<crate::server::persistence::transfers::ClientTransfers>>,
+    pub transfers: Option<Arc<transfers::ClientTransfers>>,
 }
 
 /// A plane's usage, counted in its owner's total.
-pub(crate) type SharedUsage = crate::server::quotas::quota::PlaneUsage;
+pub(crate) type SharedUsage = quota::PlaneUsage;
 
 /// Wakes the request loop (its WaitSet watches the other end of the socket pair). One byte
 /// stands for any number of events: the loop drains them all.

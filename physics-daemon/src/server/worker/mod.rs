@@ -37,6 +37,7 @@ use crate::publish::PlaneOutput;
 use crate::server::requests::refusals::{self, unknown_plane};
 use crate::DaemonError;
 
+use crate::server::persistence::persist;
 pub(crate) use cell::{Inline, PlaneCell};
 pub(crate) use messages::{Budget, Event, Job, SharedUsage, Waker};
 use ops::run_ops;
@@ -55,7 +56,7 @@ pub(crate) struct Setup {
     pub waker: Arc<Waker>,
     pub panic_on_step_dt: Option<f32>,
     /// The plane's file, when it is persistent.
-    pub file: Option<crate::server::persistence::persist::PlaneFile>,
+    pub file: Option<persist::PlaneFile>,
     /// A snapshot the plane starts from (a persistent plane restored at start).
     pub restore: Option<Vec<u8>>,
 }
@@ -91,11 +92,7 @@ pub(crate) fn spawn(mut setup: Setup, jobs: Receiver<Job>) -> std::io::Result<Jo
 }
 
 /// The worker thread's body.
-fn run(
-    setup: Setup,
-    file: Option<crate::server::persistence::persist::PlaneFile>,
-    jobs: Receiver<Job>,
-) {
+fn run(setup: Setup, file: Option<persist::PlaneFile>, jobs: Receiver<Job>) {
     let Setup {
         id,
         ticket,
@@ -229,7 +226,7 @@ struct Worker {
     /// When the next automatic tick is due; `None` for manual or disabled planes.
     next_tick: Option<Instant>,
     /// The plane's file, when it is persistent.
-    file: Option<crate::server::persistence::persist::PlaneFile>,
+    file: Option<persist::PlaneFile>,
     // The node goes last: the ports above are dropped before it.
     _node: Node<ipc::Service>,
 }
