@@ -7,7 +7,7 @@
 
 use rapier2d::prelude::*;
 
-use super::body::unlocked;
+use super::object::unlocked;
 use super::plane::Plane;
 
 impl Plane {

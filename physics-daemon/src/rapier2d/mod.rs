@@ -20,11 +20,11 @@
 //! +Z, `linear_velocity = [vx, vy, 0]` px/s, `angular_velocity = [0, 0, ω]` rad/s.
 
 mod backend;
-mod body;
 mod controller;
 mod controllers;
 mod forces;
 mod hooks;
+mod object;
 mod objects;
 mod plane;
 mod queries;
@@ -32,5 +32,5 @@ mod rollback;
 mod snapshot;
 mod state;
 
-pub use body::{LENGTH_UNIT, MAX_SLOTS};
+pub use object::{LENGTH_UNIT, MAX_SLOTS};
 pub use plane::Plane;

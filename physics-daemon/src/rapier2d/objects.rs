@@ -8,8 +8,8 @@ use shm_layout::settings::gui_plane::finite2;
 use shm_layout::settings::{GuiObjectProp, GuiObjectSettings, GuiShape, Vec2};
 use shm_layout::{CommandError, ErrorKind, Handle};
 
-use super::body::{unlocked, Body, MAX_SLOTS, WALLS_SLOT};
 use super::hooks::{layer, CONTROLLED, WALL};
+use super::object::{unlocked, Object, MAX_SLOTS, WALLS_SLOT};
 use super::plane::Plane;
 use crate::backend::held;
 
@@ -76,7 +76,7 @@ impl Plane {
             .build();
         let h = self.world.insert_body(body);
         let c = self.world.insert_collider(collider, Some(h));
-        let handle = self.bodies.insert(Body {
+        let handle = self.bodies.insert(Object {
             handle: h,
             collider: c,
             shape,
@@ -91,7 +91,7 @@ impl Plane {
     }
 
     /// The body of a live handle, or a clear error for unknown and stale handles.
-    pub(super) fn body(&self, handle: Handle) -> Result<&Body, CommandError> {
+    pub(super) fn body(&self, handle: Handle) -> Result<&Object, CommandError> {
         self.bodies.get(handle).map_err(|mut e| {
             e.message = format!("{} (GUI plane {})", e.message, self.id);
             e
@@ -100,7 +100,7 @@ impl Plane {
 
     /// The body of `handle`, which the caller is about to change: its slot is marked
     /// changed. Errors as [`Plane::body`].
-    fn changing(&mut self, handle: Handle) -> Result<&mut Body, CommandError> {
+    fn changing(&mut self, handle: Handle) -> Result<&mut Object, CommandError> {
         let id = self.id;
         self.bodies.get_mut(handle).map_err(|mut e| {
             e.message = format!("{} (GUI plane {id})", e.message);

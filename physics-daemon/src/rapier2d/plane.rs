@@ -13,8 +13,8 @@ use shm_layout::{
     StateHasher, TickHeader, FLAG_ALIVE, FLAG_ANCHORED, FLAG_SLEEPING,
 };
 
-use super::body::{Body, HeldBody, LENGTH_UNIT, MAX_SLOTS, WALLS_SLOT};
 use super::hooks;
+use super::object::{HeldBody, Object, LENGTH_UNIT, MAX_SLOTS, WALLS_SLOT};
 use super::state::State;
 use crate::backend::rollback::Ring;
 use crate::backend::{held, HeaderFigures, SlotTable};
@@ -25,7 +25,7 @@ pub struct Plane {
     pub id: PlaneId,
     pub(super) settings: GuiPlaneSettings,
     pub(super) world: PhysicsWorld,
-    pub(super) bodies: SlotTable<Body>,
+    pub(super) bodies: SlotTable<Object>,
     /// Slots of bodies with a controller, in creation order.
     pub(super) controlled: Vec<u32>,
     /// Bodies with a force or a pending impulse of their own.

@@ -6,7 +6,7 @@ use shm_layout::gui_op::{check_ray, GuiHit};
 use shm_layout::settings::Vec2;
 use shm_layout::CommandError;
 
-use super::body::WALLS_SLOT;
+use super::object::WALLS_SLOT;
 use super::plane::Plane;
 use crate::backend::rapier_world::RapierWorld;
 

@@ -6,7 +6,7 @@
 use shm_layout::settings::GuiPlaneProp;
 use shm_layout::{snapshot, CommandError, ErrorKind, PlaneKind, PlaneProp, SnapshotHeader};
 
-use super::body::MAX_SLOTS;
+use super::object::MAX_SLOTS;
 use super::plane::Plane;
 use super::state::{State, StateRef};
 use crate::backend::counted::Counter;

@@ -6,13 +6,13 @@
 use rapier2d::prelude::*;
 use shm_layout::settings::GuiPlaneSettings;
 
-use super::body::{Body, HeldBody};
+use super::object::{HeldBody, Object};
 use crate::backend::{Clock, Marks, SlotTable};
 
 crate::backend::plane_state::plane_state! {
     world: PhysicsWorld,
     settings: GuiPlaneSettings,
-    bodies: SlotTable<Body>,
+    bodies: SlotTable<Object>,
     controlled: Vec<u32>,
     driven: u32,
     query_stale: Marks<RigidBodyHandle>,

@@ -35,6 +35,6 @@ mod stack_tests;
 mod unstepped;
 
 pub use history::gpu_saved::GpuSaved;
-pub use objects::body::MAX_SLOTS;
+pub use objects::object::MAX_SLOTS;
 pub use offload::{no_other_engine, DeferHook, SimpleBody, SimplePose};
 pub use plane::Plane;

@@ -21,9 +21,9 @@ use crate::rapier3d::history::pose_mirror::PoseMirror;
 use crate::rapier3d::history::publish;
 use crate::rapier3d::history::rollback::Ring;
 use crate::rapier3d::joints::table::Joints;
-use crate::rapier3d::objects::body::{body_state, Body, MAX_SLOTS};
 use crate::rapier3d::objects::body_pass::{self, Scratch};
 use crate::rapier3d::objects::maps::PendingMap;
+use crate::rapier3d::objects::object::{body_state, Object, MAX_SLOTS};
 use crate::rapier3d::objects::tally::{Kept as TallyKept, Tally};
 
 mod held {
@@ -37,7 +37,7 @@ pub struct Plane {
     pub id: PlaneId,
     pub(super) settings: PlaneSettings,
     pub(super) world: PhysicsWorld,
-    pub(super) bodies: SlotTable<Body>,
+    pub(super) bodies: SlotTable<Object>,
     /// Tallies over the objects' parts: per quality, driven, mesh vertices.
     pub(super) tally: Tally,
     /// Buffers of the per-body passes.
@@ -373,7 +373,7 @@ fn copy_world(w: &PhysicsWorld) -> PhysicsWorld {
 plane_state! {
     world,
     pub(super) settings: PlaneSettings = settings,
-    pub(super) bodies: SlotTable<Body> = bodies,
+    pub(super) bodies: SlotTable<Object> = bodies,
     pub(super) tally: TallyKept = tally.kept,
     held: Vec<held::HeldBody> = held,
     pub(super) clock: crate::backend::Clock = clock,

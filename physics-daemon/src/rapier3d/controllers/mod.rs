@@ -34,7 +34,7 @@ use shm_layout::{
 };
 
 use crate::backend::counted::{CountedVec, Counter};
-use crate::rapier3d::objects::body::Body;
+use crate::rapier3d::objects::object::Object;
 use crate::rapier3d::objects::part::Part;
 
 mod ground;

@@ -133,7 +133,7 @@ impl Plane {
         let h = self.world.insert_body(body);
         self.world.insert_collider(collider, Some(h));
         self.tally.add(part.hit_box_quality, 0);
-        let handle = self.bodies.insert(Body {
+        let handle = self.bodies.insert(Object {
             handle: h,
             part: Box::new(part),
             flags: shm_layout::FLAG_CONTROLLER,

@@ -29,7 +29,7 @@ use rapier3d::prelude::RigidBodySet;
 use shm_layout::{BodyState, StateHasher, FLAG_ALIVE, FLAG_ANCHORED, FLAG_SLEEPING};
 
 use crate::backend::{SlotFilter, SlotTable};
-use crate::rapier3d::objects::body::{body_state, Body};
+use crate::rapier3d::objects::object::{body_state, Object};
 
 /// Every slot's published state as of the last rehashing step.
 #[derive(Debug, Default)]
@@ -82,7 +82,7 @@ impl PoseMirror {
     /// tick header's), computed on the way.
     pub(crate) fn write_and_hash(
         &mut self,
-        slots: &SlotTable<Body>,
+        slots: &SlotTable<Object>,
         bodies: &RigidBodySet,
         marks: u64,
     ) -> u64 {
@@ -121,7 +121,7 @@ impl PoseMirror {
     /// rewritten ([`PoseMirror::write_and_hash`]).
     pub(crate) fn rehash(
         &mut self,
-        slots: &SlotTable<Body>,
+        slots: &SlotTable<Object>,
         bodies: &RigidBodySet,
         marks: u64,
     ) -> u64 {
@@ -178,7 +178,7 @@ impl PoseMirror {
     /// Debug builds: the mirror and its hash equal a full rewrite (a slot the plane failed
     /// to list as moved would show here).
     #[cfg(debug_assertions)]
-    fn check(&self, slots: &SlotTable<Body>, bodies: &RigidBodySet) {
+    fn check(&self, slots: &SlotTable<Object>, bodies: &RigidBodySet) {
         let mut h = StateHasher::new();
         for (i, state) in self.states.iter().enumerate() {
             let now = body_state(slots, bodies, i);

@@ -10,7 +10,7 @@ use shm_layout::BodyState;
 
 use crate::backend::{SlotFilter, SlotTable};
 use crate::rapier3d::history::pose_mirror::{copy_run, PoseMirror};
-use crate::rapier3d::objects::body::{body_state, Body};
+use crate::rapier3d::objects::object::{body_state, Object};
 
 /// Slots below which a sample is written on the calling thread (the hand-off costs more).
 const PARALLEL_FROM: usize = 8_192;
@@ -18,7 +18,7 @@ const PARALLEL_FROM: usize = 8_192;
 const CHUNK: usize = 2_048;
 
 fn write_run(
-    slots: &SlotTable<Body>,
+    slots: &SlotTable<Object>,
     bodies: &RigidBodySet,
     first: usize,
     out: &mut [MaybeUninit<BodyState>],
@@ -36,7 +36,7 @@ fn write_run(
 /// last step's states, else read from `slots` and `world`.
 pub(crate) fn write_sample(
     mirror: &PoseMirror,
-    slots: &SlotTable<Body>,
+    slots: &SlotTable<Object>,
     world: &PhysicsWorld,
     out: &mut [MaybeUninit<BodyState>],
     filter: SlotFilter<'_>,
@@ -74,7 +74,7 @@ mod tests {
     /// not the part's settings inline (276 bytes), or every publish reads ten times the memory.
     #[test]
     fn a_slot_table_entry_stays_small() {
-        let entry = std::mem::size_of::<Option<Body>>() + std::mem::size_of::<u32>();
+        let entry = std::mem::size_of::<Option<Object>>() + std::mem::size_of::<u32>();
         assert!(entry <= 32, "slot table entry of {entry} bytes");
     }
 

@@ -13,7 +13,7 @@ use shm_layout::{snapshot, CommandError, ErrorKind, PlaneKind, PlaneProp, Snapsh
 
 use crate::rapier3d::controllers;
 use crate::rapier3d::history::gpu_saved::GpuSaved;
-use crate::rapier3d::objects::body::MAX_SLOTS;
+use crate::rapier3d::objects::object::MAX_SLOTS;
 use crate::rapier3d::plane::{Plane, State, StateRef};
 
 /// The engine named in the snapshot header: only a daemon of the same engine reads it.

@@ -21,9 +21,9 @@ use rapier3d::prelude::*;
 use rayon::prelude::*;
 
 use crate::backend::SlotTable;
-use crate::rapier3d::objects::body::Body;
 use crate::rapier3d::objects::forces::{drive, Env, Push};
 use crate::rapier3d::objects::limits::capped;
+use crate::rapier3d::objects::object::Object;
 
 /// Items (bodies, contact pairs) below which a pass runs on the calling thread: handing
 /// work to the pool and back costs more than a few thousand bodies' worth of it.
@@ -123,7 +123,7 @@ impl Scratch {
     pub(crate) fn prepare_bodies(
         &mut self,
         world: &mut PhysicsWorld,
-        slots: &SlotTable<Body>,
+        slots: &SlotTable<Object>,
         inputs: &Inputs,
     ) {
         let mut handles = std::mem::take(&mut self.handles);
@@ -245,7 +245,7 @@ impl Scratch {
 /// What the pass before the step does to body `h` (reads only).
 fn update(
     bodies: &RigidBodySet,
-    slots: &SlotTable<Body>,
+    slots: &SlotTable<Object>,
     h: RigidBodyHandle,
     inputs: &Inputs,
 ) -> Update {

@@ -92,27 +92,18 @@ pub(crate) fn clean(vertices: &[Vec3], triangles: &[[u32; 3]], scale: Vec3) -> C
     }
 }
 
-/// A map object is static: only its pose, material, collision and contact reporting may
-/// change.
+/// A map object is static: only the properties its settings rows flag `on_maps` (pose,
+/// material, collision, contact reporting, held) may change, and Anchored only to true.
 pub(crate) fn check_map_prop(prop: &ObjectProp) -> Result<(), CommandError> {
-    // An allow-list: a property added later is refused on maps until this says otherwise.
-    if let ObjectProp::Pose(_)
-    | ObjectProp::Friction(_)
-    | ObjectProp::Bounciness(_)
-    | ObjectProp::CanCollide(_)
-    | ObjectProp::CollisionGroup(_)
-    | ObjectProp::ReportContacts(_)
-    | ObjectProp::Held(_)
-    | ObjectProp::Anchored(true) = prop
-    {
+    if prop.changes_on_map() {
         return Ok(());
     }
     let name = prop.name();
     Err(CommandError::invalid_field(
         name,
         format!(
-            "{name} cannot change on a map (a static triangle mesh): only CFrame, Friction, \
-             Bounciness, CanCollide, CollisionGroup and contact reporting can"
+            "{name} cannot change on a map (a static triangle mesh): only {} can",
+            ObjectProp::map_changeable()
         ),
     ))
 }

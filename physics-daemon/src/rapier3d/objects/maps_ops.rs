@@ -5,8 +5,8 @@ use rapier3d::prelude::*;
 use shm_layout::map_op::{MapInfo, MapOp, MapReport, MAX_MAP_TRIANGLES};
 use shm_layout::{CommandError, CommandResult, ErrorKind, Handle, Pose, Reply, Vec3};
 
-use crate::rapier3d::objects::body::{rapier_pose, Body, MAX_SLOTS};
 use crate::rapier3d::objects::maps::{clean, PendingMap};
+use crate::rapier3d::objects::object::{rapier_pose, Object, MAX_SLOTS};
 use crate::rapier3d::objects::part::Part;
 use crate::rapier3d::plane::Plane;
 
@@ -130,7 +130,7 @@ impl Plane {
         self.world.insert_collider(collider, Some(h));
         self.tally
             .add(part.hit_box_quality, part.mesh_vertex_count() as u64);
-        let handle = self.bodies.insert(Body {
+        let handle = self.bodies.insert(Object {
             handle: h,
             part: Box::new(part),
             flags: 0,

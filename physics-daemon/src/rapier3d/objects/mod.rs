@@ -4,13 +4,13 @@
 //! (`maps`, `map_store`). `ops.rs`, `properties.rs`, `maps_ops.rs` and `stepping.rs` are
 //! the plane's `impl Plane` side; the others know no plane.
 
-pub(super) mod body;
 pub(super) mod body_pass;
 pub(super) mod forces;
 pub(super) mod limits;
 pub(super) mod map_store;
 pub(super) mod maps;
 mod maps_ops;
+pub(super) mod object;
 mod ops;
 pub(super) mod part;
 mod properties;

@@ -4,7 +4,7 @@
 use rapier3d::prelude::*;
 use shm_layout::{CommandError, ErrorKind, Handle, ObjectInfo, ObjectProp, Pose, Shape, Vec3};
 
-use crate::rapier3d::objects::body::{rapier_pose, Body, MAX_SLOTS};
+use crate::rapier3d::objects::object::{rapier_pose, Object, MAX_SLOTS};
 use crate::rapier3d::objects::part::Part;
 use crate::rapier3d::plane::Plane;
 
@@ -44,7 +44,7 @@ impl Plane {
         part.configure_body(&mut self.world.bodies[h], &self.world.colliders);
         self.tally
             .add(part.hit_box_quality, shape.mesh_vertices() as u64);
-        let handle = self.bodies.insert(Body {
+        let handle = self.bodies.insert(Object {
             handle: h,
             part: Box::new(part),
             flags: 0,
@@ -119,7 +119,7 @@ impl Plane {
 
     /// Removes the object; its handle becomes stale.
     pub fn destroy_object(&mut self, handle: Handle) -> Result<(), CommandError> {
-        let Body {
+        let Object {
             handle: h, part, ..
         } = self.bodies.remove(handle).map_err(|e| self.in_plane(e))?;
         self.controllers.remove(&handle.slot);

@@ -4,7 +4,7 @@
 use rapier3d::prelude::*;
 use shm_layout::{CommandError, Handle, ObjectProp};
 
-use crate::rapier3d::objects::body::rapier_pose;
+use crate::rapier3d::objects::object::rapier_pose;
 use crate::rapier3d::plane::Plane;
 
 impl Plane {

@@ -100,7 +100,7 @@ impl Plane {
                 let shape = Cuboid::new(Vector::from(size) / 2.0);
                 let hit = self.sweep(
                     &f,
-                    &crate::rapier3d::objects::body::rapier_pose(pose),
+                    &crate::rapier3d::objects::object::rapier_pose(pose),
                     &shape,
                     direction,
                 );
@@ -158,7 +158,7 @@ impl Plane {
             }
             QueryOp::BoundsInBox { pose, size, filter } => {
                 let f = self.resolve(&filter, None)?;
-                let pose = crate::rapier3d::objects::body::rapier_pose(pose);
+                let pose = crate::rapier3d::objects::object::rapier_pose(pose);
                 let cuboid = Cuboid::new(Vector::from(size) / 2.0);
                 let query = cuboid.compute_aabb(&pose);
                 self.bounds_overlapping(&f, query, |aabb| {

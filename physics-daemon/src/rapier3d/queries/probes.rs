@@ -73,7 +73,7 @@ impl Plane {
                 let own = own.and_then(|h| self.body_of(h).ok());
                 let f = self.resolve(&filter, own)?;
                 let shape = Part::new(&shape).collider_shape()?;
-                let pose = crate::rapier3d::objects::body::rapier_pose(pose);
+                let pose = crate::rapier3d::objects::object::rapier_pose(pose);
                 self.nearest(&f, &*shape, &pose, max_distance, |_| true)
             }
             QueryOp::ProbeWall {
@@ -85,7 +85,7 @@ impl Plane {
                 filter,
             } => {
                 let f = self.resolve(&filter, None)?;
-                let pose = crate::rapier3d::objects::body::rapier_pose(pose);
+                let pose = crate::rapier3d::objects::object::rapier_pose(pose);
                 self.nearest(&f, &capsule(radius, height), &pose, max_distance, |n| {
                     is_wall(n, max_slope)
                 })

@@ -12,7 +12,7 @@ pub const MAX_SLOTS: usize = 1 << 20;
 
 /// One object: its rapier body and what the API says about it.
 #[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
-pub(crate) struct Body {
+pub(crate) struct Object {
     pub(crate) handle: RigidBodyHandle,
     /// Boxed: the slot table stays small, so the publisher's pass over every slot reads one
     /// short entry per body (the part's settings are read only where they matter).
@@ -27,7 +27,7 @@ pub(crate) fn rapier_pose(p: Pose) -> rapier3d::math::Pose {
 }
 
 /// The published state of slot `i` (dead slots carry only their generation).
-pub(crate) fn body_state(slots: &SlotTable<Body>, bodies: &RigidBodySet, i: usize) -> BodyState {
+pub(crate) fn body_state(slots: &SlotTable<Object>, bodies: &RigidBodySet, i: usize) -> BodyState {
     let generation = slots.generation(i);
     let Some((body, extra)) = slots
         .at(i)

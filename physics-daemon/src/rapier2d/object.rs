@@ -1,4 +1,4 @@
-//! One object of a GUI plane ([`Body`]: its rapier body and collider and what the API says
+//! One object of a GUI plane ([`Object`]: its rapier body and collider and what the API says
 //! about it) and the limits and constants its slots live under.
 
 use rapier2d::prelude::*;
@@ -21,7 +21,7 @@ pub(super) type HeldBody = crate::backend::held::HeldIn<PhysicsWorld>;
 
 /// One object: its rapier body and collider and what the API says about it.
 #[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
-pub(super) struct Body {
+pub(super) struct Object {
     pub(super) handle: RigidBodyHandle,
     pub(super) collider: ColliderHandle,
     pub(super) shape: GuiShape,
@@ -29,7 +29,7 @@ pub(super) struct Body {
     pub(super) controller: Option<Box<Controller>>,
 }
 
-impl Body {
+impl Object {
     /// Whether the force pass must visit it for its own sake.
     pub(super) fn is_driven(&self) -> bool {
         self.settings.constant_force != [0.0; 2] || self.settings.impulse_direction != [0.0; 2]
