@@ -42,7 +42,7 @@ use client_sdk::{Client, Handle};
 use mlua::{Lua, MetaMethod, Table, UserData, UserDataMethods, Value};
 
 use method_tables::MethodTables;
-use part::state::{BodyPlane, PartState};
+use part::state::{PartPlane, PartState};
 use plane::context::{context, Context};
 use plane::props::PLANE;
 use plane::state::{PhysicsPlane, PlaneState};
@@ -155,8 +155,8 @@ fn physics_service(lua: &Lua) -> mlua::Result<Table> {
 }
 
 /// What a body asks of its plane: `part/state.rs` cannot name the plane's state (which
-/// holds the parts), so the plane answers through [`BodyPlane`].
-impl BodyPlane for PlaneState {
+/// holds the parts), so the plane answers through [`PartPlane`].
+impl PartPlane for PlaneState {
     fn forget(&self, part: &Rc<PartState>, handle: Handle) {
         PlaneState::forget(self, part, handle);
     }

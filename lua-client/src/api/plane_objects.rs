@@ -13,7 +13,7 @@ use mlua::{UserDataMethods, Value};
 use super::object::object_ud;
 use super::object::state::PhysicsObject;
 use super::part::part_ud;
-use super::part::state::{Body, PartShape, PartState};
+use super::part::state::{PartObject, PartShape, PartState};
 use super::plane::state::{PhysicsPlane, PlaneState};
 use crate::values::sdk_error;
 
@@ -50,7 +50,7 @@ fn part_of(state: &Rc<PlaneState>, handle: Handle) -> mlua::Result<Option<Rc<Par
     };
     let part = Rc::new(PartState::new(shape));
     part.set_size_as_simulated(info.size);
-    let body = Body::new(object, Rc::downgrade(state));
+    let body = PartObject::new(object, Rc::downgrade(state));
     state.adopt(&part, body, false);
     Ok(Some(part))
 }

@@ -12,7 +12,7 @@ use std::rc::Rc;
 use client_sdk::{Pose, Vec3};
 use mlua::{MetaMethod, UserData, UserDataMethods, Value};
 
-use super::part::state::{BasePart, Body, Ended};
+use super::part::state::{BasePart, Ended, PartObject};
 use super::plane::state::{ControllerState, PlaneState};
 use crate::values::{describe, expected, finite_number, sdk_error, vector, CFrame};
 use props::CONTROLLER;
@@ -207,7 +207,7 @@ pub fn new_controller(
             .set_collision_group(&group)
             .map_err(|e| sdk_error(what, e))?;
     }
-    let body = Body::new(controller.object().clone(), Rc::downgrade(plane));
+    let body = PartObject::new(controller.object().clone(), Rc::downgrade(plane));
     plane.adopt(&state, body.clone(), false);
     let c = Rc::new(ControllerState {
         controller,

@@ -5,13 +5,13 @@ use std::rc::Rc;
 use client_sdk::Object;
 use mlua::AnyUserData;
 
-use crate::api::part::state::{Body, Ended, PartState};
+use crate::api::part::state::{Ended, PartObject, PartState};
 
 /// A part's body in a plane, as scripts hold it.
 pub struct PhysicsObject {
     /// The body `plane:Add` made; it ends (and this object goes stale) on Unlink, Destroy
     /// or the plane's Destroy, and is never replaced.
-    pub body: Rc<Body>,
+    pub body: Rc<PartObject>,
     /// The wrapped part.
     pub part: Rc<PartState>,
     /// The wrapped part's own userdata, so `obj:BasePart() == part`.

@@ -1,6 +1,6 @@
 //! The state behind a `BasePart`: its shape and mesh, its own properties and signals, and
-//! its [`Body`] while a plane simulates it. The plane a body is in is reached through
-//! [`BodyPlane`] (the plane holds its parts, so this file cannot name it).
+//! its [`PartObject`] while a plane simulates it. The plane a body is in is reached through
+//! [`PartPlane`] (the plane holds its parts, so this file cannot name it).
 
 use client_sdk::Handle;
 use std::cell::{Cell, RefCell};
@@ -48,7 +48,7 @@ impl HandlersAnswer {
 
 /// What a body, its part and its PhysicsObject ask of the plane the body is in (the plane's
 /// state implements it).
-pub trait BodyPlane {
+pub trait PartPlane {
     /// Forgets `part`, whose body `handle` left the plane.
     fn forget(&self, part: &Rc<PartState>, handle: Handle);
     /// Starts reading the plane's events (a handler that needs them was connected).
@@ -178,22 +178,22 @@ impl Ended {
     }
 }
 
-/// One body a part had in a plane, shared by the part (while it is the part's body) and the
-/// PhysicsObject `plane:Add` returned. A body is its part's until it ends; a later `Add` of
-/// the same part makes a new one, so an old PhysicsObject can never reach the new body, even
-/// where the daemon reuses its slot or handle.
-pub struct Body {
-    /// The body.
+/// One object a part became in a plane, shared by the part (while it is the part's object)
+/// and the PhysicsObject `plane:Add` returned. It is its part's until it ends; a later `Add`
+/// of the same part makes a new one, so an old PhysicsObject can never reach the new object,
+/// even where the daemon reuses its slot or handle.
+pub struct PartObject {
+    /// The SDK's object.
     pub object: Object,
-    /// The plane the body is in.
-    pub plane: Weak<dyn BodyPlane>,
+    /// The plane the object is in.
+    pub plane: Weak<dyn PartPlane>,
     ended: Cell<Option<Ended>>,
 }
 
-impl Body {
+impl PartObject {
     /// A live body of `plane`.
-    pub fn new<P: BodyPlane + 'static>(object: Object, plane: Weak<P>) -> Rc<Body> {
-        Rc::new(Body {
+    pub fn new<P: PartPlane + 'static>(object: Object, plane: Weak<P>) -> Rc<PartObject> {
+        Rc::new(PartObject {
             object,
             plane,
             ended: Cell::new(None),
@@ -217,7 +217,7 @@ pub struct PartState {
     /// The pose while not simulated; the frozen last pose after the body went away.
     cframe: Cell<CFrame>,
     destroyed: Cell<bool>,
-    link: RefCell<Option<Rc<Body>>>,
+    link: RefCell<Option<Rc<PartObject>>>,
     signals: RefCell<Vec<(&'static str, Signal)>>,
     /// The last pose the per-tick change pass announced.
     last_fired: Cell<Option<CFrame>>,
@@ -389,7 +389,7 @@ impl PartState {
     }
 
     /// The part's current body, if it is in a plane.
-    pub fn body(&self) -> Option<Rc<Body>> {
+    pub fn body(&self) -> Option<Rc<PartObject>> {
         self.link.borrow().clone()
     }
 
@@ -400,7 +400,7 @@ impl PartState {
 
     /// Makes `body` the part's body (the part is simulated from now on). `reporting`: the
     /// body was created reporting contacts.
-    pub fn link(&self, body: Rc<Body>, reporting: bool) {
+    pub fn link(&self, body: Rc<PartObject>, reporting: bool) {
         self.last_fired.set(None);
         self.reporting.set(reporting);
         *self.link.borrow_mut() = Some(body);
@@ -500,7 +500,7 @@ impl PartState {
 
     /// Leaves the plane: the part keeps its last simulated pose; its body ends for `why`.
     /// Returns the body it had.
-    pub fn unlink(&self, why: Ended) -> Option<Rc<Body>> {
+    pub fn unlink(&self, why: Ended) -> Option<Rc<PartObject>> {
         let cf = self.cframe();
         self.cframe.set(cf);
         let body = self.link.borrow_mut().take()?;

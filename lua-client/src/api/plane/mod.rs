@@ -13,7 +13,7 @@ use mlua::{Lua, Value};
 
 use super::lifecycle::LuaPlane;
 use super::object::state::PhysicsObject;
-use super::part::state::{BasePart, Body, PartState};
+use super::part::state::{BasePart, PartObject, PartState};
 use crate::values::{describe, expected, sdk_error};
 use context::{context, wrap_plane};
 use props::PLANE;
@@ -113,7 +113,7 @@ pub(crate) fn add(plane: &Rc<PlaneState>, part: Value) -> mlua::Result<PhysicsOb
         .plane
         .add(collider, state.cframe().pose(), &props)
         .map_err(|e| sdk_error(&what(), e))?;
-    let body = Body::new(object, Rc::downgrade(plane));
+    let body = PartObject::new(object, Rc::downgrade(plane));
     plane.adopt(&state, body.clone(), reporting);
     if reporting {
         plane.listen_for_contacts();

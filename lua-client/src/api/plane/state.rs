@@ -10,7 +10,7 @@ use std::rc::{Rc, Weak};
 use client_sdk::{Controller, Handle, Plane, PlaneInfo};
 use mlua::AnyUserData;
 
-use crate::api::part::state::{handlers_changed, Body, Ended, HandlersAnswer, PartState};
+use crate::api::part::state::{handlers_changed, Ended, HandlersAnswer, PartObject, PartState};
 use crate::host::signal::Signal;
 use crate::values::sdk_error;
 
@@ -85,7 +85,7 @@ impl PlaneState {
     }
 
     /// Makes `body` the simulated body of `part` in this plane.
-    pub fn adopt(&self, part: &Rc<PartState>, body: Rc<Body>, reporting: bool) {
+    pub fn adopt(&self, part: &Rc<PartState>, body: Rc<PartObject>, reporting: bool) {
         let handle = body.object.handle();
         part.link(body, reporting);
         self.parts.borrow_mut().push(part.clone());
@@ -274,7 +274,7 @@ pub struct ControllerState {
     /// The part's own userdata (`controller:BasePart() == part`).
     pub part_ud: AnyUserData,
     /// Its body, shared with the part while the controller lives.
-    pub body: Rc<Body>,
+    pub body: Rc<PartObject>,
     /// The plane.
     pub plane: Weak<PlaneState>,
     /// The script's motion intent (MoveForward etc. change one axis of it).

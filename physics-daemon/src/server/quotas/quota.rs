@@ -229,14 +229,14 @@ impl OwnerUsage {
 /// until it is destroyed or the plane goes.
 #[derive(Debug)]
 pub struct PlaneUsage {
-    state: Mutex<PlaneState>,
+    state: Mutex<UsageCounts>,
     owner: Arc<OwnerUsage>,
     /// `SharedObjectLimit`: most objects other processes may have added at once.
     guest_limit: AtomicU32,
 }
 
 #[derive(Debug, Default)]
-struct PlaneState {
+struct UsageCounts {
     /// The owner's share as counted in its total.
     share: Usage,
     /// Objects other processes added, by handle: who pays, and what.
@@ -259,7 +259,7 @@ impl PlaneUsage {
         })
     }
 
-    fn lock(&self) -> std::sync::MutexGuard<'_, PlaneState> {
+    fn lock(&self) -> std::sync::MutexGuard<'_, UsageCounts> {
         self.state.lock().unwrap_or_else(|p| p.into_inner())
     }
 
@@ -341,7 +341,7 @@ impl PlaneUsage {
         for (_, (who, cost)) in st.guests.drain() {
             who.change(cost, Usage::default());
         }
-        *st = PlaneState::default();
+        *st = UsageCounts::default();
     }
 }
 
