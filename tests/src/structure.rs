@@ -198,7 +198,12 @@ pub fn paths_in(code: &str) -> Vec<Vec<String>> {
         let starts = is_ident(&t[i])
             && t.get(i + 1).map(String::as_str) == Some("::")
             && (i == 0 || t[i - 1] != "::");
-        if starts {
+        // `pub(in crate::a)` names where an item is visible, not what the file imports.
+        let visibility = i >= 2 && t[i - 1] == "in" && t[i - 2] == "(";
+        if starts && visibility {
+            let mut ignored = Vec::new();
+            i = tree(&t, i, Vec::new(), &mut ignored).max(i + 1);
+        } else if starts {
             let mut found = Vec::new();
             let j = tree(&t, i, Vec::new(), &mut found);
             out.extend(found.into_iter().filter(|p| p.len() > 1));

@@ -48,12 +48,17 @@ fn scratch_crate(tag: &str, files: &[(&str, &str)]) -> PathBuf {
 fn the_reader_expands_use_trees_and_skips_comments_and_strings() {
     let code = code_of(
         "use crate::{a::{B, c::D}, e};\n// use crate::hidden;\nlet s = \"crate::f::G\";\n\
-         fn x() { super::h::I::new(); }\n#[cfg(test)]\nmod tests { use crate::z; }\n",
+         pub(in crate::k) fn x() { super::h::I::new(); }\n#[cfg(test)]\nmod tests { use crate::z; }\n",
     );
     let paths: Vec<String> = paths_in(&code).iter().map(|p| p.join("::")).collect();
     assert_eq!(
         paths,
-        ["crate::a::B", "crate::a::c::D", "crate::e", "super::h::I::new"]
+        [
+            "crate::a::B",
+            "crate::a::c::D",
+            "crate::e",
+            "super::h::I::new"
+        ]
     );
 }
 
@@ -113,10 +118,7 @@ fn the_checker_finds_file_circles_and_follows_re_exports() {
                 "api/mod.rs",
                 "mod part;\npub struct State;\nfn register() { part::register(); }\n",
             ),
-            (
-                "api/part.rs",
-                "use super::State;\npub fn register() {}\n",
-            ),
+            ("api/part.rs", "use super::State;\npub fn register() {}\n"),
         ],
     );
     assert_eq!(FileGraph::of(&src).circles(), vec![vec!["api", "api/part"]]);
@@ -138,7 +140,11 @@ fn no_crate_has_an_import_circle_between_its_files() {
             found.push(format!("{krate}: {}", c.join(" <-> ")));
         }
     }
-    assert!(found.is_empty(), "import circles between files:\n{}", found.join("\n"));
+    assert!(
+        found.is_empty(),
+        "import circles between files:\n{}",
+        found.join("\n")
+    );
 }
 
 /// Test code: the tests crate, `tests.rs` / `*_tests.rs` unit-test files, test folders.
@@ -179,7 +185,11 @@ fn no_source_file_is_over_900_lines() {
         }
     }
     assert!(seen > 100, "only {seen} source files found");
-    assert!(long.is_empty(), "files over {MAX} lines:\n{}", long.join("\n"));
+    assert!(
+        long.is_empty(),
+        "files over {MAX} lines:\n{}",
+        long.join("\n")
+    );
 }
 
 /// The packages `package` depends on for its normal and build dependencies (transitively,
@@ -208,7 +218,10 @@ fn normal_dependencies(package: &str) -> BTreeSet<String> {
 #[test]
 fn the_daemon_depends_on_no_client_bench_or_plotting_crate() {
     let deps = normal_dependencies("physics-daemon");
-    assert!(deps.contains("rapier3d") && deps.contains("shm-layout"), "{deps:?}");
+    assert!(
+        deps.contains("rapier3d") && deps.contains("shm-layout"),
+        "{deps:?}"
+    );
     let forbidden = [
         "client-sdk",
         "lua-client",
@@ -270,12 +283,15 @@ fn the_readme_to_add_table_names_files_that_exist() {
         .iter()
         .filter(|p| !roots.iter().any(|r| r.join(p).exists()))
         .collect();
-    assert!(missing.is_empty(), "README's to-add table names missing files: {missing:?}");
+    assert!(
+        missing.is_empty(),
+        "README's to-add table names missing files: {missing:?}"
+    );
 }
 
 /// The paths docs/architecture.md's map names: the first fenced block under `## Map`; a line
-/// starting in the first column names a top folder (or file), an indented line a path inside
-/// the last top folder.
+/// starting in the first column names a top folder (or file), a line indented by two spaces
+/// a path inside the last top folder, and deeper lines continue a description.
 fn map_paths() -> Vec<String> {
     let doc = std::fs::read_to_string(repo().join("docs/architecture.md")).unwrap();
     let section = doc
@@ -292,14 +308,12 @@ fn map_paths() -> Vec<String> {
         let Some(first) = line.split_whitespace().next() else {
             continue;
         };
-        if !(first.ends_with('/') || first.contains('.')) {
-            continue;
-        }
-        if line.starts_with(' ') {
-            out.push(format!("{top}{first}"));
-        } else {
+        // Columns 0 and 2 name paths; deeper lines continue a description.
+        if !line.starts_with(' ') {
             top = first.to_string();
             out.push(top.clone());
+        } else if line.starts_with("  ") && !line.starts_with("   ") {
+            out.push(format!("{top}{first}"));
         }
     }
     out
@@ -309,11 +323,11 @@ fn map_paths() -> Vec<String> {
 fn the_architecture_map_names_every_crate_and_folder_and_nothing_else() {
     let named = map_paths();
     assert!(named.len() >= 12, "paths read from the map: {named:?}");
-    let missing: Vec<&String> = named
-        .iter()
-        .filter(|p| !repo().join(p).exists())
-        .collect();
-    assert!(missing.is_empty(), "the map names paths that do not exist: {missing:?}");
+    let missing: Vec<&String> = named.iter().filter(|p| !repo().join(p).exists()).collect();
+    assert!(
+        missing.is_empty(),
+        "the map names paths that do not exist: {missing:?}"
+    );
     let mut unnamed = Vec::new();
     for entry in std::fs::read_dir(repo()).unwrap().flatten() {
         let name = entry.file_name().to_string_lossy().to_string();
