@@ -11,6 +11,7 @@ use rapier3d::prelude::*;
 use shm_layout::query::page_of;
 use shm_layout::{CommandError, FilterType, Handle, Hit, QueryFilter, QueryOp, Reply, Vec3};
 
+use crate::backend::rapier_world::RapierWorld;
 use crate::rapier3d::plane::Plane;
 
 /// How many objects containing a ray's or sweep's start are skipped before giving up (a
@@ -198,28 +199,7 @@ impl Plane {
     /// their bodies' poses and puts their boxes into the broad phase's tree, which queries
     /// walk. No time passes and no contact is computed (the step does that as always).
     pub(in crate::rapier3d) fn refresh_scene(&mut self) {
-        if self.query_stale.is_empty() {
-            return;
-        }
-        let stale = std::mem::take(&mut self.query_stale);
-        let world = &mut self.world;
-        for h in stale {
-            let Some(body) = world.bodies.get(h) else {
-                continue; // removed since: its collider is gone from the set queries read
-            };
-            let pose = *body.position();
-            for c in body.colliders() {
-                let Some(co) = world.colliders.get_mut(*c) else {
-                    continue;
-                };
-                let local = co.position_wrt_parent().copied().unwrap_or_default();
-                co.set_position(pose * local);
-                let aabb = co.compute_aabb();
-                world
-                    .broad_phase
-                    .set_aabb(&world.integration_parameters, *c, aabb);
-            }
-        }
+        self.world.refresh_colliders(&mut self.query_stale);
     }
 
     pub(in crate::rapier3d) fn resolve(
