@@ -4,7 +4,7 @@
 use shm_layout::joint_op::AXIS_NAMES;
 use shm_layout::{AxisMotor, JointProp};
 
-use crate::{Error, Joint};
+use crate::{error::Error, joint::Joint};
 
 /// The index of an axis name (`"X"`, `"Y"`, `"Z"`, `"RotX"`, `"RotY"`, `"RotZ"`).
 pub fn axis_index(name: &str) -> Option<u8> {

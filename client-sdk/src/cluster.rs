@@ -13,7 +13,7 @@ pub use shm_layout::cluster::LoadReport;
 use shm_layout::cluster::{self as keys, Endpoint};
 use zenoh::Wait;
 
-use crate::Error;
+use crate::error::Error;
 
 /// How long a question to the cluster waits for its members' answers.
 pub const QUERY_TIMEOUT: Duration = Duration::from_millis(1000);

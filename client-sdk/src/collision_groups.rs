@@ -4,7 +4,7 @@
 use shm_layout::collision_groups::{CollisionGroups, MAX_COLLISION_GROUPS};
 use shm_layout::ObjectProp;
 
-use crate::{Client, Error, Object};
+use crate::{client::Client, error::Error, object::Object};
 
 /// One registered group, as `GetRegisteredCollisionGroups` lists it.
 #[derive(Debug, Clone, PartialEq, Eq)]

@@ -5,7 +5,7 @@
 
 use shm_layout::{Command, ContactInfo, ObjectOp, Reply};
 
-use crate::{Error, Object};
+use crate::{error::Error, object::Object};
 
 impl Object {
     /// Every object this one touches now (after the newest tick; one round trip, the queue

@@ -7,7 +7,7 @@ use shm_layout::{
     FLAG_ON_GROUND,
 };
 
-use crate::{Error, Object, Plane};
+use crate::{error::Error, object::Object, plane::Plane};
 
 /// One controller of a plane. Cheap to clone.
 #[derive(Clone, Debug)]

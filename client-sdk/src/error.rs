@@ -33,7 +33,7 @@ pub enum Error {
     #[error("{} command(s) of the batch failed; first: {}", .0.len(), .0[0])]
     Batch(Vec<CommandError>),
     /// Writes queued earlier were refused by the daemon after the call that queued them
-    /// returned ([`ConnectOptions::refusals_at_next_call`](crate::ConnectOptions)): reported
+    /// returned ([`ConnectOptions::refusals_at_next_call`](crate::client::ConnectOptions)): reported
     /// by the next call into their plane instead of being lost or ending a frame. Each
     /// message names the write and, when the host recorded it, the line that made it.
     #[error("{}", refused_text(.0))]

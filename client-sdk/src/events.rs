@@ -5,7 +5,7 @@
 use shm_layout::{EventRecord, Handle, Vec3, EVENT_CONTACT_STARTED, EVENT_CONTACT_STOPPED};
 
 use crate::plane_shared::EventReader;
-use crate::{Error, Plane};
+use crate::{error::Error, plane::Plane};
 
 pub use crate::transport::EVENT_BUFFER_TICKS;
 

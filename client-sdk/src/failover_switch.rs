@@ -14,7 +14,7 @@ use shm_layout::{Command, ErrorKind, PlaneId, PlaneOp, Reply};
 
 use crate::plane_shared::Route;
 use crate::transport::Transport;
-use crate::{Client, Error, Plane};
+use crate::{client::Client, error::Error, plane::Plane};
 
 /// How long a client looks for the member that adopts its plane (the member sees the
 /// daemon's token end at once for a killed process, within the 3 s lease for a host that

@@ -14,7 +14,7 @@ use shm_layout::{
     Pose, Reply, Vec2,
 };
 
-use crate::{Client, Error, Plane};
+use crate::{client::Client, error::Error, plane::Plane};
 
 /// Options of a new GUI plane; `None` keeps the default.
 #[derive(Debug, Clone, Default)]

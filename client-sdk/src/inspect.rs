@@ -10,7 +10,7 @@ use shm_layout::{
 
 use shm_layout::gui_op::{GuiControllerInfo, GuiObjectInfo};
 
-use crate::{Client, Error, Plane};
+use crate::{client::Client, error::Error, plane::Plane};
 
 fn unexpected(reply: Reply) -> Error {
     Error::Protocol(format!("unexpected reply {reply:?}"))

@@ -7,7 +7,7 @@ use shm_layout::{
     EVENT_JOINT_BROKE,
 };
 
-use crate::{Error, Object, Plane};
+use crate::{error::Error, object::Object, plane::Plane};
 
 /// One joint. Cheap to clone.
 #[derive(Clone)]

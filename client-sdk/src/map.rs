@@ -16,7 +16,7 @@ use shm_layout::{
     Command, JointKind, MapOp, MapReport, ObjectProp, PlaneOp, Pose, Reply, Shape, Vec3,
 };
 
-use crate::{Error, Object, Plane};
+use crate::{error::Error, object::Object, plane::Plane};
 
 /// One mesh in map space (node transforms applied).
 #[derive(Debug, Clone, Default, PartialEq)]

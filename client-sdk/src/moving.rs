@@ -16,7 +16,7 @@ use crate::client::{unexpected, Rerouted};
 use crate::cluster::ClusterOptions;
 use crate::plane_shared::Route;
 use crate::remote::RemoteOptions;
-use crate::{Client, Error, Plane};
+use crate::{client::Client, error::Error, plane::Plane};
 
 impl Client {
     /// Sends again, to the plane's new daemon, every command the old one refused because

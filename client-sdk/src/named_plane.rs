@@ -8,7 +8,7 @@
 
 use shm_layout::{Command, NamedPlane, PlaneName, PlaneOp, Reply};
 
-use crate::{Client, Error, Plane};
+use crate::{client::Client, error::Error, plane::Plane};
 
 /// A named plane just opened.
 pub struct OpenedPlane {

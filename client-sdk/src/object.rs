@@ -5,7 +5,7 @@ use shm_layout::{
     Restraint, RotateTo, Shape, Vec3,
 };
 
-use crate::{Error, Plane};
+use crate::{error::Error, plane::Plane};
 
 /// One body of a plane. Cheap to clone.
 #[derive(Clone)]

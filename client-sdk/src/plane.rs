@@ -12,7 +12,7 @@ use crate::client::unexpected;
 use crate::overlay::Entry;
 use crate::plane_shared::PlaneShared;
 use crate::transport::{BodySample, LIVENESS_PERIOD};
-use crate::{Client, Error};
+use crate::{client::Client, error::Error};
 
 /// Options of a new plane: declared with the plane settings table (one field per option,
 /// a builder over [`PlaneProp`]).

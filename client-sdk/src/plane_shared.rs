@@ -7,11 +7,11 @@ use std::rc::Rc;
 
 use shm_layout::{Handle, PlaneId};
 
+use crate::error::Error;
 use crate::members::Members;
 use crate::mirror::Mirror;
 use crate::overlay::Overlay;
 use crate::transport::{BodySample, BodySubscriber, EventSubscriber, TickListener, Transport};
-use crate::Error;
 
 /// What a client keeps per plane: the subscriber, the newest sample, the overlay.
 pub(crate) struct PlaneShared {

@@ -16,7 +16,7 @@ use shm_layout::snapshot::{self, SnapshotHeader};
 use shm_layout::snapshot_transfer::STAGE_ABOVE;
 use shm_layout::{Command, PlaneKind, PlaneOp, PlaneProp, Reply, TransferReply};
 
-use crate::{Client, Error, Plane};
+use crate::{client::Client, error::Error, plane::Plane};
 
 /// A plane's whole state at one tick. Cheap to clone (the bytes are shared).
 #[derive(Clone)]

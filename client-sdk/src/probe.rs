@@ -5,7 +5,7 @@
 
 use shm_layout::{PlaneOp, Pose, QueryOp, Reply, Shape, Vec3};
 
-use crate::{Error, Object, Plane, QueryParams};
+use crate::{error::Error, object::Object, plane::Plane, query::QueryParams};
 
 pub use shm_layout::probe::{Explosion, Falloff, ProbeHit, DEFAULT_MAX_SLOPE};
 /// Farthest any query looks (units).

@@ -9,7 +9,7 @@
 
 use shm_layout::{FilterType, Handle, Hit, PlaneOp, Pose, QueryFilter, QueryOp, Ray, Reply, Vec3};
 
-use crate::{Error, Object, Plane};
+use crate::{error::Error, object::Object, plane::Plane};
 
 /// Which objects a query considers (Roblox's `RaycastParams` / `OverlapParams`).
 #[derive(Debug, Clone, Default, PartialEq)]

@@ -5,7 +5,7 @@
 
 use shm_layout::{JointKind, JointProp, ObjectProp, Pose, Shape, Vec3};
 
-use crate::{Error, Joint, Object, Plane};
+use crate::{error::Error, joint::Joint, object::Object, plane::Plane};
 
 /// What every bone gets first: HitBoxQuality 2, since a capsule below 2 has its rotation
 /// locked against contacts (and joints could not turn it), and CCD for hits.

@@ -27,7 +27,7 @@ use zenoh::sample::{Sample, SampleKind};
 use zenoh::{Session, Wait};
 
 use crate::cluster::{Cluster, ClusterOptions};
-use crate::Error;
+use crate::error::Error;
 
 /// How long a watch request waits for the relay's answer.
 const WATCH_TIMEOUT: Duration = Duration::from_secs(5);

@@ -6,7 +6,7 @@
 use shm_layout::snapshot::checksum;
 use shm_layout::{Command, Reply, TransferOp, TransferReply};
 
-use crate::{Client, Error};
+use crate::{client::Client, error::Error};
 
 impl Client {
     /// Reads download `transfer` (`len` bytes whose checksum is `sum`) to its end.

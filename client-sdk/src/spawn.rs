@@ -4,7 +4,7 @@ use std::path::PathBuf;
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
-use crate::{Client, Error};
+use crate::{client::Client, error::Error};
 
 /// A daemon started by this process; stopped (SIGINT, then waited for) when dropped.
 pub struct DaemonChild {

@@ -14,7 +14,7 @@ pub(crate) use local_transport::{LocalTransport, PendingReply};
 use local_transport::{ShmBodySubscriber, ShmEventSubscriber};
 use shm_layout::{BodyState, EventRecord, PlaneId, TickHeader};
 
-use crate::Error;
+use crate::error::Error;
 
 /// Lets only iceoryx2's errors reach stderr (`IOX2_LOG_LEVEL` still overrides): a game or
 /// a script runner prints what it prints, not the transport's notes about dead nodes or a

@@ -9,7 +9,7 @@ use shm_layout::{
     PlaneId, PlaneOp, Reply,
 };
 
-use crate::Error;
+use crate::error::Error;
 
 use super::{Client, Queued, Refusal, Rerouted, Sent};
 

@@ -7,9 +7,9 @@ use std::time::{Duration, Instant};
 
 use shm_layout::{Command, ErrorKind, Reply};
 
+use crate::error::Error;
 use crate::remote::{RemoteOptions, RemoteTransport};
 use crate::transport::Transport;
-use crate::Error;
 
 use super::{Client, ConnectOptions, Inner};
 

@@ -7,8 +7,8 @@ use std::time::{Duration, Instant};
 use shm_layout::codec;
 use shm_layout::{Command, CommandResult, ErrorKind, Reply, Request, Response, LAYOUT_VERSION};
 
+use crate::error::Error;
 use crate::transport::LIVENESS_PERIOD;
-use crate::Error;
 
 use super::{Client, DaemonHealth, Inner, HUNG_AFTER, STALL_AFTER, WATCH_STALL_AFTER};
 

@@ -3,7 +3,7 @@
 
 use shm_layout::{CollisionGroups, Command, CommandError, PlaneOp};
 
-use crate::Error;
+use crate::error::Error;
 
 use super::Client;
 

@@ -15,10 +15,10 @@ use shm_layout::{
     CollisionGroups, Command, CommandError, Handle, PlaneId, Reply, CRATE_VERSION, LAYOUT_VERSION,
 };
 
+use crate::error::Error;
 use crate::plane_shared::PlaneShared;
 use crate::remote::RemoteOptions;
 use crate::transport::Transport;
-use crate::Error;
 
 mod batch;
 mod connect;

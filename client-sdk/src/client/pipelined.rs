@@ -5,7 +5,7 @@ use std::time::Instant;
 
 use shm_layout::Request;
 
-use crate::Error;
+use crate::error::Error;
 
 use super::{Client, InFlight, MAX_IN_FLIGHT};
 
