@@ -21,7 +21,7 @@ use std::rc::{Rc, Weak};
 
 use mlua::{ffi, AnyUserData, Function, LightUserData, Lua, Table};
 
-use super::{BasePart, PartShape, PartState};
+use super::state::{BasePart, PartShape, PartState};
 use crate::values::cframe_ud;
 
 /// One registered BasePart value: its part and the slot of the array table (the C
