@@ -2,12 +2,13 @@
 //!
 //! A file's imports are the paths it writes (`use` trees with their braces expanded, and paths
 //! in code such as `super::Plane::new`): `crate::`, `super::`, `self::` and paths through a
-//! child module. Each is resolved to the file that defines the item: the deepest module the
-//! path names, and from there through the `use`s of that file (a re-export, or a parent's
-//! import a child reaches through `super::`) to the file whose `struct`, `enum`, `fn`, `trait`,
-//! `type`, `const`, `static` or macro has that name. A `mod x;` declaration is not an import;
-//! a file's trailing unit tests (`#[cfg(test)] mod tests`) and test-only module files are left
-//! out. Paths into other crates are not edges.
+//! child module. Each is an edge to the file of the deepest module the path names: an item
+//! reached through a re-export (`crate::Error`, `super::Plane`) imports the file that
+//! re-exports it, whose own `pub use` lines are edges in turn; so a file that imports through
+//! the crate root or its parent is in a circle whenever that file re-exports something of its
+//! own. A `mod x;` declaration is not an import, nor is the path of a `pub(in ...)`; a file's
+//! trailing unit tests (`#[cfg(test)] mod tests`) and test-only module files are left out.
+//! Paths into other crates are not edges.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
@@ -215,19 +216,6 @@ pub fn paths_in(code: &str) -> Vec<Vec<String>> {
     out
 }
 
-fn defines(code: &str, name: &str) -> bool {
-    let t = tokens(code);
-    t.windows(2).any(|w| {
-        w[1] == name
-            && matches!(
-                w[0].as_str(),
-                "struct" | "enum" | "fn" | "trait" | "type" | "const" | "static" | "union"
-            )
-    }) || t
-        .windows(3)
-        .any(|w| w[0] == "macro_rules" && w[1] == "!" && w[2] == name)
-}
-
 impl FileGraph {
     /// The files of `src` (a crate's `src/`; its `bin/` aside) and their imports.
     pub fn of(src: &Path) -> FileGraph {
@@ -279,16 +267,12 @@ impl FileGraph {
             .keys()
             .map(|m| (m.clone(), paths_in(&code[m])))
             .collect();
-        let graph = Resolver {
-            files: &files,
-            code: &code,
-            paths: &paths,
-        };
+        let graph = Resolver { files: &files };
         let mut edges = BTreeMap::new();
         for m in files.keys() {
             let mut to = BTreeSet::new();
             for p in &paths[m] {
-                if let Some(target) = graph.resolve(m, p, 0) {
+                if let Some(target) = graph.resolve(m, p) {
                     if &target != m {
                         to.insert(target);
                     }
@@ -319,15 +303,13 @@ impl FileGraph {
 
 struct Resolver<'a> {
     files: &'a BTreeMap<ModPath, PathBuf>,
-    code: &'a BTreeMap<ModPath, String>,
-    paths: &'a BTreeMap<ModPath, Vec<Vec<String>>>,
 }
 
 impl Resolver<'_> {
     /// The file a path written in `me` leads to (None: another crate, a local name or a type's
     /// associated item).
-    fn resolve(&self, me: &ModPath, path: &[String], depth: usize) -> Option<ModPath> {
-        if depth > 8 || path.is_empty() {
+    fn resolve(&self, me: &ModPath, path: &[String]) -> Option<ModPath> {
+        if path.is_empty() {
             return None;
         }
         let (mut cur, rest): (ModPath, &[String]) = match path[0].as_str() {
@@ -363,20 +345,6 @@ impl Resolver<'_> {
         }
         if !self.files.contains_key(&cur) {
             return None;
-        }
-        let Some(name) = rest.get(k) else {
-            return Some(cur);
-        };
-        if name == "*" || name == "self" || defines(&self.code[&cur], name) {
-            return Some(cur);
-        }
-        // Brought in by a `use` of that file: follow it to where the item lives.
-        for p in &self.paths[&cur] {
-            if p.len() > 1 && p.last() == Some(name) {
-                if let Some(found) = self.resolve(&cur, p, depth + 1) {
-                    return Some(found);
-                }
-            }
         }
         Some(cur)
     }

@@ -11,7 +11,7 @@
 
 use shm_layout::{CommandError, ErrorKind, Handle};
 
-use super::Dirty;
+use super::dirty::Dirty;
 
 #[derive(Clone, serde::Serialize, serde::Deserialize)]
 struct Entry<T> {

@@ -13,7 +13,7 @@ use shm_layout::{
     FLAG_ALIVE, FLAG_ANCHORED,
 };
 
-use super::Plane;
+use super::plane::Plane;
 
 /// One body as a simplified stepper takes it (a sphere or a world-aligned box).
 #[derive(Debug, Clone, Copy, PartialEq)]
