@@ -11,6 +11,8 @@ use shm_layout::{
     PlaneSettings, StateHasher, TickHeader,
 };
 
+use crate::backend::rapier_world::RapierWorld;
+use crate::backend::rollback::{Duplicate, Ring};
 use crate::backend::{HeaderFigures, SlotTable};
 use crate::rapier3d::adaptive::Adaptive;
 use crate::rapier3d::contacts::figures::contact_figures;
@@ -19,7 +21,6 @@ use crate::rapier3d::contacts::log::{Events, Kept as EventsKept};
 use crate::rapier3d::controllers::Controllers;
 use crate::rapier3d::history::pose_mirror::PoseMirror;
 use crate::rapier3d::history::publish;
-use crate::rapier3d::history::rollback::Ring;
 use crate::rapier3d::joints::table::Joints;
 use crate::rapier3d::objects::body_pass::{self, Scratch};
 use crate::rapier3d::objects::maps::PendingMap;
@@ -95,7 +96,7 @@ impl Plane {
             map_pending: PendingMap::default(),
             state_hash: 0,
             state_bytes: Default::default(),
-            rollback: Default::default(),
+            rollback: Ring::dropping_off_thread(),
             mirror: Default::default(),
         }
     }
@@ -324,7 +325,7 @@ macro_rules! plane_state {
             /// The state as an owned copy (what Rewind keeps): the engine's sets cloned, its
             /// per-step workspaces fresh.
             pub(super) fn clone_state(&self) -> State {
-                State { world: copy_world(&self.world), $($field: self.$($place).+.clone(),)* }
+                State { world: self.world.copy(), $($field: self.$($place).+.clone(),)* }
             }
 
             pub(super) fn state_ref(&self) -> StateRef<'_> {
@@ -337,37 +338,20 @@ macro_rules! plane_state {
             }
         }
 
-        impl State {
+        impl Duplicate for State {
             /// Another copy of a kept state (a second rewind to the same tick).
-            pub(super) fn duplicate(&self) -> State {
-                State { world: copy_world(&self.world), $($field: self.$field.clone(),)* }
+            fn duplicate(&self) -> State {
+                State { world: self.world.copy(), $($field: self.$field.clone(),)* }
             }
+        }
 
+        impl State {
             /// The copy borrowed to encode (`Plane::snapshot_later`).
             pub(super) fn as_ref(&self) -> StateRef<'_> {
                 StateRef { world: &self.world, $($field: &self.$field,)* }
             }
         }
     };
-}
-
-/// A copy of `w`: the engine's sets cloned (shapes shared), its per-step workspaces fresh.
-fn copy_world(w: &PhysicsWorld) -> PhysicsWorld {
-    PhysicsWorld {
-        gravity: w.gravity,
-        integration_parameters: w.integration_parameters,
-        physics_pipeline: PhysicsPipeline::new(),
-        collision_pipeline: CollisionPipeline::new(),
-        islands: w.islands.clone(),
-        broad_phase: w.broad_phase.clone(),
-        narrow_phase: w.narrow_phase.clone(),
-        bodies: w.bodies.clone(),
-        colliders: w.colliders.clone(),
-        impulse_joints: w.impulse_joints.clone(),
-        multibody_joints: w.multibody_joints.clone(),
-        soft_bodies: w.soft_bodies.clone(),
-        ccd_solver: CCDSolver::new(),
-    }
 }
 
 plane_state! {

@@ -44,37 +44,9 @@ impl Plane {
     /// tick gone back to stays kept (a second rewind to it works); later ones are dropped.
     pub(in crate::rapier3d) fn rewind(&mut self, n: u32) -> Result<Reply, CommandError> {
         let k = self.settings.rollback_ticks;
-        if k == 0 {
-            return Err(CommandError::invalid_field(
-                "Rewind",
-                "Rewind needs RollbackTicks > 0 (set it when creating the plane or before the \
-                 ticks to go back over)",
-            ));
+        if let Some(copy) = self.rollback.rewind(k, n, self.clock.tick, "the plane")? {
+            self.adopt_copy(copy)?;
         }
-        if n == 0 {
-            return Ok(Reply::Applied {
-                tick: self.clock.tick,
-            });
-        }
-        let at = self
-            .clock
-            .tick
-            .checked_sub(n as u64)
-            .and_then(|t| self.rollback.position(t));
-        let (Some(at), true) = (at, n <= k) else {
-            let oldest = self.rollback.oldest_tick().unwrap_or(self.clock.tick);
-            return Err(CommandError::invalid_field(
-                "Rewind",
-                format!(
-                    "Rewind({n}) goes further back than the plane keeps: RollbackTicks = {k}, \
-                     ticks {oldest} to {} kept",
-                    self.clock.tick
-                ),
-            ));
-        };
-        // A copy: the kept state stays for another rewind to the same tick.
-        let copy = self.rollback.back_to(at).duplicate();
-        self.adopt_copy(copy)?;
         Ok(Reply::Applied {
             tick: self.clock.tick,
         })
