@@ -7,8 +7,7 @@
 //!
 //! Both rapier backends use the same code, generic over the engine's world
 //! ([`RapierWorld`]): the plane keeps a `held: Vec<HeldIn<PhysicsWorld>>`, calls [`hold`] for
-//! the property and [`before_step`] / [`after_step`] around rapier's step. (The
-//! `held_bodies!` macro expands the same bookkeeping as methods of a module's `Plane`.)
+//! the property and [`before_step`] / [`after_step`] around rapier's step.
 
 use shm_layout::settings::object::MAX_HELD_TICKS;
 
@@ -57,65 +56,3 @@ pub fn after_step<W: RapierWorld>(held: &[HeldIn<W>], world: &mut W) {
         }
     }
 }
-
-/// Expands the held-body bookkeeping for the `Plane` of the module it is used in.
-macro_rules! held_bodies {
-    ($rapier:ident) => {
-        use shm_layout::settings::object::MAX_HELD_TICKS;
-        use $rapier::prelude::*;
-
-        use super::Plane;
-
-        /// One held body and its state before the current step.
-        #[derive(Clone, serde::Serialize, serde::Deserialize)]
-        pub(super) struct HeldBody {
-            handle: RigidBodyHandle,
-            ticks: u32,
-            saved: Option<(Pose, Vector, AngVector)>,
-        }
-
-        impl Plane {
-            /// Holds (`on`) or releases the rapier body `h`.
-            pub(super) fn hold(&mut self, h: RigidBodyHandle, on: bool) {
-                self.held.retain(|b| b.handle != h);
-                if on {
-                    self.held.push(HeldBody {
-                        handle: h,
-                        ticks: 0,
-                        saved: None,
-                    });
-                }
-            }
-
-            /// Before a step: forgets bodies gone or held long enough, remembers the
-            /// others' state.
-            pub(super) fn held_before_step(&mut self) {
-                if self.held.is_empty() {
-                    return;
-                }
-                let bodies = &self.world.bodies;
-                self.held
-                    .retain(|b| b.ticks < MAX_HELD_TICKS && bodies.get(b.handle).is_some());
-                for b in &mut self.held {
-                    let body = &bodies[b.handle];
-                    b.saved = Some((*body.position(), body.linvel(), body.angvel()));
-                    b.ticks += 1;
-                }
-            }
-
-            /// After a step: puts every held body back where the step found it.
-            pub(super) fn held_after_step(&mut self) {
-                for b in &self.held {
-                    let body = self.world.bodies.get_mut(b.handle);
-                    if let (Some((pose, v, w)), Some(body)) = (b.saved, body) {
-                        body.set_position(pose, false);
-                        body.set_linvel(v, false);
-                        body.set_angvel(w, false);
-                    }
-                }
-            }
-        }
-    };
-}
-
-pub(crate) use held_bodies;

@@ -11,6 +11,7 @@ use shm_layout::{
     PlaneSettings, StateHasher, TickHeader,
 };
 
+use crate::backend::held::{self, HeldIn};
 use crate::backend::rapier_world::RapierWorld;
 use crate::backend::rollback::{Duplicate, Ring};
 use crate::backend::{HeaderFigures, SlotTable};
@@ -27,11 +28,6 @@ use crate::rapier3d::objects::maps::PendingMap;
 use crate::rapier3d::objects::object::{body_state, Object, MAX_SLOTS};
 use crate::rapier3d::objects::tally::{Kept as TallyKept, Tally};
 
-mod held {
-    //! Held objects: see `crate::backend::held`.
-    crate::backend::held::held_bodies!(rapier3d);
-}
-
 /// One rapier3d plane.
 pub struct Plane {
     /// The plane's id (stamped into its tick headers).
@@ -44,7 +40,7 @@ pub struct Plane {
     /// Buffers of the per-body passes.
     pub(super) pass: Scratch,
     /// Objects a step must leave where it found them (see `held`).
-    held: Vec<held::HeldBody>,
+    held: Vec<HeldIn<PhysicsWorld>>,
     /// The tick clock and the last step's figures (see `backend::clock`).
     pub(super) clock: crate::backend::Clock,
     /// The adaptive pass's boosted bodies and stiffened contacts (see `adaptive`).
@@ -154,7 +150,7 @@ impl Plane {
             threshold: self.settings.rest_threshold,
             gravity: self.world.gravity,
         };
-        self.held_before_step();
+        held::before_step(&mut self.held, &self.world);
         // Planes of a shared pool take turns in rapier's step (see `pools::turn`).
         let pool = self.world.physics_pipeline.thread_pool();
         let turn = pool.as_deref().map(|pool| {
@@ -170,7 +166,7 @@ impl Plane {
             self.world.step_with_events(&hooks, &());
         }
         drop(turn);
-        self.held_after_step();
+        held::after_step(&self.held, &mut self.world);
         self.query_stale.clear();
         self.limit_speeds_after_step();
         self.bodies.stepped();
@@ -285,7 +281,7 @@ impl Plane {
 
     /// Holds (`on`) or releases the rapier body `h` (see `held`).
     pub(super) fn set_held(&mut self, h: RigidBodyHandle, on: bool) {
-        self.hold(h, on);
+        held::hold(&mut self.held, h, on);
     }
 
     /// The published state of slot `i` (dead slots carry only their generation).
@@ -359,7 +355,7 @@ plane_state! {
     pub(super) settings: PlaneSettings = settings,
     pub(super) bodies: SlotTable<Object> = bodies,
     pub(super) tally: TallyKept = tally.kept,
-    held: Vec<held::HeldBody> = held,
+    held: Vec<HeldIn<PhysicsWorld>> = held,
     pub(super) clock: crate::backend::Clock = clock,
     adaptive: Adaptive = adaptive,
     events: EventsKept = events.kept,
