@@ -200,7 +200,7 @@ impl Plane {
             body.set_angvel(Vector::from(p.angular_velocity), false);
         }
         self.query_stale.push(h);
-        self.mirror.forget();
+        self.history.forget_poses();
     }
 
     /// Whether `handle` names a live object.
@@ -211,7 +211,7 @@ impl Plane {
     /// Wakes every body (motion handed back to rapier).
     pub fn wake_all(&mut self) {
         self.world.wake_up_all(true);
-        self.mirror.forget();
+        self.history.forget_poses();
     }
 
     /// What every step does first: the last tick kept for Rewind, `dt` checked. Returns
@@ -237,7 +237,7 @@ impl Plane {
         self.events.clear_step();
         self.bodies.stepped();
         self.clock.advance(dt);
-        self.state_hash = state_hash;
+        self.history.stepped_elsewhere(state_hash);
         self.clock.timed(started);
     }
 

@@ -13,7 +13,7 @@ use shm_layout::{
 
 use crate::backend::held::{self, HeldIn};
 use crate::backend::rapier_world::RapierWorld;
-use crate::backend::rollback::{Duplicate, Ring};
+use crate::backend::rollback::Duplicate;
 use crate::backend::{HeaderFigures, SlotTable};
 use crate::rapier3d::adaptive::Adaptive;
 use crate::rapier3d::contacts::figures::contact_figures;
@@ -21,7 +21,7 @@ use crate::rapier3d::contacts::hooks::RestThreshold;
 use crate::rapier3d::contacts::log::{Events, Kept as EventsKept};
 use crate::rapier3d::controllers::Controllers;
 use crate::rapier3d::history::pose_mirror::PoseMirror;
-use crate::rapier3d::history::publish;
+use crate::rapier3d::history::{publish, History};
 use crate::rapier3d::joints::table::Joints;
 use crate::rapier3d::objects::body_pass::{self, Scratch};
 use crate::rapier3d::objects::maps::PendingMap;
@@ -58,14 +58,11 @@ pub struct Plane {
     pub(super) joints: Joints,
     /// Map pieces uploaded since the last build (see `maps`).
     pub(super) map_pending: PendingMap,
-    /// [`StateHasher`] over every slot as the last step left it (the tick header's).
-    pub(super) state_hash: u64,
     /// Bytes of controller paths (counted against the owner's quota).
     pub(super) state_bytes: crate::backend::counted::Counter,
-    /// States of the last ticks while RollbackTicks > 0 (see `rollback`).
-    pub(super) rollback: Ring<State>,
-    /// Every slot's state as the last step left it, for the publisher (see `pose_mirror`).
-    pub(super) mirror: PoseMirror,
+    /// The state hash and pose mirror of the last step, the ticks kept for Rewind (see
+    /// `history`).
+    pub(super) history: History<State>,
 }
 
 impl Plane {
@@ -90,10 +87,8 @@ impl Plane {
             query_stale: Default::default(),
             joints: Joints::default(),
             map_pending: PendingMap::default(),
-            state_hash: 0,
             state_bytes: Default::default(),
-            rollback: Ring::dropping_off_thread(),
-            mirror: Default::default(),
+            history: History::default(),
         }
     }
 
@@ -175,20 +170,17 @@ impl Plane {
         self.joints_after_step(dt);
         self.events.step_done();
         let rehash = moving || self.awake_count() > 0;
-        let mut mirror = std::mem::take(&mut self.mirror);
+        let mut mirror = std::mem::take(self.history.mirror_mut());
         if rehash {
             self.list_moved(&mut mirror.moved);
         }
         let (figures, hash) = self.figures_and_hash(rehash, &mut mirror);
-        self.mirror = mirror;
+        *self.history.mirror_mut() = mirror;
         (self.clock.max_penetration, self.clock.contact_pairs) = figures;
-        if let Some(hash) = hash {
-            self.state_hash = hash;
-        }
         self.adapt_solving();
         self.clock.timed(started);
-        // Kept for Rewind off the tick's path (see `rollback`).
-        self.rollback.note_step();
+        // The new hash; the tick is kept for Rewind off the tick's path (see `history`).
+        self.history.stepped(hash);
         Ok(true)
     }
 
@@ -206,7 +198,7 @@ impl Plane {
                 body_count: self.bodies.live(),
                 max_joint_error: self.joints.max_error,
                 event_count: self.events.count(),
-                state_hash: self.state_hash,
+                state_hash: self.history.hash(),
             },
         )
     }
@@ -295,7 +287,13 @@ impl Plane {
         out: &mut [std::mem::MaybeUninit<BodyState>],
         filter: crate::backend::SlotFilter<'_>,
     ) {
-        publish::write_sample(&self.mirror, &self.bodies, &self.world, out, filter);
+        publish::write_sample(
+            self.history.mirror(),
+            &self.bodies,
+            &self.world,
+            out,
+            filter,
+        );
     }
 }
 
@@ -363,5 +361,5 @@ plane_state! {
     pub(super) groups: CollisionGroups = groups,
     pub(super) query_stale: crate::backend::Marks<RigidBodyHandle> = query_stale,
     pub(super) joints: Joints = joints,
-    pub(super) state_hash: u64 = state_hash,
+    pub(super) state_hash: u64 = history.state_hash,
 }

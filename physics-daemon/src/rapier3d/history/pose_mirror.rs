@@ -272,6 +272,7 @@ mod tests {
             .collect();
         assert!(
             plane
+                .history
                 .mirror
                 .current(plane.bodies.marks_made(), 20)
                 .is_none(),
@@ -280,6 +281,7 @@ mod tests {
         plane.step(1.0 / 60.0).unwrap();
         assert!(
             plane
+                .history
                 .mirror
                 .current(plane.bodies.marks_made(), 20)
                 .is_some(),
@@ -294,6 +296,7 @@ mod tests {
             .unwrap();
         assert!(
             plane
+                .history
                 .mirror
                 .current(plane.bodies.marks_made(), 20)
                 .is_none(),
@@ -308,6 +311,7 @@ mod tests {
         plane.set(PlaneProp::Gravity([0.0, 0.0, 0.0])).unwrap();
         assert!(
             plane
+                .history
                 .mirror
                 .current(plane.bodies.marks_made(), 20)
                 .is_none(),
@@ -321,6 +325,7 @@ mod tests {
             .unwrap();
         assert!(
             plane
+                .history
                 .mirror
                 .current(plane.bodies.marks_made(), 21)
                 .is_none(),

@@ -11,7 +11,7 @@ impl Plane {
     /// Keeps the last step's tick if that is still to be done: before anything changes the
     /// plane, and when the worker is idle.
     pub(in crate::rapier3d) fn finish_keep(&mut self) -> Result<(), CommandError> {
-        if self.rollback.take_pending() {
+        if self.history.rollback.take_pending() {
             self.keep_for_rollback()?;
         }
         Ok(())
@@ -19,15 +19,16 @@ impl Plane {
 
     /// Whether a stepped tick is yet to be kept.
     pub(in crate::rapier3d) fn keep_pending(&self) -> bool {
-        self.rollback.pending() && (self.settings.rollback_ticks > 0 || !self.rollback.is_empty())
+        let ring = &self.history.rollback;
+        ring.pending() && (self.settings.rollback_ticks > 0 || !ring.is_empty())
     }
 
     /// After a step: keeps the state of the new tick when RollbackTicks > 0.
     fn keep_for_rollback(&mut self) -> Result<(), CommandError> {
         let k = self.settings.rollback_ticks as usize;
         if k == 0 {
-            if !self.rollback.is_empty() {
-                self.rollback.clear();
+            if !self.history.rollback.is_empty() {
+                self.history.rollback.clear();
             }
             return Ok(());
         }
@@ -36,7 +37,9 @@ impl Plane {
             &self.state_bytes,
             BYTES_PER_SLOT * self.bodies.slot_count() as u64,
         );
-        self.rollback.keep(self.clock.tick, copy, counted, k);
+        self.history
+            .rollback
+            .keep(self.clock.tick, copy, counted, k);
         Ok(())
     }
 
@@ -44,7 +47,8 @@ impl Plane {
     /// tick gone back to stays kept (a second rewind to it works); later ones are dropped.
     pub(in crate::rapier3d) fn rewind(&mut self, n: u32) -> Result<Reply, CommandError> {
         let k = self.settings.rollback_ticks;
-        if let Some(copy) = self.rollback.rewind(k, n, self.clock.tick, "the plane")? {
+        let now = self.clock.tick;
+        if let Some(copy) = self.history.rollback.rewind(k, n, now, "the plane")? {
             self.adopt_copy(copy)?;
         }
         Ok(Reply::Applied {
@@ -87,8 +91,8 @@ mod tests {
             idle.idle_work().unwrap();
             assert!(!idle.has_idle_work());
             busy.step(dt).unwrap();
-            assert_eq!(idle.state_hash, busy.state_hash);
-            hashes.push(idle.state_hash);
+            assert_eq!(idle.history.state_hash, busy.history.state_hash);
+            hashes.push(idle.history.state_hash);
         }
         // `busy` kept its ticks at each next step; its last is kept by the rewind itself.
         assert!(busy.has_idle_work());
@@ -97,9 +101,9 @@ mod tests {
                 plane.apply(PlaneOp::Rewind(2)).unwrap(),
                 Reply::Applied { tick: 3 }
             );
-            assert_eq!(plane.state_hash, hashes[2]);
+            assert_eq!(plane.history.state_hash, hashes[2]);
             plane.step(dt).unwrap();
-            assert_eq!(plane.state_hash, hashes[3], "the same tick again");
+            assert_eq!(plane.history.state_hash, hashes[3], "the same tick again");
         }
         // Nothing is kept, nor pending, with RollbackTicks = 0.
         let mut none = falling(0);

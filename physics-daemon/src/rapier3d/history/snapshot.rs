@@ -90,7 +90,7 @@ impl Plane {
             engine: ENGINE.to_string(),
             kind: PlaneKind::Rapier3d,
             tick: self.clock.tick,
-            state_hash: self.state_hash,
+            state_hash: self.history.state_hash,
             objects: usage.objects,
             mesh_vertices: usage.mesh_vertices,
             state_bytes: usage.state_bytes,
@@ -192,7 +192,7 @@ impl Plane {
         }
         self.adopt(state, overrides)?;
         // Another timeline: the ticks kept for Rewind no longer lead here.
-        self.rollback.clear();
+        self.history.rollback.clear();
         Ok(gpu)
     }
 
@@ -389,7 +389,7 @@ mod tests {
         let mut copy = Plane::new(2, &[]).unwrap();
         copy.restore(&later, &[]).unwrap();
         copy.step(1.0 / 60.0).unwrap();
-        assert_eq!(copy.state_hash, plane.state_hash);
+        assert_eq!(copy.history.state_hash, plane.history.state_hash);
     }
 
     /// The restore of edited bytes whose checksum was fixed up (what a forger sends): the

@@ -29,7 +29,7 @@ impl Plane {
         self.world.wake_up_all(true);
         // Every body's sleep flag may have changed: the last step's copy of the states is no
         // longer theirs.
-        self.mirror.forget();
+        self.history.forget_poses();
         Ok(())
     }
 
