@@ -6,8 +6,10 @@
 //! - the parts' state and the free functions over it: `objects/` (the slot table's bodies,
 //!   parts, tallies, the body pass, forces, speed limits, maps), `joints/` (joint table,
 //!   motors, articulations), `contacts/` (the event log, contact hooks and figures, thin
-//!   colliders, clipped and capsule contacts), `history/` (pose mirror, publishing, the
-//!   rollback ring), `controllers` (character controllers), `adaptive` (extra substeps);
+//!   colliders, clipped and capsule contacts), `history/` (the history part: state hash,
+//!   pose mirror, publishing, the rollback ring), `queries/mod.rs` (the queries' part: the
+//!   collision-group table and the bodies a query must first bring up to date),
+//!   `controllers` (character controllers), `adaptive` (extra substeps);
 //! - `plane`: the [`Plane`] over them, its state for snapshots and its step;
 //! - the `impl Plane` files that nothing imports: `options` (creation, plane options),
 //!   `backend` (op routing), `solver`, `offload`, and in the parts' folders `objects/ops.rs`,

@@ -174,7 +174,7 @@ impl Plane {
             collide: part.can_collide,
             locks: [part.locks[0], part.locks[1], part.locks[2]],
             group_bit: 1u32 << part.collision_group,
-            group_mask: self.groups.mask(part.collision_group),
+            group_mask: self.queries.groups().mask(part.collision_group),
         })
     }
 
@@ -199,7 +199,7 @@ impl Plane {
             body.set_linvel(Vector::from(p.velocity), false);
             body.set_angvel(Vector::from(p.angular_velocity), false);
         }
-        self.query_stale.push(h);
+        self.queries.mark_stale(h);
         self.history.forget_poses();
     }
 

@@ -7,8 +7,8 @@ use std::time::Instant;
 
 use rapier3d::prelude::*;
 use shm_layout::{
-    BodyState, CollisionGroups, CommandError, EventRecord, PlaneId, PlaneInfo, PlaneKind,
-    PlaneSettings, StateHasher, TickHeader,
+    BodyState, CommandError, EventRecord, PlaneId, PlaneInfo, PlaneKind, PlaneSettings,
+    StateHasher, TickHeader,
 };
 
 use crate::backend::held::{self, HeldIn};
@@ -27,6 +27,7 @@ use crate::rapier3d::objects::body_pass::{self, Scratch};
 use crate::rapier3d::objects::maps::PendingMap;
 use crate::rapier3d::objects::object::{body_state, Object, MAX_SLOTS};
 use crate::rapier3d::objects::tally::{Kept as TallyKept, Tally};
+use crate::rapier3d::queries::Queries;
 
 /// One rapier3d plane.
 pub struct Plane {
@@ -49,11 +50,9 @@ pub struct Plane {
     pub(super) events: Events,
     /// Character controllers by slot; ticked before each step (none: nothing to do).
     pub(super) controllers: Controllers,
-    /// The collision-group table objects' CollisionGroup indexes into.
-    pub(super) groups: CollisionGroups,
-    /// Bodies an op added, moved or reshaped since the last step: a query first brings their
-    /// colliders' poses and broad-phase boxes up to date, so it sees the change.
-    pub(super) query_stale: crate::backend::Marks<RigidBodyHandle>,
+    /// The collision-group table and the bodies queries must bring up to date (see
+    /// `queries`).
+    pub(super) queries: Queries,
     /// Joints (see `joints`).
     pub(super) joints: Joints,
     /// Map pieces uploaded since the last build (see `maps`).
@@ -82,9 +81,8 @@ impl Plane {
             clock: Default::default(),
             adaptive: Adaptive::default(),
             events: Events::default(),
-            groups: CollisionGroups::default(),
             controllers: Default::default(),
-            query_stale: Default::default(),
+            queries: Queries::default(),
             joints: Joints::default(),
             map_pending: PendingMap::default(),
             state_bytes: Default::default(),
@@ -162,7 +160,7 @@ impl Plane {
         }
         drop(turn);
         held::after_step(&self.held, &mut self.world);
-        self.query_stale.clear();
+        self.queries.step_done();
         self.limit_speeds_after_step();
         self.bodies.stepped();
         self.clock.advance(asked);
@@ -358,8 +356,7 @@ plane_state! {
     adaptive: Adaptive = adaptive,
     events: EventsKept = events.kept,
     pub(super) controllers: Controllers = controllers,
-    pub(super) groups: CollisionGroups = groups,
-    pub(super) query_stale: crate::backend::Marks<RigidBodyHandle> = query_stale,
+    queries: Queries = queries,
     pub(super) joints: Joints = joints,
     pub(super) state_hash: u64 = history.state_hash,
 }

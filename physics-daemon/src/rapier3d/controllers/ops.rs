@@ -118,7 +118,7 @@ impl Plane {
         });
         part.is_controller = true;
         let mut collider = ColliderBuilder::new(controller.shape()).build();
-        part.configure_collider(&mut collider, &self.groups)?;
+        part.configure_collider(&mut collider, self.queries.groups())?;
         let slot = self
             .bodies
             .next_slot()
@@ -138,7 +138,7 @@ impl Plane {
             part: Box::new(part),
             flags: shm_layout::FLAG_CONTROLLER,
         })?;
-        self.query_stale.push(h);
+        self.queries.mark_stale(h);
         self.controllers.insert(handle.slot, controller);
         for prop in state {
             self.set_controller(handle, prop)?;
@@ -171,7 +171,7 @@ impl Plane {
         let body = &mut self.world.bodies[h];
         body.set_position(pose, true);
         body.set_next_kinematic_position(pose);
-        self.query_stale.push(h);
+        self.queries.mark_stale(h);
         Ok(())
     }
 
@@ -194,7 +194,7 @@ impl Plane {
                 for col in self.world.bodies[h].colliders().to_vec() {
                     self.world.colliders[col].set_shape(shape.clone());
                 }
-                self.query_stale.push(h);
+                self.queries.mark_stale(h);
             }
             return Ok(());
         }

@@ -115,7 +115,7 @@ impl Plane {
         };
         let part = Part::map(shape, hash, size, pending.cost());
         let mut collider = ColliderBuilder::new(part.collider_shape()?).build();
-        part.configure_collider(&mut collider, &self.groups)?;
+        part.configure_collider(&mut collider, self.queries.groups())?;
         let slot = self.bodies.next_slot().ok_or_else(|| {
             CommandError::new(
                 ErrorKind::Internal,
@@ -135,7 +135,7 @@ impl Plane {
             part: Box::new(part),
             flags: 0,
         })?;
-        self.query_stale.push(h);
+        self.queries.mark_stale(h);
         Ok((handle, report))
     }
 }

@@ -25,7 +25,7 @@ impl Plane {
             .collect::<Result<Vec<_>, _>>()?;
         let part = Part::new(shape);
         let mut collider = ColliderBuilder::new(part.collider_shape()?).build();
-        part.configure_collider(&mut collider, &self.groups)?;
+        part.configure_collider(&mut collider, self.queries.groups())?;
         let slot = self.bodies.next_slot().ok_or_else(|| {
             CommandError::new(
                 ErrorKind::Internal,
@@ -50,7 +50,7 @@ impl Plane {
             flags: 0,
         })?;
         debug_assert_eq!(handle.slot, slot);
-        self.query_stale.push(h);
+        self.queries.mark_stale(h);
         for prop in props {
             self.set_object(handle, prop)?;
         }

@@ -22,7 +22,7 @@ impl Plane {
         }
         self.reconfigure(handle, h, touched)?;
         self.recount(before, Counted::of(&self.bodies.get(handle)?.part));
-        self.query_stale.push(h);
+        self.queries.mark_stale(h);
         // Any change may need the body awake and seen by the next force pass.
         self.world.bodies[h].wake_up(true);
         Ok(())
@@ -32,7 +32,7 @@ impl Plane {
     /// and properties a triangle map cannot take.
     fn check_object_prop(&self, handle: Handle, prop: &ObjectProp) -> Result<(), CommandError> {
         if let ObjectProp::CollisionGroup(g) = *prop {
-            if !self.groups.is_registered(g) {
+            if !self.queries.groups().is_registered(g) {
                 return Err(CommandError::invalid_field(
                     "CollisionGroup",
                     format!(
@@ -130,12 +130,12 @@ impl Plane {
                 self.events.collider_removed(c, handle);
             }
             let mut collider = ColliderBuilder::new(part.collider_shape()?).build();
-            part.configure_collider(&mut collider, &self.groups)?;
+            part.configure_collider(&mut collider, self.queries.groups())?;
             self.world.insert_collider(collider, Some(h));
             body_changed = true;
         } else if touched.collider {
             for c in self.world.bodies[h].colliders().to_vec() {
-                part.configure_collider(&mut self.world.colliders[c], &self.groups)?;
+                part.configure_collider(&mut self.world.colliders[c], self.queries.groups())?;
             }
             body_changed = true;
         }

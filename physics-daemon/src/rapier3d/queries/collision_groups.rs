@@ -9,16 +9,16 @@ impl Plane {
     /// Replaces the table (checked: a forged table is refused whole). Objects in a group no
     /// longer registered return to "Default"; every collider takes its new filter.
     pub fn set_collision_groups(&mut self, table: CollisionGroups) -> Result<(), CommandError> {
-        self.groups = table.checked()?;
+        self.queries.groups = table.checked()?;
         for i in 0..self.bodies.slot_count() {
             let Some(body) = self.bodies.at_mut(i) else {
                 continue;
             };
             let part = &mut body.part;
-            if !self.groups.is_registered(part.collision_group) {
+            if !self.queries.groups.is_registered(part.collision_group) {
                 part.settings.collision_group = 0;
             }
-            let groups = part.interaction_groups(&self.groups);
+            let groups = part.interaction_groups(&self.queries.groups);
             if let Some(rb) = self.world.bodies.get(body.handle) {
                 for c in rb.colliders() {
                     self.world.colliders[*c].set_collision_groups(groups);
@@ -35,6 +35,6 @@ impl Plane {
 
     /// The table in effect.
     pub fn collision_groups(&self) -> &CollisionGroups {
-        &self.groups
+        &self.queries.groups
     }
 }

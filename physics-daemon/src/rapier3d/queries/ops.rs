@@ -199,7 +199,7 @@ impl Plane {
     /// their bodies' poses and puts their boxes into the broad phase's tree, which queries
     /// walk. No time passes and no contact is computed (the step does that as always).
     pub(in crate::rapier3d) fn refresh_scene(&mut self) {
-        self.world.refresh_colliders(&mut self.query_stale);
+        self.world.refresh_colliders(&mut self.queries.stale);
     }
 
     pub(in crate::rapier3d) fn resolve(
@@ -208,7 +208,7 @@ impl Plane {
         own_body: Option<RigidBodyHandle>,
     ) -> Result<Resolved<'_>, CommandError> {
         let group_mask = match filter.collision_group {
-            Some(g) if !self.groups.is_registered(g) => {
+            Some(g) if !self.queries.groups.is_registered(g) => {
                 return Err(CommandError::invalid_field(
                     "CollisionGroup",
                     format!(
@@ -217,7 +217,7 @@ impl Plane {
                     ),
                 ))
             }
-            Some(g) => Some(self.groups.mask(g)),
+            Some(g) => Some(self.queries.groups.mask(g)),
             None => None,
         };
         Ok(Resolved {
