@@ -62,7 +62,7 @@ pub fn write(
     Ok((json_path, md_path))
 }
 
-/// Prints the page at `md_path` (written by [`write`]) to stdout.
+/// Prints the page at `md_path` (written by [`write()`]) to stdout.
 pub fn print(md_path: &Path) {
     match std::fs::read_to_string(md_path) {
         Ok(page) => println!("{page}"),
