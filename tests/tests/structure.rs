@@ -293,8 +293,8 @@ fn the_readme_to_add_table_names_files_that_exist() {
 }
 
 /// The paths docs/architecture.md's map names: the first fenced block under `## Map`; a line
-/// starting in the first column names a top folder (or file), a line indented by two spaces
-/// a path inside the last top folder, and deeper lines continue a description.
+/// starting in the first column names a path from the repository's root (its first word),
+/// indented lines continue its description.
 fn map_paths() -> Vec<String> {
     let doc = std::fs::read_to_string(repo().join("docs/architecture.md")).unwrap();
     let section = doc
@@ -305,21 +305,13 @@ fn map_paths() -> Vec<String> {
         .split("```")
         .nth(1)
         .expect("the map is a fenced block");
-    let mut out = Vec::new();
-    let mut top = String::new();
-    for line in block.lines().skip(1) {
-        let Some(first) = line.split_whitespace().next() else {
-            continue;
-        };
-        // Columns 0 and 2 name paths; deeper lines continue a description.
-        if !line.starts_with(' ') {
-            top = first.to_string();
-            out.push(top.clone());
-        } else if line.starts_with("  ") && !line.starts_with("   ") {
-            out.push(format!("{top}{first}"));
-        }
-    }
-    out
+    block
+        .lines()
+        .skip(1)
+        .filter(|line| !line.starts_with(' '))
+        .filter_map(|line| line.split_whitespace().next())
+        .map(String::from)
+        .collect()
 }
 
 #[test]
