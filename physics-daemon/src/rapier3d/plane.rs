@@ -23,10 +23,10 @@ use crate::rapier3d::controllers::Controllers;
 use crate::rapier3d::history::pose_mirror::PoseMirror;
 use crate::rapier3d::history::{publish, History};
 use crate::rapier3d::joints::table::Joints;
-use crate::rapier3d::objects::body_pass::{self, Scratch};
-use crate::rapier3d::objects::maps::PendingMap;
-use crate::rapier3d::objects::object::{body_state, Object, MAX_SLOTS};
-use crate::rapier3d::objects::tally::{Kept as TallyKept, Tally};
+use crate::rapier3d::objects::body_pass;
+use crate::rapier3d::objects::object::{body_state, Object};
+use crate::rapier3d::objects::tally::Kept as TallyKept;
+use crate::rapier3d::objects::Objects;
 use crate::rapier3d::queries::Queries;
 
 /// One rapier3d plane.
@@ -35,11 +35,9 @@ pub struct Plane {
     pub id: PlaneId,
     pub(super) settings: PlaneSettings,
     pub(super) world: PhysicsWorld,
-    pub(super) bodies: SlotTable<Object>,
-    /// Tallies over the objects' parts: per quality, driven, mesh vertices.
-    pub(super) tally: Tally,
-    /// Buffers of the per-body passes.
-    pub(super) pass: Scratch,
+    /// The objects: the slot table, the tallies over their parts, the body pass's buffers
+    /// and the pending map (see `objects`).
+    pub(super) objects: Objects,
     /// Objects a step must leave where it found them (see `held`).
     held: Vec<HeldIn<PhysicsWorld>>,
     /// The tick clock and the last step's figures (see `backend::clock`).
@@ -55,8 +53,6 @@ pub struct Plane {
     pub(super) queries: Queries,
     /// Joints (see `joints`).
     pub(super) joints: Joints,
-    /// Map pieces uploaded since the last build (see `maps`).
-    pub(super) map_pending: PendingMap,
     /// Bytes of controller paths (counted against the owner's quota).
     pub(super) state_bytes: crate::backend::counted::Counter,
     /// The state hash and pose mirror of the last step, the ticks kept for Rewind (see
@@ -74,9 +70,7 @@ impl Plane {
             id,
             settings,
             world,
-            bodies: SlotTable::tracked("object", MAX_SLOTS),
-            tally: Tally::default(),
-            pass: Scratch::default(),
+            objects: Objects::default(),
             held: Vec::new(),
             clock: Default::default(),
             adaptive: Adaptive::default(),
@@ -84,7 +78,6 @@ impl Plane {
             controllers: Default::default(),
             queries: Queries::default(),
             joints: Joints::default(),
-            map_pending: PendingMap::default(),
             state_bytes: Default::default(),
             history: History::default(),
         }
@@ -112,7 +105,7 @@ impl Plane {
             kind: PlaneKind::Rapier3d,
             settings: self.settings,
             tick: self.clock.tick,
-            object_count: self.bodies.live(),
+            object_count: self.objects.bodies.live(),
             effective_solver_iterations: self.solver_settings(self.nominal_dt()).iterations as u32,
             max_hit_box_quality: self.max_quality(),
         }
@@ -129,7 +122,7 @@ impl Plane {
         // last step. A settled plane keeps its hash without rehashing every slot.
         let moving = self.clock.tick == 0
             || self.world.islands.num_active_bodies() > 0
-            || !self.bodies.since_step().is_empty();
+            || !self.objects.bodies.since_step().is_empty();
         // The clock advances by the step as asked; the simulation takes at least a
         // nanosecond (see `MIN_DYNAMIC_DT`).
         let asked = dt;
@@ -162,7 +155,7 @@ impl Plane {
         held::after_step(&self.held, &mut self.world);
         self.queries.step_done();
         self.limit_speeds_after_step();
-        self.bodies.stepped();
+        self.objects.bodies.stepped();
         self.clock.advance(asked);
         self.collect_events();
         self.joints_after_step(dt);
@@ -192,8 +185,8 @@ impl Plane {
         self.clock.header(
             self.id,
             HeaderFigures {
-                slot_count: self.bodies.slot_count() as u32,
-                body_count: self.bodies.live(),
+                slot_count: self.objects.bodies.slot_count() as u32,
+                body_count: self.objects.bodies.live(),
                 max_joint_error: self.joints.max_error,
                 event_count: self.events.count(),
                 state_hash: self.history.hash(),
@@ -205,8 +198,11 @@ impl Plane {
     /// hash. The hash is one sequential chain over every slot; on the plane's pool it runs
     /// beside the contact figures (themselves split over the pool), not after them.
     fn figures_and_hash(&self, rehash: bool, mirror: &mut PoseMirror) -> ((f32, u32), Option<u64>) {
-        let (slots, bodies, narrow_phase) =
-            (&self.bodies, &self.world.bodies, &self.world.narrow_phase);
+        let (slots, bodies, narrow_phase) = (
+            &self.objects.bodies,
+            &self.world.bodies,
+            &self.world.narrow_phase,
+        );
         let marks = slots.marks_made();
         let hash = move || rehash.then(move || mirror.rehash(slots, bodies, marks));
         let pairs = narrow_phase.contact_graph().raw_graph().raw_edges().len();
@@ -228,8 +224,8 @@ impl Plane {
         moved.clear();
         let bodies = &self.world.bodies;
         moved.extend(
-            self.pass
-                .handles
+            self.objects
+                .passed()
                 .iter()
                 .filter_map(|h| bodies.get(*h))
                 .map(|b| b.user_data as u32),
@@ -252,7 +248,7 @@ impl Plane {
 
     /// Length of the published body array.
     pub fn slot_count(&self) -> usize {
-        self.bodies.slot_count()
+        self.objects.bodies.slot_count()
     }
 
     /// Slots of the bodies rapier simulates now (awake dynamic and kinematic ones). A body
@@ -276,7 +272,7 @@ impl Plane {
 
     /// The published state of slot `i` (dead slots carry only their generation).
     pub fn body_state(&self, i: usize) -> BodyState {
-        body_state(&self.bodies, &self.world.bodies, i)
+        body_state(&self.objects.bodies, &self.world.bodies, i)
     }
 
     /// [`crate::backend::Backend::write_states`] of this plane.
@@ -287,7 +283,7 @@ impl Plane {
     ) {
         publish::write_sample(
             self.history.mirror(),
-            &self.bodies,
+            &self.objects.bodies,
             &self.world,
             out,
             filter,
@@ -349,8 +345,8 @@ macro_rules! plane_state {
 plane_state! {
     world,
     pub(super) settings: PlaneSettings = settings,
-    pub(super) bodies: SlotTable<Object> = bodies,
-    pub(super) tally: TallyKept = tally.kept,
+    pub(super) bodies: SlotTable<Object> = objects.bodies,
+    pub(super) tally: TallyKept = objects.tally.kept,
     held: Vec<HeldIn<PhysicsWorld>> = held,
     pub(super) clock: crate::backend::Clock = clock,
     adaptive: Adaptive = adaptive,

@@ -120,6 +120,7 @@ impl Plane {
         let mut collider = ColliderBuilder::new(controller.shape()).build();
         part.configure_collider(&mut collider, self.queries.groups())?;
         let slot = self
+            .objects
             .bodies
             .next_slot()
             .ok_or_else(|| CommandError::invalid(format!("plane {} is full", self.id)))?;
@@ -132,8 +133,8 @@ impl Plane {
             .build();
         let h = self.world.insert_body(body);
         self.world.insert_collider(collider, Some(h));
-        self.tally.add(part.hit_box_quality, 0);
-        let handle = self.bodies.insert(Object {
+        self.objects.tally.add(part.hit_box_quality, 0);
+        let handle = self.objects.bodies.insert(Object {
             handle: h,
             part: Box::new(part),
             flags: shm_layout::FLAG_CONTROLLER,
@@ -190,7 +191,7 @@ impl Plane {
                 let size = c.size();
                 let shape = c.shape();
                 let h = self.body_of(handle)?;
-                self.bodies.get_mut(handle)?.part.size = size;
+                self.objects.bodies.get_mut(handle)?.part.size = size;
                 for col in self.world.bodies[h].colliders().to_vec() {
                     self.world.colliders[col].set_shape(shape.clone());
                 }

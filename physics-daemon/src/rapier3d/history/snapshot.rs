@@ -170,7 +170,7 @@ impl Plane {
         // snapshot of a named plane restored into another plane does not take the name.
         state.settings.name = self.settings.name;
         state.settings.persistent = self.settings.persistent;
-        state.bodies.adopt_limits(&self.bodies)?;
+        state.bodies.adopt_limits(&self.objects.bodies)?;
         state.joints.adopt_limits(&self.joints)?;
         // What is not state stays: the pipeline (the thread pool), the CCD workspace, the
         // table limits, the quota counter.
@@ -198,7 +198,7 @@ impl Plane {
 
     /// Becomes `state` (a copy this plane made with [`Plane::clone_state`]).
     pub(in crate::rapier3d) fn adopt_copy(&mut self, mut state: State) -> Result<(), CommandError> {
-        state.bodies.adopt_limits(&self.bodies)?;
+        state.bodies.adopt_limits(&self.objects.bodies)?;
         state.joints.adopt_limits(&self.joints)?;
         state.world.physics_pipeline = std::mem::take(&mut self.world.physics_pipeline);
         self.adopt(state, &[])
@@ -208,20 +208,24 @@ impl Plane {
     fn adopt(&mut self, mut state: State, overrides: &[PlaneProp]) -> Result<(), CommandError> {
         controllers::count_paths_in(&mut state.controllers, &self.state_bytes);
         let threads = state.settings.threads;
-        state.bodies.take_marks_of(&mut self.bodies);
+        state.bodies.take_marks_of(&mut self.objects.bodies);
         self.take_state(state);
         self.events.reset();
-        self.map_pending = Default::default();
+        self.objects.take_pending_map();
         // Derived from the parts (rebuilt, not stored).
-        self.tally
-            .recount_qualities(self.bodies.iter().map(|(_, b)| b.part.hit_box_quality));
+        self.objects.tally.recount_qualities(
+            self.objects
+                .bodies
+                .iter()
+                .map(|(_, b)| b.part.hit_box_quality),
+        );
         self.set_threads(threads)?;
         // Their mapping onto the engine (Gravity, NeverSleep; Threads is set above; DeferGpu
         // was refused as an override).
         for prop in overrides {
             self.apply_prop(*prop, true, &mut crate::rapier3d::offload::no_other_engine)?;
         }
-        self.bodies.mark_all();
+        self.objects.bodies.mark_all();
         Ok(())
     }
 }

@@ -18,22 +18,23 @@ impl Plane {
                 vertices,
                 triangles,
             } => {
-                let total = self.map_pending.triangles.len() + triangles.len();
+                let total = self.objects.pending_map().triangles.len() + triangles.len();
                 if total > MAX_MAP_TRIANGLES {
                     return Err(CommandError::invalid_field(
                         "Map.triangles",
                         format!("a map holds at most {MAX_MAP_TRIANGLES} triangles, this upload makes {total}"),
                     ));
                 }
-                let base = self.map_pending.vertices.len() as u32;
-                self.map_pending.vertices.extend_from_slice(&vertices);
-                self.map_pending
+                let pending = self.objects.pending_map_mut();
+                let base = pending.vertices.len() as u32;
+                pending.vertices.extend_from_slice(&vertices);
+                pending
                     .triangles
                     .extend(triangles.iter().map(|t| t.map(|i| i + base)));
                 Ok(Reply::Done)
             }
             MapOp::Discard => {
-                self.map_pending = PendingMap::default();
+                self.objects.take_pending_map();
                 Ok(Reply::Done)
             }
             MapOp::Build {
@@ -42,7 +43,7 @@ impl Plane {
                 vertices,
                 triangles,
             } => {
-                let pending = std::mem::take(&mut self.map_pending);
+                let pending = self.objects.take_pending_map();
                 let got = (
                     pending.vertices.len() as u64,
                     pending.triangles.len() as u64,
@@ -116,7 +117,7 @@ impl Plane {
         let part = Part::map(shape, hash, size, pending.cost());
         let mut collider = ColliderBuilder::new(part.collider_shape()?).build();
         part.configure_collider(&mut collider, self.queries.groups())?;
-        let slot = self.bodies.next_slot().ok_or_else(|| {
+        let slot = self.objects.bodies.next_slot().ok_or_else(|| {
             CommandError::new(
                 ErrorKind::Internal,
                 format!("plane {} is full ({} objects)", self.id, MAX_SLOTS),
@@ -128,9 +129,10 @@ impl Plane {
             .build();
         let h = self.world.insert_body(body);
         self.world.insert_collider(collider, Some(h));
-        self.tally
+        self.objects
+            .tally
             .add(part.hit_box_quality, part.mesh_vertex_count() as u64);
-        let handle = self.bodies.insert(Object {
+        let handle = self.objects.bodies.insert(Object {
             handle: h,
             part: Box::new(part),
             flags: 0,

@@ -26,7 +26,7 @@ impl Plane {
         let part = Part::new(shape);
         let mut collider = ColliderBuilder::new(part.collider_shape()?).build();
         part.configure_collider(&mut collider, self.queries.groups())?;
-        let slot = self.bodies.next_slot().ok_or_else(|| {
+        let slot = self.objects.bodies.next_slot().ok_or_else(|| {
             CommandError::new(
                 ErrorKind::Internal,
                 format!("plane {} is full ({MAX_SLOTS} objects)", self.id),
@@ -42,9 +42,10 @@ impl Plane {
         let h = self.world.insert_body(body);
         self.world.insert_collider(collider, Some(h));
         part.configure_body(&mut self.world.bodies[h], &self.world.colliders);
-        self.tally
+        self.objects
+            .tally
             .add(part.hit_box_quality, shape.mesh_vertices() as u64);
-        let handle = self.bodies.insert(Object {
+        let handle = self.objects.bodies.insert(Object {
             handle: h,
             part: Box::new(part),
             flags: 0,
@@ -62,7 +63,8 @@ impl Plane {
         &self,
         handle: Handle,
     ) -> Result<RigidBodyHandle, CommandError> {
-        self.bodies
+        self.objects
+            .bodies
             .get(handle)
             .map(|b| b.handle)
             .map_err(|e| self.in_plane(e))
@@ -75,7 +77,7 @@ impl Plane {
         &mut self,
         handle: Handle,
     ) -> Result<RigidBodyHandle, CommandError> {
-        match self.bodies.get_mut(handle) {
+        match self.objects.bodies.get_mut(handle) {
             Ok(b) => Ok(b.handle),
             Err(e) => Err(self.in_plane(e)),
         }
@@ -95,7 +97,7 @@ impl Plane {
             return self.events.removed_owner(collider);
         };
         let slot = self.world.bodies.get(c.parent()?)?.user_data as usize;
-        self.bodies.handle_at(slot)
+        self.objects.bodies.handle_at(slot)
     }
 
     /// Velocity-space impulse: `Δv = impulse / mass`; anchored bodies absorb it. Returns
@@ -121,12 +123,16 @@ impl Plane {
     pub fn destroy_object(&mut self, handle: Handle) -> Result<(), CommandError> {
         let Object {
             handle: h, part, ..
-        } = self.bodies.remove(handle).map_err(|e| self.in_plane(e))?;
+        } = self
+            .objects
+            .bodies
+            .remove(handle)
+            .map_err(|e| self.in_plane(e))?;
         self.controllers.remove(&handle.slot);
         if part.report_contacts {
             self.events.count_reporting(false);
         }
-        self.tally.remove(
+        self.objects.tally.remove(
             part.hit_box_quality,
             part.mesh_vertex_count() as u64,
             part.is_driven(),
@@ -178,6 +184,11 @@ impl Plane {
 
     /// The part of a live handle (checked by the caller).
     pub(in crate::rapier3d) fn part(&self, handle: Handle) -> &Part {
-        &self.bodies.get(handle).expect("checked handle").part
+        &self
+            .objects
+            .bodies
+            .get(handle)
+            .expect("checked handle")
+            .part
     }
 }

@@ -19,17 +19,21 @@ impl Plane {
         let p = &mut self.world.integration_parameters;
         p.normalized_max_linear_velocity = self.settings.max_linear_speed / p.length_unit;
         let inputs = Inputs {
-            forces: Env::new(&self.settings, self.world.gravity, self.tally.driven(), dt),
+            forces: Env::new(
+                &self.settings,
+                self.world.gravity,
+                self.objects.tally.driven(),
+                dt,
+            ),
             max_angular_speed: self.settings.max_angular_speed,
             prediction: Prediction::new(&self.world, dt),
         };
-        self.pass
-            .prepare_bodies(&mut self.world, &self.bodies, &inputs);
+        self.objects.prepare_bodies(&mut self.world, &inputs);
     }
 
     /// After a step: caps the angular speed of the awake bodies (MaxAngularSpeed).
     pub(in crate::rapier3d) fn limit_speeds_after_step(&mut self) {
         let max = self.settings.max_angular_speed;
-        self.pass.cap_angular_speeds(&mut self.world, max);
+        self.objects.cap_angular_speeds(&mut self.world, max);
     }
 }
