@@ -124,7 +124,7 @@ impl Backend for Plane {
     }
 
     fn drain_dirty(&mut self, into: &mut Vec<u32>) -> bool {
-        self.objects.bodies.drain_marks(into)
+        self.objects.drain_marks(into)
     }
 
     fn body_state(&self, i: usize) -> BodyState {
@@ -145,8 +145,8 @@ impl Backend for Plane {
 
     fn usage(&self) -> Usage {
         Usage {
-            objects: self.objects.bodies.live() as u64 + self.joints.live() as u64,
-            mesh_vertices: self.objects.tally.mesh_vertices() + self.objects.pending_map().cost(),
+            objects: self.objects.live() as u64 + self.joints.live() as u64,
+            mesh_vertices: self.objects.tally().mesh_vertices() + self.objects.pending_map().cost(),
             state_bytes: self.state_bytes.get(),
         }
     }

@@ -45,7 +45,7 @@ fn plane(damped: bool) -> Plane {
 }
 
 fn x_and_vx(p: &Plane, h: Handle) -> (f32, f32) {
-    let b = &p.world.bodies[p.objects.bodies.get(h).unwrap().handle];
+    let b = &p.world.bodies[p.objects.get(h).unwrap().handle];
     (b.translation().x, b.linvel().x)
 }
 

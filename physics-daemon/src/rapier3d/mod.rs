@@ -3,8 +3,9 @@
 //! publisher writes what it reports.
 //!
 //! Layers, lowest first (a file imports only files of its own layer's parts or below):
-//! - the parts' state and the free functions over it: `objects/` (the slot table's bodies,
-//!   parts, tallies, the body pass, forces, speed limits, maps), `joints/` (joint table,
+//! - the parts' state and the free functions over it: `objects/` (`objects/mod.rs`: the
+//!   objects' part, the slot table's bodies with their tallies, the body pass's buffers and
+//!   the pending map; parts, the body pass, forces, speed limits, maps), `joints/` (joint table,
 //!   motors, articulations), `contacts/` (the event log, contact hooks and figures, thin
 //!   colliders, clipped and capsule contacts), `history/` (the history part: state hash,
 //!   pose mirror, publishing, the rollback ring), `queries/mod.rs` (the queries' part: the

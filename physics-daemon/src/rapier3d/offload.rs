@@ -115,8 +115,8 @@ impl Plane {
         if !self.controllers.is_empty() {
             return Some(format!("{} character controllers", self.controllers.len()));
         }
-        for slot in 0..self.objects.bodies.slot_count() {
-            let Some(body) = self.objects.bodies.at(slot) else {
+        for slot in 0..self.objects.slot_count() {
+            let Some(body) = self.objects.at(slot) else {
                 continue;
             };
             let part = &body.part;
@@ -136,7 +136,7 @@ impl Plane {
 
     /// Slot `slot` as a simplified engine takes it (`None`: no live object there).
     pub fn simple_body(&self, slot: usize) -> Option<SimpleBody> {
-        let b = self.objects.bodies.at(slot)?;
+        let b = self.objects.at(slot)?;
         let body = self.world.bodies.get(b.handle)?;
         let part = &b.part;
         let pose = body.position();
@@ -181,7 +181,7 @@ impl Plane {
     /// Writes `p` (pose and velocities from the other engine) into slot `slot`'s rapier
     /// body, so ops and queries see it.
     pub fn set_simple_pose(&mut self, slot: usize, p: SimplePose) {
-        let Some(b) = self.objects.bodies.at(slot) else {
+        let Some(b) = self.objects.at(slot) else {
             return;
         };
         let h = b.handle;
@@ -205,7 +205,7 @@ impl Plane {
 
     /// Whether `handle` names a live object.
     pub fn is_live(&self, handle: Handle) -> bool {
-        self.objects.bodies.get(handle).is_ok()
+        self.objects.get(handle).is_ok()
     }
 
     /// Wakes every body (motion handed back to rapier).
@@ -235,7 +235,7 @@ impl Plane {
         self.clock.max_penetration = max_penetration;
         self.clock.contact_pairs = contact_pairs;
         self.events.clear_step();
-        self.objects.bodies.stepped();
+        self.objects.stepped();
         self.clock.advance(dt);
         self.history.stepped_elsewhere(state_hash);
         self.clock.timed(started);
@@ -244,8 +244,8 @@ impl Plane {
     /// The published state of slot `i` with its pose from the other engine (`pose`: what
     /// that engine holds for the slot; `None` or a dead slot: only the generation).
     pub fn state_with_pose(&self, i: usize, pose: Option<SimplePose>) -> BodyState {
-        let generation = self.objects.bodies.generation(i);
-        let Some((p, b)) = pose.zip(self.objects.bodies.at(i)) else {
+        let generation = self.objects.generation(i);
+        let Some((p, b)) = pose.zip(self.objects.at(i)) else {
             return BodyState {
                 generation,
                 ..BodyState::default()

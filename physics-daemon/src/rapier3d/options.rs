@@ -50,7 +50,7 @@ impl Plane {
         if prop.changes_forces() {
             self.world.wake_up_all(true);
         }
-        self.objects.bodies.mark_all();
+        self.objects.mark_all();
         Ok(())
     }
 

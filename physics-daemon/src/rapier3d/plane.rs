@@ -105,7 +105,7 @@ impl Plane {
             kind: PlaneKind::Rapier3d,
             settings: self.settings,
             tick: self.clock.tick,
-            object_count: self.objects.bodies.live(),
+            object_count: self.objects.live(),
             effective_solver_iterations: self.solver_settings(self.nominal_dt()).iterations as u32,
             max_hit_box_quality: self.max_quality(),
         }
@@ -122,7 +122,7 @@ impl Plane {
         // last step. A settled plane keeps its hash without rehashing every slot.
         let moving = self.clock.tick == 0
             || self.world.islands.num_active_bodies() > 0
-            || !self.objects.bodies.since_step().is_empty();
+            || !self.objects.since_step().is_empty();
         // The clock advances by the step as asked; the simulation takes at least a
         // nanosecond (see `MIN_DYNAMIC_DT`).
         let asked = dt;
@@ -155,7 +155,7 @@ impl Plane {
         held::after_step(&self.held, &mut self.world);
         self.queries.step_done();
         self.limit_speeds_after_step();
-        self.objects.bodies.stepped();
+        self.objects.stepped();
         self.clock.advance(asked);
         self.collect_events();
         self.joints_after_step(dt);
@@ -185,8 +185,8 @@ impl Plane {
         self.clock.header(
             self.id,
             HeaderFigures {
-                slot_count: self.objects.bodies.slot_count() as u32,
-                body_count: self.objects.bodies.live(),
+                slot_count: self.objects.slot_count() as u32,
+                body_count: self.objects.live(),
                 max_joint_error: self.joints.max_error,
                 event_count: self.events.count(),
                 state_hash: self.history.hash(),
@@ -199,7 +199,7 @@ impl Plane {
     /// beside the contact figures (themselves split over the pool), not after them.
     fn figures_and_hash(&self, rehash: bool, mirror: &mut PoseMirror) -> ((f32, u32), Option<u64>) {
         let (slots, bodies, narrow_phase) = (
-            &self.objects.bodies,
+            self.objects.table(),
             &self.world.bodies,
             &self.world.narrow_phase,
         );
@@ -248,7 +248,7 @@ impl Plane {
 
     /// Length of the published body array.
     pub fn slot_count(&self) -> usize {
-        self.objects.bodies.slot_count()
+        self.objects.slot_count()
     }
 
     /// Slots of the bodies rapier simulates now (awake dynamic and kinematic ones). A body
@@ -272,7 +272,7 @@ impl Plane {
 
     /// The published state of slot `i` (dead slots carry only their generation).
     pub fn body_state(&self, i: usize) -> BodyState {
-        body_state(&self.objects.bodies, &self.world.bodies, i)
+        body_state(self.objects.table(), &self.world.bodies, i)
     }
 
     /// [`crate::backend::Backend::write_states`] of this plane.
@@ -283,7 +283,7 @@ impl Plane {
     ) {
         publish::write_sample(
             self.history.mirror(),
-            &self.objects.bodies,
+            self.objects.table(),
             &self.world,
             out,
             filter,

@@ -71,7 +71,7 @@ impl Plane {
     }
 
     pub(super) fn max_quality(&self) -> u32 {
-        self.objects.tally.max_quality()
+        self.objects.tally().max_quality()
     }
 
     /// The step length the solver settings are computed for when no step gives one (plane

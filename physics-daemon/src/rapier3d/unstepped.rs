@@ -39,10 +39,7 @@ fn writes_to_a_plane_that_never_steps_keep_its_marks_bounded() {
         Backend::apply(&mut plane, op).unwrap();
         // 200,000 writes to 10 cubes: at most FOLD_MIN entries each list, not 200,000.
         assert!(plane.queries.stale_count() <= FOLD_MIN, "write {i}");
-        assert!(
-            plane.objects.bodies.since_step().len() <= FOLD_MIN,
-            "write {i}"
-        );
+        assert!(plane.objects.since_step().len() <= FOLD_MIN, "write {i}");
     }
     // What the lists are for still holds: the publisher is told every written slot.
     let mut slots = Vec::new();

@@ -121,7 +121,6 @@ impl Plane {
         part.configure_collider(&mut collider, self.queries.groups())?;
         let slot = self
             .objects
-            .bodies
             .next_slot()
             .ok_or_else(|| CommandError::invalid(format!("plane {} is full", self.id)))?;
         let body = RigidBodyBuilder::kinematic_position_based()
@@ -133,8 +132,8 @@ impl Plane {
             .build();
         let h = self.world.insert_body(body);
         self.world.insert_collider(collider, Some(h));
-        self.objects.tally.add(part.hit_box_quality, 0);
-        let handle = self.objects.bodies.insert(Object {
+        self.objects.tally_mut().add(part.hit_box_quality, 0);
+        let handle = self.objects.insert(Object {
             handle: h,
             part: Box::new(part),
             flags: shm_layout::FLAG_CONTROLLER,
@@ -191,7 +190,7 @@ impl Plane {
                 let size = c.size();
                 let shape = c.shape();
                 let h = self.body_of(handle)?;
-                self.objects.bodies.get_mut(handle)?.part.size = size;
+                self.objects.get_mut(handle)?.part.size = size;
                 for col in self.world.bodies[h].colliders().to_vec() {
                     self.world.colliders[col].set_shape(shape.clone());
                 }

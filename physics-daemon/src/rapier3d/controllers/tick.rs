@@ -122,7 +122,7 @@ impl Plane {
         // pass at the end (inserting them one by one cost more than some of their ticks).
         let mut done = Vec::with_capacity(self.controllers.len());
         for (slot, c) in std::mem::take(&mut self.controllers) {
-            let Some(handle) = self.objects.bodies.handle_at(slot as usize) else {
+            let Some(handle) = self.objects.handle_at(slot as usize) else {
                 continue; // its object is gone
             };
             match self.body_of(handle) {
@@ -253,7 +253,7 @@ impl Plane {
                     .set_aabb(&world.integration_parameters, *col, aabb);
             }
         }
-        if let Ok(b) = self.objects.bodies.get_mut(handle) {
+        if let Ok(b) = self.objects.get_mut(handle) {
             b.flags = shm_layout::FLAG_CONTROLLER
                 | if c.on_ground {
                     shm_layout::FLAG_ON_GROUND

@@ -274,7 +274,7 @@ mod tests {
             plane
                 .history
                 .mirror
-                .current(plane.objects.bodies.marks_made(), 20)
+                .current(plane.objects.marks_made(), 20)
                 .is_none(),
             "not before a step"
         );
@@ -283,7 +283,7 @@ mod tests {
             plane
                 .history
                 .mirror
-                .current(plane.objects.bodies.marks_made(), 20)
+                .current(plane.objects.marks_made(), 20)
                 .is_some(),
             "written by the step"
         );
@@ -298,7 +298,7 @@ mod tests {
             plane
                 .history
                 .mirror
-                .current(plane.objects.bodies.marks_made(), 20)
+                .current(plane.objects.marks_made(), 20)
                 .is_none(),
             "an op since"
         );
@@ -313,7 +313,7 @@ mod tests {
             plane
                 .history
                 .mirror
-                .current(plane.objects.bodies.marks_made(), 20)
+                .current(plane.objects.marks_made(), 20)
                 .is_none(),
             "a plane-wide set"
         );
@@ -327,7 +327,7 @@ mod tests {
             plane
                 .history
                 .mirror
-                .current(plane.objects.bodies.marks_made(), 21)
+                .current(plane.objects.marks_made(), 21)
                 .is_none(),
             "a new slot"
         );

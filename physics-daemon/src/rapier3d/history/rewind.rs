@@ -35,7 +35,7 @@ impl Plane {
         let copy = Box::new(self.clone_state());
         let counted = CountedBytes::new(
             &self.state_bytes,
-            BYTES_PER_SLOT * self.objects.bodies.slot_count() as u64,
+            BYTES_PER_SLOT * self.objects.slot_count() as u64,
         );
         self.history
             .rollback

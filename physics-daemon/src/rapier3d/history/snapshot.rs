@@ -170,7 +170,7 @@ impl Plane {
         // snapshot of a named plane restored into another plane does not take the name.
         state.settings.name = self.settings.name;
         state.settings.persistent = self.settings.persistent;
-        state.bodies.adopt_limits(&self.objects.bodies)?;
+        state.bodies.adopt_limits(self.objects.table())?;
         state.joints.adopt_limits(&self.joints)?;
         // What is not state stays: the pipeline (the thread pool), the CCD workspace, the
         // table limits, the quota counter.
@@ -198,7 +198,7 @@ impl Plane {
 
     /// Becomes `state` (a copy this plane made with [`Plane::clone_state`]).
     pub(in crate::rapier3d) fn adopt_copy(&mut self, mut state: State) -> Result<(), CommandError> {
-        state.bodies.adopt_limits(&self.objects.bodies)?;
+        state.bodies.adopt_limits(self.objects.table())?;
         state.joints.adopt_limits(&self.joints)?;
         state.world.physics_pipeline = std::mem::take(&mut self.world.physics_pipeline);
         self.adopt(state, &[])
@@ -208,24 +208,19 @@ impl Plane {
     fn adopt(&mut self, mut state: State, overrides: &[PlaneProp]) -> Result<(), CommandError> {
         controllers::count_paths_in(&mut state.controllers, &self.state_bytes);
         let threads = state.settings.threads;
-        state.bodies.take_marks_of(&mut self.objects.bodies);
+        self.objects.hand_marks_to(&mut state.bodies);
         self.take_state(state);
         self.events.reset();
         self.objects.take_pending_map();
         // Derived from the parts (rebuilt, not stored).
-        self.objects.tally.recount_qualities(
-            self.objects
-                .bodies
-                .iter()
-                .map(|(_, b)| b.part.hit_box_quality),
-        );
+        self.objects.recount_qualities();
         self.set_threads(threads)?;
         // Their mapping onto the engine (Gravity, NeverSleep; Threads is set above; DeferGpu
         // was refused as an override).
         for prop in overrides {
             self.apply_prop(*prop, true, &mut crate::rapier3d::offload::no_other_engine)?;
         }
-        self.objects.bodies.mark_all();
+        self.objects.mark_all();
         Ok(())
     }
 }

@@ -35,7 +35,7 @@ fn info(p: &mut Plane, j: Handle) -> shm_layout::joint_op::JointInfo {
 }
 
 fn rb(p: &Plane, h: Handle) -> &RigidBody {
-    &p.world.bodies[p.objects.bodies.get(h).unwrap().handle]
+    &p.world.bodies[p.objects.get(h).unwrap().handle]
 }
 
 fn sphere(p: &mut Plane, at: [f32; 3], radius: f32, weight: f32) -> Handle {

@@ -261,7 +261,7 @@ impl Plane {
     /// rotation lock: a part a joint holds is free to rotate (see
     /// `Part::rotation_locked_by_quality`).
     pub(in crate::rapier3d::joints) fn joint_holds(&mut self, object: Handle, delta: i32) {
-        let Ok(body) = self.objects.bodies.get_mut(object) else {
+        let Ok(body) = self.objects.get_mut(object) else {
             return; // gone with its joint
         };
         let h = body.handle;

@@ -113,7 +113,7 @@ fn joints_of_quarantined_bodies_are_parked_instead_of_panicking_the_solver() {
     step(&mut p, 0, 1.0 / 60.0);
     let bodies: Vec<_> = [a, b, c]
         .iter()
-        .map(|h| p.objects.bodies.get(*h).unwrap().handle)
+        .map(|h| p.objects.get(*h).unwrap().handle)
         .collect();
     for h in &bodies {
         p.world.bodies[*h].set_enabled(false);
@@ -206,7 +206,7 @@ fn tiny_steps_leave_forced_bodies_enabled() {
     .unwrap();
     p.step(1.0e-45).unwrap();
     p.step(1.0 / 60.0).unwrap();
-    let body = &p.world.bodies[p.objects.bodies.get(a).unwrap().handle];
+    let body = &p.world.bodies[p.objects.get(a).unwrap().handle];
     assert!(body.is_enabled(), "quarantined by a tiny step");
     assert!(body.translation().is_finite() && body.linvel().is_finite());
     // Gravity (-50) and the force (+1 on weight 1) over the 1/60 s step.
@@ -277,7 +277,7 @@ fn articulations_with_motors_survive_tiny_steps() {
             }
             assert_eq!(p.tick(), steps.len() as u64);
             for h in [a, b, c] {
-                let body = &p.world.bodies[p.objects.bodies.get(h).unwrap().handle];
+                let body = &p.world.bodies[p.objects.get(h).unwrap().handle];
                 assert!(
                     body.translation().is_finite() && body.linvel().is_finite(),
                     "{kind:?}, tiny {tiny:e}: {:?} {:?}",
@@ -470,7 +470,7 @@ fn random_joint_sequences_never_panic_the_solver() {
                 8 if !objs.is_empty() && rnd(4) == 0 => {
                     // What rapier's quarantine does to a body gone non-finite.
                     let h = objs[rnd(objs.len() as u64) as usize];
-                    if let Ok(b) = p.objects.bodies.get(h) {
+                    if let Ok(b) = p.objects.get(h) {
                         let on = rnd(3) == 0;
                         p.world.bodies[b.handle].set_enabled(on);
                     }

@@ -281,7 +281,7 @@ mod tests {
         for _ in 0..3 {
             p.step(1.0 / 60.0).unwrap();
         }
-        let body = &p.world.bodies[p.objects.bodies.get(h).unwrap().handle];
+        let body = &p.world.bodies[p.objects.get(h).unwrap().handle];
         assert!(body.is_enabled(), "quarantined");
         let (x, v) = (body.translation(), body.linvel());
         assert!(x.is_finite() && v.is_finite(), "{x:?} {v:?}");

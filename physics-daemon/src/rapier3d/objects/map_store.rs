@@ -224,7 +224,7 @@ mod tests {
         }
         assert_eq!(restored.header().state_hash, mapped.header().state_hash);
         // The balls rest on the map (contacts with it were part of the continuation).
-        let ball = restored.objects.bodies.iter().nth(1).unwrap().1.handle;
+        let ball = restored.objects.iter().nth(1).unwrap().1.handle;
         let y = restored.world.bodies[ball].translation().y;
         assert!(
             (y - 1002.5).abs() < 0.4,

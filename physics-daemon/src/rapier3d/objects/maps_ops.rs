@@ -117,7 +117,7 @@ impl Plane {
         let part = Part::map(shape, hash, size, pending.cost());
         let mut collider = ColliderBuilder::new(part.collider_shape()?).build();
         part.configure_collider(&mut collider, self.queries.groups())?;
-        let slot = self.objects.bodies.next_slot().ok_or_else(|| {
+        let slot = self.objects.next_slot().ok_or_else(|| {
             CommandError::new(
                 ErrorKind::Internal,
                 format!("plane {} is full ({} objects)", self.id, MAX_SLOTS),
@@ -132,7 +132,7 @@ impl Plane {
         self.objects
             .tally
             .add(part.hit_box_quality, part.mesh_vertex_count() as u64);
-        let handle = self.objects.bodies.insert(Object {
+        let handle = self.objects.insert(Object {
             handle: h,
             part: Box::new(part),
             flags: 0,

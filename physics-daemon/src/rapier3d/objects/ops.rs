@@ -26,7 +26,7 @@ impl Plane {
         let part = Part::new(shape);
         let mut collider = ColliderBuilder::new(part.collider_shape()?).build();
         part.configure_collider(&mut collider, self.queries.groups())?;
-        let slot = self.objects.bodies.next_slot().ok_or_else(|| {
+        let slot = self.objects.next_slot().ok_or_else(|| {
             CommandError::new(
                 ErrorKind::Internal,
                 format!("plane {} is full ({MAX_SLOTS} objects)", self.id),
@@ -45,7 +45,7 @@ impl Plane {
         self.objects
             .tally
             .add(part.hit_box_quality, shape.mesh_vertices() as u64);
-        let handle = self.objects.bodies.insert(Object {
+        let handle = self.objects.insert(Object {
             handle: h,
             part: Box::new(part),
             flags: 0,
@@ -64,7 +64,6 @@ impl Plane {
         handle: Handle,
     ) -> Result<RigidBodyHandle, CommandError> {
         self.objects
-            .bodies
             .get(handle)
             .map(|b| b.handle)
             .map_err(|e| self.in_plane(e))
@@ -77,7 +76,7 @@ impl Plane {
         &mut self,
         handle: Handle,
     ) -> Result<RigidBodyHandle, CommandError> {
-        match self.objects.bodies.get_mut(handle) {
+        match self.objects.get_mut(handle) {
             Ok(b) => Ok(b.handle),
             Err(e) => Err(self.in_plane(e)),
         }
@@ -97,7 +96,7 @@ impl Plane {
             return self.events.removed_owner(collider);
         };
         let slot = self.world.bodies.get(c.parent()?)?.user_data as usize;
-        self.objects.bodies.handle_at(slot)
+        self.objects.handle_at(slot)
     }
 
     /// Velocity-space impulse: `Δv = impulse / mass`; anchored bodies absorb it. Returns
@@ -123,16 +122,12 @@ impl Plane {
     pub fn destroy_object(&mut self, handle: Handle) -> Result<(), CommandError> {
         let Object {
             handle: h, part, ..
-        } = self
-            .objects
-            .bodies
-            .remove(handle)
-            .map_err(|e| self.in_plane(e))?;
+        } = self.objects.remove(handle).map_err(|e| self.in_plane(e))?;
         self.controllers.remove(&handle.slot);
         if part.report_contacts {
             self.events.count_reporting(false);
         }
-        self.objects.tally.remove(
+        self.objects.tally_mut().remove(
             part.hit_box_quality,
             part.mesh_vertex_count() as u64,
             part.is_driven(),
@@ -184,11 +179,6 @@ impl Plane {
 
     /// The part of a live handle (checked by the caller).
     pub(in crate::rapier3d) fn part(&self, handle: Handle) -> &Part {
-        &self
-            .objects
-            .bodies
-            .get(handle)
-            .expect("checked handle")
-            .part
+        &self.objects.get(handle).expect("checked handle").part
     }
 }

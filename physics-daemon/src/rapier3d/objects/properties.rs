@@ -15,13 +15,13 @@ impl Plane {
         let prop = prop.checked()?;
         self.check_object_prop(handle, &prop)?;
         let h = self.changing(handle)?;
-        let before = Counted::of(&self.objects.bodies.get(handle)?.part);
+        let before = Counted::of(&self.objects.get(handle)?.part);
         let touched = self.apply_to_body(handle, h, prop)?;
         if let ObjectProp::Held(on) = prop {
             self.set_held(h, on);
         }
         self.reconfigure(handle, h, touched)?;
-        self.recount(before, Counted::of(&self.objects.bodies.get(handle)?.part));
+        self.recount(before, Counted::of(&self.objects.get(handle)?.part));
         self.queries.mark_stale(h);
         // Any change may need the body awake and seen by the next force pass.
         self.world.bodies[h].wake_up(true);
@@ -42,7 +42,7 @@ impl Plane {
                 ));
             }
         }
-        if self.objects.bodies.get(handle)?.part.map.is_some() {
+        if self.objects.get(handle)?.part.map.is_some() {
             crate::rapier3d::objects::maps::check_map_prop(prop)?;
         }
         Ok(())
@@ -56,7 +56,7 @@ impl Plane {
         h: RigidBodyHandle,
         prop: ObjectProp,
     ) -> Result<Touched, CommandError> {
-        let part = &mut self.objects.bodies.get_mut(handle)?.part;
+        let part = &mut self.objects.get_mut(handle)?.part;
         let was_reporting = part.report_contacts;
         let stored = part.settings.store(&prop);
         debug_assert_eq!(
@@ -120,7 +120,7 @@ impl Plane {
         h: RigidBodyHandle,
         touched: Touched,
     ) -> Result<(), CommandError> {
-        let part = &self.objects.bodies.get(handle)?.part;
+        let part = &self.objects.get(handle)?.part;
         let mut body_changed = touched.body;
         if touched.shape {
             // Rapier recycles the contacts of pairs whose poses did not move, even when a
@@ -148,10 +148,12 @@ impl Plane {
     /// Keeps the plane's per-part counts (objects per quality, driven, reporting) in step
     /// with one part's change.
     fn recount(&mut self, before: Counted, after: Counted) {
-        self.objects.tally.requalify(before.quality, after.quality);
+        self.objects
+            .tally_mut()
+            .requalify(before.quality, after.quality);
         match (before.driven, after.driven) {
-            (false, true) => self.objects.tally.count_driven(true),
-            (true, false) => self.objects.tally.count_driven(false),
+            (false, true) => self.objects.tally_mut().count_driven(true),
+            (true, false) => self.objects.tally_mut().count_driven(false),
             _ => {}
         }
         match (before.reporting, after.reporting) {

@@ -22,7 +22,7 @@ impl Plane {
             forces: Env::new(
                 &self.settings,
                 self.world.gravity,
-                self.objects.tally.driven(),
+                self.objects.tally().driven(),
                 dt,
             ),
             max_angular_speed: self.settings.max_angular_speed,

@@ -10,8 +10,8 @@ impl Plane {
     /// longer registered return to "Default"; every collider takes its new filter.
     pub fn set_collision_groups(&mut self, table: CollisionGroups) -> Result<(), CommandError> {
         self.queries.groups = table.checked()?;
-        for i in 0..self.objects.bodies.slot_count() {
-            let Some(body) = self.objects.bodies.at_mut(i) else {
+        for i in 0..self.objects.slot_count() {
+            let Some(body) = self.objects.at_mut(i) else {
                 continue;
             };
             let part = &mut body.part;

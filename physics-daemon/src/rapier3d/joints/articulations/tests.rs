@@ -46,7 +46,7 @@ fn a_pushed_pendulum_bob_takes_the_push_once() {
         op: ObjectOp::Set(ObjectProp::Velocity([5.0, 0.0, 0.0])),
     })
     .unwrap();
-    let h = p.objects.bodies.get(bob).unwrap().handle;
+    let h = p.objects.get(bob).unwrap().handle;
     for i in 0..6 {
         p.step(1.0 / 240.0).unwrap();
         let b = &p.world.bodies[h];
@@ -95,7 +95,7 @@ fn a_heavy_ended_chain_publishes_finite_states() {
     }
     for t in 0..900 {
         p.step(1.0 / 60.0).unwrap();
-        for i in 0..p.objects.bodies.slot_count() {
+        for i in 0..p.objects.slot_count() {
             let s = p.body_state(i);
             assert!(s.is_finite(), "tick {t} slot {i}: {s:?}");
         }
@@ -156,8 +156,8 @@ fn a_push_on_a_free_articulation_keeps_its_momentum() {
         p.step(1.0 / 60.0).unwrap();
     }
     let (ha, hb) = (
-        p.objects.bodies.get(a).unwrap().handle,
-        p.objects.bodies.get(b).unwrap().handle,
+        p.objects.get(a).unwrap().handle,
+        p.objects.get(b).unwrap().handle,
     );
     let v = (p.world.bodies[ha].linvel() + p.world.bodies[hb].linvel()) * 0.5;
     assert!(
