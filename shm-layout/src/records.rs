@@ -173,6 +173,16 @@ impl StateHasher {
         h.finish()
     }
 
+    /// The hash of `count` slots whose states `state(i)` gives, in slot order (a plane's
+    /// states without copying them into a slice first).
+    pub fn of_slots(count: usize, mut state: impl FnMut(usize) -> BodyState) -> u64 {
+        let mut h = StateHasher::new();
+        for i in 0..count {
+            h.add(&state(i));
+        }
+        h.finish()
+    }
+
     /// A hash that goes on from `state`, the [`StateHasher::finish`] of the slots before:
     /// adding the remaining slots gives the hash of them all. A writer that keeps each
     /// slot's running hash can then rehash from the first slot that changed only.

@@ -255,11 +255,7 @@ impl GpuPlane {
         if self.gpu.is_none() {
             return self.plane.state_hash();
         }
-        let mut h = StateHasher::new();
-        for i in 0..self.plane.slot_count() {
-            h.add(&self.body_state(i));
-        }
-        h.finish()
+        StateHasher::of_slots(self.plane.slot_count(), |i| self.body_state(i))
     }
 
     /// Number of slots that may move in the next step (every slot on the GPU).

@@ -294,11 +294,7 @@ impl Plane {
     /// [`StateHasher`] over every slot's published state, in slot order (what the tick
     /// header carries: any reader can recompute it from the sample's bodies).
     pub fn state_hash(&self) -> u64 {
-        let mut h = StateHasher::new();
-        for i in 0..self.slot_count() {
-            h.add(&self.body_state(i));
-        }
-        h.finish()
+        StateHasher::of_slots(self.slot_count(), |i| self.body_state(i))
     }
 
     /// Length of the published body array.

@@ -239,11 +239,7 @@ impl Plane {
     /// reader recomputes it from the sample's bodies; ops applied since show in the next
     /// tick's.
     pub fn state_hash(&self) -> u64 {
-        let mut h = StateHasher::new();
-        for i in 0..self.slot_count() {
-            h.add(&self.body_state(i));
-        }
-        h.finish()
+        StateHasher::of_slots(self.slot_count(), |i| self.body_state(i))
     }
 
     /// Length of the published body array.
