@@ -40,6 +40,7 @@ mod controllers;
 mod daemon;
 mod envelope;
 mod error;
+mod estimator;
 mod frame;
 mod fuzz;
 mod gpu;
@@ -47,6 +48,7 @@ mod hostile;
 mod ipc;
 mod load;
 mod maps;
+mod peers;
 mod persist;
 mod procfs;
 mod progress;
@@ -128,6 +130,9 @@ enum Bench {
     /// command; the goals; the bench's tables) into a folder, docs/reports by default, with
     /// its index README.md, without rerunning the bench.
     Render(render::RenderArgs),
+    /// Scenes other engines publish figures for (Jolt's PerformanceTest Pyramid, Box2D v3's
+    /// large_pyramid), measured here with the defaults, beside the peers' published setups.
+    Peers(peers::PeersArgs),
 }
 
 fn main() -> ExitCode {
@@ -160,6 +165,7 @@ fn main() -> ExitCode {
         Bench::Frame(args) => frame::run(args),
         Bench::Envelope(args) => envelope::run(args),
         Bench::Render(args) => render::run(args),
+        Bench::Peers(args) => peers::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
