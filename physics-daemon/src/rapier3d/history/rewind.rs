@@ -57,6 +57,42 @@ impl Plane {
     }
 }
 
+impl Plane {
+    /// The parts of a kept tick, by name, as [`Plane::rollback_record_part`] copies them:
+    /// the whole copy first, then the engine's sets and phases it holds (what it holds
+    /// besides them is the plane's own tables).
+    pub const ROLLBACK_RECORD_PARTS: [&str; 8] = [
+        "whole",
+        "bodies",
+        "colliders",
+        "narrow phase",
+        "broad phase",
+        "islands",
+        "joints",
+        "soft bodies",
+    ];
+
+    /// A copy of the part `name` (one of [`Plane::ROLLBACK_RECORD_PARTS`]) of what Rewind
+    /// keeps of the plane's current tick, made as a kept tick makes it (`None`: no such
+    /// part). What it holds is what one kept tick costs in memory for that part; what
+    /// copying and dropping it takes is its share of a kept tick's CPU (`physics-bench
+    /// snapshot` counts both per body).
+    pub fn rollback_record_part(&self, name: &str) -> Option<Box<dyn std::any::Any + Send>> {
+        let w = &self.world;
+        Some(match name {
+            "whole" => Box::new(self.clone_state()),
+            "bodies" => Box::new(w.bodies.clone()),
+            "colliders" => Box::new(w.colliders.clone()),
+            "narrow phase" => Box::new(w.narrow_phase.clone()),
+            "broad phase" => Box::new(w.broad_phase.clone()),
+            "islands" => Box::new(w.islands.clone()),
+            "joints" => Box::new((w.impulse_joints.clone(), w.multibody_joints.clone())),
+            "soft bodies" => Box::new(w.soft_bodies.clone()),
+            _ => return None,
+        })
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -75,6 +111,37 @@ mod tests {
                 .unwrap();
         }
         plane
+    }
+
+    /// Every part of a kept tick is copied by name (an unknown name gives none), and the
+    /// whole copy is what a rewind becomes: a plane that takes it steps on as the plane it
+    /// was copied from does.
+    #[test]
+    fn the_parts_of_a_kept_tick_are_copied_by_name() {
+        let dt = 1.0 / 60.0;
+        let mut plane = falling(3);
+        for _ in 0..5 {
+            plane.step(dt).unwrap();
+        }
+        for name in Plane::ROLLBACK_RECORD_PARTS {
+            assert!(plane.rollback_record_part(name).is_some(), "{name}");
+        }
+        assert!(plane.rollback_record_part("contacts").is_none());
+        let whole = plane.rollback_record_part("whole").unwrap();
+        let state = whole
+            .downcast::<crate::rapier3d::plane::State>()
+            .expect("the whole copy is the plane's state");
+        let mut copy = falling(3);
+        copy.adopt_copy(*state).unwrap();
+        assert_eq!(copy.history.state_hash, plane.history.state_hash);
+        for tick in 0..10 {
+            plane.step(dt).unwrap();
+            copy.step(dt).unwrap();
+            assert_eq!(
+                copy.history.state_hash, plane.history.state_hash,
+                "tick {tick}"
+            );
+        }
     }
 
     /// The copy a step puts off is made by whatever comes first (the worker's idle work, the
