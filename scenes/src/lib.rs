@@ -11,6 +11,8 @@
 //! - [`target`]: the trait and its implementations.
 //! - [`builders`]: the builders.
 //! - [`card_house`](mod@card_house): Box2D's card house.
+//! - [`peers`]: the scenes other engines publish benchmark figures for (Jolt's Pyramid,
+//!   Box2D's large pyramid).
 //!
 //! The fuzzer of the daemon's request decoder lives in its own crate, `physics-fuzz`.
 
@@ -18,8 +20,12 @@
 
 pub mod builders;
 pub mod card_house;
+pub mod peers;
 pub mod target;
 
 pub use builders::*;
 pub use card_house::{card_house, Card, CARD_HOUSE_SETTLE};
+pub use peers::{
+    jolt_pyramid, jolt_pyramid_layout, large_pyramid_gui, large_pyramid_layout, Placed,
+};
 pub use target::{LocalPlane, SceneTarget, Spawn};
