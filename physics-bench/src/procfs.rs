@@ -4,50 +4,54 @@ use std::time::Duration;
 
 use super::error::{BenchError, BenchResult};
 
-/// User + system CPU time of `pid` (all threads), from /proc/PID/stat.
-pub fn cpu_time(pid: u32) -> BenchResult<Duration> {
-    let path = format!("/proc/{pid}/stat");
-    let stat = std::fs::read_to_string(&path).map_err(BenchError::io(format!("read {path}")))?;
-    // The command name may contain spaces: fields are counted after its closing parenthesis.
-    let after_name = stat.rsplit_once(')').map_or("", |(_, rest)| rest);
-    let fields: Vec<&str> = after_name.split_whitespace().collect();
-    let field = |i: usize, name: &str| -> BenchResult<u64> {
-        fields
-            .get(i)
-            .and_then(|v| v.parse().ok())
-            .ok_or_else(|| BenchError::Failed(format!("{path}: field {name} unreadable: {stat:?}")))
-    };
-    // utime and stime are fields 14 and 15 of the line, 12 and 13 after the name.
-    let ticks = field(11, "utime")? + field(12, "stime")?;
-    Ok(Duration::from_secs_f64(
-        ticks as f64 / clock_ticks_per_second(),
-    ))
-}
-
-fn clock_ticks_per_second() -> f64 {
-    // SAFETY: sysconf only reads a system constant.
-    let hz = unsafe { libc::sysconf(libc::_SC_CLK_TCK) };
-    if hz > 0 {
-        hz as f64
-    } else {
-        100.0
-    }
-}
-
 /// CPU use of `pid` over `window`, in percent of one core. Counted in nanoseconds from
 /// every thread's scheduler statistics (`/proc/PID/task/*/schedstat`): `stat`'s clock
 /// ticks (10 ms) would make 0.1 % of a 10 s window a single tick. A thread that ends within
 /// the window takes its time with it, so this is for windows in which threads stay (an
 /// idle daemon).
 pub fn cpu_percent_over(pid: u32, window: Duration) -> BenchResult<f64> {
-    let before = thread_cpu_ns(pid)?;
+    let before = ThreadsCpu::of(pid)?;
     std::thread::sleep(window);
-    let after = thread_cpu_ns(pid)?;
-    let used: u64 = after
-        .iter()
-        .map(|(tid, ns)| ns.saturating_sub(before.get(tid).copied().unwrap_or(0)))
-        .sum();
+    let used = ThreadsCpu::of(pid)?.used_since(&before);
     Ok(used as f64 / 1e9 / window.as_secs_f64() * 100.0)
+}
+
+/// CPU time of this process so far, all its threads (those that ended included), in
+/// nanoseconds: `CLOCK_PROCESS_CPUTIME_ID`.
+pub fn own_cpu_ns() -> u64 {
+    let mut ts = libc::timespec {
+        tv_sec: 0,
+        tv_nsec: 0,
+    };
+    // SAFETY: clock_gettime writes one timespec, which lives for the call.
+    let rc = unsafe { libc::clock_gettime(libc::CLOCK_PROCESS_CPUTIME_ID, &mut ts) };
+    if rc != 0 {
+        return 0;
+    }
+    (ts.tv_sec.max(0) as u64) * 1_000_000_000 + ts.tv_nsec.max(0) as u64
+}
+
+/// Nanoseconds on a CPU so far of every thread of a process, by thread id (scheduler
+/// statistics: exact to the nanosecond, unlike `stat`'s 10 ms clock ticks).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct ThreadsCpu(std::collections::HashMap<u32, u64>);
+
+impl ThreadsCpu {
+    /// The threads of `pid` now.
+    pub fn of(pid: u32) -> BenchResult<ThreadsCpu> {
+        thread_cpu_ns(pid).map(ThreadsCpu)
+    }
+
+    /// Nanoseconds used since `before`: every thread's growth, a thread started since then
+    /// counted from zero. A thread that ended in between takes its time with it (the
+    /// daemons' threads live as long as their planes, so windows over a steady plane lose
+    /// nothing).
+    pub fn used_since(&self, before: &ThreadsCpu) -> u64 {
+        self.0
+            .iter()
+            .map(|(tid, ns)| ns.saturating_sub(before.0.get(tid).copied().unwrap_or(0)))
+            .sum()
+    }
 }
 
 /// Nanoseconds on a CPU so far of each thread of `pid`, by thread id.
@@ -98,4 +102,56 @@ pub fn shm_bytes(domain: &str) -> BenchResult<(u64, u64)> {
         }
     }
     Ok((size, backed))
+}
+
+/// Spins until the calling thread has used `ns` more of CPU (its own thread clock).
+#[cfg(test)]
+pub(crate) fn burn(ns: u64) {
+    let thread_ns = || {
+        let mut ts = libc::timespec {
+            tv_sec: 0,
+            tv_nsec: 0,
+        };
+        // SAFETY: clock_gettime writes one timespec, which lives for the call.
+        unsafe { libc::clock_gettime(libc::CLOCK_THREAD_CPUTIME_ID, &mut ts) };
+        ts.tv_sec as u64 * 1_000_000_000 + ts.tv_nsec as u64
+    };
+    let start = thread_ns();
+    let mut x = 0u64;
+    while thread_ns() - start < ns {
+        x = std::hint::black_box(x.wrapping_mul(31).wrapping_add(7));
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn own_cpu_time_grows_by_the_work_done() {
+        let before = own_cpu_ns();
+        assert!(before > 0, "the process clock is readable");
+        burn(20_000_000);
+        let used = own_cpu_ns() - before;
+        // At least the 20 ms this thread burnt (the process clock counts every thread); other
+        // test threads running beside stay far below 10 s.
+        assert!((20_000_000..10_000_000_000).contains(&used), "{used} ns");
+    }
+
+    #[test]
+    fn threads_cpu_of_this_process_sees_the_work_done() {
+        let pid = std::process::id();
+        let before = ThreadsCpu::of(pid).unwrap();
+        burn(30_000_000);
+        let after = ThreadsCpu::of(pid).unwrap();
+        let used = after.used_since(&before);
+        // This thread, alive at both readings, burnt 30 ms; other test threads may add some.
+        assert!((30_000_000..10_000_000_000).contains(&used), "{used} ns");
+        assert_eq!(before.used_since(&before), 0);
+        // A thread unknown before counts from zero, one gone is not counted.
+        let mut later = before.clone();
+        later.0.insert(u32::MAX, 5);
+        assert_eq!(later.used_since(&before), 5);
+        assert_eq!(before.used_since(&later), 0);
+    }
 }

@@ -7,11 +7,14 @@ use client_sdk::{PlaneOptions, Pose, Shape};
 
 use crate::daemon::DaemonProcess;
 use crate::error::BenchResult;
+use crate::estimator::Estimator;
 use crate::procfs::cpu_percent_over;
 use crate::progress::Progress;
 
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct IdleCpu {
+    /// [`Estimator::CpuOverWindow`].
+    pub estimator: Estimator,
     pub no_clients: f64,
     pub idle_manual_plane: f64,
     pub window_s: f64,
@@ -40,6 +43,7 @@ pub fn run(window: Duration, progress: &Progress) -> BenchResult<IdleCpu> {
     let idle_manual_plane = cpu_percent_over(daemon.pid(), window)?;
     progress.done();
     Ok(IdleCpu {
+        estimator: Estimator::CpuOverWindow,
         no_clients,
         idle_manual_plane,
         window_s: window.as_secs_f64(),

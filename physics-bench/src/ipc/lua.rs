@@ -8,12 +8,15 @@ use std::process::Command;
 
 use crate::daemon::DaemonProcess;
 use crate::error::{BenchError, BenchResult};
+use crate::estimator::Estimator;
 
 const CFRAME_COST: &str = include_str!("../../../examples/cframe_cost.luau");
 const PROPERTY_COST: &str = include_str!("../../../examples/property_cost.luau");
 
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct LuaReads {
+    /// [`Estimator::WallMedianOfSamples`]: the medians the scripts print.
+    pub estimator: Estimator,
     /// Median per frame, µs.
     pub cframe_x1000_us: f64,
     pub cframe_x1000_second_read_us: f64,
@@ -75,6 +78,7 @@ pub fn measure() -> BenchResult<LuaReads> {
     let cframe = run("cframe_cost.luau", CFRAME_COST)?;
     let props = run("property_cost.luau", PROPERTY_COST)?;
     Ok(LuaReads {
+        estimator: Estimator::WallMedianOfSamples,
         cframe_x1000_us: median(&cframe, "part.CFrame x1000 ")?,
         cframe_x1000_second_read_us: median(&cframe, "part.CFrame x1000 (2nd")?,
         table_x1000_us: median(&cframe, "table.field x1000")?,
