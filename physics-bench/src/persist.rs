@@ -30,8 +30,9 @@ pub struct PersistArgs {
     /// Seconds of alternating steps.
     #[arg(long, default_value_t = 6.0)]
     pub seconds: f64,
-    /// Blocks of each plane (they alternate ABBA).
-    #[arg(long, default_value_t = 8)]
+    /// Blocks of each plane (they alternate ABBA): short blocks, so that both planes see
+    /// the same stretches of a shared machine.
+    #[arg(long, default_value_t = 30)]
     pub blocks: usize,
     /// Folder receiving persist.json and persist.md.
     #[arg(long, default_value = "bench-out")]

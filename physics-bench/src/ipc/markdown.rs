@@ -60,7 +60,7 @@ pub fn method() -> BTreeMap<&'static str, &'static str> {
             "step-in-process: per scene, the daemon's plane code (physics_scenes::LocalPlane) \
              created in this process with Threads = 1 and with Threads = 2 (its own pool of 2 \
              workers pinned to cores of their own, apart from the global pool of 1), 10 ticks \
-             skipped, then 6 blocks of 10 steps each, ABBA; wall time of Plane::step alone \
+             skipped, then 12 blocks of 4 steps each, ABBA; wall time of Plane::step alone \
              (forces, speed limits, rapier's step, contact figures, events, state hash), the \
              minimum of each side's blocks (medians beside). No client shares the cores. \
              Reported beside without a goal: a Threads = 1 and a Threads = 2 plane in one \

@@ -15,7 +15,7 @@ use crate::scene::{Kind, Scene, DT};
 use crate::stats::{median, percentile, spread, Spread};
 
 /// Blocks of each side of the head-of-line and multi-plane figures.
-const BLOCKS: usize = 6;
+const BLOCKS: usize = 8;
 
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct HeadOfLine {

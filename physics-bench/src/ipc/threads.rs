@@ -160,10 +160,11 @@ impl ThreadsScene {
 /// Base of the pyramid scene.
 const PYRAMID_BASE: usize = 100;
 
-/// Blocks of each side of the in-process figure.
-const BLOCKS: usize = 6;
+/// Blocks of each side of the in-process figure: many short blocks, so that some fall in
+/// quiet stretches of a shared machine (a Threads = 2 step needs both cores at once).
+const BLOCKS: usize = 12;
 /// Steps per block.
-const BLOCK_TICKS: usize = 10;
+const BLOCK_TICKS: usize = 4;
 
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct Threads {
