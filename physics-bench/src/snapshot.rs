@@ -430,7 +430,8 @@ fn heap_bytes_of<T>(f: impl FnOnce() -> T) -> (T, i64) {
 const RECORD_KINDS: [&str; 4] = ["awake", "sleeping", "anchored", "awake pile"];
 
 /// An in-process plane of the daemon's code keeping 8 ticks: a floor and `n` unit boxes of
-/// `kind` (see [`RECORD_KINDS`]), 10 ticks in ("sleeping": until every body sleeps).
+/// `kind` (see [`RECORD_KINDS`]), 10 ticks in ("awake pile": 60, "sleeping": until every
+/// body sleeps).
 fn local_plane(n: usize, kind: &str) -> BenchResult<physics_daemon::rapier3d::Plane> {
     use physics_daemon::backend::Backend;
     use shm_layout::{ObjectProp, PlaneOp};
@@ -468,8 +469,10 @@ fn local_plane(n: usize, kind: &str) -> BenchResult<physics_daemon::rapier3d::Pl
             _ => add([i * 2.5, 0.5, j * 2.5], [1.0; 3], vec![])?,
         }
     }
+    // A second in, the pile has landed (its boxes touch the floor and each other).
+    let first = if kind == "awake pile" { 60 } else { 10 };
     let mut ticks = 0;
-    while ticks < 10 || (kind == "sleeping" && plane.awake_count() > 0 && ticks < 1200) {
+    while ticks < first || (kind == "sleeping" && plane.awake_count() > 0 && ticks < 1200) {
         plane.step(DT).map_err(failed)?;
         ticks += 1;
     }

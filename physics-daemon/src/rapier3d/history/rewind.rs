@@ -59,9 +59,9 @@ impl Plane {
 
 impl Plane {
     /// The parts of a kept tick, by name, as [`Plane::rollback_record_part`] copies them:
-    /// the whole copy first, then the engine's sets and phases it holds (what it holds
-    /// besides them is the plane's own tables).
-    pub const ROLLBACK_RECORD_PARTS: [&str; 8] = [
+    /// the whole copy first, then the engine's sets and phases it holds, then the plane's
+    /// object table (what the whole holds besides them is the plane's other tables).
+    pub const ROLLBACK_RECORD_PARTS: [&str; 9] = [
         "whole",
         "bodies",
         "colliders",
@@ -70,6 +70,7 @@ impl Plane {
         "islands",
         "joints",
         "soft bodies",
+        "objects",
     ];
 
     /// A copy of the part `name` (one of [`Plane::ROLLBACK_RECORD_PARTS`]) of what Rewind
@@ -88,6 +89,7 @@ impl Plane {
             "islands" => Box::new(w.islands.clone()),
             "joints" => Box::new((w.impulse_joints.clone(), w.multibody_joints.clone())),
             "soft bodies" => Box::new(w.soft_bodies.clone()),
+            "objects" => Box::new(self.objects.table().clone()),
             _ => return None,
         })
     }
