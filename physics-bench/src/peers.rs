@@ -1,23 +1,11 @@
 //! `physics-bench peers`: scenes other engines publish figures for, measured on our side
-//! with the defaults.
-//!
-//! - Jolt's PerformanceTest scene "Pyramid" (1,240 boxes 2 × 2 × 2, 15 layers, 0.5 apart,
-//!   sleeping off) on a 3D plane with the plane's defaults but gravity 9.81 (Jolt's; ours is
-//!   50), Threads = 1 and Threads = 2 planes in one daemon stepped alternately, so both see
-//!   the same machine load.
-//! - Box2D v3's benchmark `large_pyramid` (5,050 squares of half-size 0.5 in rows of 100 down
-//!   to 1) on a GUI plane at 100 px per unit with gravity 10 units/s² (Box2D's), sleeping off.
-//!   GUI planes have no Threads option: Threads 1 only.
-//! - The Pyramid again at SolverIterations 1, 2, 4 and 8 (`--solver-iterations`), with
-//!   AdaptiveSolving on (the default) and off, eight planes stepped alternately: steps/s,
-//!   contact pairs, the deepest contact of each tick and, from those depths, the ticks the
-//!   adaptive pass boosted and the substeps they ran (see [`boost_estimate`]).
-//!
-//! Every plane is manual (TickRate 0) and stepped at 60 Hz through client-sdk, as a game
-//! would; steps/s is steps ÷ the daemon's own step time (the tick headers' `step_time_us`,
-//! what the peers' harnesses time around their step call), with the round trip beside it.
-//! One step runs before timing (Box2D's harness does the same: the first step is the
-//! broad phase's build).
+//! with the defaults, through a real daemon (client-sdk, manual planes stepped at 60 Hz):
+//! Jolt's PerformanceTest "Pyramid" on Threads 1 and 2, Box2D v3's `large_pyramid` on a GUI
+//! plane, and the Pyramid at SolverIterations 1, 2, 4 and 8 with AdaptiveSolving on and off
+//! (the adaptive pass's boosts replayed from the tick headers: [`boost_estimate`]). Planes
+//! of one part share a daemon and are stepped alternately, so all see the same load.
+//! Steps/s is steps ÷ the daemon's own step times (the tick headers), what the peers'
+//! harnesses time around their step call; one untimed step first, as Box2D's harness does.
 
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -25,8 +13,7 @@ use std::time::Instant;
 
 use client_sdk::{Client, GuiPlane, GuiPlaneOptions, Object, Plane, PlaneOptions, Snapshot};
 use physics_scenes::peers::{
-    jolt_pyramid_rest_top, JOLT_BOX_SIZE, JOLT_PYRAMID_BOXES, LARGE_PYRAMID_BASE,
-    LARGE_PYRAMID_HALF,
+    jolt_pyramid_rest_top, JOLT_BOX_SIZE, LARGE_PYRAMID_BASE, LARGE_PYRAMID_HALF,
 };
 use physics_scenes::{jolt_pyramid, jolt_pyramid_layout, large_pyramid_gui, Placed};
 
@@ -58,8 +45,7 @@ pub struct PeersArgs {
 }
 
 /// The parts of the report.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum, serde::Serialize)]
-#[serde(rename_all = "lowercase")]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum Part {
     /// Jolt's Pyramid, Threads 1 and 2.
     Jolt,
@@ -69,7 +55,7 @@ pub enum Part {
     Sweep,
 }
 
-/// Steps of both peers' runs (Jolt's PerformanceTest default, Box2D's large_pyramid).
+/// Steps of both peers' runs.
 const STEPS: usize = 500;
 /// Steps of a `--quick` run: the Pyramid has landed and settled after about 1.2 s.
 const QUICK_STEPS: usize = 100;
@@ -85,14 +71,13 @@ const PX_PER_UNIT: f32 = physics_daemon::rapier2d::LENGTH_UNIT;
 /// quarter of its side. Settling moves a box by hundredths; a box that slides off its four
 /// supports or tips over moves by half a side (1.0) or more.
 const JOLT_DRIFT: f32 = 0.25 * JOLT_BOX_SIZE;
-/// The top box must end at most this far below its rest height (the layers' 0.5 gaps
-/// closed, 29): a quarter box, the sinking of 15 stacked contacts allowed for. A lost layer
-/// lowers it by a whole box (2).
+/// The top box may end this far below its rest height (gaps closed: 29): a quarter box for
+/// 15 stacked contacts' sinking. A lost layer lowers it by a whole box (2).
 const JOLT_SINK: f32 = 0.25 * JOLT_BOX_SIZE;
 /// A large_pyramid square stands within a quarter of its side of its start x (units).
 const BOX2D_DRIFT: f32 = 0.5 * LARGE_PYRAMID_HALF;
-/// The top square may sink this far (units): the squares start touching, so their start is
-/// their rest; a collapsed row lowers it by a whole side (1).
+/// The top square may sink this far below its start (its rest: squares start touching); a
+/// lost row lowers it by a whole side (1).
 const BOX2D_SINK: f32 = 0.5 * LARGE_PYRAMID_HALF;
 
 /// The adaptive pass's load rule (physics-daemon `rapier3d/adaptive.rs`, at HitBoxQuality
@@ -105,8 +90,7 @@ const ADAPTIVE_EXTRA: u32 = 12;
 /// The pass runs when a contact is deeper than the release depth, and every this many ticks.
 const ADAPTIVE_PASS_EVERY: u64 = 32;
 
-/// A higher SolverIterations may be this much faster than a lower one before the cost is
-/// called non-monotonic (alternating runs on a shared machine differ by a few percent).
+/// A higher SolverIterations may run this many times the steps/s of a lower one (noise).
 const MONOTONIC_SLACK: f64 = 1.15;
 
 /// What a plane's header said about each timed tick.
@@ -135,17 +119,37 @@ impl Trace {
 /// Whether a scene stood at the end, with the figures that say so (the scene's units).
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct Stand {
-    /// Largest horizontal distance of a body from its start.
+    /// Largest horizontal distance of a body from its start, and the most allowed.
     pub max_drift: f32,
-    /// Allowed drift.
     pub drift_allowed: f32,
-    /// Height of the top body's centre at the end.
+    /// Height of the top body's centre at the end, and the least allowed.
     pub top_height: f32,
-    /// Lowest top height that still stands.
     pub top_needed: f32,
     /// Bodies whose state could not be read (removed by the daemon: non-finite).
     pub missing: usize,
     pub stands: bool,
+}
+
+impl Stand {
+    /// Stands when nothing is missing, the drift is within `allowed` and the top at `needed`
+    /// or higher.
+    fn new(
+        max_drift: f32,
+        drift_allowed: f32,
+        (top_height, top_needed): (f32, f32),
+        missing: usize,
+    ) -> Stand {
+        let mut s = Stand {
+            max_drift,
+            drift_allowed,
+            top_height,
+            top_needed,
+            missing,
+            stands: false,
+        };
+        s.stands = missing == 0 && max_drift <= drift_allowed && top_height >= top_needed;
+        s
+    }
 }
 
 /// One plane's run.
@@ -162,14 +166,29 @@ pub struct PlaneRun {
     pub wall_steps_per_s: f64,
     pub median_step_ms: f64,
     pub mean_contact_pairs: f64,
-    pub last_contact_pairs: u32,
+    /// Median over the timed ticks of each tick's deepest contact.
+    pub median_penetration: f32,
     /// Deepest contact of any timed tick.
     pub max_penetration: f32,
     /// Deepest contact of the last tick.
     pub last_penetration: f32,
     /// See [`boost_estimate`] (3D planes with AdaptiveSolving only).
     pub boost: Option<Boost>,
+    /// The deepest contact pair after the last step (Pyramids only).
+    pub deepest: Option<Deepest>,
     pub stand: Stand,
+}
+
+/// A Pyramid's deepest contact pair, read from its boxes' contacts.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct Deepest {
+    pub depth: f32,
+    /// The box's layer (0: on the floor).
+    pub layer: usize,
+    /// The other body's layer; `None`: the floor.
+    pub other_layer: Option<usize>,
+    /// The pair's normal, from the box toward the other body.
+    pub normal: [f32; 3],
 }
 
 /// The adaptive pass replayed on the deepest contact of each tick (see [`boost_estimate`]).
@@ -214,11 +233,10 @@ fn step_alternately(
             let started = Instant::now();
             plane.step(DT)?;
             let snapshot = plane.snapshot()?;
-            let wall = started.elapsed().as_secs_f64() * 1e6;
-            if round > 0 {
-                trace.push(&snapshot, wall);
-            } else {
-                trace.first = (snapshot.header().tick, snapshot.header().max_penetration);
+            let (wall, h) = (started.elapsed().as_secs_f64() * 1e6, snapshot.header());
+            match round {
+                0 => trace.first = (h.tick, h.max_penetration),
+                _ => trace.push(&snapshot, wall),
             }
         }
         if round % 50 == 0 {
@@ -228,13 +246,11 @@ fn step_alternately(
     Ok(traces)
 }
 
-/// Replays the adaptive pass's load rule on the deepest contact of each tick: a pass after a
-/// tick boosts the island when that tick had a contact deeper than [`ADAPTIVE_TRIGGER`],
-/// keeps a boost while one is deeper than [`ADAPTIVE_RELEASE`], and drops it otherwise; no
-/// pass runs (the boost stays as it was) when no contact is deeper than the release depth,
-/// except every [`ADAPTIVE_PASS_EVERY`] ticks. The Pyramid is one island, and rapier runs an
-/// island at its bodies' largest boost, so one deep pair boosts every box. An estimate: the
-/// daemon reads each pair's depth, the header only the deepest.
+/// Replays the adaptive pass's load rule on each tick's deepest contact: after a tick with
+/// a contact deeper than [`ADAPTIVE_TRIGGER`] the island is boosted, a boost stays while one
+/// is deeper than [`ADAPTIVE_RELEASE`]; no pass runs (nothing changes) while none is, but
+/// every [`ADAPTIVE_PASS_EVERY`] ticks. The Pyramid is one island, run at its bodies'
+/// largest boost. An estimate: the daemon reads every pair, the header only the deepest.
 fn boost_estimate(trace: &Trace, solver_iterations: u32) -> Boost {
     // The boost of the tick after the untimed first one.
     let pass = |boosted: bool, (tick, depth): (u64, f32)| {
@@ -276,6 +292,7 @@ fn plane_run(
     let steps = trace.step_us.len();
     let total_s = |v: &[f64]| v.iter().sum::<f64>() / 1e6;
     let median_us = median(&trace.step_us).ok_or_else(|| failed("no step was timed"))?;
+    let depths: Vec<f64> = trace.penetration.iter().map(|&d| d as f64).collect();
     Ok(PlaneRun {
         threads,
         solver_iterations,
@@ -286,10 +303,11 @@ fn plane_run(
         median_step_ms: median_us / 1e3,
         mean_contact_pairs: trace.pairs.iter().map(|&p| p as f64).sum::<f64>()
             / steps.max(1) as f64,
-        last_contact_pairs: trace.pairs.last().copied().unwrap_or(0),
+        median_penetration: median(&depths).unwrap_or(0.0) as f32,
         max_penetration: trace.penetration.iter().copied().fold(0.0, f32::max),
         last_penetration: trace.penetration.last().copied().unwrap_or(0.0),
         boost,
+        deepest: None,
         stand,
     })
 }
@@ -356,26 +374,52 @@ impl Pyramid {
             }
         }
         let needed = jolt_pyramid_rest_top() - JOLT_SINK;
-        Ok(Stand {
-            max_drift: drift,
-            drift_allowed: JOLT_DRIFT,
-            top_height: top,
-            top_needed: needed,
-            missing,
-            stands: missing == 0 && drift <= JOLT_DRIFT && top >= needed,
-        })
+        Ok(Stand::new(drift, JOLT_DRIFT, (top, needed), missing))
+    }
+
+    /// The deepest contact pair among the boxes' contacts now.
+    fn deepest(&self) -> BenchResult<Option<Deepest>> {
+        let layers: Vec<usize> = jolt_pyramid_layout()
+            .iter()
+            .map(|p| ((p[1] - 1.0) / 2.5).round() as usize)
+            .collect();
+        let layer_of: std::collections::HashMap<_, _> = self
+            .boxes
+            .iter()
+            .map(|b| b.handle())
+            .zip(layers.iter().copied())
+            .collect();
+        let mut deepest: Option<Deepest> = None;
+        for (object, &layer) in self.boxes.iter().zip(&layers) {
+            for c in object.contacts()? {
+                let depth = c.points.iter().map(|p| p.depth).fold(f32::MIN, f32::max);
+                if deepest.as_ref().is_none_or(|d| depth > d.depth) {
+                    let other_layer = layer_of.get(&c.other).copied();
+                    let normal = c.normal;
+                    deepest = Some(Deepest {
+                        depth,
+                        layer,
+                        other_layer,
+                        normal,
+                    });
+                }
+            }
+        }
+        Ok(deepest)
     }
 
     fn run(&self, trace: &Trace) -> BenchResult<PlaneRun> {
         let boost = self
             .adaptive
             .then(|| boost_estimate(trace, self.solver_iterations));
-        plane_run(
+        let mut run = plane_run(
             trace,
             (self.threads, self.solver_iterations, Some(self.adaptive)),
             boost,
             self.stand()?,
-        )
+        )?;
+        run.deepest = self.deepest()?;
+        Ok(run)
     }
 }
 
@@ -458,62 +502,35 @@ fn box2d_stand(snapshot: &Snapshot, squares: &[Placed<client_sdk::GuiObject>]) -
         }
         top_start = -s.start[1] / PX_PER_UNIT;
     }
-    let needed = top_start - BOX2D_SINK;
-    Stand {
-        max_drift: drift,
-        drift_allowed: BOX2D_DRIFT,
-        top_height: top,
-        top_needed: needed,
-        missing,
-        stands: missing == 0 && drift <= BOX2D_DRIFT && top >= needed,
-    }
+    Stand::new(drift, BOX2D_DRIFT, (top, top_start - BOX2D_SINK), missing)
 }
 
 pub fn run(args: &PeersArgs) -> BenchResult<()> {
     let steps = if args.quick { QUICK_STEPS } else { STEPS };
     let wants = |p: Part| args.only.is_empty() || args.only.contains(&p);
     let progress = Progress::new(3);
-    let jolt = if wants(Part::Jolt) {
-        let runs = jolt(steps, &progress)?;
-        for r in &runs {
-            progress.note(format!(
-                "Pyramid, Threads {}: {} steps/s, stands: {}",
-                r.threads,
-                num(Some(r.steps_per_s)),
-                r.stand.stands
-            ));
-        }
-        runs
-    } else {
-        Vec::new()
+    let note = |what: String, r: &PlaneRun| {
+        let (speed, stands) = (num(Some(r.steps_per_s)), r.stand.stands);
+        progress.note(format!("{what}: {speed} steps/s, stands: {stands}"));
     };
+    let jolt = wants(Part::Jolt).then(|| jolt(steps, &progress));
+    let jolt = jolt.transpose()?.unwrap_or_default();
+    jolt.iter()
+        .for_each(|r| note(format!("Pyramid, Threads {}", r.threads), r));
     progress.done();
-    let box2d = if wants(Part::Box2d) {
-        let r = box2d(steps, &progress)?;
-        progress.note(format!(
-            "large_pyramid: {} steps/s, stands: {}",
-            num(Some(r.steps_per_s)),
-            r.stand.stands
-        ));
-        Some(r)
-    } else {
-        None
-    };
+    let box2d = wants(Part::Box2d).then(|| box2d(steps, &progress));
+    let box2d = box2d.transpose()?;
+    box2d.iter().for_each(|r| note("large_pyramid".into(), r));
     progress.done();
-    let sweep = if wants(Part::Sweep) {
-        let runs = sweep(args, steps, &progress)?;
-        for r in &runs {
-            progress.note(format!(
-                "Pyramid, SolverIterations {}, AdaptiveSolving {:?}: {} steps/s",
-                r.solver_iterations,
-                r.adaptive_solving,
-                num(Some(r.steps_per_s))
-            ));
-        }
-        runs
-    } else {
-        Vec::new()
-    };
+    let sweep = wants(Part::Sweep).then(|| sweep(args, steps, &progress));
+    let sweep = sweep.transpose()?.unwrap_or_default();
+    for r in &sweep {
+        let (n, a) = (r.solver_iterations, r.adaptive_solving);
+        note(
+            format!("Pyramid, SolverIterations {n}, AdaptiveSolving {a:?}"),
+            r,
+        );
+    }
     progress.done();
     progress.finish();
     let goals = goals(&jolt, box2d.as_ref(), &sweep, steps);
@@ -543,9 +560,36 @@ fn monotonic(runs: &[&PlaneRun]) -> Option<(bool, f64, u32, u32)> {
         .map(|(ratio, lo, hi)| (ratio <= MONOTONIC_SLACK, ratio, lo, hi))
 }
 
+fn on_off(on: bool) -> &'static str {
+    if on {
+        "on"
+    } else {
+        "off"
+    }
+}
+
 /// `a / b`, figures of f32.
 fn pair(a: f32, b: f32) -> String {
     format!("{} / {}", num(Some(a as f64)), num(Some(b as f64)))
+}
+
+/// "0.035: layer 0 on the floor (vertical)", "0.012: layer 3 against layer 3 (horizontal)".
+fn deepest_text(d: &Deepest) -> String {
+    let other = d
+        .other_layer
+        .map_or("the floor".into(), |l| format!("layer {l}"));
+    let axis = if d.normal[1].abs() > 0.7 {
+        "vertical"
+    } else {
+        "horizontal"
+    };
+    format!("{:.3}: layer {} against {other} ({axis})", d.depth, d.layer)
+}
+
+/// A run's deepest contacts (median, largest and last tick's), to the millimetre.
+fn depths(r: &PlaneRun) -> String {
+    let (m, x, l) = (r.median_penetration, r.max_penetration, r.last_penetration);
+    format!("{m:.3} / {x:.3} / {l:.3}")
 }
 
 fn steps_text(r: &PlaneRun) -> String {
@@ -565,11 +609,9 @@ fn stand_text(s: &Stand) -> String {
         num(Some(s.drift_allowed as f64)),
         num(Some(s.top_height as f64)),
         num(Some(s.top_needed as f64)),
-        if s.missing > 0 {
-            format!(", {} bodies gone", s.missing)
-        } else {
-            String::new()
-        }
+        (s.missing > 0)
+            .then(|| format!(", {} bodies gone", s.missing))
+            .unwrap_or_default()
     )
 }
 
@@ -581,22 +623,14 @@ fn goals(
 ) -> Vec<Goal> {
     let mut goals = Vec::new();
     for r in jolt {
-        let speedup = match (r.threads, jolt.first()) {
-            (2, Some(one)) => format!(
-                ", {}× Threads 1",
-                num(Some(r.steps_per_s / one.steps_per_s))
-            ),
-            _ => String::new(),
-        };
-        goals.push(Goal::new(
-            format!(
-                "Jolt's Pyramid ({JOLT_PYRAMID_BOXES} boxes) through the daemon, Threads {}: \
-                 steps/s",
-                r.threads
-            ),
-            format!("{}{speedup}", steps_text(r)),
-            None,
-        ));
+        let one = jolt.first().map_or(1.0, |o| o.steps_per_s);
+        let speedup = num(Some(r.steps_per_s / one));
+        let what = format!(
+            "Jolt's Pyramid (1,240 boxes), Threads {}: steps/s",
+            r.threads
+        );
+        let value = format!("{}, {speedup}× Threads 1", steps_text(r));
+        goals.push(Goal::new(what, value, None));
     }
     if !jolt.is_empty() {
         let all = jolt.iter().all(|r| r.stand.stands);
@@ -635,7 +669,7 @@ fn goals(
             .filter(|r| r.adaptive_solving == Some(adaptive))
             .collect();
         if let Some((ok, ratio, lo, hi)) = monotonic(&runs) {
-            let list: Vec<String> = runs
+            let list: Vec<_> = runs
                 .iter()
                 .map(|r| r.solver_iterations.to_string())
                 .collect();
@@ -644,7 +678,7 @@ fn goals(
                     "the Pyramid's step cost does not fall as SolverIterations rises ({}; \
                      AdaptiveSolving {}; a rise of steps/s up to {MONOTONIC_SLACK}× is noise)",
                     list.join(", "),
-                    if adaptive { "on" } else { "off" }
+                    on_off(adaptive)
                 ),
                 format!(
                     "worst: SolverIterations {hi} runs {}× the steps/s of {lo}",
@@ -664,7 +698,7 @@ fn row(t: &mut Table, label: String, r: &PlaneRun) {
         num(Some(r.wall_steps_per_s)),
         num(Some(r.median_step_ms)),
         num(Some(r.mean_contact_pairs)),
-        pair(r.max_penetration, r.last_penetration),
+        depths(r),
         pair(r.stand.max_drift, r.stand.top_height),
         if r.stand.stands { "yes" } else { "**no**" }.into(),
     ]);
@@ -676,7 +710,7 @@ const RUN_HEADERS: [&str; 8] = [
     "steps/s (round trip)",
     "median step (ms)",
     "contact pairs (mean)",
-    "deepest contact (run / last tick)",
+    "deepest contact (median / max / last tick)",
     "max drift / top height",
     "stands",
 ];
@@ -706,40 +740,46 @@ fn markdown(r: &PeersReport) -> String {
     md
 }
 
+/// A section: `intro`, a row per run, then the peer's published `setup`.
+fn section(title: &str, intro: &str, runs: &[(String, &PlaneRun)], setup: &str) -> String {
+    let mut t = Table::new(&RUN_HEADERS);
+    for (label, run) in runs {
+        row(&mut t, label.clone(), run);
+    }
+    format!("## {title}\n\n{intro}\n\n{}\n{setup}\n\n", t.finish())
+}
+
 fn jolt_section(runs: &[PlaneRun]) -> String {
-    let mut md = String::from("## Jolt's Pyramid\n\n");
-    let _ = writeln!(
-        md,
-        "{JOLT_PYRAMID_BOXES} boxes 2 × 2 × 2 in 15 square layers (15², 14², … 1), each layer \
+    let intro = format!(
+        "1,240 boxes 2 × 2 × 2 in 15 square layers (15², 14², … 1), each layer \
          0.5 above the one below and shifted by half a box on odd layers, on an anchored 100 × \
          2 × 100 floor whose top is y = 0 (Jolt's `PyramidScene`). Plane defaults (4 \
          SolverIterations, AdaptiveSolving on, friction 0.5) but gravity 9.81 (ours is 50) \
          and NeverSleep (Jolt's scene turns sleeping off). Threads 1 and 2 are two planes in \
          one daemon stepped alternately. Stands: every box within {JOLT_DRIFT} of its start \
-         x/z and the top box at most {JOLT_SINK} below {} (its height once the gaps close).\n",
+         x/z and the top box at most {JOLT_SINK} below {} (its height once the gaps close).",
         jolt_pyramid_rest_top()
     );
-    let mut t = Table::new(&RUN_HEADERS);
-    for run in runs {
-        row(&mut t, format!("Threads {}", run.threads), run);
-    }
-    md.push_str(&t.finish());
-    md.push_str(
-        "\nJolt's published setup: its PerformanceTest program (`-s=Pyramid`), 60 Hz \
+    let rows: Vec<_> = runs
+        .iter()
+        .map(|r| (format!("Threads {}", r.threads), r))
+        .collect();
+    section(
+        "Jolt's Pyramid",
+        &intro,
+        &rows,
+        "Jolt's published setup: its PerformanceTest program (`-s=Pyramid`), 60 Hz \
          (`cDeltaTime = 1/60`), one collision step per update, 500 steps by default (`-i`), \
          steps/s = steps ÷ the summed time of `PhysicsSystem::Update`, each thread count from \
          1 to the machine's; Jolt's solver defaults are 10 velocity and 2 position iterations \
          per step; the boxes have no convex radius and may not sleep; gravity (0, −9.81, 0); \
          Discrete and LinearCast motion quality are both run (ours has no CCD on these \
-         boxes, like Discrete).\n\n",
-    );
-    md
+         boxes, like Discrete).",
+    )
 }
 
 fn box2d_section(run: &PlaneRun) -> String {
-    let mut md = String::from("## Box2D's large_pyramid\n\n");
-    let _ = writeln!(
-        md,
+    let intro = format!(
         "Rows of 100, 99, … 1 squares of half-size 0.5 (5,050), each row shifted by half a \
          square and resting on the one below, on a 200 × 2 ground whose top is y = 0 \
          (Box2D's `LargePyramid`), on a GUI plane at {PX_PER_UNIT} px per unit (+Y down). \
@@ -747,19 +787,19 @@ fn box2d_section(run: &PlaneRun) -> String {
          0.05 / 0.10) but gravity {BOX2D_GRAVITY} units/s² (Box2D's) and NeverSleep. GUI \
          planes have no Threads option: Threads 1 only. Stands: every square within \
          {BOX2D_DRIFT} of its start x and the top one at most {BOX2D_SINK} below its start \
-         (units).\n",
+         (units).",
         run.solver_iterations
     );
-    let mut t = Table::new(&RUN_HEADERS);
-    row(&mut t, "GUI plane".into(), run);
-    md.push_str(&t.finish());
-    md.push_str(
-        "\nDrift and heights in Box2D units (px ÷ 100). Box2D's published setup: its \
-         benchmark program (`benchmark/main.c`), 60 Hz with 4 substeps, 500 steps for \
-         large_pyramid after one untimed step, sleeping off, continuous collision on, density \
-         1 and friction 0.6, gravity (0, −10), the best of 4 runs per thread count.\n\n",
-    );
-    md
+    section(
+        "Box2D's large_pyramid",
+        &intro,
+        &[("GUI plane".into(), run)],
+        "Drift and heights in Box2D units (px ÷ 100), contact depths in px. Box2D's \
+         published setup: its benchmark program (`benchmark/main.c`), 60 Hz with 4 substeps, \
+         500 steps for large_pyramid after one untimed step, sleeping off, continuous \
+         collision on, density 1 and friction 0.6, gravity (0, −10), the best of 4 runs per \
+         thread count.",
+    )
 }
 
 fn sweep_section(runs: &[PlaneRun]) -> String {
@@ -778,40 +818,36 @@ fn sweep_section(runs: &[PlaneRun]) -> String {
         "steps/s",
         "median step (ms)",
         "contact pairs (mean)",
-        "deepest contact (run / last tick)",
+        "deepest contact (median / max / last tick)",
         "boosted ticks",
         "substeps per tick (mean)",
         "step boosted / not (ms)",
+        "deepest pair at the end",
         "stands",
     ]);
     for r in runs {
-        let (boosted, substeps, split) = match &r.boost {
-            Some(b) => (
-                format!("{} of {}", b.boosted_ticks, r.steps),
-                num(Some(b.mean_substeps)),
-                format!("{} / {}", num(b.boosted_step_ms), num(b.plain_step_ms)),
-            ),
-            None => (
-                "—".into(),
-                num(Some(r.solver_iterations as f64)),
-                "—".into(),
-            ),
-        };
+        let (boosted, substeps, split) = r.boost.as_ref().map_or_else(
+            || ("—".into(), r.solver_iterations as f64, "—".into()),
+            |b| {
+                let split = format!("{} / {}", num(b.boosted_step_ms), num(b.plain_step_ms));
+                (
+                    format!("{} of {}", b.boosted_ticks, r.steps),
+                    b.mean_substeps,
+                    split,
+                )
+            },
+        );
         t.row(&[
             r.solver_iterations.to_string(),
-            if r.adaptive_solving == Some(true) {
-                "on"
-            } else {
-                "off"
-            }
-            .into(),
+            on_off(r.adaptive_solving == Some(true)).into(),
             num(Some(r.steps_per_s)),
             num(Some(r.median_step_ms)),
             num(Some(r.mean_contact_pairs)),
-            pair(r.max_penetration, r.last_penetration),
+            depths(r),
             boosted,
-            substeps,
+            num(Some(substeps)),
             split,
+            r.deepest.as_ref().map_or_else(|| "—".into(), deepest_text),
             if r.stand.stands { "yes" } else { "**no**" }.into(),
         ]);
     }
@@ -834,25 +870,22 @@ fn sweep_cause(runs: &[PlaneRun]) -> String {
         );
         return md;
     };
-    let pick = |n: u32, a: bool| {
-        runs.iter()
-            .find(|r| r.solver_iterations == n && r.adaptive_solving == Some(a))
-    };
-    let (Some(low), Some(high)) = (pick(lo, true), pick(hi, true)) else {
+    let pick = |n| on.iter().find(|r| r.solver_iterations == n);
+    let (Some(low), Some(high)) = (pick(lo), pick(hi)) else {
         return md;
     };
     let boosted = |r: &PlaneRun| r.boost.as_ref().map_or(0, |b| b.boosted_ticks);
     let substeps = |r: &PlaneRun| r.boost.as_ref().map_or(0.0, |b| b.mean_substeps);
     let _ = writeln!(
         md,
-        "Why SolverIterations {lo} costs more than {hi}: with {lo} substeps the Pyramid's \
-         lower contacts sink deeper (deepest {} against {}), past the adaptive pass's 0.03 \
-         trigger on {} of {} ticks (against {} at {hi}), and a boosted tick runs the whole \
-         island at {lo} + 12 substeps: {} substeps per tick on average against {} at {hi}. \
-         The contact pairs are the same ({} against {} on average): the pyramid does not \
-         collapse, it is solved more often.",
-        num(Some(low.max_penetration as f64)),
-        num(Some(high.max_penetration as f64)),
+        "Why SolverIterations {lo} costs more than {hi}: at {lo} the Pyramid's deepest \
+         contact is deeper ({:.3} against {:.3} in the median tick), past the adaptive pass's \
+         0.03 trigger on {} of {} ticks (against {} at {hi}), and a boosted tick runs the \
+         whole island at {lo} + 12 substeps: {} substeps per tick on average against {} at \
+         {hi}. The contact pairs are the same ({} against {} on average): the pyramid does \
+         not collapse, it is solved more often.",
+        low.median_penetration,
+        high.median_penetration,
         boosted(low),
         low.steps,
         boosted(high),
@@ -861,13 +894,5 @@ fn sweep_cause(runs: &[PlaneRun]) -> String {
         num(Some(low.mean_contact_pairs)),
         num(Some(high.mean_contact_pairs)),
     );
-    if let (Some(off_low), Some(off_high)) = (pick(lo, false), pick(hi, false)) {
-        let _ = writeln!(
-            md,
-            "With AdaptiveSolving off the same two run at {} and {} steps/s.",
-            num(Some(off_low.steps_per_s)),
-            num(Some(off_high.steps_per_s)),
-        );
-    }
     md
 }
