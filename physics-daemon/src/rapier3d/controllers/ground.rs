@@ -30,8 +30,12 @@ impl Scene<'_> {
             let v = body.velocity_at_point(foot);
             return (v * dt, v, body.angvel().y * dt);
         }
-        // Anchored or pose-driven: how far its pose moved since we stood on it.
+        // Anchored or pose-driven: how far its pose moved since we stood on it (nothing, when
+        // it has not moved at all: the floor under most controllers).
         let now = *body.position();
+        if super::tick::same_pose(&now, &ground.pose) {
+            return none;
+        }
         let delta = now * ground.pose.inverse();
         let carried = delta.transform_point(foot) - foot;
         let yaw = yaw_of(delta.rotation.to_array());
@@ -47,7 +51,7 @@ impl Scene<'_> {
         &self,
         shape: &Capsule,
         position: Vector,
-        yaw: f32,
+        rotation: Rotation,
         remaining: Vector,
         s: &ControllerSettings,
         nearby: &mut Nearby<'_>,
@@ -56,7 +60,6 @@ impl Scene<'_> {
         if dir == Vector::ZERO {
             return None;
         }
-        let rotation = yaw_rotation(yaw);
         let reach = remaining.length().max(s.capsule_radius);
         // Everything the lift, the move and the drop can touch.
         let here = capsule_aabb(shape, &rapier3d::math::Pose::from_parts(position, rotation));
@@ -155,12 +158,12 @@ impl Scene<'_> {
         &self,
         shape: &Capsule,
         position: Vector,
-        yaw: f32,
+        rotation: Rotation,
         reach: f32,
         max_slope: f32,
         nearby: &mut Nearby<'_>,
     ) -> Option<(RigidBodyHandle, f32, bool, bool)> {
-        let pose = rapier3d::math::Pose::from_parts(position, yaw_rotation(yaw));
+        let pose = rapier3d::math::Pose::from_parts(position, rotation);
         let here = capsule_aabb(shape, &pose);
         nearby.ensure(here.merged(&here.translated(-Vector::Y * reach)), 1.0);
         let options = ShapeCastOptions {

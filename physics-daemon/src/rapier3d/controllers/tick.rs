@@ -45,16 +45,21 @@ pub(super) struct Scene<'a> {
     pub side_by_side: bool,
 }
 
+/// Slack around the region a tick gathers (units): the mover's gap ([`SKIN`]) and contact
+/// prediction (`SKIN` + 0.05), with room for a slide's nudges and what a kinematic body the
+/// capsule slides along carries it by (a tick of a body at 60 units/s at 60 Hz).
+const REACH_SLACK: f32 = 1.0;
+
 /// Slack added to every covered volume: the colliders' own AABBs (what a commit changes)
 /// and the queries' volumes are computed apart and may differ by rounding.
 const COVER_SLACK: f32 = 1.0e-3;
 
 /// A controller's tick ready to commit.
 struct Outcome {
-    slot: u32,
-    controller: Controller,
     t: TickState,
     next: Vector,
+    /// The rotation of the next kinematic pose (the controller's yaw at the end of the tick).
+    rotation: Rotation,
     pushes: Vec<Push>,
     /// The controller's state before the tick (to tick it again).
     saved: Saved,
@@ -117,36 +122,53 @@ impl Plane {
             return;
         }
         self.refresh_scene();
-        let mut work = Vec::with_capacity(self.controllers.len());
-        // The controllers as they commit, in slot order: the map is built again in one
-        // pass at the end (inserting them one by one cost more than some of their ticks).
-        let mut done = Vec::with_capacity(self.controllers.len());
-        for (slot, c) in std::mem::take(&mut self.controllers) {
+        // The map is taken for the tick and its controllers ticked where they are (moving
+        // each out and building the map again cost more than some of their ticks).
+        let mut controllers = std::mem::take(&mut self.controllers);
+        let mut gone = Vec::new();
+        let mut work = Vec::with_capacity(controllers.len());
+        for (&slot, c) in controllers.iter_mut() {
             let Some(handle) = self.objects.handle_at(slot as usize) else {
-                continue; // its object is gone
+                gone.push(slot); // its object is gone
+                continue;
             };
-            match self.body_of(handle) {
-                Ok(h) => work.push((slot, handle, h, c)),
-                Err(_) => done.push((slot, c)),
+            if let Ok(h) = self.body_of(handle) {
+                work.push((handle, h, c));
             }
         }
         let pool = (work.len() >= PARALLEL_FROM)
             .then(|| self.world.physics_pipeline.thread_pool())
             .flatten();
-        let Some(pool) = pool else {
-            for (slot, handle, h, c) in work {
-                let o = self.scene(false).tick(slot, handle, h, c, dt);
-                done.push(self.commit_tick(o, dt, false).0);
+        match pool {
+            None => {
+                for (handle, h, c) in work {
+                    let o = self.scene(false).tick(handle, h, c, dt);
+                    self.commit_tick(o, c, dt, false);
+                }
             }
-            self.controllers = done.into_iter().collect();
-            return;
-        };
-        let outcomes: Vec<Outcome> = {
+            Some(pool) => self.tick_side_by_side(&pool, work, dt),
+        }
+        for slot in gone {
+            controllers.remove(&slot);
+        }
+        self.controllers = controllers;
+    }
+
+    /// The ticks of `work` on `pool`, each from the scene as the last tick left it, then
+    /// committed in slot order, those that read what an earlier commit changed ticked
+    /// again first (see the module docs).
+    fn tick_side_by_side(
+        &mut self,
+        pool: &rayon::ThreadPool,
+        work: Vec<(Handle, RigidBodyHandle, &mut Controller)>,
+        dt: f32,
+    ) {
+        let outcomes: Vec<(Outcome, &mut Controller)> = {
             let scene = self.scene(true);
             pool.install(|| {
                 work.into_par_iter()
                     .with_min_len(PARALLEL_CHUNK)
-                    .map(|(slot, handle, h, c)| scene.tick(slot, handle, h, c, dt))
+                    .map(|(handle, h, c)| (scene.tick(handle, h, c, dt), c))
                     .collect()
             })
         };
@@ -157,7 +179,7 @@ impl Plane {
         let mut moved: Vec<Moved> = vec![None; outcomes.len()];
         let mut moved_again: Vec<(Aabb, Aabb)> = Vec::new();
         let mut pushed: HashSet<RigidBodyHandle> = HashSet::new();
-        for (j, o) in outcomes.into_iter().enumerate() {
+        for (j, (o, c)) in outcomes.into_iter().enumerate() {
             let cov = o.covered;
             let inside = |(was, went): &(Aabb, Aabb)| was.intersects(&cov) || went.intersects(&cov);
             let mut again =
@@ -167,28 +189,20 @@ impl Plane {
                 next_pair += 1;
             }
             let o = if again {
-                let Outcome {
-                    slot,
-                    mut controller,
-                    t,
-                    saved,
-                    ..
-                } = o;
-                saved.restore(&mut controller);
-                self.scene(false).tick(slot, t.handle, t.h, controller, dt)
+                let Outcome { t, saved, .. } = o;
+                saved.restore(c);
+                self.scene(false).tick(t.handle, t.h, c, dt)
             } else {
                 o
             };
             pushed.extend(o.pushes.iter().map(|p| p.body));
-            let (entry, m) = self.commit_tick(o, dt, true);
+            let m = self.commit_tick(o, c, dt, true);
             match (again, m) {
                 (true, Some(m)) => moved_again.push(m),
                 (false, m) => moved[j] = m,
                 (true, None) => {}
             }
-            done.push(entry);
         }
-        self.controllers = done.into_iter().collect();
     }
 
     /// The read-only view a controller's tick works from; `side_by_side` when the tick must
@@ -205,17 +219,15 @@ impl Plane {
         }
     }
 
-    /// The end of a controller's tick: its pushes, the next kinematic pose (and the
+    /// The end of controller `c`'s tick: its pushes, the next kinematic pose (and the
     /// colliders and broad phase, so queries before the step see it where it is going), the
-    /// published flags and the tick's events. Returns the controller, for the plane's map,
-    /// and, when `track` (ticks side by side), where its capsule was and went if its pose
-    /// changed.
-    fn commit_tick(&mut self, o: Outcome, dt: f32, track: bool) -> ((u32, Controller), Moved) {
+    /// published flags and the tick's events. Returns, when `track` (ticks side by side),
+    /// where its capsule was and went if its pose changed.
+    fn commit_tick(&mut self, o: Outcome, c: &mut Controller, dt: f32, track: bool) -> Moved {
         let Outcome {
-            slot,
-            controller: mut c,
             t,
             next,
+            rotation,
             pushes,
             ..
         } = o;
@@ -235,7 +247,7 @@ impl Plane {
         if c.settings.report_moved && actual.length() > 1e-6 {
             events.push((EVENT_CONTROLLER_MOVED, 0, actual));
         }
-        let next_pose = rapier3d::math::Pose::from_parts(next, yaw_rotation(c.yaw));
+        let next_pose = rapier3d::math::Pose::from_parts(next, rotation);
         self.world.bodies[h].set_next_kinematic_position(next_pose);
         let world = &mut self.world;
         let (mut was, mut went, mut changed) = (Aabb::new_invalid(), Aabb::new_invalid(), false);
@@ -272,13 +284,13 @@ impl Plane {
                 ..EventRecord::default()
             });
         }
-        ((slot, c), changed.then_some((was, went)))
+        changed.then_some((was, went))
     }
 }
 
 /// Whether `a` and `b` are the same pose bit for bit (a query's answer can change with the
 /// last bit of either).
-fn same_pose(a: &rapier3d::math::Pose, b: &rapier3d::math::Pose) -> bool {
+pub(super) fn same_pose(a: &rapier3d::math::Pose, b: &rapier3d::math::Pose) -> bool {
     let bits = |p: &rapier3d::math::Pose| {
         let (t, r) = (p.translation, p.rotation);
         [t.x, t.y, t.z, r.x, r.y, r.z, r.w].map(f32::to_bits)
@@ -288,13 +300,13 @@ fn same_pose(a: &rapier3d::math::Pose, b: &rapier3d::math::Pose) -> bool {
 
 /// The pairs (later, earlier), as positions in slot order, of outcomes whose covered volumes
 /// overlap, sorted by the later one: a sweep along X over the volumes sorted by their start.
-fn overlapping_pairs(outcomes: &[Outcome]) -> Vec<(u32, u32)> {
+fn overlapping_pairs(outcomes: &[(Outcome, &mut Controller)]) -> Vec<(u32, u32)> {
     // The volumes side by side, sorted by their start along X (an outcome is large: reading
     // the volumes in place cost a cache miss per comparison).
     let mut boxes: Vec<(Aabb, u32)> = outcomes
         .iter()
         .enumerate()
-        .map(|(i, o)| (o.covered, i as u32))
+        .map(|(i, (o, _))| (o.covered, i as u32))
         .collect();
     boxes.sort_unstable_by(|a, b| a.0.mins.x.total_cmp(&b.0.mins.x));
     let mut pairs = Vec::new();
@@ -315,35 +327,30 @@ fn overlapping_pairs(outcomes: &[Outcome]) -> Vec<(u32, u32)> {
 
 impl<'a> Scene<'a> {
     /// One controller's tick: the stages of the module doc, each a function below.
-    fn tick(
-        &self,
-        slot: u32,
-        handle: Handle,
-        h: RigidBodyHandle,
-        mut c: Controller,
-        dt: f32,
-    ) -> Outcome {
-        let saved = Saved::of(&c);
-        let mut t = self.begin_tick(&c, handle, h);
-        let mut motion = self.intended_motion(&mut c, &mut t, dt);
+    fn tick(&self, handle: Handle, h: RigidBodyHandle, c: &mut Controller, dt: f32) -> Outcome {
+        let saved = Saved::of(c);
+        let mut t = self.begin_tick(c, handle, h);
+        let mut motion = self.intended_motion(c, &mut t, dt);
+        // The facing is fixed from here until the controller turns (stage 8).
+        t.rotation = yaw_rotation(c.yaw);
         // What the tick can reach, gathered once from the broad phase.
-        let mut nearby = Nearby::gather(self.refs, h, t.groups, t.reach(&c, motion.desired));
-        let (mut next, collisions) = self.move_capsule(&c, &t, &mut motion, dt, &mut nearby);
-        self.settle_on_ground(&mut c, &mut t, &mut next, &mut motion, &mut nearby);
-        let pushes = self.clip_velocity(&c, &collisions, &mut motion.v, dt);
+        let mut nearby = Nearby::gather(self.refs, h, t.groups, t.reach(c, motion.desired));
+        let (mut next, collisions) = self.move_capsule(c, &t, &mut motion, dt, &mut nearby);
+        self.settle_on_ground(c, &mut t, &mut next, &mut motion, &mut nearby);
+        let pushes = self.clip_velocity(c, &collisions, &mut motion.v, dt);
         c.turn_toward(motion.v, dt);
         c.follow_path(next, &mut t.events);
         c.velocity = motion.v;
+        let rotation = yaw_rotation(c.yaw);
         let (covered, dynamic) = if self.side_by_side {
-            self.what_it_read(&c, &saved, &t, next, &nearby)
+            self.what_it_read(rotation, &saved, &t, next, &nearby)
         } else {
             (Aabb::new_invalid(), Vec::new())
         };
         Outcome {
-            slot,
-            controller: c,
             t,
             next,
+            rotation,
             pushes,
             saved,
             covered,
@@ -356,13 +363,13 @@ impl<'a> Scene<'a> {
     /// slack) and the dynamic bodies within it or under it at the start.
     fn what_it_read(
         &self,
-        c: &Controller,
+        rotation: Rotation,
         saved: &Saved,
         t: &TickState,
         next: Vector,
         nearby: &Nearby<'_>,
     ) -> (Aabb, Vec<RigidBodyHandle>) {
-        let at = |p: Vector| rapier3d::math::Pose::from_parts(p, yaw_rotation(c.yaw));
+        let at = |p: Vector| rapier3d::math::Pose::from_parts(p, rotation);
         let start = capsule_aabb(&t.shape, &at(t.start));
         let end = capsule_aabb(&t.shape, &at(next));
         let covered = nearby
@@ -401,6 +408,8 @@ impl<'a> Scene<'a> {
         TickState {
             handle,
             h,
+            // Set once the platform has turned it (see `tick`).
+            rotation: Rotation::IDENTITY,
             shape: c.capsule(),
             half_height: s.capsule_half_height + s.capsule_radius,
             start: bodies[h].translation(),
@@ -490,7 +499,7 @@ impl<'a> Scene<'a> {
             min_slope_slide_angle: s.max_slope.to_radians(),
             snap_to_ground: snap,
         };
-        let pose = rapier3d::math::Pose::from_parts(position, yaw_rotation(c.yaw));
+        let pose = rapier3d::math::Pose::from_parts(position, t.rotation);
         let mut collisions: Vec<CharacterCollision> = Vec::new();
         let moved = mover.move_shape(dt, nearby, &t.shape, &pose, m.desired, |col| {
             collisions.push(col)
@@ -504,7 +513,8 @@ impl<'a> Scene<'a> {
             && s.step_height > 0.0
             && got_h.length() + 1e-4 < wanted_h.length() * 0.5
         {
-            if let Some(stepped) = self.step_up(&t.shape, next, c.yaw, wanted_h - got_h, &s, nearby)
+            if let Some(stepped) =
+                self.step_up(&t.shape, next, t.rotation, wanted_h - got_h, &s, nearby)
             {
                 next = stepped;
                 // The step's face did not stop it: keep the speed.
@@ -535,7 +545,7 @@ impl<'a> Scene<'a> {
         let ground = if rising {
             None
         } else {
-            self.probe_ground(&t.shape, *next, c.yaw, probe, s.max_slope, nearby)
+            self.probe_ground(&t.shape, *next, t.rotation, probe, s.max_slope, nearby)
         };
         c.on_ground = false;
         c.ground = None;
@@ -605,6 +615,8 @@ impl<'a> Scene<'a> {
 struct TickState {
     handle: Handle,
     h: RigidBodyHandle,
+    /// The controller's facing while it moves (set again after the platform turns it).
+    rotation: Rotation,
     shape: Capsule,
     half_height: f32,
     start: Vector,
@@ -615,14 +627,18 @@ struct TickState {
 }
 
 impl TickState {
-    /// The region a tick that starts at `start` and asks for `desired` can read: the capsule
-    /// at both ends, widened by what the move's snap, the step (lift, reach, drop) and the
-    /// ground probe reach beyond them.
+    /// The region a tick that starts at `start` and asks for `desired` reads unless it is
+    /// blocked: the capsule at both ends, widened by what the move's queries, its snap and
+    /// the ground probe reach beyond them. A step (lift, reach, drop) and a long slide
+    /// reach further and gather again ([`Nearby::ensure`]); a region as wide as those
+    /// walked the broad phase's tree over twice the area on every tick, blocked or not.
     fn reach(&self, c: &Controller, desired: Vector) -> Aabb {
         self.swept(&c.settings, self.start, desired)
     }
 
-    /// The capsule from `from` to `from + desired`, widened as in [`TickState::reach`].
+    /// The capsule from `from` to `from + desired`, widened as in [`TickState::reach`]:
+    /// by [`REACH_SLACK`] (more than the gap kept and the contact prediction), and below
+    /// and above also by the snap and probe distance.
     fn swept(&self, s: &ControllerSettings, from: Vector, desired: Vector) -> Aabb {
         let pose = rapier3d::math::Pose::from_translation(from);
         let a = capsule_aabb(&self.shape, &pose);
@@ -630,8 +646,10 @@ impl TickState {
             &self.shape,
             &(rapier3d::math::Pose::from_translation(desired) * pose),
         );
-        let margin = s.step_height.max(SKIN * 4.0) + s.capsule_radius + 0.25;
-        a.merged(&b).loosened(margin)
+        let vertical = s.step_height.max(SKIN * 4.0) + REACH_SLACK;
+        let margin = Vector::new(REACH_SLACK, vertical, REACH_SLACK);
+        let swept = a.merged(&b);
+        Aabb::new(swept.mins - margin, swept.maxs + margin)
     }
 }
 
