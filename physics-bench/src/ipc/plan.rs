@@ -9,7 +9,8 @@ pub const GOAL_BODIES: usize = 10_000;
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct Plan {
     pub sizes: Vec<usize>,
-    /// Timed blocks per scene and side (the figure is the median).
+    /// Timed blocks per scene and side of the overhead figure (ABBA; judged on the minimum
+    /// of each side's blocks, so enough of them that some fall in quiet stretches).
     pub repeats: usize,
     pub delivery_ticks: usize,
     #[serde(skip)]
@@ -31,7 +32,7 @@ impl Plan {
         if quick {
             Plan {
                 sizes: vec![GOAL_BODIES],
-                repeats: 3,
+                repeats: 8,
                 delivery_ticks: 30,
                 delivery_time_cap: Duration::from_secs(4),
                 round_trips: 1_000,
@@ -45,7 +46,7 @@ impl Plan {
         } else {
             Plan {
                 sizes: vec![100, 1_000, GOAL_BODIES, 50_000],
-                repeats: 7,
+                repeats: 12,
                 delivery_ticks: 60,
                 delivery_time_cap: Duration::from_secs(8),
                 round_trips: 5_000,
