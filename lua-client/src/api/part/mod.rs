@@ -2,6 +2,7 @@
 //! reading `part.CFrame` returns the pose of the newest tick, read from shared memory.
 
 pub(crate) mod pose_index;
+pub(crate) mod pose_table;
 pub(crate) mod props;
 pub(crate) mod state;
 

@@ -3,29 +3,32 @@
 //!
 //! A read through mlua costs its callback (~85 ns: argument references, the error and panic
 //! guards) plus an mlua userdata for the value (~80 ns); a C `__index` costs ~20 ns and a
-//! CFrame value ([`crate::values::cframe_ud`]) ~10 ns. The part behind a BasePart value is
-//! found by the value's address in a Rust map ([`PoseIndex`]: every BasePart value is
-//! registered there when `part_ud` makes it), and the value last handed out is kept in an
-//! array table at the part's slot, reused while the pose is bit for bit the same (so a
-//! second read in a tick, or a resting part, allocates nothing and reads `rawequal`).
-//! Weak-keyed Luau tables did both before: two userdata-keyed lookups a read (~25 ns each,
-//! more once the tables outgrow the cache) and two tables for the collector to clear every
-//! cycle. The pose itself is the same Rust read as before (newest sample, this process's
-//! pending writes on top); a panic there falls back to the mlua path, which reports it.
+//! CFrame value ([`crate::values::cframe_ud`]) ~10 ns. The BasePart value is found by its
+//! address in a Rust map ([`PoseIndex`]: every BasePart value is registered there when
+//! `part_ud` makes it) giving its slot; the slot's entry in the [`PoseTable`] holds the SDK
+//! object the pose is read from (so a read does not visit the part: see `pose_table`), and
+//! the value last handed out is kept in an array table at the same slot, reused while the
+//! pose is bit for bit the same (so a second read in a tick, or a resting part, allocates
+//! nothing and reads `rawequal`). The pose itself is the same SDK read as before (newest
+//! sample, this process's pending writes on top); a part without a body is read from the
+//! part; a panic there falls back to the mlua path, which reports it.
 
 use std::cell::{Cell, RefCell};
 use std::ffi::c_void;
+use std::hash::{BuildHasher, Hasher};
 use std::os::raw::c_int;
 use std::panic::AssertUnwindSafe;
 use std::rc::{Rc, Weak};
 
 use mlua::{ffi, AnyUserData, Function, LightUserData, Lua, Table};
 
+use super::pose_table::PoseTable;
 use super::state::{BasePart, PartShape, PartState};
-use crate::values::cframe_ud;
+use crate::values::{cframe_ud, CFrame};
 
-/// One registered BasePart value: its part and the slot of the array table (the C
-/// `__index`'s upvalue 2) holding the CFrame value its last read handed out.
+/// One registered BasePart value: its part and its slot (of the array table, the C
+/// `__index`'s upvalue 2, holding the CFrame value its last read handed out, and of the
+/// [`PoseTable`]).
 struct Entry {
     part: Weak<PartState>,
     slot: c_int,
@@ -34,14 +37,53 @@ struct Entry {
 /// BasePart value address → its part (see the module doc). One per Lua state, in its app
 /// data; the C `__index` reaches it through upvalue 3.
 pub(crate) struct PoseIndex {
-    parts: RefCell<hashbrown::HashMap<usize, Entry>>,
+    parts: RefCell<hashbrown::HashMap<usize, Entry, AddressHash>>,
     /// The array table of handed-out values (by slot).
     values: Table,
+    /// What reads need of each slot's part.
+    table: Rc<PoseTable>,
     /// Slots given back by entries removed (their value cleared), and the next new one.
     free: RefCell<Vec<c_int>>,
     next: Cell<c_int>,
     /// The map's size that makes the next `register` drop the entries of dropped parts.
     sweep_at: Cell<usize>,
+}
+
+/// Hashes a BasePart value's address so that values made one after another (Luau gives a
+/// size of objects consecutive addresses of the same pages) land in neighbouring buckets: a
+/// loop over parts reads the map in memory order, which the processor prefetches, where a
+/// scrambling hash made each read wait for one random cache line (the most of a first read's
+/// time in `perf annotate`). The bucket is the address / 16; the top 7 bits, the map's tag
+/// byte, come from a multiplicative mix so that neighbours' tags differ.
+#[derive(Clone, Copy, Default)]
+pub(crate) struct AddressHash;
+
+/// The hasher of [`AddressHash`].
+pub(crate) struct AddressHasher(u64);
+
+impl BuildHasher for AddressHash {
+    type Hasher = AddressHasher;
+
+    fn build_hasher(&self) -> AddressHasher {
+        AddressHasher(0)
+    }
+}
+
+impl Hasher for AddressHasher {
+    fn write(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.0 = self.0.rotate_left(8) ^ u64::from(b);
+        }
+    }
+
+    fn write_usize(&mut self, n: usize) {
+        self.0 = n as u64;
+    }
+
+    fn finish(&self) -> u64 {
+        let a = self.0;
+        (a >> 4) ^ (a.wrapping_mul(0x9E37_79B9_7F4A_7C15) & !(u64::MAX >> 7))
+    }
 }
 
 /// Fewest entries before dropped parts' entries are swept (then twice the entries kept).
@@ -64,21 +106,23 @@ pub(crate) fn install(lua: &Lua) -> mlua::Result<()> {
     };
     let fallback: Function = meta.raw_get("__index")?;
     let ix = Rc::new(PoseIndex {
-        parts: RefCell::new(hashbrown::HashMap::new()),
+        parts: RefCell::new(hashbrown::HashMap::with_hasher(AddressHash)),
         values: values.clone(),
+        table: Rc::new(PoseTable::default()),
         free: RefCell::new(Vec::new()),
         next: Cell::new(1),
         sweep_at: Cell::new(SWEEP_FROM),
     });
     // The app data keeps `ix` (and so this address) for the Lua state's life.
     let at = LightUserData(Rc::as_ptr(&ix) as *mut c_void);
-    // SAFETY: `index` reads upvalues 1 to 4 as pushed here.
+    let key = lua.create_string("CFrame")?;
+    // SAFETY: `index` reads upvalues 1 to 5 as pushed here.
     let fast = unsafe {
         cframe_ud::c_closure(
             lua,
             index,
             c"BasePart.__index",
-            (fallback, values, at, meta.clone()),
+            (fallback, values, at, meta.clone(), key),
         )?
     };
     meta.raw_set("__index", fast)?;
@@ -108,8 +152,16 @@ pub(crate) fn register(lua: &Lua, ud: &AnyUserData, part: &Rc<PartState>) -> mlu
             slot = Some(e.slot);
         } else {
             freed.push(e.slot);
+            // A part still alive (held elsewhere) no longer has this slot.
+            if let Some(other) = e.part.upgrade() {
+                if other.pose_slot() == Some(e.slot as usize) {
+                    other.set_pose_slot(None);
+                }
+            }
         }
     }
+    // A slot taken over keeps its entry (the value handed out is still at that slot).
+    let fresh = slot.is_none();
     let slot = match slot.or_else(|| ix.free.borrow_mut().pop()) {
         Some(slot) => slot,
         None => {
@@ -141,24 +193,26 @@ pub(crate) fn register(lua: &Lua, ud: &AnyUserData, part: &Rc<PartState>) -> mlu
     drop(parts);
     for &slot in &freed {
         ix.values.raw_set(slot, mlua::Value::Nil)?;
+        ix.table.clear(slot as usize);
     }
     ix.free.borrow_mut().extend(freed);
+    if fresh {
+        ix.table.clear(slot as usize);
+    }
+    part.set_pose_slot(Some((ix.table.clone(), slot as usize)));
     Ok(())
 }
 
 /// The C `__index` of BasePart: `part.CFrame` here, anything else (and a value it does not
 /// know) through the mlua `__index` in upvalue 1.
 unsafe extern "C-unwind" fn index(state: *mut ffi::lua_State) -> c_int {
-    if is_cframe_key(state) {
-        if let Some((part, slot)) = registered(state) {
-            // SAFETY: the BasePart value at index 1 holds an `Rc` of this `PartState`, and
-            // only Rust code runs until the read returns.
-            let read = std::panic::catch_unwind(AssertUnwindSafe(|| {
-                let part = &*part;
-                let cf = part.cframe();
-                (cf, part.handed_out_same(&cf))
-            }));
-            if let Ok((cf, same)) = read {
+    // Upvalue 5 is the interned string "CFrame": one pointer comparison.
+    if ffi::lua_rawequal(state, 2, ffi::lua_upvalueindex(5)) != 0 {
+        if let Some((key, slot)) = registered(state) {
+            let ix = index_of(state);
+            // Only Rust code runs until the read returns.
+            let read = std::panic::catch_unwind(AssertUnwindSafe(|| read(ix, key, slot)));
+            if let Ok(Some((cf, same))) = read {
                 if same {
                     if ffi::lua_rawgeti(state, ffi::lua_upvalueindex(2), slot.into())
                         == ffi::LUA_TUSERDATA
@@ -171,7 +225,7 @@ unsafe extern "C-unwind" fn index(state: *mut ffi::lua_State) -> c_int {
                 cframe_ud::push(state, cf);
                 ffi::lua_pushvalue(state, -1);
                 ffi::lua_rawseti(state, ffi::lua_upvalueindex(2), slot.into());
-                (*part).handed_out(cf);
+                ix.table.get(slot as usize, |s| s.last = Some(cf));
                 return 1;
             }
         }
@@ -182,8 +236,42 @@ unsafe extern "C-unwind" fn index(state: *mut ffi::lua_State) -> c_int {
     1
 }
 
-/// The part and slot of the BasePart value at index 1, if it is one the map knows.
-unsafe fn registered(state: *mut ffi::lua_State) -> Option<(*const PartState, c_int)> {
+/// The state's `PoseIndex` (upvalue 3 of the C `__index`).
+///
+/// # Safety
+/// Called from that `__index`; the app data keeps the index for the Lua state's life.
+unsafe fn index_of<'a>(state: *mut ffi::lua_State) -> &'a PoseIndex {
+    &*(ffi::lua_tolightuserdata(state, ffi::lua_upvalueindex(3)) as *const PoseIndex)
+}
+
+/// The pose of the part at `slot` and whether the value last handed out there holds it bit
+/// for bit: from the slot's SDK object while the part has a body (the part is not visited),
+/// else from the part. `None` when the slot or its part is not there (the mlua path answers).
+fn read(ix: &PoseIndex, key: usize, slot: c_int) -> Option<(CFrame, bool)> {
+    let from_source = ix.table.get(slot as usize, |s| {
+        let cf = CFrame::from_pose(s.source.as_ref()?.pose().ok()?);
+        Some((cf, s.last.is_some_and(|l| l.same_bits(&cf))))
+    })?;
+    if from_source.is_some() {
+        return from_source;
+    }
+    // No body (or its read failed): the part's own answer, as the mlua path gives it.
+    let part = ix.part_at(key)?;
+    let cf = part.cframe();
+    let last = ix.table.get(slot as usize, |s| s.last)?;
+    Some((cf, last.is_some_and(|l| l.same_bits(&cf))))
+}
+
+impl PoseIndex {
+    /// The live part of the BasePart value at address `key`.
+    fn part_at(&self, key: usize) -> Option<Rc<PartState>> {
+        let parts = self.parts.try_borrow().ok()?;
+        parts.get(&key).and_then(|e| e.part.upgrade())
+    }
+}
+
+/// The address and slot of the BasePart value at index 1, if it is one the map knows.
+unsafe fn registered(state: *mut ffi::lua_State) -> Option<(usize, c_int)> {
     // Only a BasePart value (BasePart's metatable, upvalue 4) is looked up: a script may
     // call this `__index` with any value, and an address alone may be a collected part's.
     if ffi::lua_getmetatable(state, 1) == 0 {
@@ -195,21 +283,47 @@ unsafe fn registered(state: *mut ffi::lua_State) -> Option<(*const PartState, c_
         return None;
     }
     let key = ffi::lua_touserdata(state, 1) as usize;
-    let ix = ffi::lua_tolightuserdata(state, ffi::lua_upvalueindex(3)) as *const PoseIndex;
-    // SAFETY: upvalue 3 is the state's `PoseIndex`, kept by its app data.
-    let parts = (*ix).parts.try_borrow().ok()?;
-    let e = parts.get(&key)?;
     // A live BasePart value at a registered address is that entry's (each is registered
-    // when made), so its part is alive; the count is checked all the same.
-    (e.part.strong_count() > 0).then_some((e.part.as_ptr(), e.slot))
+    // when made), so the slot is its part's.
+    let parts = index_of(state).parts.try_borrow().ok()?;
+    parts.get(&key).map(|e| (key, e.slot))
 }
 
-/// Whether the key at index 2 is the string `"CFrame"` (a number is not converted).
-unsafe fn is_cframe_key(state: *mut ffi::lua_State) -> bool {
-    if ffi::lua_type(state, 2) != ffi::LUA_TSTRING {
-        return false;
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn hash(address: usize) -> u64 {
+        AddressHash.hash_one(address)
     }
-    let mut len = 0usize;
-    let s = ffi::lua_tolstring(state, 2, &mut len) as *const u8;
-    len == 6 && std::slice::from_raw_parts(s, len) == b"CFrame"
+
+    #[test]
+    fn neighbouring_addresses_land_in_neighbouring_buckets_with_varied_tags() {
+        // Values 48 bytes apart (a Luau size class): buckets 3 apart, in address order.
+        let base = 0x7f12_3456_7000usize;
+        let hashes: Vec<u64> = (0..64).map(|i| hash(base + 48 * i)).collect();
+        let mask = (1u64 << 11) - 1; // a map of 2048 buckets
+        for (i, w) in hashes.windows(2).enumerate() {
+            assert_eq!(
+                (w[1] & mask).wrapping_sub(w[0] & mask) & mask,
+                3,
+                "value {i}"
+            );
+        }
+        let tags: std::collections::BTreeSet<u64> = hashes.iter().map(|h| h >> 57).collect();
+        assert!(tags.len() > 32, "tags of 64 neighbours: {tags:?}");
+    }
+
+    #[test]
+    fn the_map_finds_every_address_it_holds() {
+        let mut map = hashbrown::HashMap::with_hasher(AddressHash);
+        let base = 0x5555_0000_1000usize;
+        for i in 0..5000 {
+            map.insert(base + 64 * i, i);
+        }
+        for i in 0..5000 {
+            assert_eq!(map.get(&(base + 64 * i)), Some(&i));
+            assert_eq!(map.get(&(base + 64 * i + 8)), None);
+        }
+    }
 }

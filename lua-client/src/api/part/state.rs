@@ -9,6 +9,7 @@ use std::rc::{Rc, Weak};
 use client_sdk::{Object, ObjectProp, Shape};
 use mlua::{Lua, MultiValue, Value};
 
+use super::pose_table::PoseTable;
 use crate::host::signal::Signal;
 use crate::host::watched::Watched;
 use crate::props::Target;
@@ -229,8 +230,9 @@ pub struct PartState {
     mesh: RefCell<Option<Rc<MeshData>>>,
     /// The CFrame value last handed to scripts (reads of an unmoved pose reuse it).
     cframe_value: CFrameCache,
-    /// The pose of the value `part.CFrame` last handed out (see `pose_index`).
-    handed_out: Cell<Option<CFrame>>,
+    /// The pose table entry of the part's BasePart value (see `pose_table`): told the
+    /// object to read whenever the link changes.
+    pose_slot: RefCell<Option<(Rc<PoseTable>, usize)>>,
     /// The address of the BasePart value the pose index knows it by (0: none yet).
     pub(crate) pose_key: Cell<usize>,
     /// Added anchored (`Renderable.Plane`, `Renderable.Brush`: static shapes).
@@ -256,7 +258,7 @@ impl PartState {
             grouped: Cell::new(false),
             mesh: RefCell::new(None),
             cframe_value: CFrameCache::default(),
-            handed_out: Cell::new(None),
+            pose_slot: RefCell::new(None),
             pose_key: Cell::new(0),
             anchor_on_add: Cell::new(false),
             bone: RefCell::new(None),
@@ -404,6 +406,7 @@ impl PartState {
         self.last_fired.set(None);
         self.reporting.set(reporting);
         *self.link.borrow_mut() = Some(body);
+        self.push_pose_source();
     }
 
     /// Handlers connected to Touched and TouchEnded.
@@ -483,14 +486,23 @@ impl PartState {
         self.cframe_value.value(lua, cf)
     }
 
-    /// Whether `part.CFrame` last handed out a value of exactly `cf` (see `pose_index`).
-    pub(crate) fn handed_out_same(&self, cf: &CFrame) -> bool {
-        self.handed_out.get().is_some_and(|h| h.same_bits(cf))
+    /// Reads of `part.CFrame` find the part at `at` (its pose table and slot; `None`: at
+    /// none) from now on; the entry is told the object to read.
+    pub(crate) fn set_pose_slot(&self, at: Option<(Rc<PoseTable>, usize)>) {
+        *self.pose_slot.borrow_mut() = at;
+        self.push_pose_source();
     }
 
-    /// `part.CFrame` handed out a value of `cf`.
-    pub(crate) fn handed_out(&self, cf: CFrame) {
-        self.handed_out.set(Some(cf));
+    /// The pose table slot reads find the part at, if any.
+    pub(crate) fn pose_slot(&self) -> Option<usize> {
+        self.pose_slot.borrow().as_ref().map(|(_, slot)| *slot)
+    }
+
+    /// Tells the part's pose table entry the object its pose is read from now.
+    fn push_pose_source(&self) {
+        if let Some((table, slot)) = self.pose_slot.borrow().as_ref() {
+            table.set_source(*slot, self.object());
+        }
     }
 
     /// Stores a pose for a part that is not simulated.
@@ -504,6 +516,7 @@ impl PartState {
         let cf = self.cframe();
         self.cframe.set(cf);
         let body = self.link.borrow_mut().take()?;
+        self.push_pose_source();
         body.ended.set(Some(why));
         self.reporting.set(false);
         Some(body)
