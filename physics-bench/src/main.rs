@@ -37,6 +37,7 @@
 mod accuracy;
 mod cluster;
 mod controllers;
+mod counts;
 mod daemon;
 mod envelope;
 mod error;
@@ -133,6 +134,9 @@ enum Bench {
     /// Scenes other engines publish figures for (Jolt's PerformanceTest Pyramid, Box2D v3's
     /// large_pyramid), measured here with the defaults, beside the peers' published setups.
     Peers(peers::PeersArgs),
+    /// The instruction counts of benches/instructions (gungraun over Valgrind's Callgrind,
+    /// run by .ci/instructions) against their baselines: fails when one moves more than 2 %.
+    Counts(counts::CountsArgs),
 }
 
 fn main() -> ExitCode {
@@ -166,6 +170,7 @@ fn main() -> ExitCode {
         Bench::Envelope(args) => envelope::run(args),
         Bench::Render(args) => render::run(args),
         Bench::Peers(args) => peers::run(args),
+        Bench::Counts(args) => counts::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
