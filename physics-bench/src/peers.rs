@@ -603,15 +603,13 @@ fn steps_text(r: &PlaneRun) -> String {
 
 fn stand_text(s: &Stand) -> String {
     format!(
-        "{}: drift ≤ {} (allowed {}), top at {} (needed ≥ {}){}",
+        "{}: drift ≤ {} (allowed {}), top at {} (needed ≥ {}), {} bodies gone",
         if s.stands { "stands" } else { "falls" },
         num(Some(s.max_drift as f64)),
         num(Some(s.drift_allowed as f64)),
         num(Some(s.top_height as f64)),
         num(Some(s.top_needed as f64)),
-        (s.missing > 0)
-            .then(|| format!(", {} bodies gone", s.missing))
-            .unwrap_or_default()
+        s.missing
     )
 }
 

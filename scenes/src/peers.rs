@@ -42,8 +42,10 @@ pub fn jolt_pyramid_layout() -> Vec<[f32; 3]> {
     for i in 0..n {
         let offset = if i % 2 == 1 { half } else { 0.0 };
         let y = half + (JOLT_BOX_SIZE + JOLT_BOX_SEPARATION) * i as f32;
-        for j in i / 2..n - (i + 1) / 2 {
-            for k in i / 2..n - (i + 1) / 2 {
+        // Jolt's bounds, `i / 2 .. 15 − (i + 1) / 2`.
+        let (lo, hi) = (i / 2, n - i.div_ceil(2));
+        for j in lo..hi {
+            for k in lo..hi {
                 out.push([
                     -(n as f32) + JOLT_BOX_SIZE * j as f32 + offset,
                     y,
