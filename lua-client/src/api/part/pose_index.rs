@@ -54,7 +54,8 @@ pub(crate) struct PoseIndex {
 /// loop over parts reads the map in memory order, which the processor prefetches, where a
 /// scrambling hash made each read wait for one random cache line (the most of a first read's
 /// time in `perf annotate`). The bucket is the address / 16; the top 7 bits, the map's tag
-/// byte, come from a multiplicative mix so that neighbours' tags differ.
+/// byte, come from a multiplicative (Fibonacci) mix of the address / 8 so that the values
+/// sharing a probe group have different tags.
 #[derive(Clone, Copy, Default)]
 pub(crate) struct AddressHash;
 
@@ -82,7 +83,7 @@ impl Hasher for AddressHasher {
 
     fn finish(&self) -> u64 {
         let a = self.0;
-        (a >> 4) ^ (a.wrapping_mul(0x9E37_79B9_7F4A_7C15) & !(u64::MAX >> 7))
+        (a >> 4) ^ ((a >> 3).wrapping_mul(0x9E37_79B9_7F4A_7C15) & !(u64::MAX >> 7))
     }
 }
 
@@ -298,11 +299,11 @@ mod tests {
     }
 
     #[test]
-    fn neighbouring_addresses_land_in_neighbouring_buckets_with_varied_tags() {
+    fn neighbouring_addresses_land_in_neighbouring_buckets_with_distinct_tags() {
         // Values 48 bytes apart (a Luau size class): buckets 3 apart, in address order.
         let base = 0x7f12_3456_7000usize;
-        let hashes: Vec<u64> = (0..64).map(|i| hash(base + 48 * i)).collect();
         let mask = (1u64 << 11) - 1; // a map of 2048 buckets
+        let hashes: Vec<u64> = (0..64).map(|i| hash(base + 48 * i)).collect();
         for (i, w) in hashes.windows(2).enumerate() {
             assert_eq!(
                 (w[1] & mask).wrapping_sub(w[0] & mask) & mask,
@@ -310,8 +311,15 @@ mod tests {
                 "value {i}"
             );
         }
-        let tags: std::collections::BTreeSet<u64> = hashes.iter().map(|h| h >> 57).collect();
-        assert!(tags.len() > 32, "tags of 64 neighbours: {tags:?}");
+        // Any 6 neighbours (as many as share a 16-bucket probe group at the widest spacing
+        // that packs them) have 6 different tags, for every 8-aligned spacing up to 256.
+        for stride in (8..=256).step_by(8) {
+            let tags: Vec<u64> = (0..64).map(|i| hash(base + stride * i) >> 57).collect();
+            for (i, w) in tags.windows(6).enumerate() {
+                let distinct: std::collections::BTreeSet<_> = w.iter().collect();
+                assert_eq!(distinct.len(), 6, "spacing {stride}, values {i}..: {w:?}");
+            }
+        }
     }
 
     #[test]
