@@ -22,7 +22,10 @@ pub struct CountsArgs {
     #[arg(long, default_value = "target/gungraun")]
     pub summaries: PathBuf,
     /// The baselines kept in the repository.
-    #[arg(long, default_value = "physics-bench/benches/instructions/baseline.json")]
+    #[arg(
+        long,
+        default_value = "physics-bench/benches/instructions/baseline.json"
+    )]
     pub baseline: PathBuf,
     /// Write the counts as the new baseline instead of judging them.
     #[arg(long)]
@@ -91,10 +94,8 @@ pub fn run(args: &CountsArgs) -> BenchResult<()> {
         };
         let text = serde_json::to_string_pretty(&baseline)
             .map_err(|e| BenchError::Failed(format!("encode the baseline: {e}")))?;
-        std::fs::write(&args.baseline, text + "\n").map_err(BenchError::io(format!(
-            "write {}",
-            args.baseline.display()
-        )))?;
+        std::fs::write(&args.baseline, text + "\n")
+            .map_err(BenchError::io(format!("write {}", args.baseline.display())))?;
         println!(
             "wrote {} counts to {}",
             baseline.counts.len(),
@@ -131,8 +132,10 @@ pub fn run(args: &CountsArgs) -> BenchResult<()> {
 }
 
 fn read_baseline(path: &Path) -> BenchResult<Baseline> {
-    let text = std::fs::read_to_string(path)
-        .map_err(BenchError::io(format!("read the baseline {}", path.display())))?;
+    let text = std::fs::read_to_string(path).map_err(BenchError::io(format!(
+        "read the baseline {}",
+        path.display()
+    )))?;
     serde_json::from_str(&text)
         .map_err(|e| BenchError::Failed(format!("{} is not a baseline: {e}", path.display())))
 }
@@ -245,10 +248,8 @@ fn read_summaries(dir: &Path) -> BenchResult<BTreeMap<String, u64>> {
 /// One benchmark's name and instruction count from its gungraun `summary.json`.
 fn read_summary(path: &Path) -> BenchResult<(String, u64)> {
     let bad = |what: &str| BenchError::Failed(format!("{}: {what}", path.display()));
-    let text = std::fs::read_to_string(path).map_err(BenchError::io(format!(
-        "read {}",
-        path.display()
-    )))?;
+    let text = std::fs::read_to_string(path)
+        .map_err(BenchError::io(format!("read {}", path.display())))?;
     let json: serde_json::Value =
         serde_json::from_str(&text).map_err(|e| bad(&format!("not JSON: {e}")))?;
     let module = json["module_path"]
@@ -360,7 +361,12 @@ mod tests {
     fn a_count_outside_two_percent_either_way_fails() {
         let baseline = Baseline {
             made_by: String::new(),
-            counts: counts(&[("a n1", 1000), ("b n1", 1000), ("c n1", 1000), ("gone n1", 5)]),
+            counts: counts(&[
+                ("a n1", 1000),
+                ("b n1", 1000),
+                ("c n1", 1000),
+                ("gone n1", 5),
+            ]),
         };
         let report = judge(
             &counts(&[("a n1", 1020), ("b n1", 1021), ("c n1", 970), ("new n1", 7)]),
@@ -375,7 +381,11 @@ mod tests {
         assert_eq!(met["b n1"], Some(false), "+2.1 % is a regression");
         assert_eq!(met["c n1"], Some(false), "−3 % needs the baseline updated");
         assert_eq!(met["new n1"], Some(false), "a benchmark without a baseline");
-        assert_eq!(met["gone n1"], Some(false), "a baseline without a benchmark");
+        assert_eq!(
+            met["gone n1"],
+            Some(false),
+            "a baseline without a benchmark"
+        );
     }
 
     #[test]

@@ -38,7 +38,11 @@ pub fn settled_pile(n: usize) -> LocalPlane {
     let mut plane = plane(&[]);
     pile(&mut plane, n).expect("pile");
     run(&mut plane, 240);
-    assert_eq!(plane.awake_count(), 0, "the pile of {n} settles in 240 ticks");
+    assert_eq!(
+        plane.awake_count(),
+        0,
+        "the pile of {n} settles in 240 ticks"
+    );
     plane
 }
 

@@ -40,4 +40,3 @@ fn rollback_tick(mut plane: LocalPlane) -> LocalPlane {
 }
 
 library_benchmark_group!(name = history_group; benchmarks = snapshot, rollback_tick);
-

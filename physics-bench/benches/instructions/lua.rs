@@ -64,7 +64,10 @@ impl Drop for Script {
 /// The `physics-daemon` built beside this benchmark (target/PROFILE/).
 fn daemon_binary() -> PathBuf {
     let exe = std::env::current_exe().expect("current exe");
-    let profile_dir = exe.parent().and_then(|deps| deps.parent()).expect("target/PROFILE");
+    let profile_dir = exe
+        .parent()
+        .and_then(|deps| deps.parent())
+        .expect("target/PROFILE");
     let daemon = profile_dir.join("physics-daemon");
     assert!(
         daemon.is_file(),
