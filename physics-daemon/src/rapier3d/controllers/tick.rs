@@ -45,11 +45,6 @@ pub(super) struct Scene<'a> {
     pub side_by_side: bool,
 }
 
-/// Slack around the region a tick gathers (units): the mover's gap ([`SKIN`]) and contact
-/// prediction (`SKIN` + 0.05), with room for a slide's nudges and what a kinematic body the
-/// capsule slides along carries it by (a tick of a body at 60 units/s at 60 Hz).
-const REACH_SLACK: f32 = 1.0;
-
 /// Slack added to every covered volume: the colliders' own AABBs (what a commit changes)
 /// and the queries' volumes are computed apart and may differ by rounding.
 const COVER_SLACK: f32 = 1.0e-3;
@@ -627,18 +622,14 @@ struct TickState {
 }
 
 impl TickState {
-    /// The region a tick that starts at `start` and asks for `desired` reads unless it is
-    /// blocked: the capsule at both ends, widened by what the move's queries, its snap and
-    /// the ground probe reach beyond them. A step (lift, reach, drop) and a long slide
-    /// reach further and gather again ([`Nearby::ensure`]); a region as wide as those
-    /// walked the broad phase's tree over twice the area on every tick, blocked or not.
+    /// The region a tick that starts at `start` and asks for `desired` can read: the capsule
+    /// at both ends, widened by what the move's snap, the step (lift, reach, drop) and the
+    /// ground probe reach beyond them.
     fn reach(&self, c: &Controller, desired: Vector) -> Aabb {
         self.swept(&c.settings, self.start, desired)
     }
 
-    /// The capsule from `from` to `from + desired`, widened as in [`TickState::reach`]:
-    /// by [`REACH_SLACK`] (more than the gap kept and the contact prediction), and below
-    /// and above also by the snap and probe distance.
+    /// The capsule from `from` to `from + desired`, widened as in [`TickState::reach`].
     fn swept(&self, s: &ControllerSettings, from: Vector, desired: Vector) -> Aabb {
         let pose = rapier3d::math::Pose::from_translation(from);
         let a = capsule_aabb(&self.shape, &pose);
@@ -646,10 +637,8 @@ impl TickState {
             &self.shape,
             &(rapier3d::math::Pose::from_translation(desired) * pose),
         );
-        let vertical = s.step_height.max(SKIN * 4.0) + REACH_SLACK;
-        let margin = Vector::new(REACH_SLACK, vertical, REACH_SLACK);
-        let swept = a.merged(&b);
-        Aabb::new(swept.mins - margin, swept.maxs + margin)
+        let margin = s.step_height.max(SKIN * 4.0) + s.capsule_radius + 0.25;
+        a.merged(&b).loosened(margin)
     }
 }
 
