@@ -2,7 +2,7 @@
 //! scenes.
 
 use physics_scenes::{free_bodies, pile, LocalPlane};
-use shm_layout::{PlaneProp, Pose, Shape};
+use shm_layout::PlaneProp;
 
 /// The step every benchmark takes (60 Hz).
 pub const DT: f32 = 1.0 / 60.0;
@@ -61,17 +61,4 @@ pub fn free(n: usize) -> LocalPlane {
     free_bodies(&mut plane, n).expect("free bodies");
     run(&mut plane, 2);
     plane
-}
-
-/// An anchored floor `width` wide with its top at y = 0.
-pub fn floor(plane: &mut LocalPlane, width: f32) {
-    plane
-        .add_object(
-            &Shape::Cube {
-                size: [width, 1.0, width],
-            },
-            Pose::at([0.0, -0.5, 0.0]),
-            &[shm_layout::ObjectProp::Anchored(true)],
-        )
-        .expect("floor");
 }

@@ -4,16 +4,16 @@
 use std::hint::black_box;
 
 use gungraun::{library_benchmark, library_benchmark_group};
-use physics_scenes::LocalPlane;
+use physics_scenes::{floor, LocalPlane};
 use shm_layout::{ControllerOp, Pose, Reply};
 
-use crate::common::{floor, plane, run, DT};
+use crate::common::{plane, run, DT};
 
 /// `n` controllers 6 units apart on a floor, each walking a 30 × 30 square, a few ticks in
 /// (standing on the floor, walking).
 fn walking(n: usize) -> LocalPlane {
     let mut plane = plane(&[]);
-    floor(&mut plane, 400.0);
+    floor(&mut plane, 400.0, &[]).expect("floor");
     let side = (n as f64).sqrt().ceil() as usize;
     for i in 0..n {
         let at = [

@@ -5,15 +5,15 @@
 use std::hint::black_box;
 
 use gungraun::{library_benchmark, library_benchmark_group};
-use physics_scenes::LocalPlane;
+use physics_scenes::{floor, LocalPlane};
 use shm_layout::{ObjectProp, Pose, Shape};
 
-use crate::common::{floor, plane, DT};
+use crate::common::{plane, DT};
 
 /// `n` unit cubes 2 apart resting on a floor, not yet stepped.
 fn set_down(n: usize, report: bool) -> LocalPlane {
     let mut plane = plane(&[]);
-    floor(&mut plane, 2.0 * n as f32 + 4.0);
+    floor(&mut plane, 2.0 * n as f32 + 4.0, &[]).expect("floor");
     let side = (n as f64).sqrt().ceil() as usize;
     for i in 0..n {
         let (x, z) = ((i % side) as f32 * 2.0, (i / side) as f32 * 2.0);
