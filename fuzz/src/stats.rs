@@ -5,8 +5,8 @@ use std::collections::BTreeMap;
 
 use shm_layout::{
     Command, CommandResult, ControllerOp, ErrorKind, GuiControllerOp, GuiObjectOp, GuiOp, GuiShape,
-    JointOp, MapOp, ObjectOp, ObjectProp, PlaneOp, PlaneProp, QueryOp, Reply, Response, Shape,
-    TransferOp,
+    JointOp, MapOp, ObjectOp, ObjectProp, PlaneOp, PlaneProp, QueryOp, RecordOp, Reply, Response,
+    Shape, TransferOp,
 };
 
 /// How many failures a run keeps in full (the counters count all of them).
@@ -345,6 +345,7 @@ pub fn reply_name(reply: &Reply) -> &'static str {
         Reply::Saved { .. } => "Saved",
         Reply::Transfer(_) => "Transfer",
         Reply::Moved { .. } => "Moved",
+        Reply::Recording(_) => "Recording",
     }
 }
 
@@ -406,6 +407,8 @@ pub fn op_name(command: &Command) -> String {
             PlaneOp::MoveTo { .. } => "Plane.MoveTo".into(),
             PlaneOp::ClaimMoved { .. } => "Plane.ClaimMoved".into(),
             PlaneOp::Pin => "Plane.Pin".into(),
+            PlaneOp::Record(RecordOp::Start { .. }) => "Plane.Record.Start".into(),
+            PlaneOp::Record(RecordOp::Stop) => "Plane.Record.Stop".into(),
         },
         Command::Transfer(op) => match op {
             TransferOp::Open { .. } => "Transfer.Open".into(),

@@ -253,6 +253,8 @@ pub enum Reply {
         /// the next).
         tick: u64,
     },
+    /// A recording started or stopped ([`PlaneOp::Record`]): its file and what it holds.
+    Recording(crate::record_op::RecordingInfo),
 }
 
 /// The result of one command.

@@ -47,6 +47,8 @@ pub mod plane_name;
 pub mod plane_op;
 pub mod probe;
 pub mod query;
+pub mod record_op;
+pub mod recording;
 pub mod records;
 pub mod remote;
 pub mod settings;
@@ -74,6 +76,7 @@ pub use plane_name::{NamedPlane, OpenedPlane, PlaneName};
 pub use plane_op::{OpCost, PlaneKind, PlaneOp};
 pub use probe::{Explosion, Falloff, ProbeHit};
 pub use query::{FilterType, Hit, QueryFilter, QueryOp, Ray};
+pub use record_op::{RecordOp, RecordingInfo};
 pub use records::*;
 pub use settings::{
     ControllerProp, ControllerSettings, GuiObjectProp, GuiPlaneProp, GuiShape, ObjectProp,

@@ -108,6 +108,8 @@ pub enum PlaneOp {
     /// Pins the plane to its daemon (owner only): `--rebalance` never moves it (a plane
     /// placed on a daemon by name). `MoveTo` still does. Replies [`crate::Reply::Done`].
     Pin,
+    /// Starts or stops recording the plane to a file (owner only; [`crate::record_op`]).
+    Record(crate::record_op::RecordOp),
 }
 
 /// What an op may add to a plane, for the daemon's per-client quotas.

@@ -92,7 +92,8 @@ impl Backend for Plane {
             | PlaneOp::RestoreUploaded { .. }
             | PlaneOp::MoveTo { .. }
             | PlaneOp::ClaimMoved { .. }
-            | PlaneOp::Pin => Err(CommandError::new(
+            | PlaneOp::Pin
+            | PlaneOp::Record(_) => Err(CommandError::new(
                 ErrorKind::Internal,
                 format!("{op:?} is handled by the server, not the plane"),
             )),
