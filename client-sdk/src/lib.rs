@@ -39,6 +39,7 @@ mod plane_snapshot;
 mod probe;
 mod query;
 pub mod ragdoll;
+pub mod recording;
 pub mod remote;
 mod replay_check;
 mod snapshot_transfer;
@@ -63,6 +64,8 @@ pub use plane_snapshot::PlaneSnapshot;
 pub use probe::{Explosion, Falloff, ProbeHit, DEFAULT_MAX_SLOPE};
 pub use query::{Found, QueryParams};
 pub use ragdoll::{Bone, Ragdoll, RagdollDesc};
+pub use recording::{load_recording, Advanced, Divergence, Recording, Replay};
+pub use shm_layout::RecordingInfo;
 pub use replay_check::{first_difference, FieldDifference};
 /// The collision group every object starts in ("Default").
 pub use shm_layout::collision_groups::DEFAULT_GROUP;
