@@ -29,10 +29,13 @@ impl Plane {
                     field: "path".into(),
                     message: format!("cannot resolve {}: {e}", p.display()),
                 })?;
-                absolute.to_str().map(str::to_owned).ok_or_else(|| Error::Invalid {
-                    field: "path".into(),
-                    message: format!("{} is not valid UTF-8", absolute.display()),
-                })?
+                absolute
+                    .to_str()
+                    .map(str::to_owned)
+                    .ok_or_else(|| Error::Invalid {
+                        field: "path".into(),
+                        message: format!("{} is not valid UTF-8", absolute.display()),
+                    })?
             }
         };
         let op = PlaneOp::Record(RecordOp::Start { path });
@@ -128,7 +131,9 @@ impl Replay {
     /// Restores the recording's start keyframe into a new manual plane of `client`.
     pub fn start(client: &Client, recording: Arc<Recording>) -> Result<Replay, Error> {
         let Some(Event::Keyframe { range, tick, .. }) = recording.events.first() else {
-            return Err(Error::Protocol("a recording without its start keyframe".into()));
+            return Err(Error::Protocol(
+                "a recording without its start keyframe".into(),
+            ));
         };
         let snapshot = PlaneSnapshot::from_bytes(recording.snapshot(range).to_vec())?;
         let tick = *tick;
@@ -195,7 +200,10 @@ impl Replay {
                     let commands: Vec<Command> = ops
                         .into_iter()
                         .filter(|op| {
-                            !matches!(op, PlaneOp::Set(PlaneProp::TickRate(_)) | PlaneOp::Record(_))
+                            !matches!(
+                                op,
+                                PlaneOp::Set(PlaneProp::TickRate(_)) | PlaneOp::Record(_)
+                            )
                         })
                         .map(|op| Command::plane(id, op))
                         .collect();

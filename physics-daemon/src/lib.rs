@@ -8,6 +8,7 @@
 //! - `gpu`: the GPU path of 3D planes (`DeferGpu`, wgpu compute), behind the `gpu` feature.
 //! - [`publish`]: writing a plane's tick into loaned shared-memory samples.
 //! - [`cluster`]: joining a physics cluster over Zenoh (`--cluster`).
+//! - [`record`]: recording a plane to a file that replays it bit for bit.
 
 #![deny(missing_docs)]
 
@@ -21,6 +22,7 @@ pub mod publish;
 #[cfg(feature = "gui")]
 pub mod rapier2d;
 pub mod rapier3d;
+pub mod record;
 pub mod server;
 
 pub use error::DaemonError;

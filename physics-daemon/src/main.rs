@@ -29,6 +29,8 @@ struct Args {
     persist: physics_daemon::server::persist::PersistArgs,
     #[command(flatten)]
     cluster: physics_daemon::cluster::ClusterArgs,
+    #[command(flatten)]
+    record: physics_daemon::record::RecordArgs,
     /// Remove what dead processes of the domain left behind (shared memory, node records),
     /// print what was removed, and exit. Live processes keep everything of theirs.
     #[arg(long)]
@@ -135,6 +137,10 @@ fn main() -> ExitCode {
         load: cluster.as_ref().map(|_| gauge),
         adopt,
         migrate,
+        record: physics_daemon::record::RecordSettings::new(
+            &args.record,
+            args.cluster.name.as_deref().unwrap_or(&args.domain),
+        ),
     };
     let served = physics_daemon::server::run_with(&args.domain, &shutdown, options);
     if let Some(cluster) = cluster {

@@ -309,7 +309,8 @@ impl Recording {
                 return Err(cut());
             }
             let tag_byte = bytes[at];
-            let len = u32::from_le_bytes(bytes[at + 1..at + 5].try_into().expect("4 bytes")) as usize;
+            let len =
+                u32::from_le_bytes(bytes[at + 1..at + 5].try_into().expect("4 bytes")) as usize;
             let Some(tag) = EntryTag::of(tag_byte) else {
                 return Err(refused(format!(
                     "unknown entry tag {tag_byte} at byte offset {at} (corrupted)"
@@ -332,7 +333,12 @@ impl Recording {
                 )));
             }
             let payload = &bytes[payload_range.clone()];
-            let bad = |what: String| refused(format!("the {} entry at byte offset {at}: {what}", tag.word()));
+            let bad = |what: String| {
+                refused(format!(
+                    "the {} entry at byte offset {at}: {what}",
+                    tag.word()
+                ))
+            };
             if start.is_none() && tag != EntryTag::Start {
                 return Err(bad("the first entry must be the start entry".into()));
             }
@@ -583,7 +589,10 @@ mod tests {
         let r = Recording::parse(sample()).unwrap();
         assert_eq!(r.start.plane, 3);
         assert_eq!(r.events.len(), 5);
-        assert_eq!(r.ops(&r.events[1]).unwrap(), vec![PlaneOp::Info, PlaneOp::Step { dt: 0.5 }]);
+        assert_eq!(
+            r.ops(&r.events[1]).unwrap(),
+            vec![PlaneOp::Info, PlaneOp::Step { dt: 0.5 }]
+        );
         assert_eq!((r.first_tick(), r.last_tick(), r.tick_count()), (5, 7, 2));
         assert_eq!(r.end.as_deref(), Some("stopped"));
         assert_eq!(r.keyframe_for(6), 0);
@@ -612,7 +621,8 @@ mod tests {
         bad[offset + 7] ^= 1;
         let e = Recording::parse(bad).unwrap_err();
         assert!(
-            e.message.contains(&format!("batch entry at byte offset {offset}")),
+            e.message
+                .contains(&format!("batch entry at byte offset {offset}")),
             "{}",
             e.message
         );
@@ -629,7 +639,8 @@ mod tests {
         let keyframe_at = range.start - 6;
         let e = Recording::parse(good[..range.start + 3].to_vec()).unwrap_err();
         assert!(
-            e.message.contains(&format!("inside the entry at byte offset {keyframe_at}")),
+            e.message
+                .contains(&format!("inside the entry at byte offset {keyframe_at}")),
             "{}",
             e.message
         );

@@ -155,6 +155,10 @@ pub trait Backend: Send {
     fn has_idle_work(&self) -> bool {
         false
     }
+
+    /// The plane is about to go (`why`: moved to another daemon, destroyed, the daemon
+    /// stopping): what writes on its behalf (a recording, `crate::record`) ends saying so.
+    fn leaving(&mut self, _why: &str) {}
 }
 
 /// The encoding half of [`Backend::snapshot_later`]: gives the snapshot's bytes.

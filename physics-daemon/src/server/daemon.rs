@@ -46,6 +46,8 @@ pub struct Options {
     /// How planes move to and arrive from other daemons (`--cluster`; `MoveTo`); `None`
     /// outside a cluster.
     pub migrate: Option<Arc<Migration>>,
+    /// How planes record (`--record`, `--record-keyframe-every`).
+    pub record: crate::record::RecordSettings,
 }
 
 /// Planes one daemon hosts at once.

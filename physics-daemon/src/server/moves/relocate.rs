@@ -177,6 +177,11 @@ impl Daemon {
             )
         })?;
         // Gone from here between two ticks: the worker finds no plane and ends.
+        if let Some(plane) = guard.as_mut() {
+            plane.leaving(&format!(
+                "the plane moved to daemon {daemon:?} (plane {new_id} there)"
+            ));
+        }
         *guard = None;
         drop(guard);
         self.forget_file(id);

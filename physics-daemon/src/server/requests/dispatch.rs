@@ -220,6 +220,8 @@ impl Daemon {
             }
             PlaneOp::MoveTo { .. } => refused("only its owner may move it"),
             PlaneOp::Pin => refused("only its owner may pin it"),
+            // A recording writes a file on the daemon's machine.
+            PlaneOp::Record(_) => refused("only its owner may record it"),
             _ if entry.shared => Ok(()),
             _ => refused(
                 "it is not shared, so other clients may only read it (its owner can create it \
@@ -393,6 +395,7 @@ impl Daemon {
             panic_on_step_dt: self.options.panic_on_step_dt,
             file: None,
             restore: None,
+            record: self.options.record.clone(),
         }
     }
 

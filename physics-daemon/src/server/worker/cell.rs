@@ -55,6 +55,7 @@ impl PlaneCell {
                 | PlaneOp::Restore { .. }
                 | PlaneOp::Rewind(_)
                 | PlaneOp::Save
+                | PlaneOp::Record(_)
         ) && op.cost().mesh_vertices == 0
     }
 

@@ -59,6 +59,8 @@ pub(crate) struct Setup {
     pub file: Option<persist::PlaneFile>,
     /// A snapshot the plane starts from (a persistent plane restored at start).
     pub restore: Option<Vec<u8>>,
+    /// How the plane records (`--record`, `record`).
+    pub record: crate::record::RecordSettings,
 }
 
 /// Starts the worker of a plane: a thread that is the only thread of a rayon pool of its
@@ -242,13 +244,17 @@ impl Drop for Worker {
 fn create(setup: &Setup) -> Result<(Worker, Reply), CommandError> {
     let id = setup.id;
     let internal = |e: DaemonError| CommandError::new(ErrorKind::Internal, e.to_string());
-    let mut plane = crate::kinds::create(setup.kind, id, &setup.props)?;
+    let kind = crate::kinds::create(setup.kind, id, &setup.props)?;
+    let mut recorded = crate::record::Recorded::new(kind, id, setup.record.clone());
     if let Some(bytes) = &setup.restore {
-        plane.apply(PlaneOp::Restore {
+        recorded.apply(PlaneOp::Restore {
             bytes: bytes.clone(),
             overrides: Vec::new(),
         })?;
     }
+    // `--record DIR`: from its first state here (a restored or arrived plane's included).
+    recorded.record_if_asked();
+    let mut plane: Box<dyn Backend> = Box::new(recorded);
     setup.cell.marks.tick.store(plane.tick(), Ordering::SeqCst);
     // A new plane is written at once; a restored one only once it changes (its file holds
     // it already, and a daemon killed again before anyone opens it keeps that file as is).
