@@ -54,6 +54,7 @@ mod persist;
 mod procfs;
 mod progress;
 mod queries;
+mod recording_cost;
 mod render;
 mod report;
 mod scene;

@@ -4,7 +4,8 @@
 //! `RollbackTicks = 8` costs an awake plane's tick, measured side by side with a plane
 //! that keeps nothing (its CPU by the `cpu-median-of-blocks` estimator: see
 //! [`keep_cpu`]); and what one kept tick holds per awake, sleeping and anchored body (heap
-//! bytes counted in process: see [`record_rows`]).
+//! bytes counted in process: see [`record_rows`]); and what recording a plane costs its
+//! tick's CPU and how many bytes a tick adds to the file (see [`super::recording_cost`]).
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
@@ -16,6 +17,8 @@ use client_sdk::{Client, Plane, PlaneOptions, PlaneProp, Pose, Shape};
 
 use super::daemon::DaemonProcess;
 use super::error::BenchResult;
+use super::estimator::{self, Estimator};
+use super::recording_cost::{self, RecordingCost};
 use super::report::{self, mib, num, Goal, Table};
 
 /// Options of the `snapshot` subcommand.
@@ -43,6 +46,18 @@ pub struct SnapshotArgs {
     /// Bodies of each kind (awake, sleeping, anchored) whose kept-tick bytes are counted.
     #[arg(long, default_value_t = 1_000)]
     pub record_bodies: usize,
+    /// Bodies of the awake piles the cost of recording is measured on.
+    #[arg(long, default_value_t = 1_000)]
+    pub recording_bodies: usize,
+    /// Velocity writes a tick (each on its own body) on the piles of the recording row.
+    #[arg(long, default_value_t = 100)]
+    pub recording_writes: usize,
+    /// Blocks of each plane (recording, plain) of the recording row, ABBA.
+    #[arg(long, default_value_t = 16)]
+    pub recording_blocks: usize,
+    /// Ticks in each block of the recording row.
+    #[arg(long, default_value_t = 50)]
+    pub recording_block_ticks: usize,
     /// Folder receiving snapshot.json and snapshot.md.
     #[arg(long, default_value = "bench-out")]
     pub out: PathBuf,
@@ -90,7 +105,39 @@ pub struct SnapshotReport {
     pub keep_cpu_blocks: Vec<CpuBlock>,
     /// Heap bytes of one kept tick per body, by kind of body and part of the copy.
     pub record: Vec<RecordRow>,
-    pub goals: Vec<Goal>,
+    /// What recording a plane costs its tick's CPU, and the bytes a tick adds to the file.
+    pub recording: RecordingCost,
+    pub goals: Vec<SnapshotGoal>,
+    /// Every estimator's name and meaning.
+    pub estimators: std::collections::BTreeMap<&'static str, &'static str>,
+}
+
+/// A goal row: the goal, what was measured, the verdict, and the estimator that judged it
+/// on the rows judged by a named one (see [`crate::estimator`]).
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct SnapshotGoal {
+    #[serde(flatten)]
+    pub goal: Goal,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub estimator: Option<Estimator>,
+}
+
+impl From<Goal> for SnapshotGoal {
+    fn from(goal: Goal) -> SnapshotGoal {
+        SnapshotGoal {
+            goal,
+            estimator: None,
+        }
+    }
+}
+
+impl From<estimator::JudgedGoal> for SnapshotGoal {
+    fn from(g: estimator::JudgedGoal) -> SnapshotGoal {
+        SnapshotGoal {
+            goal: Goal::new(g.goal, g.value, g.met),
+            estimator: Some(g.estimator),
+        }
+    }
 }
 
 /// One block of the rollback CPU row: `steps` steps of one plane.
@@ -279,7 +326,7 @@ fn daemon_cpu_ns(pid: u32) -> BenchResult<u64> {
 /// Waits until the daemon is idle (under 2 % of a core over 10 ms, or half a second at
 /// most): what a step put off (the copy made after it is answered, the drop of the oldest
 /// copy on the disposal thread) is then done and counted in the block that caused it.
-fn until_idle(pid: u32) -> BenchResult<()> {
+pub(super) fn until_idle(pid: u32) -> BenchResult<()> {
     let started = Instant::now();
     let mut last = daemon_cpu_ns(pid)?;
     while started.elapsed() < Duration::from_millis(500) {
@@ -603,6 +650,24 @@ pub fn run(args: &SnapshotArgs) -> BenchResult<()> {
         args.block_steps,
     )?;
     eprintln!(
+        "snapshot: recording, CPU in blocks ({} bodies, {} writes a tick)",
+        args.recording_bodies, args.recording_writes
+    );
+    let recording = recording_cost::measure(
+        &client,
+        daemon.pid(),
+        recording_cost::Sizes {
+            bodies: args.recording_bodies,
+            writes: args.recording_writes,
+            blocks: args.recording_blocks,
+            ticks_per_block: args.recording_block_ticks,
+        },
+        &std::env::temp_dir().join(format!(
+            "{}.physrec",
+            super::daemon::unique_domain("recording")
+        )),
+    )?;
+    eprintln!(
         "snapshot: kept-tick bytes per body ({} bodies of each kind)",
         args.record_bodies
     );
@@ -640,6 +705,8 @@ pub fn run(args: &SnapshotArgs) -> BenchResult<()> {
         ),
     ];
     goals.extend(record_goals(&record, args.record_bodies));
+    let mut goals: Vec<SnapshotGoal> = goals.into_iter().map(SnapshotGoal::from).collect();
+    goals.push(recording_cost::goal(&recording).into());
     let report = SnapshotReport {
         piles,
         rewind_ratio,
@@ -649,13 +716,15 @@ pub fn run(args: &SnapshotArgs) -> BenchResult<()> {
         keep_cpu_ratio_min: cpu.min,
         keep_cpu_blocks: cpu.blocks,
         record,
+        recording,
         goals,
+        estimators: estimator::glossary(),
     };
     let md = markdown(&report);
     let (json, md_path) = report::write(&args.out, "snapshot", &report, &md)?;
     report::print(&md_path);
     println!("wrote {} and {}", json.display(), md_path.display());
-    if report.goals.iter().any(|g| g.met == Some(false)) {
+    if report.goals.iter().any(|g| g.goal.met == Some(false)) {
         eprintln!("snapshot: a goal was not met");
     }
     Ok(())
@@ -734,12 +803,13 @@ fn markdown(r: &SnapshotReport) -> String {
          (counted in process by the bench's allocator on a plane of the daemon's code: {} \
          bodies of the kind over a floor, less the floor alone), whole and by part of the \
          engine's world (the whole holds the plane's own tables besides), and what copying \
-         and dropping it once takes per body (medians of 5).\n\n{}",
+         and dropping it once takes per body (medians of 5).\n\n{}\n{}",
         t.finish(),
         r.keep_cpu_ratio_median,
         r.keep_cpu_ratio_min,
         blocks.finish(),
         r.record.first().map_or(0, |row| row.bodies),
         record.finish(),
+        recording_cost::markdown(&r.recording),
     )
 }
