@@ -88,3 +88,14 @@ pub fn install(lua: &Lua, client: Client) -> mlua::Result<Host> {
 pub fn start_from_snapshot(lua: &Lua, path: &std::path::Path) -> Result<(), String> {
     api::start_plane::start_from_snapshot(lua, path)
 }
+
+/// Makes `plane` (a plane of the installed client, of kind `kind`) the plane the script gets
+/// with `PhysicsService.GetStartPlane()`: `physics-lua --replay FILE --until TICK SCRIPT`
+/// hands over the plane its replay reached. Call it after [`install`].
+pub fn start_from_plane(
+    lua: &Lua,
+    plane: client_sdk::Plane,
+    kind: client_sdk::PlaneKind,
+) -> Result<(), String> {
+    api::start_plane::start_from_plane(lua, plane, kind).map_err(|e| e.to_string())
+}

@@ -32,6 +32,7 @@ pub mod plane_objects;
 pub mod probe;
 pub mod query;
 pub mod ragdoll;
+pub mod recording;
 pub mod snapshot;
 pub mod start_plane;
 pub mod static_shapes;
@@ -115,6 +116,7 @@ impl UserData for PhysicsPlane {
         lifecycle::add_methods(methods);
         query::add_methods(methods);
         snapshot::add_plane_methods(methods);
+        recording::add_methods(methods);
         methods.add_method("NewController", |_, p, (part, opts): (Value, Value)| {
             controller::new_controller(&p.0, part, opts, false)
         });

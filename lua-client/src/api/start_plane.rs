@@ -1,12 +1,13 @@
 //! The plane a run starts from: `physics-lua SCRIPT --snapshot FILE` restores FILE into a new
-//! plane of this client before the script runs, and the script gets it with
-//! `PhysicsService.GetStartPlane()` (nil when the run has no `--snapshot`). A user's bug
-//! report (`plane:Snapshot():Save(path)`, or a persistent plane's `.physnap`) becomes a
+//! plane of this client before the script runs, and `physics-lua --replay FILE --until TICK
+//! SCRIPT` hands over the plane its replay reached; the script gets it with
+//! `PhysicsService.GetStartPlane()` (nil when the run has neither). A user's bug report
+//! (`plane:Snapshot():Save(path)`, a persistent plane's `.physnap`, a recording) becomes a
 //! file anyone can replay with their own script.
 
 use std::path::Path;
 
-use client_sdk::{GuiPlane, PlaneKind, PlaneSnapshot};
+use client_sdk::{GuiPlane, Plane, PlaneKind, PlaneSnapshot};
 use mlua::{AnyUserData, Lua, Table, Value};
 
 use super::gui_plane::state::wrap_gui_plane;
@@ -25,11 +26,16 @@ pub fn start_from_snapshot(lua: &Lua, path: &Path) -> Result<(), String> {
     let plane = client
         .plane_from_snapshot(&snapshot, &[])
         .map_err(|e| format!("--snapshot {shown}: the daemon refused its state: {e}"))?;
-    let value = match snapshot.kind() {
+    start_from_plane(lua, plane, snapshot.kind()).map_err(|e| format!("--snapshot {shown}: {e}"))
+}
+
+/// Makes `plane`, a plane of this script's client of kind `kind` (a replayed recording's),
+/// the start plane: the script's `PhysicsPlane`, or `GuiPhysicsPlane` for a GUI plane.
+pub fn start_from_plane(lua: &Lua, plane: Plane, kind: PlaneKind) -> mlua::Result<()> {
+    let value = match kind {
         PlaneKind::Rapier3d => wrap_plane(lua, plane),
         PlaneKind::Gui2d => lua.create_userdata(wrap_gui_plane(lua, GuiPlane::from_plane(plane))),
-    }
-    .map_err(|e| format!("--snapshot {shown}: {e}"))?;
+    }?;
     lua.set_app_data(StartPlane(value));
     Ok(())
 }

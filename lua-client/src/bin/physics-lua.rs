@@ -2,6 +2,11 @@
 //! (starting one for the run when none answers), then keeps running frames while the script
 //! has `Heart` handlers, pending waits or change listeners.
 //!
+//! `physics-lua [SCRIPT] --replay FILE [--until TICK]` first replays a plane recording
+//! (`plane:StartRecording()`, `PhysicsService.New{ Record = true }`, `physics-daemon
+//! --record`) into a new plane, checking every tick's state hash, and hands the plane it
+//! reached to SCRIPT (`PhysicsService.GetStartPlane()`); without SCRIPT the run only replays.
+//!
 //! The script runs sandboxed (`Lua::sandbox`), under a watchdog that stops it when it runs
 //! too long without yielding (`--max-run-ms`), when `--seconds` is up, or on the first
 //! SIGINT/SIGTERM, and with a memory limit (`--max-memory-mb`).
@@ -22,8 +27,9 @@ use mlua::{Lua, Value, Variadic};
 #[derive(Parser, Debug)]
 #[command(version, about = "Run a Luau script against the physics service")]
 struct Args {
-    /// The Luau script to run.
-    script: PathBuf,
+    /// The Luau script to run (optional with `--replay`, which then only replays).
+    #[arg(required_unless_present = "replay")]
+    script: Option<PathBuf>,
     /// Domain of the daemon to use; one is started for the run when none answers.
     #[arg(long, env = "PHYSICS_DOMAIN", default_value = "physics")]
     domain: String,
@@ -65,6 +71,18 @@ struct Args {
     /// gets that plane with `PhysicsService.GetStartPlane()`.
     #[arg(long)]
     snapshot: Option<PathBuf>,
+    /// Replay this plane recording (`plane:StartRecording()`, `New{ Record = true }`,
+    /// `physics-daemon --record`) into a new plane before the script runs, checking every
+    /// tick's state hash: the first tick that differs ends the run with an error naming it
+    /// and the batch of writes before it. The script gets the plane with
+    /// `PhysicsService.GetStartPlane()` (manual: it steps it); without a script the run only
+    /// replays.
+    #[arg(long, conflicts_with = "snapshot")]
+    replay: Option<PathBuf>,
+    /// With `--replay`: stop the replay once the plane is at this tick (a tick past the
+    /// recording's last replays it to its end).
+    #[arg(long, requires = "replay")]
+    until: Option<u64>,
     /// Run against a daemon of this physics cluster, on this host or another, instead of
     /// this host's domain (docs/cluster.md); no daemon is started. Needs `--connect`.
     #[arg(long, requires = "connect")]
@@ -92,13 +110,11 @@ fn asset_roots(args: &Args) -> lua_client::AssetRoots {
     if !args.asset_roots.is_empty() {
         return lua_client::AssetRoots::new(args.asset_roots.iter().cloned());
     }
-    let script_dir = args
-        .script
-        .parent()
-        .map(|p| match p.as_os_str().is_empty() {
-            true => PathBuf::from("."),
-            false => p.to_path_buf(),
-        });
+    let dir = |p: &std::path::Path| match p.as_os_str().is_empty() {
+        true => PathBuf::from("."),
+        false => p.to_path_buf(),
+    };
+    let script_dir = args.script.as_deref().and_then(|s| s.parent()).map(dir);
     lua_client::AssetRoots::new(script_dir.into_iter().chain(std::env::current_dir().ok()))
 }
 
@@ -336,8 +352,13 @@ fn check_args(args: &Args) -> Result<(), String> {
 
 fn run(args: &Args, signals: &Signals) -> Result<Ended, String> {
     check_args(args)?;
-    let source = std::fs::read_to_string(&args.script)
-        .map_err(|e| format!("cannot read {}: {e}", args.script.display()))?;
+    let source = match &args.script {
+        Some(script) => Some(
+            std::fs::read_to_string(script)
+                .map_err(|e| format!("cannot read {}: {e}", script.display()))?,
+        ),
+        None => None,
+    };
     // A daemon started for this run logs warnings only, unless the user asked for more.
     if std::env::var_os("PHYSICS_LOG").is_none() {
         std::env::set_var("PHYSICS_LOG", "warn");
@@ -366,6 +387,9 @@ fn run(args: &Args, signals: &Signals) -> Result<Ended, String> {
     if let Some(file) = &args.snapshot {
         lua_client::start_from_snapshot(&lua, file)?;
     }
+    if let Some(file) = &args.replay {
+        replay::run(&lua, &session.client, file, args.until)?;
+    }
     // Every global is in place: from here on scripts cannot change builtins or the API.
     lua.sandbox(true).map_err(lua_err)?;
     host.set_stop_flag(signals.shared.stop.clone());
@@ -373,16 +397,24 @@ fn run(args: &Args, signals: &Signals) -> Result<Ended, String> {
     host.set_max_run_time(max_run);
     let max_memory = (args.max_memory_mb > 0).then_some((args.max_memory_mb as usize) << 20);
     host.set_memory_limit(max_memory).map_err(lua_err)?;
-    let chunk = lua
-        .load(source)
-        .set_name(format!("@{}", args.script.display()))
-        .into_function()
-        .map_err(lua_err)?;
+    let chunk = match (&args.script, source) {
+        (Some(script), Some(source)) => Some(
+            lua.load(source)
+                .set_name(format!("@{}", script.display()))
+                .into_function()
+                .map_err(lua_err)?,
+        ),
+        _ => None,
+    };
     let started = Instant::now();
     let deadline = args.seconds.map(|s| started + Duration::from_secs_f64(s));
     host.set_deadline(deadline);
-    let mut ended = frames(&host, chunk, args.fps, deadline, signals)
-        .or_else(|e| failed(args, &host, signals, e));
+    let mut ended = match chunk {
+        Some(chunk) => frames(&host, chunk, args.fps, deadline, signals)
+            .or_else(|e| failed(args, &host, signals, e)),
+        // `--replay` without a script: the replay was the run.
+        None => Ok(Ended::Finished),
+    };
     if let (Some(v), Ok(Ended::Finished)) = (&viewer, &ended) {
         // The script is done; its planes stay (and keep ticking) for the viewer.
         ended = Ok(viewer::linger(v, &host, args.fps, deadline, signals));
@@ -394,6 +426,75 @@ fn run(args: &Args, signals: &Signals) -> Result<Ended, String> {
     drop(viewer);
     drop(session);
     ended
+}
+
+/// `--replay FILE [--until TICK]`: the recording replayed into a new plane of the run's
+/// client, which becomes the script's start plane.
+mod replay {
+    use std::path::Path;
+    use std::sync::Arc;
+
+    use client_sdk::{Advanced, Client, Replay};
+    use mlua::Lua;
+
+    /// Loads `file` (a damaged one is refused naming the byte offset), restores its start
+    /// into a new manual plane, re-applies its batches tick by tick up to `until` (or its
+    /// end) checking each tick's state hash, says on stderr what it replayed and hands the
+    /// plane to the script. A divergence, or a file that cannot be replayed, is the error.
+    pub fn run(lua: &Lua, client: &Client, file: &Path, until: Option<u64>) -> Result<(), String> {
+        let shown = file.display();
+        let recording =
+            client_sdk::load_recording(file).map_err(|e| format!("--replay {shown}: {e}"))?;
+        let (first, last) = (recording.first_tick(), recording.last_tick());
+        if let Some(u) = until.filter(|u| *u < first) {
+            return Err(format!(
+                "--until {u}: the recording {shown} starts at tick {first} (it holds ticks \
+                 {first}..{last})"
+            ));
+        }
+        let kind = recording.start.kind;
+        let complete = recording.end.is_some();
+        let mut replay = Replay::start(client, Arc::new(recording))
+            .map_err(|e| format!("--replay {shown}: cannot restore its start keyframe: {e}"))?;
+        let target = until.map(|u| u.min(last));
+        let mut checked = 0u64;
+        loop {
+            if target.is_some_and(|t| replay.tick() >= t) {
+                break;
+            }
+            match replay.advance() {
+                Ok(Advanced::Tick(_)) => checked += 1,
+                Ok(Advanced::End) => break,
+                Ok(Advanced::Diverged(d)) => {
+                    return Err(format!(
+                        "--replay {shown}: {d} ({checked} tick(s) before it agreed)"
+                    ))
+                }
+                Err(e) => {
+                    return Err(format!(
+                        "--replay {shown}: the replay stopped after tick {}: {e}",
+                        replay.tick()
+                    ))
+                }
+            }
+        }
+        let at = replay.tick();
+        let mut line = format!(
+            "physics-lua: replayed ticks {first}..{at} of {shown}: every state hash equal \
+             ({checked} ticks)"
+        );
+        if let Some(u) = until.filter(|u| *u > last) {
+            line.push_str(&format!(
+                "; --until {u} is past its last tick {last}: replayed to its end"
+            ));
+        }
+        if !complete && replay.at_end() {
+            line.push_str("; the file has no end entry (its daemon stopped while recording)");
+        }
+        eprintln!("{line}");
+        lua_client::start_from_plane(lua, replay.into_plane(), kind)
+            .map_err(|e| format!("--replay {shown}: {e}"))
+    }
 }
 
 /// `--view`: the `physics-view` process next to this runner.

@@ -163,6 +163,7 @@ impl UserData for GuiPhysicsPlane {
             super::gui_object::gui_object_ud(lua, p.0.add("GuiPhysicsPlane:Add", &prim)?)
         });
         super::snapshot::add_gui_plane_methods(methods);
+        super::recording::add_methods(methods);
         super::named_plane::add_gui_methods(methods);
         methods.add_method("NewController", |_, p, (prim, opts): (Value, Value)| {
             p.0.new_controller("GuiPhysicsPlane:NewController", &prim, opts, false)
@@ -271,9 +272,13 @@ pub fn new_gui(lua: &Lua, opts: Value) -> mlua::Result<GuiPhysicsPlane> {
     };
     let mut o = GuiPlaneOptions::default();
     let (mut bmin, mut bmax) = (None, None);
+    let mut record = false;
     for pair in opts.iter().flat_map(|t| t.pairs::<Value, Value>()) {
         let (key, value) = pair?;
         match &key {
+            k if super::recording::is_record_option(k) => {
+                record = super::recording::record_option(WHAT, &value)?
+            }
             Value::String(s) if &*s.as_bytes() == b"BoundsMin" => {
                 bmin = Some(dim_arg(&format!("{WHAT} option BoundsMin"), &value)?)
             }
@@ -315,5 +320,8 @@ pub fn new_gui(lua: &Lua, opts: Value) -> mlua::Result<GuiPhysicsPlane> {
         .client
         .create_gui_plane(&o)
         .map_err(|e| sdk_error(WHAT, e))?;
+    if record {
+        super::recording::record_new_plane(WHAT, plane.plane())?;
+    }
     Ok(wrap_gui_plane(lua, plane))
 }

@@ -137,8 +137,14 @@ pub(crate) fn new_plane(lua: &Lua, opts: Value) -> mlua::Result<mlua::AnyUserDat
     // them apply (a manual plane never ticks on its own at all).
     let mut options = PlaneOptions::default();
     let mut placement: Option<String> = None;
+    let mut record = false;
     for pair in opts.iter().flat_map(|t| t.pairs::<Value, Value>()) {
         let (key, value) = pair?;
+        // Whether the daemon records the plane from its first tick: not a plane setting.
+        if super::recording::is_record_option(&key) {
+            record = super::recording::record_option(WHAT, &value)?;
+            continue;
+        }
         // Where the plane lives: not a plane setting, a choice of daemon.
         if matches!(&key, Value::String(k) if k.as_bytes() == b"Placement") {
             placement = match value {
@@ -167,6 +173,9 @@ pub(crate) fn new_plane(lua: &Lua, opts: Value) -> mlua::Result<mlua::AnyUserDat
         .is_some_and(|p| p != "local" && p != "auto")
     {
         plane.pin().map_err(|e| sdk_error(WHAT, e))?;
+    }
+    if record {
+        super::recording::record_new_plane(WHAT, &plane)?;
     }
     wrap_plane(lua, plane)
 }
