@@ -124,8 +124,14 @@ pub struct Replay {
 /// Options every replayed plane gets on top of its snapshot: it advances only when the
 /// replay steps it.
 fn replay_overrides() -> Vec<PlaneProp> {
-    vec![PlaneProp::TickRate(0.0), PlaneProp::Enabled(true)]
+    vec![PlaneProp::TickRate(0.0)]
 }
+
+/// Most bytes of recorded ops one replay request carries (a quarter of the daemon's
+/// default request limit).
+const MAX_REQUEST_BYTES: usize = 4 << 20;
+/// Most recorded ops one replay request carries.
+const MAX_REQUEST_OPS: usize = 16_384;
 
 impl Replay {
     /// Restores the recording's start keyframe into a new manual plane of `client`.
@@ -195,23 +201,7 @@ impl Replay {
             self.next += 1;
             match event {
                 Event::Batch { .. } => {
-                    let ops = self.recording.ops(&event)?;
-                    let id = self.plane.id();
-                    let commands: Vec<Command> = ops
-                        .into_iter()
-                        .filter(|op| {
-                            !matches!(
-                                op,
-                                PlaneOp::Set(PlaneProp::TickRate(_)) | PlaneOp::Record(_)
-                            )
-                        })
-                        .map(|op| Command::plane(id, op))
-                        .collect();
-                    if !commands.is_empty() {
-                        // Per-op refusals are part of what happened; only a lost request
-                        // stops the replay.
-                        self.plane.client().send(commands)?;
-                    }
+                    self.send_batch(&event)?;
                     self.batch = Some(self.next - 1);
                 }
                 Event::Keyframe {
@@ -290,6 +280,36 @@ impl Replay {
                 other => return Ok(other),
             }
         }
+    }
+
+    /// Sends a batch's ops as recorded, in requests of bounded size (a batch gathers every
+    /// request applied between two ticks). Per-op refusals are part of what happened (the
+    /// recorded plane refused them too); only a lost request stops the replay.
+    fn send_batch(&self, event: &Event) -> Result<(), Error> {
+        let id = self.plane.id();
+        let mut commands = Vec::new();
+        let mut bytes = 0;
+        for (op, size) in self.recording.sized_ops(event)? {
+            // The replay drives the plane's ticks itself.
+            if matches!(
+                op,
+                PlaneOp::Set(PlaneProp::TickRate(_)) | PlaneOp::Record(_)
+            ) {
+                continue;
+            }
+            if !commands.is_empty()
+                && (bytes + size > MAX_REQUEST_BYTES || commands.len() >= MAX_REQUEST_OPS)
+            {
+                self.plane.client().send(std::mem::take(&mut commands))?;
+                bytes = 0;
+            }
+            bytes += size;
+            commands.push(Command::plane(id, op));
+        }
+        if !commands.is_empty() {
+            self.plane.client().send(commands)?;
+        }
+        Ok(())
     }
 
     fn describe_batch(&self, index: usize) -> String {

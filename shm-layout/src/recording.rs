@@ -467,6 +467,16 @@ impl Recording {
     /// The ops of a batch event, decoded; an op that does not decode is refused naming the
     /// byte offset where it starts.
     pub fn ops(&self, event: &Event) -> Result<Vec<PlaneOp>, CommandError> {
+        Ok(self
+            .sized_ops(event)?
+            .into_iter()
+            .map(|(op, _)| op)
+            .collect())
+    }
+
+    /// [`Recording::ops`], each with the bytes of its encoding (a replay sends a large
+    /// batch in requests of bounded size).
+    pub fn sized_ops(&self, event: &Event) -> Result<Vec<(PlaneOp, usize)>, CommandError> {
         let Event::Batch {
             count,
             range,
@@ -477,7 +487,7 @@ impl Recording {
             return Ok(Vec::new());
         };
         let mut rest = &self.bytes[range.clone()];
-        let mut ops = Vec::with_capacity(*count as usize);
+        let mut ops = Vec::with_capacity((*count as usize).min(rest.len()));
         for i in 0..*count {
             let at = range.end - rest.len();
             let (op, tail) = postcard::take_from_bytes::<PlaneOp>(rest).map_err(|e| {
@@ -486,7 +496,7 @@ impl Recording {
                      not decode: {e}"
                 ))
             })?;
-            ops.push(op);
+            ops.push((op, rest.len() - tail.len()));
             rest = tail;
         }
         if !rest.is_empty() {
