@@ -8,7 +8,12 @@
 //! the daemon's publishers overwrite what the viewer has not read. Controls that change a
 //! plane (pause, step, resume) are refused unless `--allow-control` is given; it binds to
 //! 127.0.0.1 unless `--bind` says otherwise.
+//!
+//! `--replay FILE` plays a recording (`physics-daemon --record`, `plane:StartRecording`)
+//! into a plane of the viewer's own, on the domain's daemon (started when none runs), with
+//! a timeline in the page: play, pause, step, jump to a tick, speed.
 
+mod replay;
 mod sampler;
 mod server;
 
@@ -48,6 +53,10 @@ struct Args {
     /// `physics-lua --view` passes, so a runner that is killed leaves no viewer behind.
     #[arg(long, value_name = "PID")]
     exit_with: Option<u32>,
+    /// Play this recording (a `.physrec` file) into a plane of the viewer's own, with a
+    /// timeline in the page; starts a daemon for --domain when none runs.
+    #[arg(long, value_name = "FILE")]
+    replay: Option<std::path::PathBuf>,
 }
 
 fn main() -> ExitCode {
@@ -66,6 +75,26 @@ fn main() -> ExitCode {
         );
         return ExitCode::from(2);
     }
+    // A recording is read and checked before anything starts: a damaged one is refused
+    // naming the byte offset.
+    let (replay, started) = match &args.replay {
+        None => (None, None),
+        Some(path) => match client_sdk::load_recording(path) {
+            Ok(recording) => {
+                let (ready, started) = mpsc::channel();
+                let start = sampler::ReplayStart {
+                    path: path.display().to_string(),
+                    recording: Arc::new(recording),
+                    ready,
+                };
+                (Some(start), Some(started))
+            }
+            Err(e) => {
+                eprintln!("physics-view: {e}");
+                return ExitCode::FAILURE;
+            }
+        },
+    };
     let overview = Arc::new(Mutex::new(sampler::Overview::default()));
     let (jobs, rx) = mpsc::channel();
     {
@@ -73,8 +102,22 @@ fn main() -> ExitCode {
         let history = args.history_seconds;
         std::thread::Builder::new()
             .name("sampler".into())
-            .spawn(move || sampler::run(domain, overview, rx, history))
+            .spawn(move || sampler::run(domain, overview, rx, history, replay))
             .expect("spawn the sampler thread");
+    }
+    if let Some(started) = started {
+        match started.recv() {
+            Ok(Ok(plane)) => tracing::info!(plane, "replaying"),
+            Ok(Err(e)) => {
+                let file = args.replay.as_deref().unwrap_or(std::path::Path::new(""));
+                eprintln!("physics-view: cannot replay {}: {e}", file.display());
+                return ExitCode::FAILURE;
+            }
+            Err(_) => {
+                eprintln!("physics-view: the sampler stopped before the replay started");
+                return ExitCode::FAILURE;
+            }
+        }
     }
     {
         let jobs = jobs.clone();

@@ -3,7 +3,9 @@
 //! header a few times a second (the plane list and the plots), and answers the web server's
 //! jobs (a plane's bodies, a body's properties, controls) from the newest published tick.
 //! It only reads shared memory and asks read-only questions, except for the controls, which
-//! the server refuses unless `--allow-control` was given.
+//! the server refuses unless `--allow-control` was given. With `--replay FILE` it also owns
+//! the replay ([`crate::replay::Player`]): the plane it plays into is one of its client's,
+//! so the replay lives on this thread too and advances between jobs.
 
 use std::collections::{BTreeMap, HashMap, VecDeque};
 use std::sync::mpsc::{Receiver, RecvTimeoutError};
@@ -18,6 +20,8 @@ use serde::Serialize;
 use serde_json::{json, Value};
 use shm_layout::FLAG_CONTROLLER;
 use tokio::sync::oneshot;
+
+use crate::replay::{Player, Refusal, ReplayRequest};
 
 /// How often tick headers are sampled for the plane list and the plots.
 pub const SAMPLE_PERIOD: Duration = Duration::from_millis(100);
@@ -70,6 +74,14 @@ pub enum Job {
         /// The answer.
         reply: oneshot::Sender<Result<(u64, Vec<u8>), String>>,
     },
+    /// The replay's timeline: its state (`request` `None`) or a play, pause, step, seek or
+    /// speed change, answered with the state after it.
+    Replay {
+        /// What to do, if anything.
+        request: Option<ReplayRequest>,
+        /// The answer, or an HTTP status and why not.
+        reply: oneshot::Sender<Result<Value, (u16, String)>>,
+    },
 }
 
 /// A control of the page.
@@ -120,6 +132,8 @@ pub struct PlaneSummary {
     pub contact_pairs: u32,
     /// Largest joint error after the last step.
     pub max_joint_error: f32,
+    /// The plane plays the recording of `--replay`.
+    pub replay: bool,
 }
 
 /// The last minutes of one plane's tick-header figures, one point per sampled tick.
@@ -168,6 +182,10 @@ pub struct Overview {
     pub planes: Vec<PlaneSummary>,
     /// Figures over time, by plane.
     pub histories: HashMap<PlaneId, History>,
+    /// The recording played (`--replay FILE`).
+    pub replay_file: Option<String>,
+    /// The plane it plays into, while a daemon runs it.
+    pub replay_plane: Option<PlaneId>,
 }
 
 /// A body's shape as drawn, and what else its description adds (controllers, GUI).
@@ -204,14 +222,32 @@ struct Sampler {
     history_points: usize,
     last_list: Option<Instant>,
     last_connect: Option<Instant>,
+    /// The replay of `--replay FILE`.
+    player: Option<Player>,
+    /// The daemon this viewer started for its replay (none ran); stopped when it exits.
+    daemon: Option<client_sdk::DaemonChild>,
 }
 
-/// Runs the sampler until the job channel closes or a `Shutdown` job arrives.
+/// A replay to start before anything else, and where to say whether it started (its
+/// plane) or why not.
+pub struct ReplayStart {
+    /// The file, as named.
+    pub path: String,
+    /// Its recording, read and checked.
+    pub recording: Arc<client_sdk::Recording>,
+    /// The answer.
+    pub ready: std::sync::mpsc::Sender<Result<PlaneId, String>>,
+}
+
+/// Runs the sampler until the job channel closes or a `Shutdown` job arrives. With a
+/// replay, it first connects (starting a daemon for the domain when none runs) and starts
+/// the replay; when that fails it says why on `ready` and returns.
 pub fn run(
     domain: String,
     shared: Arc<Mutex<Overview>>,
     jobs: Receiver<Job>,
     history_seconds: f64,
+    replay: Option<ReplayStart>,
 ) {
     let history_points =
         ((history_seconds / SAMPLE_PERIOD.as_secs_f64()).ceil() as usize).clamp(10, 1_000_000);
@@ -223,18 +259,46 @@ pub fn run(
         history_points,
         last_list: None,
         last_connect: None,
+        player: None,
+        daemon: None,
     };
+    if let Some(ReplayStart {
+        path,
+        recording,
+        ready,
+    }) = replay
+    {
+        let player = Player::new(path, recording);
+        {
+            let mut o = sampler.shared.lock().expect("overview lock");
+            o.replay_file = Some(player.path().to_string());
+        }
+        sampler.player = Some(player);
+        sampler.last_connect = Some(Instant::now());
+        let started = sampler.connect_now();
+        let failed = started.is_err();
+        let started = started.map(|()| sampler.replay_plane().unwrap_or_default());
+        let _ = ready.send(started.map_err(|e| e.to_string()));
+        if failed {
+            sampler.stop();
+            return;
+        }
+    }
     let mut next = Instant::now();
     loop {
         if Instant::now() >= next {
             sampler.housekeeping();
             next = Instant::now() + SAMPLE_PERIOD;
         }
-        match jobs.recv_timeout(next.saturating_duration_since(Instant::now())) {
+        sampler.pump();
+        let wake = sampler
+            .player
+            .as_ref()
+            .and_then(Player::due)
+            .map_or(next, |due| due.min(next));
+        match jobs.recv_timeout(wake.saturating_duration_since(Instant::now())) {
             Ok(Job::Shutdown) => {
-                // Dropping the client says goodbye to the daemon.
-                sampler.planes.clear();
-                sampler.client = None;
+                sampler.stop();
                 std::process::exit(0);
             }
             Ok(job) => sampler.handle(job),
@@ -275,28 +339,98 @@ impl Sampler {
                 return;
             }
             self.last_connect = Some(Instant::now());
-            match Client::connect(&self.domain) {
-                Ok(client) => {
-                    tracing::info!(domain = self.domain, pid = client.daemon_pid(), "connected");
-                    let mut o = self.shared.lock().expect("overview lock");
-                    o.connected = true;
-                    o.error = None;
-                    o.daemon_pid = client.daemon_pid();
-                    drop(o);
-                    self.client = Some(client);
-                    self.last_list = None;
-                }
-                Err(e) => {
-                    let mut o = self.shared.lock().expect("overview lock");
-                    o.connected = false;
-                    o.error = Some(e.to_string());
-                    return;
-                }
+            if let Err(e) = self.connect_now() {
+                let mut o = self.shared.lock().expect("overview lock");
+                o.connected = false;
+                o.error = Some(e.to_string());
+                return;
             }
         }
         if let Err(e) = self.sample() {
             self.check(&e);
         }
+    }
+
+    /// Connects to the domain's daemon (with a replay: starting one when none runs) and
+    /// starts the replay in it.
+    fn connect_now(&mut self) -> Result<(), Error> {
+        let client = match Client::connect(&self.domain) {
+            Ok(client) => client,
+            Err(Error::NoDaemon { .. }) if self.player.is_some() => self.start_daemon()?,
+            Err(e) => return Err(e),
+        };
+        tracing::info!(domain = self.domain, pid = client.daemon_pid(), "connected");
+        {
+            let mut o = self.shared.lock().expect("overview lock");
+            o.connected = true;
+            o.error = None;
+            o.daemon_pid = client.daemon_pid();
+        }
+        self.client = Some(client.clone());
+        self.last_list = None;
+        let Some(player) = self.player.as_mut() else {
+            return Ok(());
+        };
+        let id = match player.start(&client) {
+            Ok(id) => id,
+            Err(e) => {
+                player.lost(&e.to_string());
+                return Err(e);
+            }
+        };
+        self.shared.lock().expect("overview lock").replay_plane = Some(id);
+        // The camera's framing: the bodies as the recording starts.
+        let first = self.snapshot(id)?;
+        if let Some(player) = self.player.as_mut() {
+            player.set_fit(&first["bodies"]);
+        }
+        Ok(())
+    }
+
+    /// Starts a daemon for the domain (its log in a file of the temporary folder), as
+    /// `physics-lua` does when none runs; it exits with this process.
+    fn start_daemon(&mut self) -> Result<Client, Error> {
+        // One that died is reaped first.
+        self.daemon = None;
+        let log = std::env::temp_dir().join(format!("physics-daemon-{}.log", self.domain));
+        let stderr = std::fs::File::create(&log)
+            .map(std::process::Stdio::from)
+            .unwrap_or_else(|_| std::process::Stdio::inherit());
+        let (child, client) = client_sdk::start_daemon_with(&self.domain, &[], stderr)?;
+        eprintln!(
+            "physics-view: no daemon served domain {}: started one (pid {}, log {})",
+            self.domain,
+            child.pid(),
+            log.display()
+        );
+        self.daemon = Some(child);
+        Ok(client)
+    }
+
+    /// Says goodbye to the daemon (the replay's plane goes with the client) and stops the
+    /// daemon this viewer started, if it did.
+    fn stop(&mut self) {
+        self.player = None;
+        self.planes.clear();
+        self.client = None;
+        self.daemon = None;
+    }
+
+    /// Advances the replay's ticks that are due.
+    fn pump(&mut self) {
+        let Some(player) = self.player.as_mut() else {
+            return;
+        };
+        if player.due().is_some_and(|due| due <= Instant::now()) {
+            if let Err(e) = player.pump() {
+                self.check(&e);
+            }
+        }
+    }
+
+    /// The plane the replay plays into.
+    fn replay_plane(&self) -> Option<PlaneId> {
+        self.player.as_ref().and_then(Player::plane_id)
     }
 
     /// Drops the client when `e` says the daemon is gone.
@@ -305,11 +439,15 @@ impl Sampler {
             tracing::warn!("daemon lost: {e}");
             self.planes.clear();
             self.client = None;
+            if let Some(player) = self.player.as_mut() {
+                player.lost(&e.to_string());
+            }
             let mut o = self.shared.lock().expect("overview lock");
             o.connected = false;
             o.daemon_pid = 0;
             o.error = Some(e.to_string());
             o.planes.clear();
+            o.replay_plane = None;
         }
     }
 
@@ -354,6 +492,7 @@ impl Sampler {
         }
         let mut summaries = Vec::with_capacity(self.planes.len());
         let mut fresh = Vec::new();
+        let replay = self.replay_plane();
         for (id, w) in &mut self.planes {
             let Ok(snap) = w.plane.snapshot() else {
                 continue;
@@ -372,6 +511,7 @@ impl Sampler {
                 max_penetration: h.max_penetration,
                 contact_pairs: h.contact_pairs,
                 max_joint_error: h.max_joint_error,
+                replay: replay == Some(*id),
             });
             if w.last_tick != Some(h.tick) {
                 w.last_tick = Some(h.tick);
@@ -438,6 +578,10 @@ impl Sampler {
                 let _ = reply.send(result);
                 return;
             }
+            Job::Replay { request, reply } => {
+                let _ = reply.send(self.replay(request));
+                return;
+            }
         };
         let result = result.map_err(|e| {
             let message = e.to_string();
@@ -447,7 +591,30 @@ impl Sampler {
         let _ = reply.send(result);
     }
 
+    /// The replay's state, after `request` if any.
+    fn replay(&mut self, request: Option<ReplayRequest>) -> Result<Value, (u16, String)> {
+        let Some(player) = self.player.as_mut() else {
+            return Err((
+                404,
+                "not replaying: start physics-view with --replay FILE".to_string(),
+            ));
+        };
+        let Some(request) = request else {
+            return Ok(player.status());
+        };
+        match player.act(request) {
+            Ok(v) => Ok(v),
+            Err(Refusal::Conflict(message)) => Err((409, message)),
+            Err(Refusal::Daemon(e)) => {
+                let message = e.to_string();
+                self.check(&e);
+                Err((503, message))
+            }
+        }
+    }
+
     fn snapshot(&mut self, id: PlaneId) -> Result<Value, Error> {
+        let replayed = self.replay_plane() == Some(id);
         let w = self.watched(id)?;
         let snap = w.plane.snapshot()?;
         drain_contacts(w)?;
@@ -456,11 +623,15 @@ impl Sampler {
         let mut fetches = 0;
         let mut bodies = Vec::with_capacity(h.body_count as usize);
         let mut controllers = Vec::new();
+        let mut live = Vec::new();
         for (slot, b) in snap.bodies().iter().enumerate() {
             let slot = slot as u32;
             if !b.is_alive() {
                 w.shapes.remove(&slot);
                 continue;
+            }
+            if replayed {
+                live.push((slot, b.generation, b.position, b.flags));
             }
             let stale = w.shapes.get(&slot).is_none_or(|k| {
                 k.generation != b.generation || k.fetched.elapsed() > SHAPE_REFRESH
@@ -520,7 +691,7 @@ impl Sampler {
                        "tick": t.tick})
             })
             .collect();
-        Ok(json!({
+        let mut out = json!({
             "id": id,
             "kind": kind_name(w.info.kind),
             "tick": h.tick,
@@ -540,7 +711,21 @@ impl Sampler {
             "contacts": contacts,
             "controllers": controllers,
             "described": fetches < SHAPE_FETCHES_PER_SNAPSHOT,
-        }))
+        });
+        if replayed {
+            let gui = w.info.kind == PlaneKind::Gui2d;
+            if let Some(player) = self.player.as_mut() {
+                if let Value::Object(extra) = player.overlay(&live)? {
+                    for (k, v) in extra {
+                        // A GUI plane's contacts come from its events, as for a live plane.
+                        if !(gui && k == "contacts") {
+                            out[k] = v;
+                        }
+                    }
+                }
+            }
+        }
+        Ok(out)
     }
 
     fn body(&mut self, id: PlaneId, slot: u32) -> Result<Value, Error> {
@@ -576,6 +761,14 @@ impl Sampler {
     }
 
     fn control(&mut self, id: PlaneId, action: Action) -> Result<Value, Error> {
+        if self.replay_plane() == Some(id) {
+            return Err(Error::Invalid {
+                field: "plane".into(),
+                message: format!(
+                    "plane {id} plays the recording: its timeline drives it (POST /api/replay)"
+                ),
+            });
+        }
         let w = self.watched(id)?;
         let plane = w.plane.clone();
         let tick = match action {

@@ -13,6 +13,7 @@ use axum::{Json, Router};
 use serde_json::{json, Value};
 use tokio::sync::oneshot;
 
+use crate::replay::ReplayRequest;
 use crate::sampler::{Action, Job, Overview};
 
 const INDEX_HTML: &str = include_str!("../static/index.html");
@@ -47,6 +48,7 @@ pub fn router(state: AppState) -> Router {
         .route("/api/plane/{id}/body/{slot}", get(body))
         .route("/api/plane/{id}/{action}", post(control))
         .route("/api/plane/{id}/snapshot", get(download))
+        .route("/api/replay", get(replay_status).post(replay_action))
         .with_state(state)
 }
 
@@ -90,6 +92,10 @@ async fn info(State(s): State<AppState>) -> Response {
         "error": o.error,
         "daemon_pid": o.daemon_pid,
         "version": env!("CARGO_PKG_VERSION"),
+        "replay": o.replay_file.as_ref().map(|file| json!({
+            "file": file,
+            "plane": o.replay_plane,
+        })),
     }))
     .into_response()
 }
@@ -189,5 +195,37 @@ async fn download(State(s): State<AppState>, Path(plane): Path<u32>) -> Response
             .into_response(),
         Ok(Err(message)) => error(StatusCode::NOT_FOUND, message),
         Err(_) => error(StatusCode::SERVICE_UNAVAILABLE, "the sampler has stopped"),
+    }
+}
+
+/// Sends a timeline job to the sampler and waits for its answer.
+async fn ask_replay(s: &AppState, request: Option<ReplayRequest>) -> Response {
+    let (tx, rx) = oneshot::channel();
+    if s.jobs.send(Job::Replay { request, reply: tx }).is_err() {
+        return error(StatusCode::SERVICE_UNAVAILABLE, "the sampler has stopped");
+    }
+    match rx.await {
+        Ok(Ok(v)) => Json(v).into_response(),
+        Ok(Err((status, message))) => error(
+            StatusCode::from_u16(status).unwrap_or(StatusCode::INTERNAL_SERVER_ERROR),
+            message,
+        ),
+        Err(_) => error(StatusCode::SERVICE_UNAVAILABLE, "the sampler has stopped"),
+    }
+}
+
+/// `GET /api/replay`: the timeline of `--replay FILE` (first and last tick, the current
+/// one, playing, speed, a divergence's message).
+async fn replay_status(State(s): State<AppState>) -> Response {
+    ask_replay(&s, None).await
+}
+
+/// `POST /api/replay` with `{"action": "play"|"pause"|"step"|"seek"|"speed", "tick"?,
+/// "speed"?}`. It drives the viewer's own replay plane only, so it needs no
+/// `--allow-control`.
+async fn replay_action(State(s): State<AppState>, body: axum::body::Bytes) -> Response {
+    match ReplayRequest::parse(&body) {
+        Ok(request) => ask_replay(&s, Some(request)).await,
+        Err(message) => error(StatusCode::BAD_REQUEST, message),
     }
 }

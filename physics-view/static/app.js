@@ -1,7 +1,11 @@
 // physics-view page: polls the viewer's JSON API at display rate and draws the chosen plane
 // with three.js (3D planes) or a 2D canvas in pixel space (GUI planes). What it shows is also
 // written into data- attributes of #view (plane, kind, tick, body count, bodies with their
-// poses, meshes drawn) so a headless browser can check the page through the DOM.
+// poses, meshes drawn) so a headless browser can check the page through the DOM. With
+// `physics-view --replay FILE` a timeline drives the replay plane (play, pause, step, jump to
+// a tick, speed) and the recorded rays of the current tick are drawn; the timeline's state
+// goes into data-replay-* attributes, and each rendered frame of the replay plane into a
+// coarse grid of its pixels' luminance with the bodies' screen positions.
 import * as THREE from '/static/three.module.min.js';
 
 const $ = (id) => document.getElementById(id);
@@ -15,10 +19,12 @@ let snapshot = null;
 let selectedSlot = null;
 let frames = 0;
 let drawnSelection = null;
+let replayPlane = null; // the plane of --replay, when replaying
+let sliding = false; // the timeline's slider is being dragged
 
 const COLORS = {
   awake: 0xe0894a, sleeping: 0x5b79c9, anchored: 0x8a8f98, controller: 0x3cc47c,
-  contact: 0xff3b6b, selected: 0xffe066,
+  contact: 0xff3b6b, selected: 0xffe066, ray: 0x4cc9f0,
 };
 const css = (c) => '#' + c.toString(16).padStart(6, '0');
 
@@ -155,7 +161,8 @@ function draw3d(s) {
     }
   }
   drawOverlays3d(s);
-  if (fittedPlane !== s.id) fitCamera(s);
+  // A replay keeps the framing of its first tick, whatever tick the page opens at.
+  if (fittedPlane !== s.id) fitCamera(s.fit && s.fit.length ? { ...s, bodies: s.fit } : s);
   view.dataset.meshes = String(bodyGroup.children.length);
 }
 
@@ -183,6 +190,13 @@ function drawOverlays3d(s) {
     const lg = new THREE.BufferGeometry();
     lg.setAttribute('position', new THREE.Float32BufferAttribute(lines, 3));
     overlayGroup.add(new THREE.LineSegments(lg, new THREE.LineBasicMaterial({ color: COLORS.contact, depthTest: false })));
+  }
+  if ($('show-rays').checked && s.rays && s.rays.length) {
+    const pts = [];
+    for (const r of s.rays) pts.push(...r.from, ...r.to);
+    const rg = new THREE.BufferGeometry();
+    rg.setAttribute('position', new THREE.Float32BufferAttribute(pts, 3));
+    overlayGroup.add(new THREE.LineSegments(rg, new THREE.LineBasicMaterial({ color: COLORS.ray, depthTest: false })));
   }
   if ($('show-controllers').checked) {
     for (const c of s.controllers) {
@@ -351,8 +365,102 @@ function applySnapshot(s) {
     slot: b.slot, generation: b.generation, shape: b.shape, size: b.size,
     position: b.position, rotation: b.rotation, sleeping: b.sleeping, anchored: b.anchored,
   })));
+  showReplay(s);
   view.dataset.frames = String(++frames);
   view.dataset.ready = '1';
+}
+
+// ---------------------------------------------------------------- replay timeline
+function showReplay(s) {
+  const r = s.replay;
+  const attrs = ['replayTick', 'replayFirst', 'replayLast', 'replayPlaying', 'replaySpeed',
+    'replayDiverged', 'replayRays', 'replayAtEnd'];
+  if (!r) {
+    for (const a of attrs) delete view.dataset[a];
+    return;
+  }
+  $('replay-now').textContent = `tick ${r.tick} of ${r.first}–${r.last} · ${r.playing ? 'playing' : 'paused'}` +
+    ` · ${r.speed}× of ${fmt(r.rate_hz)} Hz${r.at_end ? ' · end' : ''}`;
+  const slider = $('replay-slider');
+  slider.min = String(r.first);
+  slider.max = String(r.last);
+  if (!sliding) slider.value = String(r.tick);
+  const input = $('replay-tick');
+  input.min = String(r.first);
+  input.max = String(r.last);
+  if (document.activeElement !== input) input.value = String(r.tick);
+  const speed = $('replay-speed');
+  if (speed.options.length !== r.speeds.length) {
+    speed.innerHTML = r.speeds.map((v) => `<option value="${v}">${v}×</option>`).join('');
+  }
+  if (document.activeElement !== speed) speed.value = String(r.speed);
+  $('replay-diverged').textContent = r.diverged || r.error || '';
+  view.dataset.replayTick = String(r.tick);
+  view.dataset.replayFirst = String(r.first);
+  view.dataset.replayLast = String(r.last);
+  view.dataset.replayPlaying = String(r.playing);
+  view.dataset.replaySpeed = String(r.speed);
+  view.dataset.replayAtEnd = String(r.at_end);
+  view.dataset.replayDiverged = r.diverged || '';
+  view.dataset.replayRays = JSON.stringify(s.rays || []);
+}
+
+async function replayAct(body) {
+  try {
+    const r = await getJSON('/api/replay', {
+      method: 'POST', headers: { 'content-type': 'application/json' }, body: JSON.stringify(body),
+    });
+    $('replay-diverged').textContent = r.diverged || '';
+  } catch (e) {
+    $('replay-diverged').textContent = String(e.message || e);
+  }
+}
+
+for (const b of document.querySelectorAll('#replay button[data-replay]')) {
+  b.addEventListener('click', () => {
+    const action = b.dataset.replay;
+    replayAct(action === 'seek' ? { action, tick: Number($('replay-tick').value) } : { action });
+  });
+}
+$('replay-tick').addEventListener('keydown', (ev) => {
+  if (ev.key === 'Enter') replayAct({ action: 'seek', tick: Number($('replay-tick').value) });
+});
+$('replay-slider').addEventListener('input', () => {
+  sliding = true;
+  $('replay-tick').value = $('replay-slider').value;
+});
+$('replay-slider').addEventListener('change', async () => {
+  await replayAct({ action: 'seek', tick: Number($('replay-slider').value) });
+  sliding = false;
+});
+$('replay-speed').addEventListener('change', () => {
+  replayAct({ action: 'speed', speed: Number($('replay-speed').value) });
+});
+
+// What a rendered frame of the replay plane shows, for a headless browser to compare two
+// ticks: the luminance of a GRID_W x GRID_H downscale of the canvas (two hex digits per
+// cell, rows from the top) and each body's centre on screen (0..1, x right, y down).
+const GRID_W = 64, GRID_H = 40;
+const probe = document.createElement('canvas');
+probe.width = GRID_W;
+probe.height = GRID_H;
+function sampleFrame(s) {
+  const ctx = probe.getContext('2d', { willReadFrequently: true });
+  ctx.imageSmoothingEnabled = true;
+  ctx.imageSmoothingQuality = 'high';
+  ctx.drawImage(glCanvas, 0, 0, GRID_W, GRID_H);
+  const d = ctx.getImageData(0, 0, GRID_W, GRID_H).data;
+  let hex = '';
+  for (let i = 0; i < d.length; i += 4) {
+    hex += Math.round(0.299 * d[i] + 0.587 * d[i + 1] + 0.114 * d[i + 2]).toString(16).padStart(2, '0');
+  }
+  const screen = s.bodies.map((b) => {
+    const p = new THREE.Vector3(...b.position).project(camera);
+    return { slot: b.slot, x: (p.x + 1) / 2, y: (1 - p.y) / 2 };
+  });
+  view.dataset.grid = `${GRID_W}x${GRID_H}:${hex}`;
+  view.dataset.screen = JSON.stringify(screen);
+  view.dataset.frameTick = String(s.tick);
 }
 
 async function refreshPlanes() {
@@ -362,11 +470,19 @@ async function refreshPlanes() {
     allowControl = info.allow_control;
     $('status').textContent = info.connected ? `daemon pid ${info.daemon_pid}` : `no daemon: ${info.error || ''}`;
     $('status').className = info.connected ? '' : 'bad';
+    const rp = info.replay ? info.replay.plane : null;
+    $('replay').hidden = !info.replay;
+    if (info.replay) $('replay-file').textContent = info.replay.file;
+    if (rp !== null && rp !== replayPlane) {
+      // The replay plane is shown unless the page was opened on another one.
+      if (selected === null || selected === replayPlane) selected = rp;
+      replayPlane = rp;
+    }
     const planes = await getJSON('/api/planes');
     if (selected === null && planes.length) selected = planes[0].id;
     const rows = planes.map((p) =>
       `<tr data-plane-id="${p.id}" data-kind="${p.kind}" data-body-count="${p.body_count}" class="${p.id === selected ? 'selected' : ''}">` +
-      `<td>${p.id}</td><td>${p.kind}</td><td>${p.body_count}</td>` +
+      `<td>${p.id}</td><td>${p.kind}${p.replay ? ' (replay)' : ''}</td><td>${p.body_count}</td>` +
       `<td>${p.tick_rate > 0 ? fmt(p.tick_rate) : 'manual'}</td><td>${fmt(p.step_time_us)}</td></tr>`).join('');
     const body = document.querySelector('#planes tbody');
     body.innerHTML = rows;
@@ -447,7 +563,7 @@ function resize() {
   camera.updateProjectionMatrix();
 }
 window.addEventListener('resize', () => { resize(); dirty = true; });
-for (const id of ['show-contacts', 'show-controllers']) {
+for (const id of ['show-contacts', 'show-controllers', 'show-rays']) {
   $(id).addEventListener('change', () => { drawnSelection = undefined; });
 }
 resize();
@@ -457,6 +573,7 @@ function render() {
   if (dirty && renderer && snapshot && snapshot.kind !== 'Gui2d') {
     renderer.render(scene, camera);
     dirty = false;
+    if (snapshot.replay) sampleFrame(snapshot);
   }
   requestAnimationFrame(render);
 }
