@@ -77,11 +77,11 @@ struct Args {
     /// and the batch of writes before it. The script gets the plane with
     /// `PhysicsService.GetStartPlane()` (manual: it steps it); without a script the run only
     /// replays.
-    #[arg(long, conflicts_with = "snapshot")]
+    #[arg(long, value_name = "FILE", conflicts_with = "snapshot")]
     replay: Option<PathBuf>,
     /// With `--replay`: stop the replay once the plane is at this tick (a tick past the
     /// recording's last replays it to its end).
-    #[arg(long, requires = "replay")]
+    #[arg(long, value_name = "TICK", requires = "replay")]
     until: Option<u64>,
     /// Run against a daemon of this physics cluster, on this host or another, instead of
     /// this host's domain (docs/cluster.md); no daemon is started. Needs `--connect`.
