@@ -361,6 +361,24 @@ fn ops_before(recording: &Recording, tick: u64) -> usize {
         .sum()
 }
 
+/// A recording started right after objects were added, before the plane steps again: its
+/// start keyframe holds bodies that have not moved yet (the thrown ball with its velocity),
+/// and the replay restores it and steps on with every hash equal.
+#[test]
+fn a_recording_started_right_after_adds_replays_with_every_hash_equal() {
+    let daemon = TestDaemon::start("rec-fresh");
+    let dir = TempDir::new("rec-fresh");
+    let path = dir.join("fresh.physrec");
+    let client = daemon.client();
+    // Recording starts at tick 0, with the whole game just added.
+    let (_game, live, bodies, recording) = record_game(&client, &path, 0, 60);
+    assert_eq!(file_hashes(&recording), live);
+    let (replayed, replay) = replay_to_end(&daemon.client(), &recording);
+    assert_eq!(replayed, live);
+    let again = replay.plane().snapshot().unwrap().bodies().to_vec();
+    assert_same_bodies(&bodies, &again, "a recording started before the first step");
+}
+
 #[test]
 fn a_plane_ticking_by_itself_with_writes_between_its_ticks_replays() {
     let daemon = TestDaemon::start("rec-ticking");
@@ -493,12 +511,15 @@ fn a_daemon_started_with_record_writes_a_file_per_plane_that_replays() {
             .unwrap_or_else(|| panic!("no recording of plane {id}"));
         let name = path.file_name().unwrap().to_str().unwrap();
         let ms = name
-            .strip_prefix(&format!("{id}-"))
+            .strip_prefix(&format!("plane-{id}-"))
             .and_then(|n| n.strip_suffix(".physrec"))
-            .unwrap_or_else(|| panic!("{name} is not <plane id>-<unix ms>.physrec"));
-        assert_eq!(
-            ms.parse::<u64>().ok(),
-            Some(recording.start.started_unix_ms)
+            .unwrap_or_else(|| panic!("{name} is not plane-<id>-<unix ms>.physrec"));
+        // Named when the file is made, just before the start entry is written.
+        let named_ms: u64 = ms.parse().unwrap();
+        let started = recording.start.started_unix_ms;
+        assert!(
+            named_ms <= started && started - named_ms < 1000,
+            "{name}: started at {started} ms"
         );
         // Recorded from its creation: the objects come in the batches.
         assert_eq!(recording.first_tick(), 0);
@@ -514,7 +535,9 @@ fn periodic_keyframes_let_a_replay_seek_forwards_and_back() {
     let dir = TempDir::new("rec-keys");
     let path = dir.join("keys.physrec");
     let client = daemon.client();
-    let (_game, live, bodies, recording) = record_game(&client, &path, 0, 300);
+    // Recording starts at tick 10: the keyframes are every 50 ticks from there.
+    let k0 = 10u64;
+    let (_game, live, bodies, recording) = record_game(&client, &path, k0 as u32, 300);
     assert_eq!(recording.start.keyframe_every, 50);
     let periodic: Vec<(u64, u64)> = recording
         .events
@@ -530,34 +553,38 @@ fn periodic_keyframes_let_a_replay_seek_forwards_and_back() {
         })
         .collect();
     let ticks: Vec<u64> = periodic.iter().map(|&(t, _)| t).collect();
-    assert_eq!(ticks, vec![50, 100, 150, 200, 250, 300]);
-    let hash_at = |tick: u64| live[tick as usize - 1].1;
+    let every_50: Vec<u64> = (1..=6).map(|k| k0 + 50 * k).collect();
+    assert_eq!(ticks, every_50);
+    let hash_at = |tick: u64| live[(tick - k0) as usize - 1].1;
     for (tick, hash) in periodic {
         assert_eq!(hash, hash_at(tick), "the keyframe of tick {tick}");
     }
     // From the start to 200, against a seek that enters at the keyframe of 200.
     let mut from_start = Replay::start(&daemon.client(), recording.clone()).unwrap();
-    assert_eq!(from_start.run(Some(200)).unwrap(), Advanced::Tick(200));
+    assert_eq!(
+        from_start.run(Some(k0 + 200)).unwrap(),
+        Advanced::Tick(k0 + 200)
+    );
     let mut seeking = Replay::start(&daemon.client(), recording.clone()).unwrap();
-    assert_eq!(seeking.seek(200).unwrap(), Advanced::Tick(200));
-    assert_eq!(seeking.tick(), 200);
+    assert_eq!(seeking.seek(k0 + 200).unwrap(), Advanced::Tick(k0 + 200));
+    assert_eq!(seeking.tick(), k0 + 200);
     let hash = seeking.plane().state_hash().unwrap();
     assert_eq!(hash, from_start.plane().state_hash().unwrap());
-    assert_eq!(hash, hash_at(200));
+    assert_eq!(hash, hash_at(k0 + 200));
     assert_same_bodies(
         &from_start.plane().snapshot().unwrap().bodies().to_vec(),
         &seeking.plane().snapshot().unwrap().bodies().to_vec(),
         "a seek to 200 against a replay from the start",
     );
     // Forwards past a keyframe, then back before the one it came from.
-    assert_eq!(seeking.seek(250).unwrap(), Advanced::Tick(250));
-    assert_eq!(seeking.plane().state_hash().unwrap(), hash_at(250));
-    assert_eq!(seeking.seek(60).unwrap(), Advanced::Tick(60));
-    assert_eq!(seeking.tick(), 60);
-    assert_eq!(seeking.plane().state_hash().unwrap(), hash_at(60));
+    assert_eq!(seeking.seek(k0 + 250).unwrap(), Advanced::Tick(k0 + 250));
+    assert_eq!(seeking.plane().state_hash().unwrap(), hash_at(k0 + 250));
+    assert_eq!(seeking.seek(k0 + 60).unwrap(), Advanced::Tick(k0 + 60));
+    assert_eq!(seeking.tick(), k0 + 60);
+    assert_eq!(seeking.plane().state_hash().unwrap(), hash_at(k0 + 60));
     // And on from there to the end, every hash checked.
     assert_eq!(seeking.run(None).unwrap(), Advanced::End);
-    assert_eq!(seeking.tick(), 300);
+    assert_eq!(seeking.tick(), k0 + 300);
     assert_same_bodies(
         &bodies,
         &seeking.plane().snapshot().unwrap().bodies().to_vec(),
@@ -641,8 +668,9 @@ fn a_rewritten_tick_hash_stops_the_replay_at_that_tick_naming_the_batch_before_i
     let dir = TempDir::new("rec-diverge");
     let path = dir.join("game.physrec");
     let client = daemon.client();
-    let (_game, live, _bodies, recording) = record_game(&client, &path, 0, 60);
-    let tick = 40u64;
+    let k0 = 5u64;
+    let (_game, live, _bodies, recording) = record_game(&client, &path, k0 as u32, 60);
+    let tick = k0 + 40;
     let good = &recording.bytes;
     let at = tick_entry(good, tick);
     let (dt, hash) = recording
@@ -657,8 +685,8 @@ fn a_rewritten_tick_hash_stops_the_replay_at_that_tick_naming_the_batch_before_i
             _ => None,
         })
         .unwrap();
-    assert_eq!(hash, live[tick as usize - 1].1);
-    // The batch applied after tick 39, before tick 40.
+    assert_eq!(hash, live[(tick - k0) as usize - 1].1);
+    // The batch applied after the tick before.
     let batch_at = recording
         .events
         .iter()
@@ -668,7 +696,7 @@ fn a_rewritten_tick_hash_stops_the_replay_at_that_tick_naming_the_batch_before_i
             } if *t == tick - 1 => Some(*offset),
             _ => None,
         })
-        .expect("a batch before tick 40");
+        .expect("a batch before the tick");
     let forged = hash ^ 0x0100_0000_0000_0001;
     let mut bytes = good[..at].to_vec();
     push_tick(&mut bytes, tick, dt, forged);
@@ -682,13 +710,17 @@ fn a_rewritten_tick_hash_stops_the_replay_at_that_tick_naming_the_batch_before_i
         match replay.advance().unwrap() {
             Advanced::Tick(t) => {
                 agreed += 1;
-                assert_eq!(t, agreed);
+                assert_eq!(t, k0 + agreed);
             }
             Advanced::Diverged(d) => break d,
             Advanced::End => panic!("the replay ran to the end past a forged hash"),
         }
     };
-    assert_eq!(agreed, tick - 1, "every tick before the forged one agrees");
+    assert_eq!(
+        agreed,
+        tick - k0 - 1,
+        "every tick before the forged one agrees"
+    );
     assert_eq!(divergence.tick, tick);
     assert_eq!(divergence.recorded, forged);
     assert_eq!(
