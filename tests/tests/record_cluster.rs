@@ -1,0 +1,204 @@
+//! A recording of a plane that moves to another daemon of its cluster: recording on `a`,
+//! stepped, moved to `b` (`Plane::move_to`) and stepped on there. The file on `a` ends
+//! with the move (its end entry says so) and replays with every tick's hash equal, the
+//! write sent with the move included; a recording started on `b` through the moved
+//! plane's handle replays too, on either daemon.
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::time::Duration;
+
+use client_sdk::{
+    load_recording, Advanced, Client, Object, ObjectProp, Plane, PlaneOptions, Pose, Recording,
+    Replay, Shape,
+};
+use integration_tests::cluster::{endpoint, free_port, member, unique_cluster};
+use integration_tests::{eventually, unique_domain, TestDaemon};
+use shm_layout::recording::Event;
+
+const DT: f32 = 1.0 / 60.0;
+
+/// A folder of its own under the temporary folder, removed when dropped.
+struct TempDir(PathBuf);
+
+impl TempDir {
+    fn new(tag: &str) -> TempDir {
+        let path = std::env::temp_dir().join(unique_domain(tag));
+        std::fs::create_dir_all(&path).expect("create a temporary folder");
+        TempDir(path)
+    }
+
+    fn join(&self, name: &str) -> PathBuf {
+        self.0.join(name)
+    }
+}
+
+impl Drop for TempDir {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+/// Two members of one cluster, `a` and `b`.
+struct Pair {
+    a: TestDaemon,
+    b: TestDaemon,
+}
+
+fn pair(tag: &str) -> Pair {
+    let cluster = unique_cluster(tag);
+    let (pa, pb) = (free_port(), free_port());
+    let a = member(&cluster, "a", pa, &[], &[]);
+    let b = member(&cluster, "b", pb, &[pa], &[]);
+    let view = client_sdk::cluster::Cluster::connect(&cluster, &[&endpoint(pa)]).unwrap();
+    eventually(Duration::from_secs(10), || {
+        (view.daemons().ok()?.len() == 2).then_some(())
+    })
+    .expect("both members joined");
+    Pair { a, b }
+}
+
+/// A pile of cubes on a floor with a ball thrown into it and a paddle beside it.
+fn game(plane: &Plane) -> (Vec<Object>, Object) {
+    physics_scenes::floor(&mut &*plane, 60.0, &[]).unwrap();
+    let cubes = physics_scenes::pyramid(&mut &*plane, 4, 0.0).unwrap();
+    physics_scenes::ball(
+        &mut &*plane,
+        [-10.0, 1.0, 0.0],
+        &[ObjectProp::Velocity([14.0, 4.0, 0.2])],
+    )
+    .unwrap();
+    let paddle = plane
+        .add(
+            Shape::Cube {
+                size: [1.0, 1.5, 0.4],
+            },
+            Pose::at([0.0, 1.2, 2.0]),
+            &[ObjectProp::GravityScale(0.0)],
+        )
+        .unwrap();
+    (cubes, paddle)
+}
+
+/// Ticks `from..=to`: the paddle's velocity every tick, an impulse every 10; (tick, hash)
+/// of each step.
+fn play(plane: &Plane, cubes: &[Object], paddle: &Object, from: u32, to: u32) -> Vec<(u64, u64)> {
+    (from..=to)
+        .map(|t| {
+            paddle
+                .set_velocity([0.0, 0.0, -3.0 * (t as f32 * 0.08).sin()])
+                .unwrap();
+            if t % 10 == 3 {
+                cubes[t as usize % cubes.len()]
+                    .apply_impulse([0.0, 3.0, -1.0])
+                    .unwrap();
+            }
+            let tick = plane.step(DT).unwrap();
+            (tick, plane.state_hash().unwrap())
+        })
+        .collect()
+}
+
+fn file_hashes(recording: &Recording) -> Vec<(u64, u64)> {
+    recording
+        .events
+        .iter()
+        .filter_map(|e| match e {
+            Event::Tick {
+                tick, state_hash, ..
+            } => Some((*tick, *state_hash)),
+            _ => None,
+        })
+        .collect()
+}
+
+/// Replays `recording` on `client` to its end, one tick at a time (a divergence fails the
+/// test naming it): (tick, hash) of each tick, and the replay.
+fn replay_to_end(client: &Client, recording: &Arc<Recording>) -> (Vec<(u64, u64)>, Replay) {
+    let mut replay = Replay::start(client, recording.clone()).expect("start the replay");
+    let mut seen = Vec::new();
+    loop {
+        match replay.advance().expect("advance the replay") {
+            Advanced::Tick(tick) => seen.push((tick, replay.plane().state_hash().unwrap())),
+            Advanced::End => break,
+            Advanced::Diverged(d) => panic!("after {} tick(s): {d}", seen.len()),
+        }
+    }
+    (seen, replay)
+}
+
+/// The recording at `path` once its end entry is written.
+fn finished(path: &Path) -> Recording {
+    eventually(Duration::from_secs(5), || {
+        load_recording(path).ok().filter(|r| r.end.is_some())
+    })
+    .unwrap_or_else(|| {
+        panic!(
+            "{} has no end entry: {:?}",
+            path.display(),
+            load_recording(path).map(|r| r.events.len())
+        )
+    })
+}
+
+#[test]
+fn a_recording_of_a_plane_that_moves_to_another_daemon_ends_there_and_replays() {
+    let pair = pair("rec-move");
+    let dir = TempDir::new("rec-move");
+    let owner = pair.a.client();
+    let plane = owner.create_plane(&PlaneOptions::manual()).unwrap();
+    let (cubes, paddle) = game(&plane);
+    plane.step(DT).unwrap();
+    let on_a = dir.join("on-a.physrec");
+    plane.start_recording(Some(&on_a)).unwrap();
+    let live_a = play(&plane, &cubes, &paddle, 1, 40);
+    // A write queued right before the move goes with the move's request: applied on a,
+    // before the cut, so it is in a's recording.
+    paddle.set_velocity([0.0, 2.0, 0.0]).unwrap();
+    plane.move_to("b").unwrap();
+    assert_eq!(plane.daemon().as_deref(), Some("b"));
+    let first_on_b = plane.step(DT).unwrap();
+    assert_eq!(first_on_b, 42, "tick 41 on a, 42 on b");
+    let hash_on_b = plane.state_hash().unwrap();
+    let live_b = play(&plane, &cubes, &paddle, 42, 70);
+
+    // The file on a ends with the move.
+    let recording_a = Arc::new(finished(&on_a));
+    let end = recording_a.end.clone().unwrap();
+    assert!(
+        end.contains("moved") && end.contains('b'),
+        "end entry: {end:?}"
+    );
+    assert_eq!(recording_a.start.daemon, "a");
+    assert_eq!(recording_a.tick_count(), 40);
+    assert_eq!(file_hashes(&recording_a), live_a);
+    // The recording stopped with the move: b's plane does not record.
+    assert_eq!(plane.stop_recording().unwrap(), None);
+
+    // It replays on a, and the replayed plane steps on to what b computed after the move
+    // (the write sent with the move is in the file).
+    let (replayed, replay) = replay_to_end(&pair.a.client(), &recording_a);
+    assert_eq!(replayed, live_a);
+    assert_eq!(replay.plane().step(DT).unwrap(), 42);
+    assert_eq!(
+        replay.plane().state_hash().unwrap(),
+        hash_on_b,
+        "the replay, stepped once more, agrees with b's first tick"
+    );
+
+    // A recording started on b through the moved plane's handle.
+    let on_b = dir.join("on-b.physrec");
+    plane.start_recording(Some(&on_b)).unwrap();
+    let live_b2 = play(&plane, &cubes, &paddle, 71, 100);
+    let info = plane.stop_recording().unwrap().expect("recording on b");
+    assert_eq!(info.ticks, 30);
+    let recording_b = Arc::new(load_recording(&on_b).unwrap());
+    assert_eq!(recording_b.start.daemon, "b");
+    assert_eq!(recording_b.end.as_deref(), Some("stopped"));
+    assert_eq!(recording_b.first_tick(), live_b.last().unwrap().0);
+    assert_eq!(file_hashes(&recording_b), live_b2);
+    for (what, client) in [("b", pair.b.client()), ("a", pair.a.client())] {
+        let (replayed, _replay) = replay_to_end(&client, &recording_b);
+        assert_eq!(replayed, live_b2, "b's recording replayed on {what}");
+    }
+}
