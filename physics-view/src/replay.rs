@@ -129,8 +129,9 @@ pub struct Player {
     due: Instant,
     diverged: Option<(u64, String)>,
     error: Option<String>,
-    /// The camera's framing: every body at the first tick (position and size), so the view
-    /// keeps its place whatever tick the page is opened at.
+    /// The camera's framing: every body at the first and at the last tick (position and
+    /// size), so the view holds the whole recording and keeps its place whatever tick the
+    /// page is opened at.
     fit: Value,
     /// Contacts of the current tick, asked for once per tick.
     contacts: Option<(u64, Value)>,
@@ -177,17 +178,26 @@ impl Player {
         Ok(id)
     }
 
-    /// Keeps the bodies of the first tick for the camera's framing.
-    pub fn set_fit(&mut self, bodies: &Value) {
+    /// The recording's first and last tick.
+    pub fn range(&self) -> (u64, u64) {
+        (self.recording.first_tick(), self.recording.last_tick())
+    }
+
+    /// Goes to `tick` without changing the timeline's state (a divergence on the way is
+    /// found again when played): for looking at the recording's extent.
+    pub fn jump(&mut self, tick: u64) -> Result<(), Error> {
+        if let Some(replay) = self.replay.as_mut() {
+            replay.seek(tick)?;
+        }
+        Ok(())
+    }
+
+    /// Keeps `bodies` (of the first and the last tick) for the camera's framing.
+    pub fn set_fit(&mut self, bodies: &[Value]) {
         let fit = bodies
-            .as_array()
-            .map(|bodies| {
-                bodies
-                    .iter()
-                    .map(|b| json!({"position": b["position"], "size": b["size"]}))
-                    .collect()
-            })
-            .unwrap_or_default();
+            .iter()
+            .map(|b| json!({"position": b["position"], "size": b["size"]}))
+            .collect();
         self.fit = Value::Array(fit);
     }
 

@@ -378,12 +378,24 @@ impl Sampler {
                 return Err(e);
             }
         };
-        self.shared.lock().expect("overview lock").replay_plane = Some(id);
-        // The camera's framing: the bodies as the recording starts.
-        let first = self.snapshot(id)?;
-        if let Some(player) = self.player.as_mut() {
-            player.set_fit(&first["bodies"]);
+        let (first, last) = player.range();
+        // The camera's framing: the bodies as the recording starts and as it ends (the
+        // way there restores the last keyframe before the end: at most one keyframe
+        // interval of steps), then back to the start.
+        let mut fit = bodies_of(self.snapshot(id)?);
+        if last > first {
+            if let Some(player) = self.player.as_mut() {
+                player.jump(last)?;
+            }
+            fit.extend(bodies_of(self.snapshot(id)?));
+            if let Some(player) = self.player.as_mut() {
+                player.jump(first)?;
+            }
         }
+        if let Some(player) = self.player.as_mut() {
+            player.set_fit(&fit);
+        }
+        self.shared.lock().expect("overview lock").replay_plane = Some(id);
         Ok(())
     }
 
@@ -784,6 +796,17 @@ impl Sampler {
         };
         w.info = plane.info()?;
         Ok(json!({"plane": id, "tick": tick, "enabled": w.info.enabled}))
+    }
+}
+
+/// The bodies of a plane's snapshot answer.
+fn bodies_of(snapshot: Value) -> Vec<Value> {
+    match snapshot {
+        Value::Object(mut o) => match o.remove("bodies") {
+            Some(Value::Array(bodies)) => bodies,
+            _ => Vec::new(),
+        },
+        _ => Vec::new(),
     }
 }
 

@@ -438,8 +438,9 @@ $('replay-speed').addEventListener('change', () => {
 });
 
 // What a rendered frame of the replay plane shows, for a headless browser to compare two
-// ticks: the luminance of a GRID_W x GRID_H downscale of the canvas (two hex digits per
-// cell, rows from the top) and each body's centre on screen (0..1, x right, y down).
+// ticks: a GRID_W x GRID_H downscale of the canvas (RGB, six hex digits per cell, rows from
+// the top) and each body's centre and radius on screen (fractions of the canvas: x right,
+// y down, r of its height).
 const GRID_W = 64, GRID_H = 40;
 const probe = document.createElement('canvas');
 probe.width = GRID_W;
@@ -452,11 +453,16 @@ function sampleFrame(s) {
   const d = ctx.getImageData(0, 0, GRID_W, GRID_H).data;
   let hex = '';
   for (let i = 0; i < d.length; i += 4) {
-    hex += Math.round(0.299 * d[i] + 0.587 * d[i + 1] + 0.114 * d[i + 2]).toString(16).padStart(2, '0');
+    for (let c = 0; c < 3; c++) hex += d[i + c].toString(16).padStart(2, '0');
   }
+  const up = new THREE.Vector3(0, 1, 0).applyQuaternion(camera.quaternion);
   const screen = s.bodies.map((b) => {
-    const p = new THREE.Vector3(...b.position).project(camera);
-    return { slot: b.slot, x: (p.x + 1) / 2, y: (1 - p.y) / 2 };
+    const centre = new THREE.Vector3(...b.position);
+    const p = centre.clone().project(camera);
+    // The bounding sphere's top, seen from the camera.
+    const half = Math.hypot(...b.size) / 2;
+    const top = centre.clone().addScaledVector(up, half).project(camera);
+    return { slot: b.slot, x: (p.x + 1) / 2, y: (1 - p.y) / 2, r: Math.abs(top.y - p.y) / 2 };
   });
   view.dataset.grid = `${GRID_W}x${GRID_H}:${hex}`;
   view.dataset.screen = JSON.stringify(screen);
