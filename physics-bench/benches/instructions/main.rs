@@ -11,7 +11,8 @@
 //! `publish` (a tick written into shared memory per body), `codec` (encoding and decoding
 //! per command), `apply` (applying per command), `controllers` (a controller tick),
 //! `history` (a snapshot and a rollback tick per body), `events` (an event record per
-//! contact), `lua` (a Luau `part.CFrame` read, first and repeated, and a property write).
+//! contact), `lua` (a Luau `part.CFrame` read, first and repeated, and a property write),
+//! `record` (a frame of writes and a step with a recording running and without).
 //! Every measured call runs on the benchmark's main thread (see [`common::one_thread`]),
 //! which is the one Callgrind counts.
 
@@ -23,6 +24,7 @@ mod events;
 mod history;
 mod lua;
 mod publish;
+mod record;
 mod step;
 
 use apply::apply_group;
@@ -32,6 +34,7 @@ use events::events_group;
 use history::history_group;
 use lua::lua_group;
 use publish::publish_group;
+use record::record_group;
 use step::step_group;
 
 gungraun::main!(
@@ -44,5 +47,6 @@ gungraun::main!(
     controllers_group,
     history_group,
     events_group,
-    lua_group
+    lua_group,
+    record_group
 );
