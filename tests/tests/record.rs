@@ -187,15 +187,13 @@ fn play_ticks(game: &mut Game, from: u32, to: u32) -> Vec<(u64, u64)> {
         .collect()
 }
 
+/// A recorded game: the game, the live (tick, hash) of every step recorded, the plane's
+/// final bodies and the recording.
+type Recorded = (Game, Vec<(u64, u64)>, Vec<BodyState>, Arc<Recording>);
+
 /// The game on a new manual plane of `client`, recorded into `path` from tick `warm_up`
-/// for `ticks` ticks: the live (tick, hash) of every step, the plane's final bodies and the
-/// recording.
-fn record_game(
-    client: &Client,
-    path: &Path,
-    warm_up: u32,
-    ticks: u32,
-) -> (Game, Vec<(u64, u64)>, Vec<BodyState>, Arc<Recording>) {
+/// for `ticks` ticks.
+fn record_game(client: &Client, path: &Path, warm_up: u32, ticks: u32) -> Recorded {
     let mut game = build_game(client.create_plane(&PlaneOptions::manual()).unwrap());
     for _ in 0..warm_up {
         game.plane.step(DT).unwrap();
@@ -413,7 +411,7 @@ fn a_plane_ticking_by_itself_with_writes_between_its_ticks_replays() {
         paddle
             .set_velocity([0.0, 0.0, -3.0 * (i as f32 * 0.1).sin()])
             .unwrap();
-        if i % 7 == 0 {
+        if i.is_multiple_of(7) {
             cubes[(i / 7) as usize % cubes.len()]
                 .apply_impulse([0.5, 4.0, 0.0])
                 .unwrap();
@@ -572,8 +570,8 @@ fn periodic_keyframes_let_a_replay_seek_forwards_and_back() {
     assert_eq!(hash, from_start.plane().state_hash().unwrap());
     assert_eq!(hash, hash_at(k0 + 200));
     assert_same_bodies(
-        &from_start.plane().snapshot().unwrap().bodies().to_vec(),
-        &seeking.plane().snapshot().unwrap().bodies().to_vec(),
+        from_start.plane().snapshot().unwrap().bodies(),
+        seeking.plane().snapshot().unwrap().bodies(),
         "a seek to 200 against a replay from the start",
     );
     // Forwards past a keyframe, then back before the one it came from.
@@ -587,7 +585,7 @@ fn periodic_keyframes_let_a_replay_seek_forwards_and_back() {
     assert_eq!(seeking.tick(), k0 + 300);
     assert_same_bodies(
         &bodies,
-        &seeking.plane().snapshot().unwrap().bodies().to_vec(),
+        seeking.plane().snapshot().unwrap().bodies(),
         "the end after seeking back",
     );
 }
@@ -798,7 +796,7 @@ fn rewinds_and_restores_while_recording_replay_through_their_jump_keyframes() {
     assert_eq!(replayed, live);
     assert_same_bodies(
         &bodies,
-        &replay.plane().snapshot().unwrap().bodies().to_vec(),
+        replay.plane().snapshot().unwrap().bodies(),
         "the end of a replay through jumps",
     );
 }
