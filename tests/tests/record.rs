@@ -405,7 +405,10 @@ fn a_plane_ticking_by_itself_with_writes_between_its_ticks_replays() {
     let started = Instant::now();
     let mut added = Vec::new();
     let mut writes = 0u32;
-    while started.elapsed() < Duration::from_secs(1) {
+    // About a second, and at least 40 rounds of writes (a loaded machine takes longer).
+    while started.elapsed() < Duration::from_secs(1)
+        || (writes < 40 && started.elapsed() < Duration::from_secs(5))
+    {
         writes += 1;
         let i = writes;
         paddle
@@ -451,6 +454,12 @@ fn a_plane_ticking_by_itself_with_writes_between_its_ticks_replays() {
             _ => None,
         })
         .collect();
+    println!(
+        "{} ticks recorded in {:?}, {writes} rounds of writes, batches at {} ticks",
+        info.ticks,
+        started.elapsed(),
+        batch_ticks.len()
+    );
     assert!(
         batch_ticks.len() >= 15,
         "the writes landed between many ticks: {batch_ticks:?}"
