@@ -419,9 +419,9 @@ const BALLS: [u64; 3] = [1, 2, 3];
 #[test]
 fn the_page_shows_the_replay_at_the_tick_its_timeline_is_at() {
     chromium();
-    let daemon = TestDaemon::start("viewer-replay");
+    let daemon = TestDaemon::start("vr-shows");
     let client = daemon.client();
-    let dir = TempDir::new("viewer-replay");
+    let dir = TempDir::new("vr-shows");
     let file = dir.join("balls.physrec");
     let (_recorded, recording) = record_balls(&client, &file);
     let (a, b) = (10u64, 90u64);
@@ -551,12 +551,18 @@ fn the_page_shows_the_replay_at_the_tick_its_timeline_is_at() {
     viewer.ok(json!({"action": "seek", "tick": RAY_TICK}));
     let attrs = load_tick(&profile, &url, RAY_TICK);
     let rays: Value = serde_json::from_str(&attrs["data-replay-rays"]).unwrap();
+    let rays = rays.as_array().expect("rays");
+    assert_eq!(rays.len(), 1, "{rays:?}");
+    assert_eq!(rays[0]["kind"], "Raycast", "{rays:?}");
     let to = [0, 1, 2].map(|i| RAY.0[i] + RAY.1[i]);
-    assert_eq!(
-        rays,
-        json!([{"kind": "Raycast", "from": RAY.0, "to": to}]),
-        "{attrs:?}"
-    );
+    for i in 0..3 {
+        assert_eq!(
+            rays[0]["from"][i].as_f64(),
+            Some(RAY.0[i] as f64),
+            "{rays:?}"
+        );
+        assert_eq!(rays[0]["to"][i].as_f64(), Some(to[i] as f64), "{rays:?}");
+    }
 
     // The contacts of the last tick: each ball's with the floor, as the test's replay has
     // them.
@@ -589,9 +595,9 @@ fn the_page_shows_the_replay_at_the_tick_its_timeline_is_at() {
 /// plane refuses the plane controls (its timeline drives it).
 #[test]
 fn play_pause_step_and_the_end_of_the_recording() {
-    let daemon = TestDaemon::start("viewer-replay-play");
+    let daemon = TestDaemon::start("vr-play");
     let client = daemon.client();
-    let dir = TempDir::new("viewer-replay-play");
+    let dir = TempDir::new("vr-play");
     let file = dir.join("balls.physrec");
     let (_recorded, recording) = record_balls(&client, &file);
     let mut mine = Replay::start(&client, recording).unwrap();
@@ -687,9 +693,9 @@ fn tick_entry(bytes: &[u8], tick: u64) -> usize {
 #[test]
 fn a_divergence_stops_playback_and_the_page_shows_it() {
     chromium();
-    let daemon = TestDaemon::start("viewer-replay-diverge");
+    let daemon = TestDaemon::start("vr-diverge");
     let client = daemon.client();
-    let dir = TempDir::new("viewer-replay-diverge");
+    let dir = TempDir::new("vr-diverge");
     let file = dir.join("balls.physrec");
     let (_recorded, recording) = record_balls(&client, &file);
     let tick = 40u64;
@@ -708,7 +714,8 @@ fn a_divergence_stops_playback_and_the_page_shows_it() {
     let good = &recording.bytes;
     let at = tick_entry(good, tick);
     let mut bytes = good[..at].to_vec();
-    push_tick(&mut bytes, tick, dt, hash ^ 0x0100_0000_0000_0001);
+    let forged_hash = hash ^ 0x0100_0000_0000_0001;
+    push_tick(&mut bytes, tick, dt, forged_hash);
     bytes.extend_from_slice(&good[at + ENTRY_OVERHEAD + 20..]);
     assert_eq!(bytes.len(), good.len());
     let forged = dir.join("forged.physrec");
@@ -730,7 +737,10 @@ fn a_divergence_stops_playback_and_the_page_shows_it() {
         .expect("a divergence")
         .to_string();
     assert!(message.contains("diverged at tick 40"), "{message}");
-    assert!(message.contains("byte offset"), "{message}");
+    assert!(
+        message.contains(&format!("the recording has {forged_hash:016x}")),
+        "{message}"
+    );
 
     let profile = dir.join("profile");
     let attrs = load_tick(&profile, &format!("{}/", viewer.base), tick);
@@ -759,9 +769,9 @@ fn a_divergence_stops_playback_and_the_page_shows_it() {
 /// before it listens, naming the byte offset of the damage.
 #[test]
 fn a_damaged_recording_is_refused_naming_the_byte_offset() {
-    let daemon = TestDaemon::start("viewer-replay-damaged");
+    let daemon = TestDaemon::start("vr-damaged");
     let client = daemon.client();
-    let dir = TempDir::new("viewer-replay-damaged");
+    let dir = TempDir::new("vr-damaged");
     let file = dir.join("balls.physrec");
     let (_recorded, recording) = record_balls(&client, &file);
     let good = recording.bytes.clone();
@@ -815,15 +825,15 @@ fn a_damaged_recording_is_refused_naming_the_byte_offset() {
 /// there, and stops it when the viewer exits. `--help` documents `--replay`.
 #[test]
 fn a_replay_starts_a_daemon_when_none_runs_and_stops_it() {
-    let recorder = TestDaemon::start("viewer-replay-rec");
+    let recorder = TestDaemon::start("vr-rec");
     let client = recorder.client();
-    let dir = TempDir::new("viewer-replay-own");
+    let dir = TempDir::new("vr-own");
     let file = dir.join("balls.physrec");
     let (_recorded, recording) = record_balls(&client, &file);
     let mut mine = Replay::start(&client, recording).unwrap();
     let want = poses_at(&mut mine, 60);
 
-    let domain = unique_domain("viewer-replay-own");
+    let domain = unique_domain("vr-own");
     let viewer = Viewer::replay(&domain, &file, &[]);
     let info = viewer.get("/api/info");
     assert_eq!(info["connected"], true, "{info}");
