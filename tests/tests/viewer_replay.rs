@@ -322,8 +322,12 @@ fn record_balls(client: &Client, path: &Path) -> (Plane, Arc<Recording>) {
         }
     }
     let info = plane.stop_recording().unwrap().expect("the plane recorded");
-    assert_eq!(info.ticks, TICKS);
-    (plane, Arc::new(load_recording(path).unwrap()))
+    let recording = load_recording(path).unwrap();
+    assert_eq!(info.ticks, recording.tick_count());
+    assert_eq!(recording.last_tick(), TICKS);
+    // The recording enters at the state the first step made (or before it).
+    assert!(recording.first_tick() <= 1, "{}", recording.first_tick());
+    (plane, Arc::new(recording))
 }
 
 /// Every body of a plane (slot → position, rotation) as a replay in the test reaches `tick`.
@@ -449,10 +453,11 @@ fn the_page_shows_the_replay_at_the_tick_its_timeline_is_at() {
 
     let viewer = Viewer::replay(&daemon.domain, &file, &[]);
     let state = viewer.get("/api/replay");
-    assert_eq!(state["first"], 0, "{state}");
+    let first = recording.first_tick();
+    assert_eq!(state["first"], first, "{state}");
     assert_eq!(state["last"], TICKS, "{state}");
     assert_eq!(
-        state["tick"], 0,
+        state["tick"], first,
         "the replay starts paused at its first tick: {state}"
     );
     assert_eq!(state["playing"], false, "{state}");
@@ -477,7 +482,7 @@ fn the_page_shows_the_replay_at_the_tick_its_timeline_is_at() {
         // The replay plane is the one shown (no ?plane= in the URL).
         assert_eq!(attrs["data-plane"], plane.to_string());
         assert_eq!(attrs["data-tick"], tick.to_string());
-        assert_eq!(attrs["data-replay-first"], "0");
+        assert_eq!(attrs["data-replay-first"], first.to_string());
         assert_eq!(attrs["data-replay-last"], TICKS.to_string());
         assert_eq!(attrs["data-replay-playing"], "false");
         assert_eq!(attrs["data-replay-diverged"], "");
@@ -600,6 +605,7 @@ fn play_pause_step_and_the_end_of_the_recording() {
     let dir = TempDir::new("vr-play");
     let file = dir.join("balls.physrec");
     let (_recorded, recording) = record_balls(&client, &file);
+    let first = recording.first_tick();
     let mut mine = Replay::start(&client, recording).unwrap();
     let viewer = Viewer::replay(&daemon.domain, &file, &["--allow-control"]);
     let plane = viewer.get("/api/replay")["plane"].as_u64().unwrap();
@@ -649,7 +655,10 @@ fn play_pause_step_and_the_end_of_the_recording() {
     let (status, r) = viewer.act(json!({"action": "seek", "tick": 500}));
     assert_eq!(status, 409, "{r}");
     assert!(
-        r["error"].as_str().unwrap().contains("ticks 0 to 120"),
+        r["error"]
+            .as_str()
+            .unwrap()
+            .contains(&format!("ticks {first} to {TICKS}")),
         "{r}"
     );
     for bad in [
@@ -723,7 +732,7 @@ fn a_divergence_stops_playback_and_the_page_shows_it() {
 
     let viewer = Viewer::replay(&daemon.domain, &forged, &[]);
     let state = viewer.get("/api/replay");
-    assert_eq!(state["tick"], 0, "{state}");
+    assert_eq!(state["tick"], recording.first_tick(), "{state}");
     assert_eq!(state["diverged"], Value::Null, "{state}");
     viewer.ok(json!({"action": "play", "speed": 4}));
     let stopped = eventually(Duration::from_secs(30), || {
