@@ -208,11 +208,17 @@ impl Replay {
                     why: KeyframeWhy::Jump,
                     range,
                     tick,
-                    ..
+                    state_hash,
                 } => {
-                    let snapshot =
-                        PlaneSnapshot::from_bytes(self.recording.snapshot(&range).to_vec())?;
-                    self.plane.restore_with(&snapshot, &replay_overrides())?;
+                    // The Restore or Rewind before it was repeated with its batch; the
+                    // keyframe is the state it made. Restored only where the repeat did not
+                    // get there (a Rewind reaching past where the replay started).
+                    let here = self.plane.snapshot()?.header().state_hash;
+                    if self.plane_tick()? != tick || here != state_hash {
+                        let snapshot =
+                            PlaneSnapshot::from_bytes(self.recording.snapshot(&range).to_vec())?;
+                        self.plane.restore_with(&snapshot, &replay_overrides())?;
+                    }
                     self.tick = tick;
                 }
                 Event::Keyframe { .. } => {}
@@ -280,6 +286,11 @@ impl Replay {
                 other => return Ok(other),
             }
         }
+    }
+
+    /// The tick the plane's newest sample shows.
+    fn plane_tick(&self) -> Result<u64, Error> {
+        Ok(self.plane.snapshot()?.tick())
     }
 
     /// Sends a batch's ops as recorded, in requests of bounded size (a batch gathers every
