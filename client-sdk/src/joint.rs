@@ -2,6 +2,7 @@
 //! options, the error figures, breaking. Every call is one round trip (the queue goes with
 //! it), so a bad option is reported where it was given.
 
+use shm_layout::joint_op::MAX_JOINT_PAGE;
 use shm_layout::{
     Command, EventRecord, Handle, JointInfo, JointKind, JointOp, JointProp, PlaneOp, Reply, Vec3,
     EVENT_JOINT_BROKE,
@@ -73,6 +74,51 @@ impl Plane {
                 kind,
             }),
             other => Err(Error::Protocol(format!("expected a joint, got {other:?}"))),
+        }
+    }
+
+    /// Every live joint of the plane, described as [`Joint::info`] describes one, in
+    /// ascending slot order (asked a page of [`MAX_JOINT_PAGE`] at a time until a short
+    /// page). Read-only: any client may list any plane's joints.
+    pub fn joints(&self) -> Result<Vec<JointInfo>, Error> {
+        let mut all = Vec::new();
+        let mut after = 0u32;
+        loop {
+            let page = self.joint_page(after, MAX_JOINT_PAGE)?;
+            let full = page.len() >= MAX_JOINT_PAGE as usize;
+            let next = match page.last() {
+                Some(last) if last.handle.slot < after => {
+                    return Err(Error::Protocol(format!(
+                        "a joint page from slot {after} listed slot {}",
+                        last.handle.slot
+                    )))
+                }
+                Some(last) => last.handle.slot.checked_add(1),
+                None => None,
+            };
+            all.extend(page);
+            match next {
+                Some(n) if full => after = n,
+                _ => return Ok(all),
+            }
+        }
+    }
+
+    /// One page of the plane's joints: those in slots from `after` on, ascending, at most
+    /// `limit` (1 to [`MAX_JOINT_PAGE`]; more is cut to a page). The next page starts at
+    /// the last joint's slot + 1; a page shorter than `limit` is the last.
+    pub fn joint_page(&self, after: u32, limit: u32) -> Result<Vec<JointInfo>, Error> {
+        let op = JointOp::List { after, limit }
+            .checked()
+            .map_err(Error::invalid_value)?;
+        match self
+            .client()
+            .call(Command::plane(self.id(), PlaneOp::Joint(op)))?
+        {
+            Reply::Joints(joints) => Ok(joints),
+            other => Err(Error::Protocol(format!(
+                "expected a joint list, got {other:?}"
+            ))),
         }
     }
 }

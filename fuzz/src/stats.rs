@@ -346,6 +346,7 @@ pub fn reply_name(reply: &Reply) -> &'static str {
         Reply::Transfer(_) => "Transfer",
         Reply::Moved { .. } => "Moved",
         Reply::Recording(_) => "Recording",
+        Reply::Joints(_) => "Joints",
     }
 }
 
@@ -392,6 +393,7 @@ pub fn op_name(command: &Command) -> String {
                 JointOp::Set { prop, .. } => format!("Plane.Joint.Set.{}", prop.name()),
                 JointOp::Info { .. } => "Plane.Joint.Info".into(),
                 JointOp::Destroy { .. } => "Plane.Joint.Destroy".into(),
+                JointOp::List { .. } => "Plane.Joint.List".into(),
             },
             PlaneOp::Map(m) => match m {
                 MapOp::Upload { .. } => "Plane.Map.Upload".into(),

@@ -21,6 +21,7 @@ use serde_json::{json, Value};
 use shm_layout::FLAG_CONTROLLER;
 use tokio::sync::oneshot;
 
+use crate::joints::{self, JointCache, PoseOf};
 use crate::replay::{Player, Refusal, ReplayRequest};
 
 /// How often tick headers are sampled for the plane list and the plots.
@@ -211,6 +212,8 @@ struct Watched {
     shapes: HashMap<u32, Known>,
     contacts: HashMap<(Handle, Handle), Touch>,
     last_tick: Option<u64>,
+    /// The plane's joints as last listed (a 3D plane's; GUI planes have none).
+    joints: JointCache,
 }
 
 /// The sampler's state (lives on its own thread).
@@ -554,6 +557,7 @@ impl Sampler {
             shapes: HashMap::new(),
             contacts: HashMap::new(),
             last_tick: None,
+            joints: JointCache::default(),
         })
     }
 
@@ -636,6 +640,7 @@ impl Sampler {
         let mut bodies = Vec::with_capacity(h.body_count as usize);
         let mut controllers = Vec::new();
         let mut live = Vec::new();
+        let mut poses: HashMap<u32, PoseOf> = HashMap::new();
         for (slot, b) in snap.bodies().iter().enumerate() {
             let slot = slot as u32;
             if !b.is_alive() {
@@ -644,6 +649,9 @@ impl Sampler {
             }
             if replayed {
                 live.push((slot, b.generation, b.position, b.flags));
+            }
+            if !gui {
+                poses.insert(slot, (b.generation, b.position, b.rotation));
             }
             let stale = w.shapes.get(&slot).is_none_or(|k| {
                 k.generation != b.generation || k.fetched.elapsed() > SHAPE_REFRESH
@@ -703,6 +711,15 @@ impl Sampler {
                        "tick": t.tick})
             })
             .collect();
+        // Joints: listed again once a second (live) or once per tick drawn (replay), their
+        // anchors placed with this tick's poses.
+        let joint_lines = if gui {
+            Vec::new()
+        } else {
+            w.joints.refresh(&w.plane, h.tick, replayed)?;
+            joints::lines(w.joints.joints(), &poses)
+        };
+        let joint_count = w.joints.joints().len();
         let mut out = json!({
             "id": id,
             "kind": kind_name(w.info.kind),
@@ -722,6 +739,8 @@ impl Sampler {
             "bodies": bodies,
             "contacts": contacts,
             "controllers": controllers,
+            "joints": joint_lines,
+            "joint_count": joint_count,
             "described": fetches < SHAPE_FETCHES_PER_SNAPSHOT,
         });
         if replayed {

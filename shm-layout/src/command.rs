@@ -255,6 +255,8 @@ pub enum Reply {
     },
     /// A recording started or stopped ([`PlaneOp::Record`]): its file and what it holds.
     Recording(crate::record_op::RecordingInfo),
+    /// A page of a plane's joints, ascending slots ([`crate::joint_op::JointOp::List`]).
+    Joints(Vec<JointInfo>),
 }
 
 /// The result of one command.

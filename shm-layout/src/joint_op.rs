@@ -571,6 +571,10 @@ pub struct JointInfo {
 /// Most joints one plane may hold.
 pub const MAX_JOINTS: usize = 1 << 20;
 
+/// Most joints one [`JointOp::List`] answers (a larger `limit` is cut to this): bounds one
+/// reply (a few hundred bytes per joint) whatever the plane holds.
+pub const MAX_JOINT_PAGE: u32 = 4096;
+
 /// An op on a plane's joints.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub enum JointOp {
@@ -603,6 +607,16 @@ pub enum JointOp {
         /// The joint.
         joint: Handle,
     },
+    /// Describes the plane's live joints in ascending slot order, starting at slot `after`,
+    /// at most `limit` of them (cut to [`MAX_JOINT_PAGE`]): [`crate::Reply::Joints`]. The
+    /// first page asks from `after` 0; the next from the last listed joint's slot + 1; an
+    /// answer shorter than the limit is the last page. Read-only.
+    List {
+        /// The first slot looked at (0: from the start).
+        after: u32,
+        /// Most joints answered, 1 to [`MAX_JOINT_PAGE`] (more is cut to the page size).
+        limit: u32,
+    },
 }
 
 impl JointOp {
@@ -625,6 +639,18 @@ impl JointOp {
                 joint,
                 prop: prop.checked()?,
             },
+            JointOp::List { after, limit } => {
+                if limit == 0 {
+                    return Err(CommandError::invalid_field(
+                        "limit",
+                        format!("a joint list needs a limit of 1 to {MAX_JOINT_PAGE}, got 0"),
+                    ));
+                }
+                JointOp::List {
+                    after,
+                    limit: limit.min(MAX_JOINT_PAGE),
+                }
+            }
             op => op,
         })
     }
@@ -692,6 +718,28 @@ mod tests {
         }
         assert_eq!(s, JointSettings::default());
         assert_eq!(OptionalJointProp::from_name("AnchorA"), None);
+    }
+
+    #[test]
+    fn a_list_needs_a_limit_and_is_cut_to_a_page() {
+        let e = JointOp::List { after: 0, limit: 0 }.checked().unwrap_err();
+        assert_eq!(e.field.as_deref(), Some("limit"));
+        assert_eq!(
+            JointOp::List {
+                after: 7,
+                limit: u32::MAX
+            }
+            .checked()
+            .unwrap(),
+            JointOp::List {
+                after: 7,
+                limit: MAX_JOINT_PAGE
+            }
+        );
+        assert_eq!(
+            JointOp::List { after: 0, limit: 3 }.checked().unwrap(),
+            JointOp::List { after: 0, limit: 3 }
+        );
     }
 
     #[test]

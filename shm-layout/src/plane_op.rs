@@ -134,6 +134,7 @@ impl PlaneOp {
                 | PlaneOp::Snapshot
                 | PlaneOp::Controller(ControllerOp::Info { .. })
                 | PlaneOp::Joint(JointOp::Info { .. })
+                | PlaneOp::Joint(JointOp::List { .. })
                 | PlaneOp::Object {
                     op: ObjectOp::Info,
                     ..

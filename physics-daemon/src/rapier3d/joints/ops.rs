@@ -1,4 +1,4 @@
-//! Joint ops of the plane: create, set, info, destroy, and the joints of a removed body.
+//! Joint ops of the plane: create, set, info, list, destroy, and the joints of a removed body.
 
 use rapier3d::prelude::*;
 use shm_layout::joint_op::{JointInfo, JointKind, JointOp, JointProp, JointSettings};
@@ -85,6 +85,7 @@ impl Plane {
                 })
             }
             JointOp::Info { joint } => Ok(Reply::JointInfo(Box::new(self.joint_info(joint)?))),
+            JointOp::List { after, limit } => Ok(Reply::Joints(self.joint_page(after, limit))),
             JointOp::Destroy { joint } => {
                 let j = self.joints.table.remove(joint)?;
                 self.remove_rapier_joint(&j);
@@ -217,6 +218,16 @@ impl Plane {
             force: j.force,
             position: j.position,
         })
+    }
+
+    /// The live joints from slot `after` on, ascending, at most `limit` (checked: 1 to
+    /// `MAX_JOINT_PAGE`), each described as `JointOp::Info` describes it.
+    pub(in crate::rapier3d::joints) fn joint_page(&self, after: u32, limit: u32) -> Vec<JointInfo> {
+        let table = &self.joints.table;
+        (after as usize..table.slot_count())
+            .filter_map(|slot| self.joint_info(table.handle_at(slot)?).ok())
+            .take(limit as usize)
+            .collect()
     }
 
     pub(in crate::rapier3d::joints) fn remove_rapier_joint(&mut self, j: &Joint) {

@@ -43,7 +43,8 @@ impl PlaneCell {
     /// Whether the loop may apply `op` itself: a short op that neither steps nor touches the
     /// plane's shared-memory output (which lives on the worker's thread), and that is cheap
     /// enough not to hold up the other clients (no meshes, no maps, no scene queries: a
-    /// query's time grows with its rays and filter, so it runs on the plane's worker).
+    /// query's time grows with its rays and filter, so it runs on the plane's worker; nor a
+    /// joint list, whose page may describe thousands of joints).
     pub fn inline_op(op: &PlaneOp) -> bool {
         !matches!(
             op,
@@ -51,6 +52,7 @@ impl PlaneCell {
                 | PlaneOp::Info
                 | PlaneOp::Map(_)
                 | PlaneOp::Query(_)
+                | PlaneOp::Joint(shm_layout::joint_op::JointOp::List { .. })
                 | PlaneOp::Snapshot
                 | PlaneOp::Restore { .. }
                 | PlaneOp::Rewind(_)
