@@ -1,7 +1,8 @@
 // physics-view page: polls the viewer's JSON API at display rate and draws the chosen plane
 // with three.js (3D planes) or a 2D canvas in pixel space (GUI planes). What it shows is also
 // written into data- attributes of #view (plane, kind, tick, body count, bodies with their
-// poses, meshes drawn) so a headless browser can check the page through the DOM. With
+// poses, meshes drawn, joints drawn) so a headless browser can check the page through the DOM.
+// Joints are drawn as lines between their anchors (dashed and faded once broken). With
 // `physics-view --replay FILE` a timeline drives the replay plane (play, pause, step, jump to
 // a tick, speed) and the recorded rays of the current tick are drawn; the timeline's state
 // goes into data-replay-* attributes, and each rendered frame of the replay plane into a
@@ -24,7 +25,7 @@ let sliding = false; // the timeline's slider is being dragged
 
 const COLORS = {
   awake: 0xe0894a, sleeping: 0x5b79c9, anchored: 0x8a8f98, controller: 0x3cc47c,
-  contact: 0xff3b6b, selected: 0xffe066, ray: 0x4cc9f0,
+  contact: 0xff3b6b, selected: 0xffe066, ray: 0x4cc9f0, joint: 0xc77dff,
 };
 const css = (c) => '#' + c.toString(16).padStart(6, '0');
 
@@ -198,6 +199,7 @@ function drawOverlays3d(s) {
     rg.setAttribute('position', new THREE.Float32BufferAttribute(pts, 3));
     overlayGroup.add(new THREE.LineSegments(rg, new THREE.LineBasicMaterial({ color: COLORS.ray, depthTest: false })));
   }
+  drawJoints3d(s, len);
   if ($('show-controllers').checked) {
     for (const c of s.controllers) {
       const k = c.controller || {};
@@ -216,6 +218,47 @@ function drawOverlays3d(s) {
       }
     }
   }
+}
+
+// Each joint as a line from A's anchor to B's (or to its world point), over the bodies; a
+// broken joint dashed and faded. data-joints: the joints drawn; data-joints-broken: of them
+// broken; data-joint-lines: each drawn joint's slot, ends and state.
+function drawJoints3d(s, len) {
+  const joints = $('show-joints').checked && s.joints ? s.joints : [];
+  const whole = [], broken = [], ends = [];
+  for (const j of joints) {
+    (j.broken ? broken : whole).push(...j.from, ...j.to);
+    ends.push(...j.from, ...j.to);
+  }
+  const lines = (pts, material) => {
+    const g = new THREE.BufferGeometry();
+    g.setAttribute('position', new THREE.Float32BufferAttribute(pts, 3));
+    const l = new THREE.LineSegments(g, material);
+    l.computeLineDistances();
+    l.renderOrder = 2;
+    overlayGroup.add(l);
+  };
+  if (whole.length) {
+    lines(whole, new THREE.LineBasicMaterial({ color: COLORS.joint, depthTest: false }));
+  }
+  if (broken.length) {
+    lines(broken, new THREE.LineDashedMaterial({
+      color: COLORS.joint, dashSize: len * 0.15, gapSize: len * 0.1,
+      transparent: true, opacity: 0.4, depthTest: false,
+    }));
+  }
+  if (ends.length) {
+    const g = new THREE.BufferGeometry();
+    g.setAttribute('position', new THREE.Float32BufferAttribute(ends, 3));
+    overlayGroup.add(new THREE.Points(g, new THREE.PointsMaterial({
+      color: COLORS.joint, size: 5, sizeAttenuation: false, depthTest: false,
+    })));
+  }
+  view.dataset.joints = String(joints.length);
+  view.dataset.jointsBroken = String(broken.length / 6);
+  view.dataset.jointLines = JSON.stringify(joints.map((j) => ({
+    slot: j.slot, kind: j.kind, a: j.a, b: j.b, from: j.from, to: j.to, broken: j.broken,
+  })));
 }
 
 function fitCamera(s) {
@@ -308,6 +351,9 @@ function draw2d(s) {
     }
   }
   view.dataset.meshes = String(s.bodies.length);
+  view.dataset.joints = '0';
+  view.dataset.jointsBroken = '0';
+  view.dataset.jointLines = '[]';
 }
 
 canvas2d.addEventListener('click', (ev) => {
@@ -343,7 +389,8 @@ function fmt(v, digits = 3) {
 
 function applySnapshot(s) {
   if (!snapshot || snapshot.id !== s.id || snapshot.tick !== s.tick ||
-      snapshot.bodies.length !== s.bodies.length || drawnSelection !== selectedSlot) dirty = true;
+      snapshot.bodies.length !== s.bodies.length || drawnSelection !== selectedSlot ||
+      JSON.stringify(snapshot.joints) !== JSON.stringify(s.joints)) dirty = true;
   drawnSelection = selectedSlot;
   snapshot = s;
   const gui = s.kind === 'Gui2d';
@@ -354,7 +401,7 @@ function applySnapshot(s) {
     `plane ${s.id} · ${s.kind} · tick ${s.tick} · t ${fmt(s.sim_time)} s<br>` +
     `bodies ${s.body_count} · ${s.tick_rate > 0 ? fmt(s.tick_rate) + ' Hz' : 'manual'} · ${s.enabled ? 'enabled' : 'paused'}<br>` +
     `step ${fmt(s.step_time_us)} µs · penetration ${fmt(s.max_penetration)}<br>` +
-    `contact pairs ${s.contact_pairs} · joint error ${fmt(s.max_joint_error)}`;
+    `contact pairs ${s.contact_pairs} · joints ${s.joint_count || 0} · joint error ${fmt(s.max_joint_error)}`;
   view.dataset.plane = String(s.id);
   view.dataset.kind = s.kind;
   view.dataset.tick = String(s.tick);
@@ -569,7 +616,7 @@ function resize() {
   camera.updateProjectionMatrix();
 }
 window.addEventListener('resize', () => { resize(); dirty = true; });
-for (const id of ['show-contacts', 'show-controllers', 'show-rays']) {
+for (const id of ['show-contacts', 'show-controllers', 'show-rays', 'show-joints']) {
   $(id).addEventListener('change', () => { drawnSelection = undefined; });
 }
 resize();
