@@ -7,11 +7,14 @@
 //! changed ([`Dirty`]): [`SlotTable::insert`], [`SlotTable::get_mut`] and
 //! [`SlotTable::remove`] mark their slot themselves, so an op that changes an object through
 //! its handle cannot forget to; the publisher drains the marks. The engine's own passes
-//! ([`SlotTable::at_mut`], [`SlotTable::iter_mut`]) do not mark.
+//! ([`SlotTable::at_mut`], [`SlotTable::iter_mut`]) do not mark. The marks no step has seen
+//! yet are state (the next step's force pass lists their bodies): a snapshot of the table
+//! carries them, and a table that replaces a plane's (restored, or a copy kept for Rewind)
+//! brings them to the marks it takes over ([`SlotTable::take_marks_of`]).
 
 use shm_layout::{CommandError, ErrorKind, Handle};
 
-use super::dirty::Dirty;
+use super::dirty::{Dirty, Unseen};
 
 #[derive(Clone, serde::Serialize, serde::Deserialize)]
 struct Entry<T> {
@@ -31,11 +34,33 @@ pub struct SlotTable<T> {
     live: u32,
     #[serde(skip)]
     max_slots: usize,
-    /// Slots changed since the last publish, in a tracked table. Not state: a copy or a
-    /// decoded table takes the marks of the live table it replaces
-    /// ([`SlotTable::take_marks_of`]).
-    #[serde(skip)]
+    /// Slots changed since the last publish, in a tracked table. Only the marks no step
+    /// has seen yet are state (written as [`Dirty::unseen`]; an untracked table writes
+    /// none): a copy or a decoded table takes the marks of the live table it replaces,
+    /// its unseen ones with them ([`SlotTable::take_marks_of`]).
+    #[serde(with = "unseen_marks")]
     marks: Option<Dirty>,
+}
+
+/// A table's marks on the wire: the unseen ones ([`Dirty::unseen`]); decoded, marks that
+/// hold only those (`None` when there are none: a table that replaces a live one takes
+/// the live one's marks).
+mod unseen_marks {
+    use serde::{Deserialize, Deserializer, Serialize, Serializer};
+
+    use super::{Dirty, Unseen};
+
+    pub fn serialize<S: Serializer>(marks: &Option<Dirty>, s: S) -> Result<S::Ok, S::Error> {
+        match marks {
+            Some(marks) => marks.unseen().serialize(s),
+            None => Dirty::default().unseen().serialize(s),
+        }
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Option<Dirty>, D::Error> {
+        let unseen = Unseen::deserialize(d)?;
+        Ok((unseen != Unseen::default()).then(|| Dirty::carrying(unseen)))
+    }
 }
 
 impl<T> SlotTable<T> {
@@ -98,9 +123,15 @@ impl<T> SlotTable<T> {
     }
 
     /// Takes over the marks of `live`, the table this one replaces (a restore or a rewind:
-    /// what changed since the last publish is still to be published).
+    /// what changed since the last publish is still to be published). `live`'s marks count
+    /// as seen by a step; the next step sees this table's unseen marks instead, those of
+    /// the plane it was taken from (see [`Dirty::resume`]).
     pub fn take_marks_of(&mut self, live: &mut SlotTable<T>) {
+        let carried = self.marks.take().unwrap_or_default();
         self.marks = live.marks.take();
+        if let Some(marks) = &mut self.marks {
+            marks.resume(carried);
+        }
     }
 
     /// Takes the name and slot limit of `like` (a table decoded from a snapshot has
@@ -133,6 +164,14 @@ impl<T> SlotTable<T> {
         }
         if self.free.len() + live != self.entries.len() {
             return bad("loses track of a slot".into());
+        }
+        if let Some(marks) = &self.marks {
+            if like.marks.is_none() {
+                return bad("marks slots (a table that keeps no marks)".into());
+            }
+            if let Err(why) = marks.check_unseen(self.entries.len()) {
+                return bad(why);
+            }
         }
         self.what = like.what;
         self.max_slots = like.max_slots;
@@ -341,6 +380,8 @@ mod tests {
         let a = t.insert("a").unwrap();
         let b = t.insert("b").unwrap();
         let c = t.insert("c").unwrap();
+        assert_eq!(t.since_step(), &[0, 1, 2]);
+        t.stepped();
         assert_eq!(drained(&mut t), (vec![0, 1, 2], false), "inserts mark");
         t.get(a).unwrap();
         t.at(1).unwrap();
@@ -364,12 +405,33 @@ mod tests {
         );
         t.mark_all();
         assert_eq!(drained(&mut t), (vec![], true));
-        // A copy (Rewind) or a decoded table takes the live table's marks when it replaces it.
+        // A copy (Rewind) or a decoded table takes the live table's marks when it replaces
+        // it; the next step sees the copy's unseen marks, not the live table's.
         t.get_mut(a).unwrap();
+        t.stepped();
         let mut copy = t.clone();
         copy.get_mut(b).unwrap();
+        t.insert("d").unwrap();
+        assert_eq!(t.since_step(), &[2]);
         copy.take_marks_of(&mut t);
-        assert_eq!(drained(&mut copy), (vec![0], false));
+        assert_eq!(copy.since_step(), &[1], "the copy's");
+        assert_eq!(drained(&mut copy), (vec![0, 1, 2], false));
+        assert_eq!(
+            copy.since_step(),
+            &[1],
+            "still the next step's after a publish"
+        );
+        copy.stepped();
+        assert!(copy.since_step().is_empty());
+        // Through a snapshot's bytes: the unseen marks only.
+        copy.get_mut(b).unwrap();
+        copy.get_mut(a).unwrap();
+        let bytes = postcard::to_allocvec(&copy).unwrap();
+        let mut decoded: SlotTable<&str> = postcard::from_bytes(&bytes).unwrap();
+        decoded.adopt_limits(&copy).unwrap();
+        decoded.take_marks_of(&mut copy);
+        assert_eq!(decoded.since_step(), &[1, 0]);
+        assert_eq!(drained(&mut decoded), (vec![0, 1], false));
         // An untracked table (joints) keeps no marks.
         let mut u = SlotTable::new("thing", 2);
         let x = u.insert("x").unwrap();

@@ -343,6 +343,7 @@ plane_state! {
     pub(super) settings: PlaneSettings = settings,
     pub(super) bodies: SlotTable<Object> = objects.bodies,
     pub(super) tally: TallyKept = objects.tally.kept,
+    forced: Vec<RigidBodyHandle> = objects.pass.previous,
     held: Vec<HeldIn<PhysicsWorld>> = held,
     pub(super) clock: crate::backend::Clock = clock,
     adaptive: Adaptive = adaptive,

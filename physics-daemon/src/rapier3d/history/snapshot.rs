@@ -17,7 +17,7 @@ use crate::rapier3d::objects::object::MAX_SLOTS;
 use crate::rapier3d::plane::{Plane, State, StateRef};
 
 /// The engine named in the snapshot header: only a daemon of the same engine reads it.
-pub const ENGINE: &str = "rapier3d 0.36 / physics-daemon state 3";
+pub const ENGINE: &str = "rapier3d 0.36 / physics-daemon state 4";
 
 /// A snapshot body: the state, then the GPU world of a DeferGpu plane.
 #[derive(serde::Serialize)]
@@ -465,5 +465,324 @@ mod tests {
             b.step(1.0 / 60.0).unwrap();
             assert_eq!(a.header().state_hash, b.header().state_hash, "tick {tick}");
         }
+    }
+}
+
+/// A snapshot taken between two ticks, after ops the plane has not stepped over yet: the
+/// restored plane's next step lists the bodies those ops touched as the original's does
+/// (the marks no step has seen are state), and clears the forces the original's would (the
+/// bodies the last pass left a force on are state).
+#[cfg(test)]
+mod between_ticks {
+    use shm_layout::{
+        Handle, ObjectOp, ObjectProp, PlaneKind, PlaneOp, PlaneProp, Pose, Reply, Shape,
+    };
+
+    use shm_layout::snapshot::header;
+
+    use crate::backend::Backend;
+    use crate::rapier3d::Plane;
+
+    const DT: f32 = 1.0 / 60.0;
+
+    fn add(p: &mut dyn Backend, shape: Shape, at: [f32; 3], props: Vec<ObjectProp>) -> Handle {
+        match p
+            .apply(PlaneOp::AddObject {
+                shape,
+                pose: Pose::at(at),
+                props,
+            })
+            .unwrap()
+        {
+            Reply::Object { handle, .. } => handle,
+            other => panic!("{other:?}"),
+        }
+    }
+
+    fn set(p: &mut dyn Backend, handle: Handle, prop: ObjectProp) {
+        p.apply(PlaneOp::Object {
+            handle,
+            op: ObjectOp::Set(prop),
+        })
+        .unwrap();
+    }
+
+    fn snapshot(p: &mut dyn Backend) -> Vec<u8> {
+        match p.apply(PlaneOp::Snapshot).unwrap() {
+            Reply::Snapshot(bytes) => bytes,
+            other => panic!("{other:?}"),
+        }
+    }
+
+    /// `bytes` restored into `p`, then published as the daemon's worker does at once (a
+    /// publish drains the plane's marks).
+    fn restore(p: &mut dyn Backend, bytes: &[u8]) {
+        p.apply(PlaneOp::Restore {
+            bytes: bytes.to_vec(),
+            overrides: vec![],
+        })
+        .unwrap();
+        p.drain_dirty(&mut Vec::new());
+    }
+
+    /// A fresh plane restored from `bytes` (published at once).
+    fn restored(bytes: &[u8]) -> Plane {
+        let mut p = Plane::new(2, &[]).unwrap();
+        restore(&mut p, bytes);
+        p
+    }
+
+    /// Every slot's published state, as bits.
+    fn states(p: &dyn Backend) -> Vec<[u32; 13]> {
+        (0..p.slot_count())
+            .map(|i| {
+                let s = p.body_state(i);
+                let mut bits = [s.generation ^ s.flags.rotate_left(16); 13];
+                let values = s
+                    .position
+                    .iter()
+                    .chain(&s.rotation)
+                    .chain(&s.linear_velocity)
+                    .chain(&s.angular_velocity);
+                for (b, v) in bits.iter_mut().zip(values) {
+                    *b = v.to_bits();
+                }
+                bits
+            })
+            .collect()
+    }
+
+    /// `a` and `b` hold the same state to the bit: the same published states and hash, and
+    /// the same snapshot body (the engine's whole world: forces, contact cache, islands, the
+    /// bodies rapier records as changed), the last step's wall time aside; the headers
+    /// differ at most in the state bytes counted (kept ticks are not state).
+    fn same(a: &mut Plane, b: &mut Plane, what: &str) {
+        assert_eq!(states(a), states(b), "{what}");
+        assert_eq!(a.header().state_hash, b.header().state_hash, "{what}");
+        a.clock.last_step_us = 0.0;
+        b.clock.last_step_us = 0.0;
+        let (x, y) = (a.snapshot().unwrap(), b.snapshot().unwrap());
+        let ((mut hx, ix), (mut hy, iy)) = (header(&x).unwrap(), header(&y).unwrap());
+        (hx.state_bytes, hy.state_bytes) = (0, 0);
+        assert_eq!(hx, hy, "{what}");
+        let (x, y) = (&x[ix..], &y[iy..]);
+        let at = x.iter().zip(y).position(|(p, q)| p != q);
+        assert!(
+            x == y,
+            "{what}: the states differ at byte {at:?} ({} and {} bytes)",
+            x.len(),
+            y.len()
+        );
+    }
+
+    /// The minimal case: a lone ball added with a velocity (default damping) and never
+    /// stepped, restored into a plane made by `crate::kinds::create`.
+    #[test]
+    fn a_ball_added_and_not_stepped_restores_bit_for_bit() {
+        let mut a = crate::kinds::create(PlaneKind::Rapier3d, 1, &[]).unwrap();
+        let ball = add(
+            a.as_mut(),
+            Shape::Sphere { radius: 0.5 },
+            [-10.0, 5.0, 0.0],
+            vec![ObjectProp::Velocity([14.0, 0.0, 0.0])],
+        );
+        let bytes = snapshot(a.as_mut());
+        let mut b = crate::kinds::create(PlaneKind::Rapier3d, 2, &[]).unwrap();
+        restore(b.as_mut(), &bytes);
+        a.step(DT).unwrap();
+        b.step(DT).unwrap();
+        let slot = ball.slot as usize;
+        let (x_a, x_b) = (
+            a.body_state(slot).position[0],
+            b.body_state(slot).position[0],
+        );
+        // Damped (the plane's default LinearDamping): short of the undamped -10 + 14·dt.
+        assert!(x_a < -10.0 + 14.0 * DT - 1e-4, "x = {x_a}");
+        assert_eq!(
+            x_a.to_bits(),
+            x_b.to_bits(),
+            "original {x_a}, restored {x_b}"
+        );
+        assert_eq!(states(a.as_ref()), states(b.as_ref()));
+        assert_eq!(a.header().state_hash, b.header().state_hash);
+    }
+
+    /// A pile settled and partly asleep, then: objects added (some with velocities), sleeping
+    /// and awake ones written many times over (past the count at which the marks fold), a
+    /// force, an impulse, a destroy.
+    fn written_scene(p: &mut Plane) -> Vec<Handle> {
+        p.set(PlaneProp::Drag(0.05)).unwrap();
+        add(
+            p,
+            Shape::Cube {
+                size: [40.0, 1.0, 40.0],
+            },
+            [0.0, -0.5, 0.0],
+            vec![ObjectProp::Anchored(true)],
+        );
+        let mut bodies: Vec<Handle> = (0..24)
+            .map(|i| {
+                let at = [(i % 6) as f32 * 2.5 - 6.0, 0.5, (i / 6) as f32 * 2.5 - 4.0];
+                add(p, Shape::Cube { size: [1.0; 3] }, at, vec![])
+            })
+            .collect();
+        for _ in 0..150 {
+            p.step(DT).unwrap();
+        }
+        assert!(p.awake_count() < bodies.len(), "some sleep");
+        for i in 0..6 {
+            let v = ObjectProp::Velocity([3.0 + i as f32, 2.0, -1.0]);
+            let at = [i as f32 * 2.0 - 6.0, 4.0, 6.0];
+            bodies.push(add(p, Shape::Sphere { radius: 0.4 }, at, vec![v]));
+        }
+        // More writes than the marks hold unfolded.
+        for k in 0..1_500usize {
+            let h = bodies[(k * 7) % bodies.len()];
+            let v = [(k % 5) as f32 * 0.3, 0.5, -((k % 3) as f32) * 0.2];
+            set(p, h, ObjectProp::Velocity(v));
+        }
+        set(p, bodies[3], ObjectProp::ConstantForce([0.0, 15.0, 0.0]));
+        set(p, bodies[5], ObjectProp::AngularVelocity([0.0, 4.0, 0.0]));
+        p.apply(PlaneOp::Object {
+            handle: bodies[8],
+            op: ObjectOp::ApplyImpulse([2.0, 3.0, 0.0]),
+        })
+        .unwrap();
+        p.apply(PlaneOp::Object {
+            handle: bodies[9],
+            op: ObjectOp::Destroy,
+        })
+        .unwrap();
+        bodies.remove(9);
+        bodies
+    }
+
+    /// The same writes and adds on both planes after the restore, before their first step.
+    fn written_after(p: &mut Plane, bodies: &[Handle]) {
+        add(
+            p,
+            Shape::Sphere { radius: 0.5 },
+            [0.0, 6.0, 0.0],
+            vec![ObjectProp::Velocity([0.0, -5.0, 2.0])],
+        );
+        for k in 0..800usize {
+            let h = bodies[(k * 5 + 1) % bodies.len()];
+            set(p, h, ObjectProp::Velocity([0.2, (k % 4) as f32 * 0.5, 0.1]));
+        }
+    }
+
+    /// Many writes and adds mixed, some folded, before the snapshot and after the restore:
+    /// the restored plane and the original step on to the bit, tick after tick.
+    #[test]
+    fn writes_and_adds_before_the_snapshot_and_after_the_restore_step_on_to_the_bit() {
+        let mut a = Plane::new(1, &[]).unwrap();
+        let bodies = written_scene(&mut a);
+        assert!(
+            a.objects.since_step().len() < 1_000,
+            "the marks folded: {}",
+            a.objects.since_step().len()
+        );
+        let bytes = a.snapshot().unwrap();
+        let mut b = restored(&bytes);
+        written_after(&mut a, &bodies);
+        written_after(&mut b, &bodies);
+        assert_eq!(a.objects.since_step(), b.objects.since_step());
+        for tick in 0..40 {
+            a.step(DT).unwrap();
+            b.step(DT).unwrap();
+            assert_eq!(states(&a), states(&b), "tick {tick}");
+        }
+        same(&mut a, &mut b, "after 40 ticks");
+    }
+
+    /// A snapshot restored into the plane it was taken from, after that plane went on
+    /// (ops of its own not stepped over yet, and no publish between): it steps on as a
+    /// plane that never went on.
+    #[test]
+    fn a_snapshot_restored_into_its_own_plane_forgets_the_ops_since() {
+        let mut a = Plane::new(1, &[]).unwrap();
+        written_scene(&mut a);
+        let bytes = a.snapshot().unwrap();
+        let mut reference = Plane::new(1, &[]).unwrap();
+        written_scene(&mut reference);
+        for _ in 0..3 {
+            a.step(DT).unwrap();
+        }
+        for k in 0..20 {
+            add(
+                &mut a,
+                Shape::Sphere { radius: 0.3 },
+                [k as f32 - 10.0, 8.0, 0.0],
+                vec![ObjectProp::Velocity([0.0, 0.0, 9.0])],
+            );
+        }
+        a.apply(PlaneOp::Restore {
+            bytes,
+            overrides: vec![],
+        })
+        .unwrap();
+        for tick in 0..30 {
+            a.step(DT).unwrap();
+            reference.step(DT).unwrap();
+            assert_eq!(states(&a), states(&reference), "tick {tick}");
+        }
+        same(&mut a, &mut reference, "after 30 ticks");
+    }
+
+    /// A ball rolling to rest on the ground (damped: each pass leaves it a force) that fell
+    /// asleep in the last step, that pass's force still in rapier's accumulator.
+    fn rolled_to_sleep(p: &mut Plane) {
+        add(
+            p,
+            Shape::Cube {
+                size: [20.0, 1.0, 20.0],
+            },
+            [0.0, -0.5, 0.0],
+            vec![ObjectProp::Anchored(true)],
+        );
+        let v = ObjectProp::Velocity([0.3, 0.0, 0.0]);
+        add(p, Shape::Sphere { radius: 0.5 }, [0.0, 0.5, 0.0], vec![v]);
+        p.step(DT).unwrap();
+        let mut ticks = 0;
+        while p.awake_count() > 0 {
+            p.step(DT).unwrap();
+            ticks += 1;
+            assert!(ticks < 2_000, "the ball never sleeps");
+        }
+        let zero = rapier3d::prelude::Vector::ZERO;
+        let forced = p.world.bodies.iter().any(|(_, b)| b.user_force() != zero);
+        assert!(forced, "a force stays");
+    }
+
+    /// The next pass clears the force the last one left on a body that fell asleep since.
+    /// A plane restored from a snapshot of that tick clears it too, and the ball, woken by
+    /// another landing on it, moves as the original's.
+    #[test]
+    fn a_force_left_on_a_body_that_fell_asleep_is_cleared_after_a_restore() {
+        let mut a = Plane::new(1, &[]).unwrap();
+        rolled_to_sleep(&mut a);
+        let mut b = restored(&a.snapshot().unwrap());
+        for p in [&mut a, &mut b] {
+            add(p, Shape::Sphere { radius: 0.5 }, [0.2, 3.0, 0.0], vec![]);
+        }
+        for tick in 0..90 {
+            a.step(DT).unwrap();
+            b.step(DT).unwrap();
+            assert_eq!(states(&a), states(&b), "tick {tick}");
+        }
+        same(&mut a, &mut b, "after 90 ticks");
+    }
+
+    /// The same through Rewind: the tick kept when the ball fell asleep steps on as it did.
+    #[test]
+    fn a_rewind_clears_the_forces_the_kept_tick_would() {
+        let mut a = Plane::new(1, &[PlaneProp::RollbackTicks(2)]).unwrap();
+        rolled_to_sleep(&mut a);
+        a.step(DT).unwrap();
+        let mut once = Plane::new(1, &[]).unwrap();
+        once.restore(&a.snapshot().unwrap(), &[]).unwrap();
+        a.apply(PlaneOp::Rewind(1)).unwrap();
+        a.step(DT).unwrap();
+        same(&mut a, &mut once, "stepped again after the rewind");
     }
 }

@@ -40,8 +40,10 @@ pub(crate) struct Scratch {
     pub active: Vec<RigidBodyHandle>,
     /// What the pass does to each of `handles`.
     updates: Vec<Update>,
-    /// Bodies the last pass left a force on (reset by the next one).
-    previous: Vec<RigidBodyHandle>,
+    /// Bodies the last pass left a force on (reset by the next one). Snapshot state (the
+    /// plane's `plane_state!` names it): the next pass clears the force of those it does
+    /// not list, which a restored plane must do as the original would.
+    pub(in crate::rapier3d) previous: Vec<RigidBodyHandle>,
     /// Bodies the pass running now leaves a force on.
     forced: Vec<RigidBodyHandle>,
     /// Bodies the pass running now has written.

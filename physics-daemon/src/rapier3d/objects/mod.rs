@@ -29,16 +29,17 @@ use crate::rapier3d::objects::tally::Tally;
 
 /// The objects' part of the plane: the slot table, the tallies over its parts, the body
 /// pass's buffers and the map pieces uploaded since the last build. Everything goes through
-/// its methods but the plane's `plane_state!`, which names the slot table and the tallies'
-/// kept half (snapshot state) as fields.
+/// its methods but the plane's `plane_state!`, which names the slot table, the tallies'
+/// kept half and the bodies the last pass left a force on (snapshot state) as fields.
 pub(crate) struct Objects {
     /// The objects by slot (snapshot state: only `plane_state!` reaches the field).
     pub(in crate::rapier3d) bodies: SlotTable<Object>,
     /// Tallies over the objects' parts: per quality, driven, mesh vertices (its `kept` is
     /// snapshot state: only `plane_state!` reaches the field).
     pub(in crate::rapier3d) tally: Tally,
-    /// Buffers of the per-body passes.
-    pass: Scratch,
+    /// Buffers of the per-body passes (the bodies the last pass left a force on are
+    /// snapshot state: only `plane_state!` reaches that field).
+    pub(in crate::rapier3d) pass: Scratch,
     /// Map pieces uploaded since the last build (see `maps`).
     map_pending: PendingMap,
 }
