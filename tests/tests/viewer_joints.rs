@@ -308,9 +308,12 @@ fn rotate(q: [f32; 4], v: [f32; 3]) -> [f64; 3] {
     [0, 1, 2].map(|k| 2.0 * d * u[k] + (s * s - uu) * v[k] + 2.0 * s * uv[k])
 }
 
-/// What the page must draw for `plane` now: joint slot → (from, to, broken), the anchors
-/// placed by the poses of its snapshot; with the plane's joints as listed.
-fn expected(plane: &Plane) -> (HashMap<u64, ([f64; 3], [f64; 3], bool)>, u64) {
+/// Joint slot → (from, to, broken).
+type Lines = HashMap<u64, ([f64; 3], [f64; 3], bool)>;
+
+/// What the page must draw for `plane` now (the anchors of the plane's joints as listed,
+/// placed by the poses of its snapshot), and the snapshot's tick.
+fn expected(plane: &Plane) -> (Lines, u64) {
     let snap = plane.snapshot().unwrap();
     let bodies = snap.bodies();
     let place = |h: client_sdk::Handle, local: [f32; 3]| {
@@ -347,7 +350,7 @@ fn distance(a: [f64; 3], b: [f64; 3]) -> f64 {
 /// every unbroken joint's ends meet. Returns the lines shown.
 fn assert_lines(
     attrs: &HashMap<String, String>,
-    want: &HashMap<u64, ([f64; 3], [f64; 3], bool)>,
+    want: &Lines,
     what: &str,
 ) -> HashMap<u64, ([f64; 3], [f64; 3])> {
     let shown: Value = serde_json::from_str(&attrs["data-joint-lines"]).unwrap();
