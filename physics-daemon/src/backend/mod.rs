@@ -156,14 +156,6 @@ pub trait Backend: Send {
         false
     }
 
-    /// Whether ops applied since the last step wait in the plane for the next one (slots
-    /// they marked that the next step's force pass reads): a snapshot taken now holds a
-    /// state whose next step depends on them, so a recording takes its start keyframe after
-    /// the next step instead. True when the kind cannot tell.
-    fn ops_pending(&self) -> bool {
-        true
-    }
-
     /// The plane is about to go (`why`: moved to another daemon, destroyed, the daemon
     /// stopping): what writes on its behalf (a recording, `crate::record`) ends saying so.
     fn leaving(&mut self, _why: &str) {}

@@ -382,10 +382,6 @@ impl Backend for GpuPlane {
         self.plane.has_idle_work()
     }
 
-    fn ops_pending(&self) -> bool {
-        self.gpu.is_some() || self.plane.ops_pending()
-    }
-
     fn apply(&mut self, op: PlaneOp) -> CommandResult {
         // The last tick is kept for Rewind before an op changes anything (see
         // `rapier3d::history`).

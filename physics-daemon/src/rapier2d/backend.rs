@@ -51,10 +51,6 @@ impl Backend for Plane {
         PlaneKind::Gui2d
     }
 
-    fn ops_pending(&self) -> bool {
-        !self.bodies.since_step().is_empty()
-    }
-
     fn apply(&mut self, op: PlaneOp) -> CommandResult {
         match op {
             PlaneOp::Info => Ok(Reply::Plane(self.info())),

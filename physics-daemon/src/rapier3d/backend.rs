@@ -84,10 +84,6 @@ impl Backend for Plane {
         self.keep_pending()
     }
 
-    fn ops_pending(&self) -> bool {
-        !self.objects.since_step().is_empty()
-    }
-
     fn apply(&mut self, op: PlaneOp) -> CommandResult {
         // The last tick is kept for Rewind before an op changes anything (see `rollback`).
         self.finish_keep()?;

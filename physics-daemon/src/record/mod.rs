@@ -2,13 +2,14 @@
 //! ([`shm_layout::recording`]). Every plane the server creates is a [`Recorded`]: a
 //! [`Backend`] around the plane kind's own that passes everything through and, while a
 //! recording runs, writes what the plane does in the order it happens: a keyframe of the
-//! state it starts from (at once, or right after the next step when ops were applied
-//! since the last one: a keyframe never holds ops pending for a step), the ops of each run (encoded as they are applied, one batch entry per
-//! tick), each tick's dt and state hash, a keyframe every `--record-keyframe-every` ticks, and
-//! after every Restore or Rewind the op and a keyframe of the state it made. It starts with `PlaneOp::Record(Start)` (owner only) or,
-//! for every plane of the daemon, `--record DIR`; it ends with `Stop`, or when the plane goes
-//! (destroyed, moved to another daemon, the daemon stopping): the end entry says which.
-//! Nothing is written, and nothing paid beyond one branch per op and step, unless asked.
+//! state it starts from (a snapshot holds the ops applied since the last step too), the
+//! ops of each run (encoded as they are applied, one batch entry per tick), each tick's dt
+//! and state hash, a keyframe every `--record-keyframe-every` ticks, and after every
+//! Restore or Rewind the op and a keyframe of the state it made. It starts with
+//! `PlaneOp::Record(Start)` (owner only) or, for every plane of the daemon, `--record DIR`;
+//! it ends with `Stop`, or when the plane goes (destroyed, moved to another daemon, the
+//! daemon stopping): the end entry says which. Nothing is written, and nothing paid beyond
+//! one branch per op and step, unless asked.
 
 #[cfg(test)]
 mod tests;
@@ -109,11 +110,6 @@ struct Recorder {
     /// Ticks since the last keyframe.
     since_keyframe: u32,
     keyframe_every: u32,
-    /// Whether the start keyframe is written. It is taken at the start when nothing was
-    /// applied since the plane's last step; otherwise right after the next step (or at the
-    /// stop, when none came), so that no op is pending in the state it holds; until then
-    /// ops go into it rather than into batches.
-    keyed: bool,
 }
 
 /// A plane that records when asked (see the module's text).
@@ -259,11 +255,7 @@ impl Recorded {
             },
         );
         writer.send(Chunk::Entries(head));
-        // Nothing applied since the last step: the start keyframe is the state now.
-        let keyed = !self.inner.ops_pending();
-        if keyed {
-            writer.send(self.keyframe(KeyframeWhy::Start)?);
-        }
+        writer.send(self.keyframe(KeyframeWhy::Start)?);
         tracing::info!(plane = self.id, path = %path.display(), "recording started");
         let info = RecordingInfo {
             path: path.display().to_string(),
@@ -277,22 +269,12 @@ impl Recorded {
             ticks: 0,
             since_keyframe: 0,
             keyframe_every: self.settings.keyframe_every,
-            keyed,
         });
         Ok(Reply::Recording(info))
     }
 
     /// Ends the recording (if one runs) with `reason`; what it wrote.
     fn stop(&mut self, reason: &str) -> Option<Result<RecordingInfo, CommandError>> {
-        if self.recorder.as_ref().is_some_and(|r| !r.keyed) {
-            // No step came since the start: the file holds the state now and no tick.
-            if let Ok(chunk) = self.keyframe(KeyframeWhy::Start) {
-                if let Some(r) = &mut self.recorder {
-                    r.writer.send(chunk);
-                    r.keyed = true;
-                }
-            }
-        }
         let mut r = self.recorder.take()?;
         let mut rest = Vec::new();
         r.batch.push_to(&mut rest);
@@ -372,7 +354,7 @@ impl Backend for Recorded {
                 },
             };
         }
-        let Some(r) = self.recorder.as_mut().filter(|r| r.keyed) else {
+        let Some(r) = &mut self.recorder else {
             return self.inner.apply(op);
         };
         if Recorded::recorded(&op) {
@@ -394,25 +376,6 @@ impl Backend for Recorded {
             return self.inner.step(dt);
         };
         let before = self.inner.tick();
-        if !r.keyed {
-            let stepped = self.inner.step(dt);
-            if self.inner.tick() != before {
-                match self.keyframe(KeyframeWhy::Start) {
-                    Ok(chunk) => {
-                        if let Some(r) = &mut self.recorder {
-                            r.writer.send(chunk);
-                            r.keyed = true;
-                        }
-                    }
-                    Err(e) => {
-                        let reason =
-                            format!("the start keyframe could not be taken: {}", e.message);
-                        let _ = self.stop(&reason);
-                    }
-                }
-            }
-            return stepped;
-        }
         let mut entries = Vec::with_capacity(64);
         r.batch.push_to(&mut entries);
         let stepped = self.inner.step(dt);
