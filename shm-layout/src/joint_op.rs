@@ -743,6 +743,60 @@ mod tests {
     }
 
     #[test]
+    fn a_full_page_of_the_largest_joints_fits_well_within_a_reply() {
+        // Every optional field set, every axis motor with a target position, handles with
+        // the largest varints: the most bytes one joint may take in a reply.
+        let motor = Some(AxisMotor {
+            target_position: Some(1.0),
+            ..AxisMotor::default()
+        });
+        let big = Handle {
+            slot: u32::MAX,
+            generation: u32::MAX,
+        };
+        let joint = JointInfo {
+            handle: big,
+            kind: JointKind::SixDof,
+            a: big,
+            b: Some(big),
+            settings: JointSettings {
+                lower_angle: Some(-1.0),
+                upper_angle: Some(1.0),
+                swing_limit: Some(1.0),
+                twist_limit: Some(1.0),
+                lower_distance: Some(-1.0),
+                upper_distance: Some(1.0),
+                motor_speed: Some(1.0),
+                motor_target: Some(1.0),
+                axis_motors: [motor; 6],
+                ..JointSettings::default()
+            },
+            error: 1.0,
+            angular_error: 1.0,
+            broken: true,
+            force: 1.0,
+            position: 1.0,
+        };
+        let one = crate::codec::result_size(&Ok(crate::Reply::Joints(vec![joint.clone()])));
+        let page = crate::codec::result_size(&Ok(crate::Reply::Joints(vec![
+            joint;
+            MAX_JOINT_PAGE
+                as usize
+        ])));
+        // A page stays under 2 MiB (measured: 1,163,268 bytes, 284 per joint): a quarter of
+        // the daemon's default reply limit (8 MiB), leaving room for the other answers of
+        // the same request.
+        assert!(
+            page <= 2 << 20,
+            "a page takes {page} bytes ({one} for one joint)"
+        );
+        assert!(
+            page >= (one - 4) * MAX_JOINT_PAGE as usize,
+            "{page} vs {one}"
+        );
+    }
+
+    #[test]
     fn axis_motors_need_a_sixdof_joint_and_an_axis_that_moves() {
         let mut s = JointSettings::default();
         s.store(JointProp::AxisMotor {
