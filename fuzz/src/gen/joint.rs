@@ -7,7 +7,7 @@ use crate::rng::Rng;
 
 impl Gen<'_> {
     /// A joint op: creation between live objects (or the world) with valid or wild options,
-    /// and Set / Info / Destroy on handles that may or may not be joints.
+    /// and Set / Info / List / Destroy on handles that may or may not be joints.
     pub(super) fn joint_op(&mut self, wild: bool, id: PlaneId) -> JointOp {
         let joint = self.handle(true, id);
         // Joints count against the objects quota and few destroys find one: creating them
@@ -30,7 +30,16 @@ impl Gen<'_> {
                 joint,
                 prop: self.joint_prop(wild),
             },
-            60..=79 => JointOp::Info { joint },
+            60..=74 => JointOp::Info { joint },
+            // Pages of the joint list, from a joint's slot; wild limits include 0 (refused)
+            // and more than a page holds (cut).
+            75..=79 => JointOp::List {
+                after: joint.slot,
+                limit: match wild {
+                    true => *self.rng.pick(&[0, 1, 4_096, 4_097, u32::MAX]),
+                    false => 1 + self.rng.below(8) as u32,
+                },
+            },
             _ => JointOp::Destroy { joint },
         }
     }
