@@ -52,11 +52,14 @@ pub struct SnapshotArgs {
     /// Velocity writes a tick (each on its own body) on the piles of the recording row.
     #[arg(long, default_value_t = 100)]
     pub recording_writes: usize,
+    /// Ticks both piles of the recording row make (with the writes) before any is measured.
+    #[arg(long, default_value_t = 300)]
+    pub recording_settle_ticks: usize,
     /// Blocks of each plane (recording, plain) of the recording row, ABBA.
-    #[arg(long, default_value_t = 16)]
+    #[arg(long, default_value_t = 48)]
     pub recording_blocks: usize,
     /// Ticks in each block of the recording row.
-    #[arg(long, default_value_t = 50)]
+    #[arg(long, default_value_t = 40)]
     pub recording_block_ticks: usize,
     /// Folder receiving snapshot.json and snapshot.md.
     #[arg(long, default_value = "bench-out")]
@@ -659,6 +662,7 @@ pub fn run(args: &SnapshotArgs) -> BenchResult<()> {
         recording_cost::Sizes {
             bodies: args.recording_bodies,
             writes: args.recording_writes,
+            settle_ticks: args.recording_settle_ticks,
             blocks: args.recording_blocks,
             ticks_per_block: args.recording_block_ticks,
         },
