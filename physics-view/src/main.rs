@@ -13,6 +13,7 @@
 //! into a plane of the viewer's own, on the domain's daemon (started when none runs), with
 //! a timeline in the page: play, pause, step, jump to a tick, speed.
 
+mod describe;
 mod joints;
 mod replay;
 mod sampler;
