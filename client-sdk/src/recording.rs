@@ -14,7 +14,7 @@ use shm_layout::{Command, PlaneOp, PlaneProp, RecordOp, RecordingInfo, Reply};
 
 pub use shm_layout::recording::Recording;
 
-use crate::{Client, Error, Plane, PlaneSnapshot};
+use crate::{client::Client, error::Error, plane::Plane, plane_snapshot::PlaneSnapshot};
 
 impl Plane {
     /// Starts recording the plane into a new file at `path` on the daemon's machine

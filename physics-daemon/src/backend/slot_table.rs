@@ -14,7 +14,7 @@
 
 use shm_layout::{CommandError, ErrorKind, Handle};
 
-use super::dirty::{Dirty, Unseen};
+use super::dirty::Dirty;
 
 #[derive(Clone, serde::Serialize, serde::Deserialize)]
 struct Entry<T> {
@@ -48,7 +48,7 @@ pub struct SlotTable<T> {
 mod unseen_marks {
     use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
-    use super::{Dirty, Unseen};
+    use crate::backend::dirty::{Dirty, Unseen};
 
     pub fn serialize<S: Serializer>(marks: &Option<Dirty>, s: S) -> Result<S::Ok, S::Error> {
         match marks {
