@@ -396,7 +396,7 @@ mod tests {
     /// as far as the checks see). The engine's own structures (its BVH, islands) are not
     /// all checkable from outside: a step of an accepted forgery may panic inside rapier,
     /// which the plane's worker contains (the forger's plane fails, the daemon serves on:
-    /// `tests/tests/snapshot.rs`). Counted here so a change that makes that worse shows.
+    /// `tests/tests/snapshot/`). Counted here so a change that makes that worse shows.
     #[test]
     fn edited_snapshots_never_panic_in_restore_and_rarely_in_a_step() {
         let good = scene().snapshot().unwrap();

@@ -7,6 +7,10 @@
 //!
 //! Chromium is required: without it the test fails and says how to install it.
 
+// The viewer's other subjects: joints drawn (live and replayed) and `--replay`.
+mod joints;
+mod replay;
+
 use std::io::{BufRead, BufReader, Read, Write};
 use std::net::TcpStream;
 use std::path::{Path, PathBuf};

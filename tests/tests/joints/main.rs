@@ -3,6 +3,9 @@
 //! chain's error (an articulation, see tests/tests/articulations.rs), and what destroying
 //! an object does to its joints.
 
+// Listing a plane's joints page by page (`JointOp::List`).
+mod list;
+
 use client_sdk::{
     Error, ErrorKind, JointBroke, JointKind, JointProp, Object, ObjectProp, Pose, Shape,
 };

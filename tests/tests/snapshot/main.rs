@@ -5,6 +5,9 @@
 //! planes. A one-bit difference in the log shows on exactly the tick it enters. Damaged
 //! snapshots are refused with a message naming the damage, and the plane stays as it was.
 
+// Snapshots taken between two ticks, with ops waiting for the next step.
+mod pending;
+
 use client_sdk::{
     Client, Controller, GuiPlane, GuiPlaneOptions, JointKind, JointProp, MapMesh, MapOptions,
     Object, Plane, PlaneOptions, PlaneSnapshot, Pose, Shape,
