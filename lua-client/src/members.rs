@@ -1,5 +1,5 @@
 //! The property names the runtime gives each Lua type (the rows of `props`), listed for the
-//! test that keeps `types/physics.d.luau` in step with them (`tests/tests/lua_definitions.rs`).
+//! test that keeps `types/physics.d.luau` in step with them (`tests/tests/lua/definitions.rs`).
 
 use crate::props;
 

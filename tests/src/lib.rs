@@ -22,7 +22,11 @@ pub fn unique_domain(tag: &str) -> String {
         .duration_since(std::time::UNIX_EPOCH)
         .unwrap()
         .subsec_nanos();
-    format!("{tag}-{}-{n}-{}", std::process::id(), t % 100_000)
+    let suffix = format!("-{}-{n}-{}", std::process::id(), t % 100_000);
+    // Domains are at most 32 characters: the tag gives way (the suffix keeps it unique).
+    let keep = tag.len().min(32usize.saturating_sub(suffix.len()));
+    let tag = tag.get(..keep).unwrap_or("t");
+    format!("{tag}{suffix}")
 }
 
 fn daemon_bin() -> PathBuf {

@@ -132,7 +132,7 @@ fn names_are_unique_listed_and_opened_by_any_client() {
         "{}",
         message(&e)
     );
-    // GUI planes take names too (more in tests/tests/gui_named.rs); this one goes again
+    // GUI planes take names too (more in tests/tests/gui/named.rs); this one goes again
     // (and its handle with it: it holds the client).
     {
         let gui = a

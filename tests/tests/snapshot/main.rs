@@ -5,8 +5,10 @@
 //! planes. A one-bit difference in the log shows on exactly the tick it enters. Damaged
 //! snapshots are refused with a message naming the damage, and the plane stays as it was.
 
-// Snapshots taken between two ticks, with ops waiting for the next step.
+// Snapshots between two ticks, in pieces (transfers), and the validation bench's check.
 mod pending;
+mod pieces;
+mod validate;
 
 use client_sdk::{
     Client, Controller, GuiPlane, GuiPlaneOptions, JointKind, JointProp, MapMesh, MapOptions,

@@ -4,6 +4,9 @@
 //! controller (MoveSpeed reached at Acceleration, jumps only on the ground, waypoints in
 //! order with PathFinished once).
 
+// Named, persistent and rewound GUI planes.
+mod named;
+
 use client_sdk::{
     Client, GuiControllerProp, GuiEvent, GuiObject, GuiObjectProp as P, GuiPlane, GuiPlaneOptions,
     GuiShape,

@@ -2,6 +2,10 @@
 //! (acceleration, jump apex, slopes, steps, ground snap, walls, platforms, pushing,
 //! depenetration, GroundY, paths) and its events.
 
+// Controllers on floors of every kind, and on a plane with Threads > 1.
+mod floors;
+mod threads;
+
 use client_sdk::{
     Contact, Controller, ControllerProp, Events, Object, ObjectProp, PlaneOptions, Pose, Shape,
 };

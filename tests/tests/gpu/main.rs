@@ -4,6 +4,9 @@
 //! keep every pose and velocity, ops the GPU path refuses, and the refusal when no adapter
 //! exists (`PHYSICS_GPU=off` in the daemon's environment hides them).
 
+// Snapshots of DeferGpu planes.
+mod snapshot;
+
 use client_sdk::{ErrorKind, Object, ObjectProp, PlaneOptions, PlaneProp, Pose, Shape};
 use integration_tests::{no_damping, Scene, TestDaemon};
 

@@ -2,6 +2,13 @@
 //! `physics-lua` runner against a real daemon and assert behaviour themselves; these tests
 //! check the runner's exit status and what the scripts printed.
 
+// The Luau API's other subjects, one module each: the generated reference, the declarations, the runner, shapes, untrusted scripts.
+mod api_doc;
+mod definitions;
+mod runner;
+mod shapes;
+mod trust;
+
 use std::process::Output;
 use std::time::Duration;
 

@@ -1,5 +1,5 @@
 //! Snapshots of DeferGpu planes through a real daemon, on whatever Vulkan adapter the
-//! machine has (Mesa's lavapipe in CI, as `tests/tests/gpu.rs`): a pile of boxes and balls
+//! machine has (Mesa's lavapipe in CI, as `tests/tests/gpu/main.rs`): a pile of boxes and balls
 //! falling into an anchored container on the GPU path, snapshot at tick 20, 40 ticks of a
 //! command log; Restore on the same plane and FromSnapshot as a new plane (on the GPU
 //! again) replay the same hashes on every tick, bit for bit on the same adapter, and a
