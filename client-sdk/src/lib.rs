@@ -65,7 +65,6 @@ pub use probe::{Explosion, Falloff, ProbeHit, DEFAULT_MAX_SLOPE};
 pub use query::{Found, QueryParams};
 pub use ragdoll::{Bone, Ragdoll, RagdollDesc};
 pub use recording::{load_recording, Advanced, Divergence, Recording, Replay};
-pub use shm_layout::RecordingInfo;
 pub use replay_check::{first_difference, FieldDifference};
 /// The collision group every object starts in ("Default").
 pub use shm_layout::collision_groups::DEFAULT_GROUP;
@@ -74,6 +73,7 @@ pub use shm_layout::gui_op::{GuiControllerInfo, GuiObjectInfo, GuiPlaneInfo};
 pub use shm_layout::settings;
 /// The limits and checks the daemon applies, for callers that want to check early.
 pub use shm_layout::validate;
+pub use shm_layout::RecordingInfo;
 pub use shm_layout::{
     AxisMode, BodyState, CollisionGroups, CommandError, ControllerInfo, ControllerProp,
     ControllerSettings, ErrorKind, EventRecord, FilterType, GuiControllerProp, GuiHit,
