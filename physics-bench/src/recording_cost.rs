@@ -318,10 +318,19 @@ pub fn measure(client: &Client, pid: u32, sizes: Sizes, file: &Path) -> BenchRes
     let stopped = recording.stop_recording();
     let _ = recording.destroy();
     let _ = plain.destroy();
-    let (pair, check) = result?;
-    let info = stopped?.ok_or_else(|| {
-        BenchError::Failed("the recording plane was not recording when stopped".into())
-    })?;
+    let stopped = stopped.map_err(BenchError::from).and_then(|info| {
+        info.ok_or_else(|| {
+            BenchError::Failed("the recording plane was not recording when stopped".into())
+        })
+    });
+    let (pair, check, info) = match (result, stopped) {
+        (Ok((pair, check)), Ok(info)) => (pair, check, info),
+        (Err(e), _) | (_, Err(e)) => {
+            // No file is left behind by a row that failed.
+            let _ = std::fs::remove_file(file);
+            return Err(e);
+        }
+    };
     let file_bytes = std::fs::metadata(file).map(|m| m.len()).unwrap_or(0);
     let read = client_sdk::load_recording(file);
     let _ = std::fs::remove_file(file);
