@@ -99,17 +99,42 @@ impl RecordSettings {
     }
 }
 
+/// Bytes of entries a recording gathers before handing them to its writer.
+const HAND_OVER_BYTES: usize = 64 * 1024;
+/// Ticks a recording gathers before handing their entries to its writer: the writer wakes
+/// once per this many ticks, not every tick (a daemon killed loses at most these).
+const HAND_OVER_TICKS: u32 = 16;
+
 /// A recording running.
 struct Recorder {
     writer: Writer,
     path: PathBuf,
     /// Ops applied since the last tick.
     batch: BatchWriter,
+    /// Entries not handed to the writer yet, and the ticks among them.
+    gathered: Vec<u8>,
+    gathered_ticks: u32,
     /// Ticks recorded.
     ticks: u64,
     /// Ticks since the last keyframe.
     since_keyframe: u32,
     keyframe_every: u32,
+}
+
+impl Recorder {
+    /// Hands the gathered entries (the batch not yet closed by a tick included), then
+    /// `then` (a keyframe), to the writer.
+    fn hand_over(&mut self, then: Option<Chunk>) {
+        self.batch.push_to(&mut self.gathered);
+        if !self.gathered.is_empty() {
+            let entries = std::mem::replace(&mut self.gathered, Vec::with_capacity(4096));
+            self.writer.send(Chunk::Entries(entries));
+        }
+        self.gathered_ticks = 0;
+        if let Some(chunk) = then {
+            self.writer.send(chunk);
+        }
+    }
 }
 
 /// A plane that records when asked (see the module's text).
@@ -269,6 +294,8 @@ impl Recorded {
             ticks: 0,
             since_keyframe: 0,
             keyframe_every: self.settings.keyframe_every,
+            gathered: Vec::new(),
+            gathered_ticks: 0,
         });
         Ok(Reply::Recording(info))
     }
@@ -276,11 +303,7 @@ impl Recorded {
     /// Ends the recording (if one runs) with `reason`; what it wrote.
     fn stop(&mut self, reason: &str) -> Option<Result<RecordingInfo, CommandError>> {
         let mut r = self.recorder.take()?;
-        let mut rest = Vec::new();
-        r.batch.push_to(&mut rest);
-        if !rest.is_empty() {
-            r.writer.send(Chunk::Entries(rest));
-        }
+        r.hand_over(None);
         let path = r.path.display().to_string();
         let ticks = r.ticks;
         let result = r.writer.finish(reason).map(|bytes| RecordingInfo {
@@ -312,12 +335,7 @@ impl Recorded {
         match self.keyframe(KeyframeWhy::Jump) {
             Ok(chunk) => {
                 if let Some(r) = &mut self.recorder {
-                    let mut pending = Vec::new();
-                    r.batch.push_to(&mut pending);
-                    if !pending.is_empty() {
-                        r.writer.send(Chunk::Entries(pending));
-                    }
-                    r.writer.send(chunk);
+                    r.hand_over(Some(chunk));
                     r.since_keyframe = 0;
                 }
             }
@@ -376,17 +394,17 @@ impl Backend for Recorded {
             return self.inner.step(dt);
         };
         let before = self.inner.tick();
-        let mut entries = Vec::with_capacity(64);
-        r.batch.push_to(&mut entries);
+        r.batch.push_to(&mut r.gathered);
         let stepped = self.inner.step(dt);
         let tick = self.inner.tick();
         if tick == before + 1 {
-            push_tick(&mut entries, tick, dt, self.inner.header().state_hash);
+            push_tick(&mut r.gathered, tick, dt, self.inner.header().state_hash);
             r.ticks += 1;
             r.since_keyframe += 1;
+            r.gathered_ticks += 1;
         }
-        if !entries.is_empty() {
-            r.writer.send(Chunk::Entries(entries));
+        if r.gathered.len() >= HAND_OVER_BYTES || r.gathered_ticks >= HAND_OVER_TICKS {
+            r.hand_over(None);
         }
         if r.writer.failed.load(Ordering::Relaxed) {
             // The writer says why when the recording is stopped.
@@ -397,8 +415,8 @@ impl Backend for Recorded {
             r.since_keyframe = 0;
             match self.keyframe(KeyframeWhy::Periodic) {
                 Ok(chunk) => {
-                    if let Some(r) = &self.recorder {
-                        r.writer.send(chunk);
+                    if let Some(r) = &mut self.recorder {
+                        r.hand_over(Some(chunk));
                     }
                 }
                 Err(e) => {
