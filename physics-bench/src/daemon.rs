@@ -4,6 +4,7 @@
 use std::path::Path;
 use std::process::Stdio;
 use std::sync::atomic::{AtomicU32, Ordering};
+use std::time::{Duration, Instant};
 
 use client_sdk::{Client, DaemonChild};
 
@@ -82,4 +83,43 @@ impl Drop for DaemonProcess {
         drop(self.child.take());
         let _ = physics_daemon::cleanup_domain(&self.domain);
     }
+}
+
+/// Nanoseconds on a CPU so far of every thread of `pid` together (`/proc/PID/task/*/
+/// schedstat`: nanoseconds, where `stat`'s clock ticks are 10 ms). The daemon's threads
+/// live as long as it does, so a difference of two readings is what ran in between.
+pub fn daemon_cpu_ns(pid: u32) -> BenchResult<u64> {
+    let dir = format!("/proc/{pid}/task");
+    let entries =
+        std::fs::read_dir(&dir).map_err(|e| BenchError::Failed(format!("list {dir}: {e}")))?;
+    let mut sum = 0u64;
+    for entry in entries.flatten() {
+        // A thread may end between the listing and the read: it is simply not counted.
+        let Ok(stat) = std::fs::read_to_string(entry.path().join("schedstat")) else {
+            continue;
+        };
+        sum += stat
+            .split_whitespace()
+            .next()
+            .and_then(|v| v.parse::<u64>().ok())
+            .unwrap_or(0);
+    }
+    Ok(sum)
+}
+
+/// Waits until the daemon is idle (under 2 % of a core over 10 ms, or half a second at
+/// most): what a step put off (the copy made after it is answered, the drop of the oldest
+/// copy on the disposal thread) is then done and counted in the block that caused it.
+pub fn until_idle(pid: u32) -> BenchResult<()> {
+    let started = Instant::now();
+    let mut last = daemon_cpu_ns(pid)?;
+    while started.elapsed() < Duration::from_millis(500) {
+        std::thread::sleep(Duration::from_millis(10));
+        let now = daemon_cpu_ns(pid)?;
+        if now.saturating_sub(last) < 200_000 {
+            return Ok(());
+        }
+        last = now;
+    }
+    Ok(())
 }

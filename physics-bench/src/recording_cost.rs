@@ -370,7 +370,7 @@ fn blocks_and_check(
     let (b_plane, b_written, t_off) = b;
     let clock = CpuClock::daemons_only(&[pid]);
     let block = |plane: &Plane, written: &[Object], t: &mut u64| -> BenchResult<Block> {
-        super::snapshot::until_idle(pid)?;
+        super::daemon::until_idle(pid)?;
         let cpu0 = clock.read()?;
         let started = Instant::now();
         for _ in 0..ticks_per_block {
@@ -378,7 +378,7 @@ fn blocks_and_check(
             *t += 1;
         }
         let wall = started.elapsed();
-        super::snapshot::until_idle(pid)?;
+        super::daemon::until_idle(pid)?;
         let cpu = clock.read()?.used_since(&cpu0);
         Ok(Block {
             wall_us: wall.as_secs_f64() * 1e6 / ticks_per_block as f64,
@@ -402,7 +402,7 @@ fn blocks_and_check(
     let mut ratios = Vec::with_capacity(CHECK_STRETCHES);
     let mut total = [0u64; 3];
     for stretch in 0..CHECK_STRETCHES {
-        super::snapshot::until_idle(pid)?;
+        super::daemon::until_idle(pid)?;
         let before = named_threads_ns(pid, &names)?;
         // The first tick after the daemon idled finds its caches cold: each plane takes it
         // in every other stretch (A B B A ..., then B A A B ...).
@@ -416,7 +416,7 @@ fn blocks_and_check(
                 *t_off += 1;
             }
         }
-        super::snapshot::until_idle(pid)?;
+        super::daemon::until_idle(pid)?;
         let after = named_threads_ns(pid, &names)?;
         let used: Vec<u64> = after
             .iter()
