@@ -4,6 +4,9 @@
 //! list with the daemon / no-physics verdicts, and no write refused (a frame-stepped plane
 //! advanced one tick a frame).
 
+// The recording row of `physics-bench snapshot`, run tiny.
+mod recording;
+
 use std::process::Command;
 
 #[test]
