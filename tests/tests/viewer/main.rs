@@ -8,6 +8,7 @@
 //! Chromium is required: without it the test fails and says how to install it.
 
 // The viewer's other subjects: joints drawn (live and replayed) and `--replay`.
+mod browser;
 mod joints;
 mod replay;
 
@@ -18,48 +19,11 @@ use std::process::{Child, Command, Stdio};
 use std::sync::mpsc;
 use std::time::Duration;
 
+use browser::{chromium, view_attributes, viewer_bin};
 use client_sdk::{Client, GuiPlaneOptions, GuiShape, Plane, PlaneOptions, Pose, Shape};
 use integration_tests::{eventually, physics_lua, quat, unique_domain, TestDaemon};
 use serde_json::Value;
 use shm_layout::{GuiObjectProp, ObjectProp, FLAG_ANCHORED};
-
-/// The browser: `$CHROMIUM`, else the first of the usual names on `PATH`.
-fn chromium() -> PathBuf {
-    if let Some(p) = std::env::var_os("CHROMIUM") {
-        return PathBuf::from(p);
-    }
-    for name in ["chromium", "chromium-browser", "google-chrome", "chrome"] {
-        if let Some(dir) = std::env::var_os("PATH") {
-            for d in std::env::split_paths(&dir) {
-                let p = d.join(name);
-                if p.is_file() {
-                    return p;
-                }
-            }
-        }
-    }
-    panic!(
-        "Chromium not found (looked for $CHROMIUM, chromium, chromium-browser, google-chrome \
-         on PATH): the viewer test needs a real browser. Install it, e.g. \
-         `apt-get install chromium` (.ci/run does)."
-    );
-}
-
-/// The `physics-view` binary built next to this test by `cargo build --workspace --bins`.
-fn viewer_bin() -> PathBuf {
-    let exe = std::env::current_exe().expect("test executable");
-    exe.ancestors()
-        .skip(1)
-        .take(3)
-        .map(|dir| dir.join("physics-view"))
-        .find(|p| p.is_file())
-        .unwrap_or_else(|| {
-            panic!(
-                "physics-view not found near {} (run cargo build --workspace --bins first)",
-                exe.display()
-            )
-        })
-}
 
 /// A running viewer; killed when dropped.
 struct Viewer {
@@ -179,32 +143,6 @@ fn chromium_run(profile: &Path, extra: &[String], url: &str) -> String {
         String::from_utf8_lossy(&out.stderr)
     );
     String::from_utf8_lossy(&out.stdout).into_owned()
-}
-
-/// The attributes of the element with `id="view"` in a serialized DOM, entities decoded.
-fn view_attributes(dom: &str) -> std::collections::HashMap<String, String> {
-    let start = dom
-        .find("id=\"view\"")
-        .and_then(|i| dom[..i].rfind('<'))
-        .unwrap_or_else(|| panic!("no #view in the page: {}", &dom[..dom.len().min(2000)]));
-    let tag = &dom[start..start + dom[start..].find('>').expect("end of the tag")];
-    let mut attrs = std::collections::HashMap::new();
-    let mut rest = tag.split_once(char::is_whitespace).map_or("", |(_, r)| r);
-    while let Some(eq) = rest.find("=\"") {
-        let name = rest[..eq].trim().to_string();
-        let after = &rest[eq + 2..];
-        let end = after.find('"').expect("closing quote");
-        let value = after[..end]
-            .replace("&quot;", "\"")
-            .replace("&lt;", "<")
-            .replace("&gt;", ">")
-            .replace("&#39;", "'")
-            .replace("&nbsp;", "\u{a0}")
-            .replace("&amp;", "&");
-        attrs.insert(name, value);
-        rest = &after[end + 1..];
-    }
-    attrs
 }
 
 /// Loads `url` until the page has drawn a snapshot (`data-ready="1"`); returns #view's
