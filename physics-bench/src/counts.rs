@@ -176,12 +176,51 @@ fn judge(counts: &BTreeMap<String, u64>, baseline: &Baseline) -> CountsReport {
             ));
         }
     }
+    let slopes = slopes(counts);
+    goals.extend(recording_goal(&slopes));
     CountsReport {
         goals,
-        slopes: slopes(counts),
+        slopes,
         rows,
         tolerance_pct: TOLERANCE_PCT,
     }
+}
+
+/// Bodies, writes a tick and ticks between keyframes of the recording goal's plane.
+const RECORDED_PLANE: (f64, f64, f64) = (1_000.0, 100.0, 600.0);
+
+/// What recording adds to a tick, in instructions, from the slopes (the goal of
+/// docs/recording.md judged where wall and CPU time swing with the machine's load): per
+/// recorded write and per tick, the recorded frame less the same frame unrecorded; a
+/// keyframe every 600 ticks at a snapshot's cost per body; against a tick of 1,000 awake
+/// bodies (the awake pile's step) and 100 velocity writes. `None` without those benchmarks.
+fn recording_goal(slopes: &[Slope]) -> Option<Goal> {
+    let of = |name: &str| slopes.iter().find(|s| s.bench == name);
+    let (rec, plain) = (
+        of("record::recorded_frame")?,
+        of("record::unrecorded_frame")?,
+    );
+    let (snapshot, step, apply) = (
+        of("history::snapshot")?,
+        of("step::awake")?,
+        of("apply::set_velocity")?,
+    );
+    let (bodies, writes, every) = RECORDED_PLANE;
+    let per_write = rec.per_entity - plain.per_entity;
+    let per_tick = rec.fixed - plain.fixed;
+    let keyframe = snapshot.per_entity * bodies / every;
+    let added = per_write * writes + per_tick + keyframe;
+    let tick = step.per_entity * bodies + apply.per_entity * writes;
+    let pct = added / tick * 100.0;
+    Some(Goal::new(
+        "recording adds <= 5 % to a tick (1,000 awake bodies, 100 writes a tick, a keyframe \
+         every 600 ticks; instructions, from the slopes) [instructions-from-slopes]",
+        format!(
+            "{pct:+.2} % ({per_write:.0} a write, {per_tick:.0} a tick, {keyframe:.0} a tick \
+             of keyframes, against {tick:.0} a tick)"
+        ),
+        Some(pct <= 5.0),
+    ))
 }
 
 /// Splits a benchmark name's size off: `step::awake n200` → (`step::awake`, 200);
@@ -355,6 +394,27 @@ mod tests {
         assert_eq!(s.len(), 1);
         assert!((s[0].per_entity - 100.0).abs() < 1e-9);
         assert!((s[0].fixed - 500.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn the_recording_goal_adds_writes_ticks_and_keyframes_against_a_tick() {
+        let c = counts(&[
+            ("record::recorded_frame n10", 10 * 130 + 50),
+            ("record::recorded_frame n100", 100 * 130 + 50),
+            ("record::unrecorded_frame n10", 10 * 100 + 20),
+            ("record::unrecorded_frame n100", 100 * 100 + 20),
+            ("history::snapshot n50", 50 * 600),
+            ("history::snapshot n200", 200 * 600),
+            ("step::awake n50", 50 * 1_000),
+            ("step::awake n200", 200 * 1_000),
+            ("apply::set_velocity n10", 10 * 10),
+            ("apply::set_velocity n1000", 1000 * 10),
+        ]);
+        let goal = recording_goal(&slopes(&c)).expect("every slope there");
+        // 30 a write × 100 + 30 a tick + 600 × 1,000 / 600 = 4,030 against 1,001,000.
+        assert!(goal.value.starts_with("+0.40 %"), "{}", goal.value);
+        assert_eq!(goal.met, Some(true));
+        assert!(recording_goal(&slopes(&counts(&[("step::awake n1", 1)]))).is_none());
     }
 
     #[test]
