@@ -18,7 +18,7 @@ use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 use shm_layout::remote::{self as wire, BodyFrame, EventFrame, WatchOp, WatchReply};
-use shm_layout::{codec, BodyState, Command, TickHeader};
+use shm_layout::{codec, BodyState, Command, PlaneOp, RecordOp, TickHeader};
 use zenoh::query::{Query, Queryable};
 use zenoh::sample::{Sample, SampleKind};
 use zenoh::{Session, Wait};
@@ -341,24 +341,39 @@ fn relay_request(
 
 /// The request with every Hello's pid set to this process's (the daemon checks a client's
 /// process on its own host: for a relayed client that is the relay, whose life bounds the
-/// session's), and whether it holds a Hello and a Goodbye. Bytes that do not decode are
-/// passed on untouched: the daemon's answer names what is wrong with them.
+/// session's), a recording's path emptied (a remote client names no file on this host), and
+/// whether it holds a Hello and a Goodbye. Bytes that do not decode are passed on
+/// untouched: the daemon's answer names what is wrong with them.
 fn own_pid(bytes: Vec<u8>) -> (Vec<u8>, bool, bool) {
     let Ok(mut request) = codec::decode_request(&bytes) else {
         return (bytes, false, false);
     };
     let mut hello = false;
+    let mut rewritten = false;
     let goodbye = request
         .commands
         .iter()
         .any(|c| matches!(c, Command::Goodbye));
     for c in &mut request.commands {
-        if let Command::Hello { pid, .. } = c {
-            *pid = std::process::id();
-            hello = true;
+        match c {
+            Command::Hello { pid, .. } => {
+                *pid = std::process::id();
+                hello = true;
+                rewritten = true;
+            }
+            // A remote client names no file on this host: its recording goes where the
+            // daemon puts recordings (the reply names the file).
+            Command::Plane {
+                op: PlaneOp::Record(RecordOp::Start { path }),
+                ..
+            } if !path.is_empty() => {
+                path.clear();
+                rewritten = true;
+            }
+            _ => {}
         }
     }
-    if !hello {
+    if !rewritten {
         return (bytes, false, goodbye);
     }
     let version = bytes
@@ -368,7 +383,7 @@ fn own_pid(bytes: Vec<u8>) -> (Vec<u8>, bool, bool) {
         .unwrap_or(shm_layout::LAYOUT_VERSION);
     (
         codec::encode_request_with_version(&request, version),
-        true,
+        hello,
         goodbye,
     )
 }
@@ -551,4 +566,34 @@ fn forward(plane: u32, w: &mut Watch) {
     let frame = BodyFrame::between(&header, last, bodies);
     let _ = w.publisher.put(frame.encode()).wait();
     w.sent = Some((header, bodies.to_vec()));
+}
+
+#[cfg(test)]
+mod tests {
+    use shm_layout::{codec, Command, PlaneOp, RecordOp, Request};
+
+    use super::own_pid;
+
+    fn request(commands: Vec<Command>) -> Vec<u8> {
+        codec::encode_request(&Request { commands })
+    }
+
+    #[test]
+    fn a_remote_recording_path_is_emptied_and_hello_takes_the_relays_pid() {
+        let start = |path: &str| {
+            Command::plane(
+                3,
+                PlaneOp::Record(RecordOp::Start {
+                    path: path.to_string(),
+                }),
+            )
+        };
+        let (bytes, hello, goodbye) = own_pid(request(vec![start("/etc/passwd")]));
+        assert!(!hello && !goodbye);
+        let sent = codec::decode_request(&bytes).unwrap();
+        assert_eq!(sent.commands, vec![start("")]);
+        // Nothing to rewrite: the bytes pass untouched.
+        let plain = request(vec![start(""), Command::Goodbye]);
+        assert_eq!(own_pid(plain.clone()), (plain, false, true));
+    }
 }
