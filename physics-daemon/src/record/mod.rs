@@ -41,6 +41,10 @@ pub struct RecordArgs {
     /// temporary folder.
     #[arg(long = "record", value_name = "DIR")]
     pub record: Option<PathBuf>,
+    /// Most bytes one recording file may hold: past it the recording ends (its end entry
+    /// says so). Default 4 GiB.
+    #[arg(long = "record-max-bytes", value_name = "BYTES", default_value_t = DEFAULT_MAX_BYTES)]
+    pub max_bytes: u64,
     /// Ticks between the keyframes of a recording (a full snapshot, where a replay or the
     /// viewer can enter it). Within [1, 1000000].
     #[arg(long = "record-keyframe-every", value_name = "TICKS",
@@ -60,9 +64,14 @@ fn parse_every(s: &str) -> Result<u32, String> {
     Ok(v)
 }
 
+/// Default `--record-max-bytes`: 4 GiB.
+pub const DEFAULT_MAX_BYTES: u64 = 4 << 30;
+
 /// How the daemon's planes record.
 #[derive(Debug, Clone)]
 pub struct RecordSettings {
+    /// Most bytes of one recording file.
+    pub max_bytes: u64,
     /// `--record DIR`: every plane records there from its creation.
     pub all_into: Option<PathBuf>,
     /// Ticks between keyframes.
@@ -77,6 +86,7 @@ impl Default for RecordSettings {
             all_into: None,
             keyframe_every: DEFAULT_KEYFRAME_EVERY,
             daemon: String::new(),
+            max_bytes: DEFAULT_MAX_BYTES,
         }
     }
 }
@@ -88,6 +98,7 @@ impl RecordSettings {
             all_into: args.record.clone(),
             keyframe_every: args.keyframe_every,
             daemon: daemon.to_owned(),
+            max_bytes: args.max_bytes,
         }
     }
 
@@ -266,7 +277,7 @@ impl Recorded {
             ));
         }
         let (file, path) = self.new_file(&path)?;
-        let writer = Writer::start(file, path.clone(), self.id)?;
+        let writer = Writer::start(file, path.clone(), self.id, self.settings.max_bytes)?;
         let mut head = preamble().to_vec();
         push_start(
             &mut head,
@@ -409,6 +420,14 @@ impl Backend for Recorded {
         if r.writer.failed.load(Ordering::Relaxed) {
             // The writer says why when the recording is stopped.
             let _ = self.stop("writing failed");
+            return stepped;
+        }
+        if r.writer.full.load(Ordering::Relaxed) {
+            let reason = format!(
+                "the file reached --record-max-bytes ({} bytes)",
+                self.settings.max_bytes
+            );
+            let _ = self.stop(&reason);
             return stepped;
         }
         if r.since_keyframe >= r.keyframe_every {

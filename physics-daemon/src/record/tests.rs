@@ -211,3 +211,51 @@ fn recording_refuses_relative_paths_and_a_second_start() {
     let rec = Recording::parse(std::fs::read(&path).unwrap()).unwrap();
     assert!(rec.end.unwrap().contains("removed"));
 }
+
+#[test]
+fn a_recording_ends_at_its_most_bytes_and_what_it_holds_replays() {
+    let path = temp("c.physrec");
+    let mut p = plane(RecordSettings {
+        max_bytes: 20_000,
+        ..RecordSettings::default()
+    });
+    let balls: Vec<Handle> = (0..5)
+        .map(|i| {
+            add(
+                &mut p,
+                Shape::Sphere { radius: 0.5 },
+                [i as f32 * 2.0, 3.0, 0.0],
+                vec![],
+            )
+        })
+        .collect();
+    p.apply(PlaneOp::Record(RecordOp::Start {
+        path: path.display().to_string(),
+    }))
+    .unwrap();
+    for t in 0..400u32 {
+        for h in &balls {
+            let _ = p.apply(PlaneOp::Object {
+                handle: *h,
+                op: ObjectOp::Set(ObjectProp::Velocity([0.0, 0.1 * t as f32, 0.0])),
+            });
+        }
+        p.step(1.0 / 60.0).unwrap();
+    }
+    // It ended by itself: nothing is recording any more.
+    assert!(!p.recording());
+    let bytes = std::fs::read(&path).unwrap();
+    assert!(bytes.len() <= 20_000 + 200, "{} bytes", bytes.len());
+    let rec = Recording::parse(bytes).unwrap();
+    assert!(
+        rec.end
+            .as_deref()
+            .unwrap()
+            .contains("--record-max-bytes (20000 bytes)"),
+        "{:?}",
+        rec.end
+    );
+    let ticks = rec.tick_count();
+    assert!(ticks > 10 && ticks < 400, "{ticks} ticks");
+    assert_eq!(replay(&rec), Ok(ticks));
+}

@@ -31,15 +31,25 @@ pub(super) struct Writer {
     thread: Option<JoinHandle<()>>,
     /// Set by the thread when writing failed (the recording then stops at the next tick).
     pub failed: Arc<AtomicBool>,
+    /// Set by the thread when the file reached its most bytes: what comes after is not
+    /// written (but the end entry), and the recording stops at the next tick.
+    pub full: Arc<AtomicBool>,
     path: PathBuf,
 }
 
 impl Writer {
     /// Starts the thread writing to `file` (at `path`), which holds nothing yet.
-    pub fn start(file: File, path: PathBuf, plane: u32) -> Result<Writer, CommandError> {
+    pub fn start(
+        file: File,
+        path: PathBuf,
+        plane: u32,
+        max_bytes: u64,
+    ) -> Result<Writer, CommandError> {
         let (tx, rx) = channel::<Chunk>();
         let failed = Arc::new(AtomicBool::new(false));
         let flag = failed.clone();
+        let full = Arc::new(AtomicBool::new(false));
+        let full_flag = full.clone();
         let shown = path.display().to_string();
         let thread = std::thread::Builder::new()
             .name(format!("record-{plane}"))
@@ -47,8 +57,12 @@ impl Writer {
                 let mut out = BufWriter::with_capacity(256 * 1024, file);
                 let mut written: u64 = 0;
                 let mut error: Option<String> = None;
-                let mut put = |bytes: &[u8], error: &mut Option<String>| {
+                let mut put = |bytes: &[u8], error: &mut Option<String>, last: bool| {
                     if error.is_some() {
+                        return;
+                    }
+                    if !last && written + bytes.len() as u64 > max_bytes {
+                        full_flag.store(true, Ordering::SeqCst);
                         return;
                     }
                     match out.write_all(bytes) {
@@ -61,12 +75,12 @@ impl Writer {
                 };
                 for chunk in rx {
                     match chunk {
-                        Chunk::Entries(bytes) => put(&bytes, &mut error),
+                        Chunk::Entries(bytes) => put(&bytes, &mut error, false),
                         Chunk::Later(why, job) => match job() {
                             Ok(snapshot) => {
                                 let mut entry = Vec::with_capacity(snapshot.len() + 16);
                                 push_keyframe(&mut entry, why, &snapshot);
-                                put(&entry, &mut error);
+                                put(&entry, &mut error, false);
                             }
                             Err(e) => {
                                 error = Some(format!("a keyframe of {shown}: {}", e.message));
@@ -76,7 +90,7 @@ impl Writer {
                         Chunk::End(reason, done) => {
                             let mut entry = Vec::new();
                             push_end(&mut entry, &reason);
-                            put(&entry, &mut error);
+                            put(&entry, &mut error, true);
                             if error.is_none() {
                                 if let Err(e) = out.flush().and_then(|_| out.get_ref().sync_data())
                                 {
@@ -104,6 +118,7 @@ impl Writer {
             tx,
             thread: Some(thread),
             failed,
+            full,
             path,
         })
     }
