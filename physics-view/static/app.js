@@ -530,6 +530,8 @@ async function refreshPlanes() {
       // The replay plane is shown unless the page was opened on another one.
       if (selected === null || selected === replayPlane) selected = rp;
       replayPlane = rp;
+      // `?tick=T` opens the replay at tick T (a link to the moment a bug happened).
+      if (params.has('tick')) await replayAct({ action: 'seek', tick: Number(params.get('tick')) });
     }
     const planes = await getJSON('/api/planes');
     if (selected === null && planes.length) selected = planes[0].id;

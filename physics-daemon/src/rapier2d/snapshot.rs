@@ -195,9 +195,7 @@ fn check(state: &State) -> Result<(), CommandError> {
 /// restored plane's next force pass visits the bodies those ops touched, as the original's.
 #[cfg(test)]
 mod between_ticks {
-    use shm_layout::{
-        GuiObjectOp, GuiObjectProp, GuiOp, GuiShape, Handle, PlaneKind, PlaneOp, Reply,
-    };
+    use shm_layout::{GuiObjectOp, GuiObjectProp, GuiOp, GuiShape, Handle, PlaneOp, Reply};
 
     use super::Plane;
     use crate::backend::Backend;
@@ -260,17 +258,17 @@ mod between_ticks {
     }
 
     /// A lone square added with a velocity (the GUI plane's default LinearDamping) and
-    /// never stepped, restored into a plane made by `crate::kinds::create`.
+    /// never stepped, restored into a fresh plane.
     #[test]
     fn a_square_added_and_not_stepped_restores_bit_for_bit() {
-        let mut a = crate::kinds::create(PlaneKind::Gui2d, 1, &[]).unwrap();
+        let mut a: Box<dyn Backend> = Box::new(Plane::new(1, &[]).unwrap());
         let square = add(
             a.as_mut(),
             [100.0, 100.0],
             vec![GuiObjectProp::Velocity([300.0, 0.0])],
         );
         let bytes = snapshot(a.as_mut());
-        let mut b = crate::kinds::create(PlaneKind::Gui2d, 2, &[]).unwrap();
+        let mut b: Box<dyn Backend> = Box::new(Plane::new(2, &[]).unwrap());
         restore(b.as_mut(), &bytes);
         a.step(DT).unwrap();
         b.step(DT).unwrap();

@@ -186,9 +186,14 @@ fn a_recording_of_a_plane_that_moves_to_another_daemon_ends_there_and_replays() 
         "the replay, stepped once more, agrees with b's first tick"
     );
 
-    // A recording started on b through the moved plane's handle.
-    let on_b = dir.join("on-b.physrec");
-    plane.start_recording(Some(&on_b)).unwrap();
+    // A recording started on b through the moved plane's handle: the client reaches b
+    // through a's relay, so the path it asks for is dropped (a remote client names no file
+    // on the daemon's host) and b names the file in its recordings folder.
+    let asked = dir.join("on-b.physrec");
+    let on_b = plane.start_recording(Some(&asked)).unwrap();
+    assert!(!asked.exists(), "a remote client's path is not written");
+    assert_ne!(on_b, asked);
+    let _remove = RemoveOnDrop(on_b.clone());
     let live_b2 = play(&plane, &cubes, &paddle, 71, 100);
     let info = plane.stop_recording().unwrap().expect("recording on b");
     assert_eq!(info.ticks, 30);
@@ -200,5 +205,14 @@ fn a_recording_of_a_plane_that_moves_to_another_daemon_ends_there_and_replays() 
     for (what, client) in [("b", pair.b.client()), ("a", pair.a.client())] {
         let (replayed, _replay) = replay_to_end(&client, &recording_b);
         assert_eq!(replayed, live_b2, "b's recording replayed on {what}");
+    }
+}
+
+/// Removes a file when dropped (one the daemon named in its own folder).
+struct RemoveOnDrop(std::path::PathBuf);
+
+impl Drop for RemoveOnDrop {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_file(&self.0);
     }
 }

@@ -393,6 +393,11 @@ fn the_page_shows_the_replay_at_the_tick_its_timeline_is_at() {
         shots[0], shots[1],
         "the screenshots at ticks {a} and {b} are the same"
     );
+    // A link to a tick: `/?tick=T` jumps the replay there as the page opens.
+    let linked = 50u64;
+    let attrs = load_tick(&profile, &format!("{}/?tick={linked}", viewer.base), linked);
+    assert_eq!(attrs["data-tick"], linked.to_string());
+    assert_eq!(viewer.get("/api/replay")["tick"], linked);
 
     // Where the two frames differ: the cells of the balls' discs at either tick, and only
     // those (the camera keeps its framing; the floor and the background are the same).
