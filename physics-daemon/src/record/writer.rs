@@ -61,7 +61,11 @@ impl Writer {
                     if error.is_some() {
                         return;
                     }
-                    if !last && written + bytes.len() as u64 > max_bytes {
+                    // Once full, nothing more but the end: the file stays whole up to there.
+                    if !last
+                        && (full_flag.load(Ordering::SeqCst)
+                            || written + bytes.len() as u64 > max_bytes)
+                    {
                         full_flag.store(true, Ordering::SeqCst);
                         return;
                     }
