@@ -7,7 +7,7 @@
 //!
 //! This file holds the generator, the batch, the command and plane-op dispatch, handles and
 //! the snapshot ops; each family of ops or values draws in a file of its own (`props`,
-//! `shape`, `query`, `controller`, `gui`, `joint`, `map`), adding methods to [`Gen`].
+//! `shape`, `query`, `controller`, `gui`, `joint`, `map`, `record`), adding methods to [`Gen`].
 
 mod controller;
 mod gui;
@@ -15,6 +15,7 @@ mod joint;
 mod map;
 mod props;
 mod query;
+mod record;
 mod shape;
 
 use shm_layout::{
@@ -245,6 +246,7 @@ impl<'a> Gen<'a> {
             u if u < 0.555 => PlaneOp::Joint(self.joint_op(wild, id)),
             u if u < 0.565 => PlaneOp::Map(self.map_op(wild)),
             u if u < 0.57 => self.snapshot_op(wild),
+            u if u < 0.573 => self.record_op(wild),
             _ => {
                 let handle = self.handle(wild, id);
                 PlaneOp::Object {
