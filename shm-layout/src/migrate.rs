@@ -34,6 +34,9 @@ pub struct MovingPlane {
     pub claim: u128,
     /// Its snapshot ([`crate::snapshot`] framing): same objects, same handles, same tick.
     pub bytes: Vec<u8>,
+    /// It was recording: the target records it on (a file of its own, in its recordings
+    /// folder), the recording here having ended saying where the plane went.
+    pub recording: bool,
 }
 
 /// The target's answer to a [`MovingPlane`]: the plane's id there, or why it was refused.

@@ -156,6 +156,11 @@ pub trait Backend: Send {
         false
     }
 
+    /// Whether a recording of the plane runs (`crate::record`).
+    fn recording(&self) -> bool {
+        false
+    }
+
     /// The plane is about to go (`why`: moved to another daemon, destroyed, the daemon
     /// stopping): what writes on its behalf (a recording, `crate::record`) ends saying so.
     fn leaving(&mut self, _why: &str) {}

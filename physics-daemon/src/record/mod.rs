@@ -181,19 +181,16 @@ impl Recorded {
         }
     }
 
-    /// Starts recording when the daemon records every plane (`--record DIR`); a plane
-    /// that cannot (the folder is not writable) runs on unrecorded, with the reason logged.
-    pub fn record_if_asked(&mut self) {
-        if self.settings.all_into.is_some() {
+    /// Starts recording when the daemon records every plane (`--record DIR`), or when the
+    /// plane arrived recording from another daemon; a plane that cannot (the folder is not
+    /// writable) runs on unrecorded, with the reason logged.
+    /// `arrived_recording`: the plane arrived from another daemon where it was recording.
+    pub fn record_if_asked(&mut self, arrived_recording: bool) {
+        if self.settings.all_into.is_some() || arrived_recording {
             if let Err(e) = self.start(String::new()) {
                 tracing::error!(plane = self.id, "--record: {}", e.message);
             }
         }
-    }
-
-    /// Whether a recording runs.
-    pub fn recording(&self) -> bool {
-        self.recorder.is_some()
     }
 
     fn new_file(&self, path: &str) -> Result<(std::fs::File, PathBuf), CommandError> {
@@ -505,6 +502,10 @@ impl Backend for Recorded {
 
     fn has_idle_work(&self) -> bool {
         self.inner.has_idle_work()
+    }
+
+    fn recording(&self) -> bool {
+        self.recorder.is_some()
     }
 
     fn leaving(&mut self, why: &str) {

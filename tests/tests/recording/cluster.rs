@@ -142,7 +142,7 @@ fn finished(path: &Path) -> Recording {
 }
 
 #[test]
-fn a_recording_of_a_plane_that_moves_to_another_daemon_ends_there_and_replays() {
+fn a_recording_of_a_plane_that_moves_to_another_daemon_ends_there_goes_on_there_and_replays() {
     let pair = pair("rec-move");
     let dir = TempDir::new("rec-move");
     let owner = pair.a.client();
@@ -172,8 +172,22 @@ fn a_recording_of_a_plane_that_moves_to_another_daemon_ends_there_and_replays() 
     assert_eq!(recording_a.start.daemon, "a");
     assert_eq!(recording_a.tick_count(), 40);
     assert_eq!(file_hashes(&recording_a), live_a);
-    // The recording stopped with the move: b's plane does not record.
-    assert_eq!(plane.stop_recording().unwrap(), None);
+    // The recording goes on on b, in a file of b's own (its recordings folder), from the
+    // state the plane arrived in: ticks 42..=71 (the first on b included) replay too.
+    let info = plane
+        .stop_recording()
+        .unwrap()
+        .expect("b records the plane on");
+    let _remove_b = RemoveOnDrop(info.path.clone().into());
+    assert_eq!(info.ticks, 30);
+    let arrived = Arc::new(load_recording(&info.path).unwrap());
+    assert_eq!(arrived.start.daemon, "b");
+    assert_eq!(arrived.first_tick(), 41, "it starts where a's ends");
+    assert_eq!(arrived.end.as_deref(), Some("stopped"));
+    let mut on_b = vec![(first_on_b, hash_on_b)];
+    on_b.extend(live_b.iter().copied());
+    assert_eq!(file_hashes(&arrived), on_b);
+    assert_eq!(replay_to_end(&pair.a.client(), &arrived).0, on_b);
 
     // It replays on a, and the replayed plane steps on to what b computed after the move
     // (the write sent with the move is in the file).

@@ -150,6 +150,7 @@ impl Daemon {
             return Err(unknown_plane(id));
         };
         let tick = plane.tick();
+        let recording = plane.recording();
         let bytes = match plane.apply(shm_layout::PlaneOp::Snapshot)? {
             Reply::Snapshot(bytes) => bytes,
             other => {
@@ -168,6 +169,7 @@ impl Daemon {
             persistent,
             claim: key,
             bytes,
+            recording,
         };
         let size = moving.bytes.len();
         let new_id = migration.courier.deliver(daemon, &moving).map_err(|e| {
@@ -294,6 +296,7 @@ impl Daemon {
         let setup = worker::Setup {
             file,
             restore: Some(moving.bytes),
+            arrived_recording: moving.recording,
             ..self.worker_setup(id, moving.kind, props, &cell, &usage)
         };
         self.start_worker(setup, receiver)?;

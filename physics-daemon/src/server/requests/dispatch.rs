@@ -396,6 +396,7 @@ impl Daemon {
             file: None,
             restore: None,
             record: self.options.record.clone(),
+            arrived_recording: false,
         }
     }
 

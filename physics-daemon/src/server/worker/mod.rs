@@ -61,6 +61,8 @@ pub(crate) struct Setup {
     pub restore: Option<Vec<u8>>,
     /// How the plane records (`--record`, `record`).
     pub record: crate::record::RecordSettings,
+    /// It arrived from another daemon where it was recording: it records on here.
+    pub arrived_recording: bool,
 }
 
 /// Starts the worker of a plane: a thread that is the only thread of a rayon pool of its
@@ -253,7 +255,7 @@ fn create(setup: &Setup) -> Result<(Worker, Reply), CommandError> {
         })?;
     }
     // `--record DIR`: from its first state here (a restored or arrived plane's included).
-    recorded.record_if_asked();
+    recorded.record_if_asked(setup.arrived_recording);
     let mut plane: Box<dyn Backend> = Box::new(recorded);
     setup.cell.marks.tick.store(plane.tick(), Ordering::SeqCst);
     // A new plane is written at once; a restored one only once it changes (its file holds
