@@ -4,40 +4,16 @@
 //! write sent with the move included; a recording started on `b` through the moved
 //! plane's handle replays too, on either daemon.
 
-use std::path::{Path, PathBuf};
+use crate::common::{file_hashes, replay_to_end, RemoveOnDrop, TempDir};
+use std::path::Path;
 use std::sync::Arc;
 use std::time::Duration;
 
-use client_sdk::{
-    load_recording, Advanced, Client, Object, ObjectProp, Plane, PlaneOptions, Pose, Recording,
-    Replay, Shape,
-};
+use client_sdk::{load_recording, Object, ObjectProp, Plane, PlaneOptions, Pose, Recording, Shape};
 use integration_tests::cluster::{endpoint, free_port, member, unique_cluster};
-use integration_tests::{eventually, unique_domain, TestDaemon};
-use shm_layout::recording::Event;
+use integration_tests::{eventually, TestDaemon};
 
 const DT: f32 = 1.0 / 60.0;
-
-/// A folder of its own under the temporary folder, removed when dropped.
-struct TempDir(PathBuf);
-
-impl TempDir {
-    fn new(tag: &str) -> TempDir {
-        let path = std::env::temp_dir().join(unique_domain(tag));
-        std::fs::create_dir_all(&path).expect("create a temporary folder");
-        TempDir(path)
-    }
-
-    fn join(&self, name: &str) -> PathBuf {
-        self.0.join(name)
-    }
-}
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
-}
 
 /// Two members of one cluster, `a` and `b`.
 struct Pair {
@@ -97,34 +73,6 @@ fn play(plane: &Plane, cubes: &[Object], paddle: &Object, from: u32, to: u32) ->
             (tick, plane.state_hash().unwrap())
         })
         .collect()
-}
-
-fn file_hashes(recording: &Recording) -> Vec<(u64, u64)> {
-    recording
-        .events
-        .iter()
-        .filter_map(|e| match e {
-            Event::Tick {
-                tick, state_hash, ..
-            } => Some((*tick, *state_hash)),
-            _ => None,
-        })
-        .collect()
-}
-
-/// Replays `recording` on `client` to its end, one tick at a time (a divergence fails the
-/// test naming it): (tick, hash) of each tick, and the replay.
-fn replay_to_end(client: &Client, recording: &Arc<Recording>) -> (Vec<(u64, u64)>, Replay) {
-    let mut replay = Replay::start(client, recording.clone()).expect("start the replay");
-    let mut seen = Vec::new();
-    loop {
-        match replay.advance().expect("advance the replay") {
-            Advanced::Tick(tick) => seen.push((tick, replay.plane().state_hash().unwrap())),
-            Advanced::End => break,
-            Advanced::Diverged(d) => panic!("after {} tick(s): {d}", seen.len()),
-        }
-    }
-    (seen, replay)
 }
 
 /// The recording at `path` once its end entry is written.
@@ -219,14 +167,5 @@ fn a_recording_of_a_plane_that_moves_to_another_daemon_ends_there_goes_on_there_
     for (what, client) in [("b", pair.b.client()), ("a", pair.a.client())] {
         let (replayed, _replay) = replay_to_end(&client, &recording_b);
         assert_eq!(replayed, live_b2, "b's recording replayed on {what}");
-    }
-}
-
-/// Removes a file when dropped (one the daemon named in its own folder).
-struct RemoveOnDrop(std::path::PathBuf);
-
-impl Drop for RemoveOnDrop {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_file(&self.0);
     }
 }

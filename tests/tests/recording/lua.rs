@@ -6,6 +6,7 @@
 //! refuses a file that exists naming it; GUI planes record and replay too; the runner's
 //! flags are checked. Real daemon, real `physics-lua`.
 
+use crate::common::TempDir;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
@@ -18,23 +19,6 @@ const LIMIT: Duration = Duration::from_secs(120);
 
 fn repo() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
-}
-
-/// A folder of the test's own, removed with what is in it.
-struct TempDir(PathBuf);
-
-impl TempDir {
-    fn new(tag: &str) -> TempDir {
-        let dir = std::env::temp_dir().join(unique_domain(tag));
-        std::fs::create_dir_all(&dir).unwrap();
-        TempDir(dir)
-    }
-}
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
 }
 
 /// Files the daemon named (in its temporary `physics-recordings` folder), removed at the end.

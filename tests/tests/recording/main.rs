@@ -10,6 +10,7 @@
 //!   [--until]`.
 
 mod cluster;
+mod common;
 mod kinds;
 mod lua;
 mod replay;

@@ -8,8 +8,9 @@
 //! naming the byte offset of the entry; a rewritten tick hash stops the replay at that tick
 //! naming the batch before it; bad recording requests are refused by name.
 
+use crate::common::{file_hashes, replay_to_end, TempDir};
 use std::collections::BTreeSet;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
@@ -18,7 +19,7 @@ use client_sdk::{
     JointKind, JointProp, Object, ObjectProp, Plane, PlaneOptions, PlaneProp, Pose, Recording,
     Replay, Shape,
 };
-use integration_tests::{eventually, unique_domain, TestDaemon};
+use integration_tests::{eventually, TestDaemon};
 use shm_layout::recording::{
     push_tick, EntryTag, Event, KeyframeWhy, ENTRY_OVERHEAD, PREAMBLE_LEN,
 };
@@ -26,31 +27,6 @@ use shm_layout::recording::{
 const DT: f32 = 1.0 / 60.0;
 /// Ticks the scenario game is recorded for.
 const GAME_TICKS: u32 = 240;
-
-/// A folder of its own under the temporary folder, removed when dropped.
-struct TempDir(PathBuf);
-
-impl TempDir {
-    fn new(tag: &str) -> TempDir {
-        let path = std::env::temp_dir().join(unique_domain(tag));
-        std::fs::create_dir_all(&path).expect("create a temporary folder");
-        TempDir(path)
-    }
-
-    fn path(&self) -> &Path {
-        &self.0
-    }
-
-    fn join(&self, name: &str) -> PathBuf {
-        self.0.join(name)
-    }
-}
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
-}
 
 /// The scenario game's handles.
 struct Game {
@@ -215,40 +191,6 @@ fn record_game(client: &Client, path: &Path, warm_up: u32, ticks: u32) -> Record
     let bodies = game.plane.snapshot().unwrap().bodies().to_vec();
     let recording = Arc::new(load_recording(path).unwrap());
     (game, live, bodies, recording)
-}
-
-/// (tick, state hash) of every `Tick` entry of `recording`.
-fn file_hashes(recording: &Recording) -> Vec<(u64, u64)> {
-    recording
-        .events
-        .iter()
-        .filter_map(|e| match e {
-            Event::Tick {
-                tick, state_hash, ..
-            } => Some((*tick, *state_hash)),
-            _ => None,
-        })
-        .collect()
-}
-
-/// Replays `recording` on `client` one tick at a time to its end (a divergence fails the
-/// test naming it): (tick, state hash) of every tick as the replayed plane published it,
-/// and the replay.
-fn replay_to_end(client: &Client, recording: &Arc<Recording>) -> (Vec<(u64, u64)>, Replay) {
-    let mut replay = Replay::start(client, recording.clone()).expect("start the replay");
-    let mut seen = Vec::new();
-    loop {
-        match replay.advance().expect("advance the replay") {
-            Advanced::Tick(tick) => {
-                assert_eq!(replay.tick(), tick);
-                seen.push((tick, replay.plane().state_hash().unwrap()));
-            }
-            Advanced::End => break,
-            Advanced::Diverged(d) => panic!("after {} tick(s): {d}", seen.len()),
-        }
-    }
-    assert!(replay.at_end());
-    (seen, replay)
 }
 
 /// Panics naming the first field whose bits differ between `a` and `b`.
