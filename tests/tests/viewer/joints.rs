@@ -9,13 +9,9 @@
 //!
 //! Chromium is required: without it the test fails and says how to install it.
 
-use crate::browser::{chromium, http, view_attributes, viewer_bin, TempDir};
+use crate::browser::{chromium, chromium_run, view_attributes, TempDir, Viewer};
 use std::collections::HashMap;
-use std::io::{BufRead, BufReader};
 use std::path::Path;
-use std::process::{Child, Command, Stdio};
-use std::sync::mpsc;
-use std::time::Duration;
 
 use client_sdk::{
     load_recording, Advanced, Client, JointKind, JointProp, Object, ObjectProp, Plane,
@@ -35,107 +31,11 @@ const END_TOLERANCE: f64 = 1e-4;
 /// checked too); a rotation applied wrongly puts them up to a ball spacing (1) apart.
 const MEET_TOLERANCE: f64 = 0.02;
 
-/// A running viewer; interrupted (then killed) when dropped.
-struct Viewer {
-    child: Child,
-    base: String,
-}
-
-impl Viewer {
-    /// `physics-view --domain DOMAIN --port 0 EXTRA...`, once it listens.
-    fn start(domain: &str, extra: &[&str]) -> Viewer {
-        let mut child = Command::new(viewer_bin())
-            .args(["--domain", domain, "--port", "0"])
-            .args(extra)
-            .env("PHYSICS_LOG", "warn")
-            .stdin(Stdio::null())
-            .stdout(Stdio::piped())
-            .spawn()
-            .expect("spawn physics-view");
-        let out = child.stdout.take().expect("stdout");
-        let (tx, rx) = mpsc::channel();
-        std::thread::spawn(move || {
-            for line in BufReader::new(out).lines().map_while(Result::ok) {
-                let _ = tx.send(line);
-            }
-        });
-        let line = rx
-            .recv_timeout(Duration::from_secs(60))
-            .expect("physics-view printed no URL within 60 s");
-        let url = line
-            .split_whitespace()
-            .find(|w| w.starts_with("http://"))
-            .unwrap_or_else(|| panic!("no URL in {line:?}"));
-        Viewer {
-            child,
-            base: url.trim_end_matches('/').to_string(),
-        }
-    }
-
-    fn get(&self, path: &str) -> Value {
-        let (status, body) = http(&self.base, "GET", path, "");
-        assert_eq!(status, 200, "GET {path}: {body}");
-        serde_json::from_str(&body).unwrap_or_else(|e| panic!("GET {path}: {e}: {body}"))
-    }
-
-    /// `POST /api/replay` that must succeed: the timeline's state after it.
-    fn replay(&self, body: Value) -> Value {
-        let (status, text) = http(&self.base, "POST", "/api/replay", &body.to_string());
-        assert_eq!(status, 200, "POST /api/replay {body}: {text}");
-        serde_json::from_str(&text).unwrap_or_else(|e| panic!("{body}: {e}: {text}"))
-    }
-}
-
-impl Drop for Viewer {
-    fn drop(&mut self) {
-        // SAFETY: kill(2) on our own child: SIGINT lets it say goodbye to the daemon.
-        unsafe { libc::kill(self.child.id() as i32, libc::SIGINT) };
-        for _ in 0..300 {
-            if let Ok(Some(_)) = self.child.try_wait() {
-                return;
-            }
-            std::thread::sleep(Duration::from_millis(20));
-        }
-        let _ = self.child.kill();
-        let _ = self.child.wait();
-    }
-}
-
-/// Headless Chromium with a software WebGL (SwiftShader) and a profile of its own dumping
-/// the DOM of `url`.
-fn dump_dom(profile: &Path, url: &str) -> String {
-    let out = Command::new(chromium())
-        .args([
-            "--headless",
-            "--no-sandbox",
-            "--disable-gpu",
-            "--use-gl=swiftshader",
-            "--enable-unsafe-swiftshader",
-            "--no-first-run",
-            "--hide-scrollbars",
-            "--window-size=1280,800",
-            "--virtual-time-budget=3000",
-            "--dump-dom",
-        ])
-        .arg(format!("--user-data-dir={}", profile.display()))
-        .arg(url)
-        .stdin(Stdio::null())
-        .output()
-        .expect("run chromium");
-    assert!(
-        out.status.success(),
-        "chromium failed ({}): {}",
-        out.status,
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8_lossy(&out.stdout).into_owned()
-}
-
 /// Loads `url` until the page has drawn plane `plane` at `tick`; returns #view's attributes.
 fn load(profile: &Path, url: &str, plane: u32, tick: u64) -> HashMap<String, String> {
     let mut last = HashMap::new();
     for _ in 0..4 {
-        let attrs = view_attributes(&dump_dom(profile, url));
+        let attrs = view_attributes(&chromium_run(profile, &["--dump-dom".to_string()], url));
         if attrs.get("data-ready").map(String::as_str) == Some("1")
             && attrs.get("data-plane") == Some(&plane.to_string())
             && attrs.get("data-tick") == Some(&tick.to_string())
@@ -338,7 +238,7 @@ fn the_page_draws_a_live_planes_joints_between_their_anchors() {
         }
     }
 
-    let viewer = Viewer::start(&daemon.domain, &[]);
+    let viewer = Viewer::start::<&str>(&daemon.domain, &[]);
     // The JSON the page draws from: every joint's line.
     let api = viewer.get(&format!("/api/plane/{}", plane.id()));
     assert_eq!(api["joint_count"], CHAIN + 1, "{}", api["joints"]);
@@ -399,14 +299,14 @@ fn the_page_draws_a_replayed_planes_joints_at_each_tick() {
     assert!(largest_turn(mine.plane()) > 0.1);
     mine.into_plane().destroy().unwrap();
 
-    let viewer = Viewer::start(&daemon.domain, &["--replay", file.to_str().unwrap()]);
+    let viewer = Viewer::replay(&daemon.domain, &file, &[]);
     let state = viewer.get("/api/replay");
     let id = state["plane"].as_u64().expect("the replay's plane") as u32;
     let profile = dir.join("profile");
     let url = format!("{}/", viewer.base);
     let mut drawn = Vec::new();
     for (tick, want) in [a, b].into_iter().zip(&wants) {
-        let r = viewer.replay(json!({"action": "seek", "tick": tick}));
+        let r = viewer.ok(json!({"action": "seek", "tick": tick}));
         assert_eq!(r["tick"], tick, "{r}");
         let attrs = load(&profile, &url, id, tick);
         assert_eq!(attrs["data-replay-tick"], tick.to_string());

@@ -19,7 +19,7 @@ use std::process::{Child, Command, Stdio};
 use std::sync::mpsc;
 use std::time::Duration;
 
-use browser::{chromium, view_attributes, viewer_bin};
+use browser::{chromium, chromium_run, view_attributes, viewer_bin};
 use client_sdk::{Client, GuiPlaneOptions, GuiShape, Plane, PlaneOptions, Pose, Shape};
 use integration_tests::{eventually, physics_lua, quat, unique_domain, TestDaemon};
 use serde_json::Value;
@@ -113,36 +113,6 @@ fn try_http(base: &str, method: &str, path: &str) -> std::io::Result<(u16, Strin
         .and_then(|c| c.parse().ok())
         .expect("status code");
     Ok((status, body.to_string()))
-}
-
-/// Headless Chromium with a software WebGL (SwiftShader), a profile of its own, and
-/// `extra` (e.g. `--dump-dom`) on `url`. Returns stdout.
-fn chromium_run(profile: &Path, extra: &[String], url: &str) -> String {
-    let out = Command::new(chromium())
-        .args([
-            "--headless",
-            "--no-sandbox",
-            "--disable-gpu",
-            "--use-gl=swiftshader",
-            "--enable-unsafe-swiftshader",
-            "--no-first-run",
-            "--hide-scrollbars",
-            "--window-size=1280,800",
-            "--virtual-time-budget=3000",
-        ])
-        .arg(format!("--user-data-dir={}", profile.display()))
-        .args(extra)
-        .arg(url)
-        .stdin(Stdio::null())
-        .output()
-        .expect("run chromium");
-    assert!(
-        out.status.success(),
-        "chromium failed ({}): {}",
-        out.status,
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8_lossy(&out.stdout).into_owned()
 }
 
 /// Loads `url` until the page has drawn a snapshot (`data-ready="1"`); returns #view's

@@ -12,12 +12,11 @@
 //!
 //! Chromium is required: without it the browser tests fail and say how to install it.
 
-use crate::browser::{chromium, http, view_attributes, viewer_bin, TempDir};
+use crate::browser::{chromium, chromium_run, http, view_attributes, viewer_bin, TempDir, Viewer};
 use std::collections::HashMap;
-use std::io::{BufRead, BufReader, Read};
 use std::path::Path;
-use std::process::{Child, Command, Stdio};
-use std::sync::{mpsc, Arc, Mutex};
+use std::process::{Command, Stdio};
+use std::sync::Arc;
 use std::time::Duration;
 
 use client_sdk::{
@@ -38,130 +37,6 @@ const RAY: ([f32; 3], [f32; 3]) = ([0.0, 12.0, 2.0], [0.0, -12.0, 0.0]);
 /// Poses travel f32 → JSON → JS double → JSON, and the two replays step the same ops with
 /// the same dt (their hashes are checked equal to the recording's): 1e-4 is ample.
 const POSE_TOLERANCE: f64 = 1e-4;
-
-/// A running viewer; interrupted (then killed) when dropped.
-struct Viewer {
-    child: Child,
-    base: String,
-    /// What it wrote on stderr so far.
-    stderr: Arc<Mutex<Vec<String>>>,
-}
-
-/// Lines of a pipe, collected by a thread of their own.
-fn collect_lines(
-    pipe: impl Read + Send + 'static,
-) -> (mpsc::Receiver<String>, Arc<Mutex<Vec<String>>>) {
-    let (tx, rx) = mpsc::channel();
-    let all = Arc::new(Mutex::new(Vec::new()));
-    let keep = all.clone();
-    std::thread::spawn(move || {
-        for line in BufReader::new(pipe).lines().map_while(Result::ok) {
-            keep.lock().unwrap().push(line.clone());
-            let _ = tx.send(line);
-        }
-    });
-    (rx, all)
-}
-
-impl Viewer {
-    /// `physics-view --domain DOMAIN --port 0 --replay FILE EXTRA...`, once it listens.
-    fn replay(domain: &str, file: &Path, extra: &[&str]) -> Viewer {
-        let mut child = Command::new(viewer_bin())
-            .args(["--domain", domain, "--port", "0", "--replay"])
-            .arg(file)
-            .args(extra)
-            .env("PHYSICS_LOG", "warn")
-            .stdin(Stdio::null())
-            .stdout(Stdio::piped())
-            .stderr(Stdio::piped())
-            .spawn()
-            .expect("spawn physics-view");
-        let (lines, _) = collect_lines(child.stdout.take().expect("stdout"));
-        let (_, stderr) = collect_lines(child.stderr.take().expect("stderr"));
-        let line = lines
-            .recv_timeout(Duration::from_secs(60))
-            .unwrap_or_else(|_| {
-                panic!(
-                    "physics-view printed no URL within 60 s; stderr: {:?}",
-                    stderr.lock().unwrap()
-                )
-            });
-        let url = line
-            .split_whitespace()
-            .find(|w| w.starts_with("http://"))
-            .unwrap_or_else(|| panic!("no URL in {line:?}"));
-        Viewer {
-            child,
-            base: url.trim_end_matches('/').to_string(),
-            stderr,
-        }
-    }
-
-    fn get(&self, path: &str) -> Value {
-        let (status, body) = http(&self.base, "GET", path, "");
-        assert_eq!(status, 200, "GET {path}: {body}");
-        serde_json::from_str(&body).unwrap_or_else(|e| panic!("GET {path}: {e}: {body}"))
-    }
-
-    /// `POST /api/replay` with `body`: (status, answer).
-    fn act(&self, body: Value) -> (u16, Value) {
-        let (status, text) = http(&self.base, "POST", "/api/replay", &body.to_string());
-        let v = serde_json::from_str(&text).unwrap_or_else(|e| panic!("{body}: {e}: {text}"));
-        (status, v)
-    }
-
-    /// `POST /api/replay` that must succeed: the timeline's state after it.
-    fn ok(&self, body: Value) -> Value {
-        let (status, v) = self.act(body.clone());
-        assert_eq!(status, 200, "POST /api/replay {body}: {v}");
-        v
-    }
-}
-
-impl Drop for Viewer {
-    fn drop(&mut self) {
-        // SAFETY: kill(2) on our own child: SIGINT lets it say goodbye to the daemon.
-        unsafe { libc::kill(self.child.id() as i32, libc::SIGINT) };
-        for _ in 0..300 {
-            if let Ok(Some(_)) = self.child.try_wait() {
-                return;
-            }
-            std::thread::sleep(Duration::from_millis(20));
-        }
-        let _ = self.child.kill();
-        let _ = self.child.wait();
-    }
-}
-
-/// Headless Chromium with a software WebGL (SwiftShader), a profile of its own, and
-/// `extra` (e.g. `--dump-dom`) on `url`. Returns stdout.
-fn chromium_run(profile: &Path, extra: &[String], url: &str) -> String {
-    let out = Command::new(chromium())
-        .args([
-            "--headless",
-            "--no-sandbox",
-            "--disable-gpu",
-            "--use-gl=swiftshader",
-            "--enable-unsafe-swiftshader",
-            "--no-first-run",
-            "--hide-scrollbars",
-            "--window-size=1280,800",
-            "--virtual-time-budget=3000",
-        ])
-        .arg(format!("--user-data-dir={}", profile.display()))
-        .args(extra)
-        .arg(url)
-        .stdin(Stdio::null())
-        .output()
-        .expect("run chromium");
-    assert!(
-        out.status.success(),
-        "chromium failed ({}): {}",
-        out.status,
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8_lossy(&out.stdout).into_owned()
-}
 
 /// Loads the page until it shows the replay at `tick` and has rendered that tick (its
 /// pixel grid written); returns #view's attributes.
