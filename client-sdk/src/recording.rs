@@ -119,6 +119,9 @@ pub struct Replay {
     /// The batch applied since the last tick (its event index).
     batch: Option<usize>,
     tick: u64,
+    /// The batch events of each tick, by event index ([`Replay::ops_at`] is asked every
+    /// tick a viewer shows: one pass over the file at the start, not one a tick).
+    batches: std::collections::BTreeMap<u64, Vec<usize>>,
 }
 
 /// Options every replayed plane gets on top of its snapshot: it advances only when the
@@ -144,12 +147,19 @@ impl Replay {
         let snapshot = PlaneSnapshot::from_bytes(recording.snapshot(range).to_vec())?;
         let tick = *tick;
         let plane = client.plane_from_snapshot(&snapshot, &replay_overrides())?;
+        let mut batches = std::collections::BTreeMap::<u64, Vec<usize>>::new();
+        for (i, e) in recording.events.iter().enumerate() {
+            if let Event::Batch { tick, .. } = e {
+                batches.entry(*tick).or_default().push(i);
+            }
+        }
         Ok(Replay {
             recording,
             plane,
             next: 1,
             batch: None,
             tick,
+            batches,
         })
     }
 
@@ -181,15 +191,15 @@ impl Replay {
     /// The ops of the batch applied at `tick` (before tick + 1), as recorded: what a
     /// viewer draws (rays of queries) at that tick. Empty when none was.
     pub fn ops_at(&self, tick: u64) -> Vec<PlaneOp> {
-        let mut ops = Vec::new();
-        for e in &self.recording.events {
-            if let Event::Batch { tick: t, .. } = e {
-                if *t == tick {
-                    ops.extend(self.recording.ops(e).unwrap_or_default());
-                }
-            }
-        }
-        ops
+        let events = self.batches.get(&tick).map_or(&[][..], Vec::as_slice);
+        events
+            .iter()
+            .flat_map(|&i| {
+                self.recording
+                    .ops(&self.recording.events[i])
+                    .unwrap_or_default()
+            })
+            .collect()
     }
 
     /// Applies the recorded events up to and including the next tick: the batch before it
