@@ -300,6 +300,52 @@ pub fn physics_lua(domain: &str, script: &str, extra: &[&str]) -> Command {
 
 pub mod structure;
 
+/// Walking a recording file's entries (`shm_layout::recording`), to damage or forge one in
+/// a test.
+pub mod recording_file {
+    use shm_layout::recording::{push_tick, EntryTag, ENTRY_OVERHEAD, PREAMBLE_LEN};
+
+    /// (byte offset, tag, whole length) of every entry, asserting that they tile the file.
+    pub fn entries(bytes: &[u8]) -> Vec<(usize, u8, usize)> {
+        let mut at = PREAMBLE_LEN;
+        let mut out = Vec::new();
+        while at + ENTRY_OVERHEAD <= bytes.len() {
+            let len = u32::from_le_bytes(bytes[at + 1..at + 5].try_into().unwrap()) as usize;
+            out.push((at, bytes[at], len + ENTRY_OVERHEAD));
+            at += len + ENTRY_OVERHEAD;
+        }
+        assert_eq!(at, bytes.len(), "the entries tile the file");
+        out
+    }
+
+    /// The byte offset of the `Tick` entry of `tick`.
+    pub fn tick_entry(bytes: &[u8], tick: u64) -> usize {
+        entries(bytes)
+            .into_iter()
+            .find(|&(at, tag, _)| {
+                tag == EntryTag::Tick as u8
+                    && u64::from_le_bytes(bytes[at + 5..at + 13].try_into().unwrap()) == tick
+            })
+            .map(|(at, _, _)| at)
+            .unwrap_or_else(|| panic!("no tick entry of tick {tick}"))
+    }
+
+    /// `bytes` with the `Tick` entry of `tick` holding another state hash (and the checksum
+    /// that goes with it, so the file still reads), and that hash.
+    pub fn forge_tick_hash(bytes: &[u8], tick: u64) -> (Vec<u8>, u64) {
+        let at = tick_entry(bytes, tick);
+        // Payload: tick u64 | dt f32 | state hash u64.
+        let dt = f32::from_le_bytes(bytes[at + 13..at + 17].try_into().unwrap());
+        let hash = u64::from_le_bytes(bytes[at + 17..at + 25].try_into().unwrap());
+        let forged = hash ^ 0x0100_0000_0000_0001;
+        let mut out = bytes[..at].to_vec();
+        push_tick(&mut out, tick, dt, forged);
+        out.extend_from_slice(&bytes[at + ENTRY_OVERHEAD + 20..]);
+        assert_eq!(out.len(), bytes.len());
+        (out, forged)
+    }
+}
+
 /// The .glb files the examples and Luau tests load (`examples/assets/`), generated here with
 /// the SDK's glTF writer; `tests/tests/maps.rs` checks the shipped files are exactly these
 /// (`PHYSICS_WRITE_ASSETS=1` rewrites them).

@@ -7,12 +7,12 @@
 //! flags are checked. Real daemon, real `physics-lua`.
 
 use crate::common::TempDir;
+use integration_tests::recording_file::forge_tick_hash;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
 use integration_tests::{physics_lua, run_lua, unique_domain, TestDaemon};
-use shm_layout::recording::{push_tick, EntryTag, ENTRY_OVERHEAD, PREAMBLE_LEN};
 
 /// How long one run of the runner may take on a loaded 2-core machine.
 const LIMIT: Duration = Duration::from_secs(120);
@@ -94,40 +94,6 @@ fn after<'a>(text: &'a str, prefix: &str) -> &'a str {
     text.lines()
         .find_map(|l| l.strip_prefix(prefix))
         .unwrap_or_else(|| panic!("no line {prefix:?} in:\n{text}"))
-}
-
-/// Every entry of a recording file: (byte offset, tag), in file order.
-fn entries(bytes: &[u8]) -> Vec<(usize, u8)> {
-    let mut at = PREAMBLE_LEN;
-    let mut out = Vec::new();
-    while at + ENTRY_OVERHEAD <= bytes.len() {
-        let len = u32::from_le_bytes(bytes[at + 1..at + 5].try_into().unwrap()) as usize;
-        out.push((at, bytes[at]));
-        at += len + ENTRY_OVERHEAD;
-    }
-    assert_eq!(at, bytes.len(), "the entries tile the file");
-    out
-}
-
-/// `bytes` with the `Tick` entry of `tick` holding another state hash (and the checksum
-/// that goes with it, so the file still reads).
-fn forge_tick_hash(bytes: &[u8], tick: u64) -> Vec<u8> {
-    let at = entries(bytes)
-        .into_iter()
-        .find(|&(at, tag)| {
-            tag == EntryTag::Tick as u8
-                && u64::from_le_bytes(bytes[at + 5..at + 13].try_into().unwrap()) == tick
-        })
-        .map(|(at, _)| at)
-        .unwrap_or_else(|| panic!("no tick entry of tick {tick}"));
-    // Payload: tick u64 | dt f32 | state hash u64.
-    let dt = f32::from_le_bytes(bytes[at + 13..at + 17].try_into().unwrap());
-    let hash = u64::from_le_bytes(bytes[at + 17..at + 25].try_into().unwrap());
-    let mut out = bytes[..at].to_vec();
-    push_tick(&mut out, tick, dt, hash ^ 0x0100_0000_0000_0001);
-    out.extend_from_slice(&bytes[at + ENTRY_OVERHEAD + 20..]);
-    assert_eq!(out.len(), bytes.len());
-    out
 }
 
 #[test]
@@ -214,7 +180,7 @@ fn a_recorded_scenario_game_replays_with_every_hash_and_hands_its_plane_over_at_
     // the batch of writes before it.
     let forged_tick = start + 60;
     let forged = dir.0.join("forged.physrec");
-    std::fs::write(&forged, forge_tick_hash(&bytes, forged_tick)).unwrap();
+    std::fs::write(&forged, forge_tick_hash(&bytes, forged_tick).0).unwrap();
     let diverged = replay_only(&daemon.domain, &forged, &[]);
     assert_eq!(diverged.status.code(), Some(1), "{}", shown(&diverged));
     let message = stderr(&diverged);

@@ -9,6 +9,7 @@
 //! naming the batch before it; bad recording requests are refused by name.
 
 use crate::common::{file_hashes, replay_to_end, TempDir};
+use integration_tests::recording_file::{entries, forge_tick_hash, tick_entry};
 use std::collections::BTreeSet;
 use std::path::Path;
 use std::sync::Arc;
@@ -20,9 +21,7 @@ use client_sdk::{
     Replay, Shape,
 };
 use integration_tests::{eventually, TestDaemon};
-use shm_layout::recording::{
-    push_tick, EntryTag, Event, KeyframeWhy, ENTRY_OVERHEAD, PREAMBLE_LEN,
-};
+use shm_layout::recording::{EntryTag, Event, KeyframeWhy, ENTRY_OVERHEAD};
 
 const DT: f32 = 1.0 / 60.0;
 /// Ticks the scenario game is recorded for.
@@ -198,32 +197,6 @@ fn assert_same_bodies(a: &[BodyState], b: &[BodyState], what: &str) {
     if let Some(d) = first_difference(a, b) {
         panic!("{what}: {d}");
     }
-}
-
-/// Every entry of a recording file: (byte offset, tag, whole length with framing), in
-/// file order.
-fn entries(bytes: &[u8]) -> Vec<(usize, u8, usize)> {
-    let mut at = PREAMBLE_LEN;
-    let mut out = Vec::new();
-    while at + ENTRY_OVERHEAD <= bytes.len() {
-        let len = u32::from_le_bytes(bytes[at + 1..at + 5].try_into().unwrap()) as usize;
-        out.push((at, bytes[at], len + ENTRY_OVERHEAD));
-        at += len + ENTRY_OVERHEAD;
-    }
-    assert_eq!(at, bytes.len(), "the entries tile the file");
-    out
-}
-
-/// The byte offset of the `Tick` entry of `tick`.
-fn tick_entry(bytes: &[u8], tick: u64) -> usize {
-    entries(bytes)
-        .into_iter()
-        .find(|&(at, tag, _)| {
-            tag == EntryTag::Tick as u8
-                && u64::from_le_bytes(bytes[at + 5..at + 13].try_into().unwrap()) == tick
-        })
-        .map(|(at, _, _)| at)
-        .unwrap_or_else(|| panic!("no tick entry of tick {tick}"))
 }
 
 /// The message `load_recording` refuses `bytes` with (written to `path` first).
@@ -621,16 +594,15 @@ fn a_rewritten_tick_hash_stops_the_replay_at_that_tick_naming_the_batch_before_i
     let (_game, live, _bodies, recording) = record_game(&client, &path, k0 as u32, 60);
     let tick = k0 + 40;
     let good = &recording.bytes;
-    let at = tick_entry(good, tick);
-    let (dt, hash) = recording
+    let hash = recording
         .events
         .iter()
         .find_map(|e| match e {
             Event::Tick {
                 tick: t,
-                dt,
                 state_hash,
-            } if *t == tick => Some((*dt, *state_hash)),
+                ..
+            } if *t == tick => Some(*state_hash),
             _ => None,
         })
         .unwrap();
@@ -646,11 +618,7 @@ fn a_rewritten_tick_hash_stops_the_replay_at_that_tick_naming_the_batch_before_i
             _ => None,
         })
         .expect("a batch before the tick");
-    let forged = hash ^ 0x0100_0000_0000_0001;
-    let mut bytes = good[..at].to_vec();
-    push_tick(&mut bytes, tick, dt, forged);
-    bytes.extend_from_slice(&good[at + ENTRY_OVERHEAD + 20..]);
-    assert_eq!(bytes.len(), good.len());
+    let (bytes, forged) = forge_tick_hash(good, tick);
     let patched = Arc::new(Recording::parse(bytes).expect("a well-formed file"));
 
     let mut replay = Replay::start(&daemon.client(), patched.clone()).unwrap();

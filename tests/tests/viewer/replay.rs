@@ -13,6 +13,7 @@
 //! Chromium is required: without it the browser tests fail and say how to install it.
 
 use crate::browser::{chromium, chromium_run, http, view_attributes, viewer_bin, TempDir, Viewer};
+use integration_tests::recording_file::{forge_tick_hash, tick_entry};
 use std::collections::HashMap;
 use std::path::Path;
 use std::process::{Command, Stdio};
@@ -25,7 +26,6 @@ use client_sdk::{
 };
 use integration_tests::{eventually, unique_domain, TestDaemon};
 use serde_json::{json, Value};
-use shm_layout::recording::{push_tick, EntryTag, Event, ENTRY_OVERHEAD, PREAMBLE_LEN};
 
 const DT: f32 = 1.0 / 60.0;
 /// Ticks recorded.
@@ -453,21 +453,6 @@ fn play_pause_step_and_the_end_of_the_recording() {
     assert_eq!(viewer.get("/api/replay")["tick"], TICKS);
 }
 
-/// The byte offset of the `Tick` entry of `tick` in a recording file.
-fn tick_entry(bytes: &[u8], tick: u64) -> usize {
-    let mut at = PREAMBLE_LEN;
-    while at + ENTRY_OVERHEAD <= bytes.len() {
-        let len = u32::from_le_bytes(bytes[at + 1..at + 5].try_into().unwrap()) as usize;
-        if bytes[at] == EntryTag::Tick as u8
-            && u64::from_le_bytes(bytes[at + 5..at + 13].try_into().unwrap()) == tick
-        {
-            return at;
-        }
-        at += len + ENTRY_OVERHEAD;
-    }
-    panic!("no tick entry of tick {tick}");
-}
-
 /// A recording whose tick 40 carries another state hash (a well-formed entry): playing
 /// stops at tick 40, the page shows the divergence's message, play and step are refused
 /// until a seek goes back before it.
@@ -480,25 +465,8 @@ fn a_divergence_stops_playback_and_the_page_shows_it() {
     let file = dir.join("balls.physrec");
     let (_recorded, recording) = record_balls(&client, &file);
     let tick = 40u64;
-    let (dt, hash) = recording
-        .events
-        .iter()
-        .find_map(|e| match e {
-            Event::Tick {
-                tick: t,
-                dt,
-                state_hash,
-            } if *t == tick => Some((*dt, *state_hash)),
-            _ => None,
-        })
-        .unwrap();
     let good = &recording.bytes;
-    let at = tick_entry(good, tick);
-    let mut bytes = good[..at].to_vec();
-    let forged_hash = hash ^ 0x0100_0000_0000_0001;
-    push_tick(&mut bytes, tick, dt, forged_hash);
-    bytes.extend_from_slice(&good[at + ENTRY_OVERHEAD + 20..]);
-    assert_eq!(bytes.len(), good.len());
+    let (bytes, forged_hash) = forge_tick_hash(good, tick);
     let forged = dir.join("forged.physrec");
     std::fs::write(&forged, &bytes).unwrap();
 
