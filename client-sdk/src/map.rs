@@ -8,6 +8,7 @@
 //! of the file's vertices, or with `decompose` a convex decomposition whose hulls become
 //! objects welded by Fixed joints.
 
+use shm_layout::geometry::rotate;
 use std::path::Path;
 
 use gltf::json;
@@ -601,25 +602,6 @@ impl Plane {
         }
         Ok(objects)
     }
-}
-
-/// `q · v` for a unit quaternion `[x, y, z, w]`.
-fn rotate(q: [f32; 4], v: Vec3) -> Vec3 {
-    let (u, s) = ([q[0], q[1], q[2]], q[3]);
-    let cross = |a: Vec3, b: Vec3| {
-        [
-            a[1] * b[2] - a[2] * b[1],
-            a[2] * b[0] - a[0] * b[2],
-            a[0] * b[1] - a[1] * b[0],
-        ]
-    };
-    let dot = u[0] * v[0] + u[1] * v[1] + u[2] * v[2];
-    let uv = cross(u, v);
-    [0, 1, 2].map(|k| 2.0 * dot * u[k] + (s * s - dot_self(u)) * v[k] + 2.0 * s * uv[k])
-}
-
-fn dot_self(u: Vec3) -> f32 {
-    u[0] * u[0] + u[1] * u[1] + u[2] * u[2]
 }
 
 #[cfg(test)]

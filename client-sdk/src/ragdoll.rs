@@ -3,6 +3,7 @@
 //! limits the description gives per bone. [`RagdollDesc::humanoid`] is the default 15-bone
 //! humanoid.
 
+use shm_layout::geometry::rotate;
 use shm_layout::{JointKind, JointProp, ObjectProp, Pose, Shape, Vec3};
 
 use crate::{error::Error, joint::Joint, object::Object, plane::Plane};
@@ -56,23 +57,6 @@ impl Ragdoll {
 
 fn invalid(field: String, message: String) -> Error {
     Error::Invalid { field, message }
-}
-
-/// `q · v` for a unit quaternion `[x, y, z, w]`.
-pub(crate) fn rotate(q: [f32; 4], v: Vec3) -> Vec3 {
-    let u = [q[0], q[1], q[2]];
-    let s = q[3];
-    let cross = |a: Vec3, b: Vec3| {
-        [
-            a[1] * b[2] - a[2] * b[1],
-            a[2] * b[0] - a[0] * b[2],
-            a[0] * b[1] - a[1] * b[0],
-        ]
-    };
-    let dot = |a: Vec3, b: Vec3| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-    let uv = cross(u, v);
-    let (d, uu) = (dot(u, v), dot(u, u));
-    [0, 1, 2].map(|k| 2.0 * d * u[k] + (s * s - uu) * v[k] + 2.0 * s * uv[k])
 }
 
 fn conjugate(q: [f32; 4]) -> [f32; 4] {

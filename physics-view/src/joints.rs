@@ -9,6 +9,7 @@ use std::time::{Duration, Instant};
 
 use client_sdk::{Error, JointInfo, Plane, Vec3};
 use serde_json::{json, Value};
+use shm_layout::geometry::rotate;
 
 /// A live plane's joints are listed again after this long (joints come and go far less
 /// often than bodies move; their anchors follow the bodies at every tick regardless).
@@ -54,23 +55,6 @@ impl JointCache {
     pub fn joints(&self) -> &[JointInfo] {
         &self.joints
     }
-}
-
-/// `q · v` for a unit quaternion `[x, y, z, w]`.
-fn rotate(q: [f32; 4], v: Vec3) -> Vec3 {
-    let u = [q[0], q[1], q[2]];
-    let s = q[3];
-    let cross = |a: Vec3, b: Vec3| {
-        [
-            a[1] * b[2] - a[2] * b[1],
-            a[2] * b[0] - a[0] * b[2],
-            a[0] * b[1] - a[1] * b[0],
-        ]
-    };
-    let dot = |a: Vec3, b: Vec3| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-    let uv = cross(u, v);
-    let (d, uu) = (dot(u, v), dot(u, u));
-    [0, 1, 2].map(|k| 2.0 * d * u[k] + (s * s - uu) * v[k] + 2.0 * s * uv[k])
 }
 
 /// A local point of a body in the world.

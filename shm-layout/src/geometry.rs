@@ -7,6 +7,23 @@ pub type Vec3 = [f32; 3];
 /// A 2D vector on the wire (GUI planes: pixels, pixels/s, ...).
 pub type Vec2 = [f32; 2];
 
+/// `q · v` for a unit quaternion `q = [x, y, z, w]`: `v` rotated by `q`.
+pub fn rotate(q: [f32; 4], v: Vec3) -> Vec3 {
+    let u = [q[0], q[1], q[2]];
+    let s = q[3];
+    let cross = |a: Vec3, b: Vec3| {
+        [
+            a[1] * b[2] - a[2] * b[1],
+            a[2] * b[0] - a[0] * b[2],
+            a[0] * b[1] - a[1] * b[0],
+        ]
+    };
+    let dot = |a: Vec3, b: Vec3| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    let uv = cross(u, v);
+    let (d, uu) = (dot(u, v), dot(u, u));
+    [0, 1, 2].map(|k| 2.0 * d * u[k] + (s * s - uu) * v[k] + 2.0 * s * uv[k])
+}
+
 /// Position plus unit quaternion `[x, y, z, w]`.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Pose {
